@@ -1,0 +1,43 @@
+# fieldkit — every target works on a fresh machine: it creates .venv and installs first.
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.installed
+
+.PHONY: demo test test-all bench lint video clean
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	touch $(STAMP)
+
+## Reduce the bundled Tornado Mountain survey (thesis Table 2-4) to an ImpactTable and figures.
+demo: $(STAMP)
+	MPLBACKEND=Agg $(BIN)/fieldkit reduce \
+	    --impacts surveys/tornado_mountain/boulder_a_impacts.gpx \
+	    --trees surveys/tornado_mountain/boulder_a_trees.csv \
+	    --theta0 32.6 --mass 3750 --radius 0.725 --gyration 0.46 --path-id boulder_a \
+	    --figures out/demo/figures -o out/demo/boulder_a_impacts.csv
+
+## Fast test suite (a few minutes on 2 cores).
+test: $(STAMP)
+	MPLBACKEND=Agg $(BIN)/python -m pytest -q
+
+## Everything, including tests marked slow.
+test-all: $(STAMP)
+	MPLBACKEND=Agg $(BIN)/python -m pytest -q -m ''
+
+## Speed and memory figures (printed, not asserted).
+bench: $(STAMP)
+	MPLBACKEND=Agg $(BIN)/python benchmarks/run_all.py
+
+## Re-render the synthetic high-speed clips in video/ (deterministic).
+video: $(STAMP)
+	$(BIN)/python video/render.py
+
+lint: $(STAMP)
+	$(BIN)/ruff check fieldkit tests benchmarks examples
+
+clean:
+	rm -rf $(VENV) out .pytest_cache

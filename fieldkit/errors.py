@@ -1,0 +1,57 @@
+"""The one error type that bad input raises, and how it prints.
+
+Every reader, physics guard and command raises :class:`FieldkitError` (or a subclass)
+for problems with the *user's input*. The command line turns it into a single line on
+stderr and a non-zero exit code; anything else escaping is a bug and keeps its traceback.
+"""
+
+from __future__ import annotations
+
+from os import PathLike
+
+
+class FieldkitError(Exception):
+    """Bad input, described in one line.
+
+    Parameters
+    ----------
+    message
+        What is wrong, e.g. ``"elevation missing"``.
+    source
+        The file (or argument name, e.g. ``"--mass"``) the problem is in.
+    where
+        The row, point or frame, e.g. ``"row 7"``, ``"point 12"``, ``"frames 210-245"``.
+
+    Examples
+    --------
+    >>> str(FieldkitError("elevation missing", source="a.gpx", where="point 3"))
+    'a.gpx: point 3: elevation missing'
+    """
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        source: str | PathLike[str] | None = None,
+        where: str | None = None,
+    ) -> None:
+        self.message = " ".join(str(message).split())  # always one line
+        self.source = None if source is None else str(source)
+        self.where = where
+        super().__init__(str(self))
+
+    def __str__(self) -> str:
+        parts = [p for p in (self.source, self.where) if p]
+        return ": ".join([*parts, self.message])
+
+
+class InputFileError(FieldkitError):
+    """A file that cannot be read, is empty, truncated, or has a bad value."""
+
+
+class PhysicsError(FieldkitError):
+    """Inputs that no physical solution satisfies (e.g. no ballistic path reaches a point)."""
+
+
+class ArgumentError(FieldkitError):
+    """A parameter outside its physical range (negative mass, e_n < 0, ...)."""

@@ -1,0 +1,273 @@
+"""The ImpactTable: one row per impact, the spine every stage reads or writes.
+
+Survey reduction and video tracking produce it; fitting, diagnosis, figures and exports
+consume it. The column names and meanings are a contract (ARCHITECTURE §3); units are in
+the names. Primary columns (positions, slope, section-frame velocities, body, spin) are
+what a producer measures; :meth:`ImpactTable.derive` computes every derived column from
+them with the conventions of ARCHITECTURE §2, so both producers agree by construction.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from fieldkit.errors import InputFileError
+from fieldkit.io.atomic import write_atomic
+from fieldkit.physics.energy import energy_head, kinetic_energy, rotational_energy
+from fieldkit.physics.local_axes import angle_to_ground_deg, to_local
+
+
+@dataclass(frozen=True)
+class Column:
+    """One ImpactTable column: name (with unit), kind, whether required, meaning."""
+
+    name: str
+    kind: str  # "str", "float", "bool"
+    required: bool
+    description: str
+
+
+#: Contract columns in their canonical order (ARCHITECTURE §3).
+CONTRACT_COLUMNS: tuple[Column, ...] = (
+    Column("path_id", "str", True, "rock / test identifier"),
+    Column("point", "str", True, "impact identifier"),
+    Column("x_m", "float", True, "impact x in the section plane [m]"),
+    Column("z_m", "float", True, "impact elevation [m]"),
+    Column("slope_deg", "float", True, "ground dip psi used for N/T axes [deg]"),
+    Column("material", "str", False, "slope material label"),
+    Column("mass_kg", "float", False, "body mass [kg]"),
+    Column("radius_m", "float", False, "body contact radius [m]"),
+    Column("gyration_m", "float", False, "radius of gyration k [m]"),
+    Column("theta0_deg", "float", False, "restitution angle to ground for the next flight [deg]"),
+    Column("theta0_source", "str", False, "tree | assumed | video | given"),
+    Column("vi_x_mps", "float", True, "impact velocity, x [m/s]"),
+    Column("vi_z_mps", "float", True, "impact velocity, z [m/s]"),
+    Column("vf_x_mps", "float", True, "restitution velocity, x [m/s]"),
+    Column("vf_z_mps", "float", True, "restitution velocity, z [m/s]"),
+    Column("vi_mps", "float", False, "impact speed [m/s]"),
+    Column("vf_mps", "float", False, "restitution speed [m/s]"),
+    Column("vin_mps", "float", False, "impact normal velocity (<0) [m/s]"),
+    Column("vit_mps", "float", False, "impact tangential velocity [m/s]"),
+    Column("vfn_mps", "float", False, "restitution normal velocity (>0) [m/s]"),
+    Column("vft_mps", "float", False, "restitution tangential velocity [m/s]"),
+    Column("theta_i_deg", "float", False, "impact angle to the ground [deg]"),
+    Column("theta_f_deg", "float", False, "restitution angle to the ground [deg]"),
+    Column("e_n", "float", False, "normal coefficient of restitution -vfn/vin (eq. 4.6)"),
+    Column("e_t", "float", False, "tangential coefficient of restitution vft/vit (eq. 4.7)"),
+    Column("omega_i_radps", "float", False, "angular velocity before impact [rad/s]"),
+    Column("omega_f_radps", "float", False, "angular velocity after impact [rad/s]"),
+    Column("ke_i_j", "float", False, "kinetic energy before impact [J]"),
+    Column("ke_f_j", "float", False, "kinetic energy after impact [J]"),
+    Column("dke_j", "float", False, "ke_f - ke_i (negative = loss) [J]"),
+    Column("re_i_j", "float", False, "rotational energy before impact [J]"),
+    Column("re_f_j", "float", False, "rotational energy after impact [J]"),
+    Column("energy_head_i_m", "float", False, "energy head z + v^2/2g before impact [m]"),
+    Column("energy_head_f_m", "float", False, "energy head after impact [m]"),
+    Column("flight_time_s", "float", False, "duration of the flight leaving this impact [s]"),
+    Column("flight_length_m", "float", False, "horizontal length of that flight [m]"),
+    Column("hmax_vertical_m", "float", False, "max vertical height above the chord [m]"),
+    Column("hmax_normal_m", "float", False, "max height normal to the chord [m]"),
+    Column("tree_strike", "bool", False, "the flight arriving here struck a tree"),
+    Column("t_s", "float", False, "time of the impact [s]"),
+)
+
+#: Documented extension columns that fieldkit producers may add (kept on read/write).
+EXTENSION_COLUMNS: tuple[Column, ...] = (
+    Column("omega_source", "str", False, "measured | estimated (v/r, eq. 3.17) | none"),
+    Column("slope_source", "str", False, "chord | surveyed | given | video"),
+    Column("flight_dke_j", "float", False, "KE gained in the flight arriving here [J]"),
+    Column("dke_theory_j", "float", False, "impact-mechanics KE change for this impact [J]"),
+    Column("theory_loss_fraction", "float", False, "dke_theory_j / dke_j (thesis §6.3)"),
+)
+
+COLUMNS_BY_NAME: dict[str, Column] = {c.name: c for c in CONTRACT_COLUMNS + EXTENSION_COLUMNS}
+REQUIRED_COLUMNS: tuple[str, ...] = tuple(c.name for c in CONTRACT_COLUMNS if c.required)
+THETA0_SOURCES: frozenset[str] = frozenset({"tree", "assumed", "video", "given"})
+FORMATS: dict[str, str] = {".csv": "csv", ".parquet": "parquet", ".xlsx": "xlsx"}
+
+_EPS = 1e-12
+
+
+class ImpactTable:
+    """A validated, column-ordered table of impacts.
+
+    Parameters
+    ----------
+    frame
+        One row per impact. Must hold the required contract columns; missing optional
+        contract columns are added as NaN; extra columns are kept after them.
+    source
+        Where the table came from (file name), used in error messages.
+
+    Examples
+    --------
+    >>> t = ImpactTable(pd.DataFrame({"path_id": ["A"], "point": ["1"], "x_m": [0.0],
+    ...     "z_m": [0.0], "slope_deg": [0.0], "vi_x_mps": [3.0], "vi_z_mps": [-4.0],
+    ...     "vf_x_mps": [3.0], "vf_z_mps": [2.0]})).derive()
+    >>> float(t.frame.loc[0, "e_n"])
+    0.5
+    """
+
+    def __init__(self, frame: pd.DataFrame, *, source: str | None = None) -> None:
+        self.source = source
+        self.frame = self._normalise(frame)
+
+    # ------------------------------------------------------------------ construction
+    def _normalise(self, frame: pd.DataFrame) -> pd.DataFrame:
+        missing = [c for c in REQUIRED_COLUMNS if c not in frame.columns]
+        if missing:
+            raise InputFileError(
+                f"ImpactTable lacks required column(s) {', '.join(missing)}",
+                source=self.source,
+            )
+        out = frame.copy()
+        for col in CONTRACT_COLUMNS:
+            if col.name not in out.columns:
+                out[col.name] = pd.NA if col.kind in ("str", "bool") else np.nan
+        for name in out.columns:
+            spec = COLUMNS_BY_NAME.get(name)
+            if spec is None:
+                continue
+            if spec.kind == "float":
+                out[name] = self._as_float(out[name], name)
+            elif spec.kind == "str":
+                out[name] = out[name].astype("string")
+            elif spec.kind == "bool":
+                out[name] = out[name].astype("boolean")
+        for key in ("path_id", "point"):
+            bad = out.index[out[key].isna()]
+            if len(bad):
+                raise InputFileError(f"empty {key}", source=self.source, where=f"row {bad[0] + 1}")
+        dup = out.duplicated(["path_id", "point"])
+        if dup.any():
+            i = int(np.flatnonzero(dup.to_numpy())[0])
+            raise InputFileError(
+                f"duplicated point {out['point'].iloc[i]!s} in path {out['path_id'].iloc[i]!s}",
+                source=self.source,
+                where=f"row {i + 1}",
+            )
+        src = out["theta0_source"].dropna()
+        bad_src = src[~src.isin(sorted(THETA0_SOURCES))]
+        if len(bad_src):
+            raise InputFileError(
+                f"theta0_source {bad_src.iloc[0]!r} is not one of {sorted(THETA0_SOURCES)}",
+                source=self.source,
+                where=f"row {bad_src.index[0] + 1}",
+            )
+        contract = [c.name for c in CONTRACT_COLUMNS]
+        extras = [c for c in out.columns if c not in contract]
+        return out[contract + extras].reset_index(drop=True)
+
+    def _as_float(self, series: pd.Series, name: str) -> pd.Series:
+        values = pd.to_numeric(series, errors="coerce")
+        bad = series.notna() & values.isna()
+        if bad.any():
+            i = int(np.flatnonzero(bad.to_numpy())[0])
+            raise InputFileError(
+                f"column {name}: {series.iloc[i]!r} is not a number",
+                source=self.source,
+                where=f"row {i + 1}",
+            )
+        return values.astype(float)
+
+    # ------------------------------------------------------------------ physics
+    def derive(self) -> ImpactTable:
+        """Return a copy with every derived column recomputed from the primary ones.
+
+        Speeds, N/T components on ``slope_deg`` (ARCHITECTURE §2), angles to the ground,
+        ``e_n = -vfn/vin`` and ``e_t = vft/vit`` (eqs. 4.6, 4.7), kinetic and rotational
+        energies (``I = m k^2``), ``dke_j`` and energy heads (eq. 6.14). Values the data
+        do not allow (no mass, no spin) stay NaN.
+        """
+        f = self.frame.copy()
+        vix, viz = f["vi_x_mps"].to_numpy(), f["vi_z_mps"].to_numpy()
+        vfx, vfz = f["vf_x_mps"].to_numpy(), f["vf_z_mps"].to_numpy()
+        psi = f["slope_deg"].to_numpy()
+        vit, vin = to_local(vix, viz, psi)
+        vft, vfn = to_local(vfx, vfz, psi)
+        vi, vf = np.hypot(vix, viz), np.hypot(vfx, vfz)
+        f["vi_mps"], f["vf_mps"] = vi, vf
+        f["vin_mps"], f["vit_mps"], f["vfn_mps"], f["vft_mps"] = vin, vit, vfn, vft
+        f["theta_i_deg"] = angle_to_ground_deg(vit, vin)
+        f["theta_f_deg"] = angle_to_ground_deg(vft, vfn)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            f["e_n"] = np.where(np.abs(vin) > _EPS, -vfn / vin, np.nan)
+            f["e_t"] = np.where(np.abs(vit) > _EPS, vft / vit, np.nan)
+        m = f["mass_kg"].to_numpy()
+        k = f["gyration_m"].to_numpy()
+        f["ke_i_j"], f["ke_f_j"] = kinetic_energy(m, vi), kinetic_energy(m, vf)
+        f["dke_j"] = f["ke_f_j"] - f["ke_i_j"]
+        f["re_i_j"] = rotational_energy(m, k, f["omega_i_radps"].to_numpy())
+        f["re_f_j"] = rotational_energy(m, k, f["omega_f_radps"].to_numpy())
+        z = f["z_m"].to_numpy()
+        f["energy_head_i_m"], f["energy_head_f_m"] = energy_head(z, vi), energy_head(z, vf)
+        return ImpactTable(f, source=self.source)
+
+    # ------------------------------------------------------------------ access
+    def __len__(self) -> int:
+        return len(self.frame)
+
+    def __repr__(self) -> str:
+        paths = self.frame["path_id"].nunique()
+        return f"ImpactTable({len(self)} impacts, {paths} path(s))"
+
+    def paths(self) -> list[str]:
+        """Path identifiers in order of first appearance."""
+        return list(dict.fromkeys(self.frame["path_id"].tolist()))
+
+    def column(self, name: str) -> np.ndarray:
+        """A float column as a numpy array (NaN where missing)."""
+        return self.frame[name].to_numpy(dtype=float, na_value=np.nan)
+
+    # ------------------------------------------------------------------ files
+    @classmethod
+    def read(cls, path: str | os.PathLike[str]) -> ImpactTable:
+        """Read a CSV, Parquet or XLSX ImpactTable (format from the extension)."""
+        p = Path(path)
+        fmt = _format_of(p)
+        if not p.is_file():
+            raise InputFileError("file not found", source=p)
+        if p.stat().st_size == 0:
+            raise InputFileError("file is empty", source=p)
+        text_cols = {c.name: "string" for c in CONTRACT_COLUMNS + EXTENSION_COLUMNS
+                     if c.kind == "str"}
+        try:
+            if fmt == "csv":
+                frame = pd.read_csv(p, dtype=text_cols)
+            elif fmt == "parquet":
+                frame = pd.read_parquet(p)
+            else:
+                frame = pd.read_excel(p, dtype=text_cols)
+        except (ValueError, OSError, pd.errors.ParserError) as exc:
+            raise InputFileError(f"cannot read {fmt.upper()}: {exc}", source=p) from None
+        if frame.empty:
+            raise InputFileError("table has no rows", source=p)
+        return cls(frame, source=str(p))
+
+    def write(self, path: str | os.PathLike[str]) -> Path:
+        """Write atomically as CSV, Parquet or XLSX (format from the extension)."""
+        p = Path(path)
+        fmt = _format_of(p)
+        frame = self.frame
+        if fmt == "csv":
+            return write_atomic(p, lambda tmp: frame.to_csv(tmp, index=False))
+        if fmt == "parquet":
+            return write_atomic(p, lambda tmp: frame.to_parquet(tmp, index=False))
+        return write_atomic(
+            p, lambda tmp: frame.to_excel(tmp, index=False, sheet_name="impacts")
+        )
+
+
+def _format_of(path: Path) -> str:
+    fmt = FORMATS.get(path.suffix.lower())
+    if fmt is None:
+        raise InputFileError(
+            f"unknown table format {path.suffix!r}; use one of {', '.join(FORMATS)}",
+            source=path,
+        )
+    return fmt

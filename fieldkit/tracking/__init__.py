@@ -1,0 +1,1 @@
+"""High-speed video and track exports -> Track -> flights and impacts (ImpactTable)."""

@@ -1,0 +1,88 @@
+"""ImpactTable contract: required columns, derivation conventions, file round trips."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from fieldkit.errors import InputFileError
+from fieldkit.impact_table import CONTRACT_COLUMNS, REQUIRED_COLUMNS, ImpactTable
+from fieldkit.physics.local_axes import to_local, to_section
+
+
+def _table(**over):
+    base = {"path_id": ["A", "A"], "point": ["1", "2"], "x_m": [0.0, 10.0],
+            "z_m": [10.0, 5.0], "slope_deg": [30.0, 30.0],
+            "vi_x_mps": [5.0, 6.0], "vi_z_mps": [-8.0, -7.0],
+            "vf_x_mps": [4.0, 5.0], "vf_z_mps": [1.0, 2.0],
+            "mass_kg": [100.0, 100.0], "gyration_m": [0.3, 0.3],
+            "omega_i_radps": [-2.0, np.nan], "omega_f_radps": [-5.0, np.nan]}
+    base.update(over)
+    return ImpactTable(pd.DataFrame(base))
+
+
+def test_columns_in_contract_order_and_extras_kept():
+    t = _table(my_note=["a", "b"])
+    names = [c.name for c in CONTRACT_COLUMNS]
+    assert list(t.frame.columns[: len(names)]) == names
+    assert t.frame.columns[-1] == "my_note"
+
+
+def test_derive_matches_hand_decomposition():
+    t = _table().derive().frame
+    psi = np.radians(30.0)
+    # T = (cos psi, -sin psi), N = (sin psi, cos psi)
+    vit = 5.0 * np.cos(psi) + 8.0 * np.sin(psi)
+    vin = 5.0 * np.sin(psi) - 8.0 * np.cos(psi)
+    vft = 4.0 * np.cos(psi) - 1.0 * np.sin(psi)
+    vfn = 4.0 * np.sin(psi) + 1.0 * np.cos(psi)
+    assert t.loc[0, "vin_mps"] < 0 < t.loc[0, "vfn_mps"]
+    assert t.loc[0, "e_n"] == pytest.approx(-vfn / vin, rel=1e-12)
+    assert t.loc[0, "e_t"] == pytest.approx(vft / vit, rel=1e-12)
+    assert t.loc[0, "theta_i_deg"] == pytest.approx(np.degrees(np.arctan(-vin / vit)))
+    assert t.loc[0, "ke_i_j"] == pytest.approx(0.5 * 100 * (25 + 64))
+    assert t.loc[0, "re_f_j"] == pytest.approx(0.5 * 100 * 0.09 * 25)
+    assert np.isnan(t.loc[1, "re_i_j"])  # no spin measured: no rotational energy
+    assert t.loc[0, "energy_head_i_m"] == pytest.approx(10 + 89 / (2 * 9.81))
+
+
+def test_local_axes_round_trip():
+    rng = np.random.default_rng(1)
+    vx, vz, psi = rng.normal(size=(3, 50)) * [[10], [10], [40]]
+    assert np.allclose(to_section(*to_local(vx, vz, psi), psi), (vx, vz))
+    # speed is preserved by the rotation
+    assert np.allclose(np.hypot(*to_local(vx, vz, psi)), np.hypot(vx, vz))
+
+
+@pytest.mark.parametrize("ext", [".csv", ".parquet", ".xlsx"])
+def test_file_round_trip(tmp_path, ext):
+    t = _table(material=["rock", "talus"], tree_strike=[True, False]).derive()
+    path = t.write(tmp_path / f"t{ext}")
+    back = ImpactTable.read(path)
+    assert list(back.frame.columns) == list(t.frame.columns)
+    assert back.frame["point"].tolist() == ["1", "2"]
+    assert np.allclose(back.column("e_n"), t.column("e_n"))
+    assert back.frame["tree_strike"].tolist() == [True, False]
+
+
+def test_missing_required_column_is_named():
+    frame = _table().frame.drop(columns=["vf_z_mps"])
+    with pytest.raises(InputFileError, match="vf_z_mps"):
+        ImpactTable(frame, source="t.csv")
+    assert "vf_z_mps" in REQUIRED_COLUMNS
+
+
+def test_bad_values_name_the_row(tmp_path):
+    with pytest.raises(InputFileError, match=r"row 2: column x_m: 'abc' is not a number"):
+        _table(x_m=["0", "abc"])
+    with pytest.raises(InputFileError, match=r"row 2: duplicated point 1"):
+        _table(point=["1", "1"])
+    with pytest.raises(InputFileError, match="theta0_source"):
+        _table(theta0_source=["tree", "guess"])
+    (tmp_path / "empty.csv").write_text("")
+    with pytest.raises(InputFileError, match="empty.csv: file is empty"):
+        ImpactTable.read(tmp_path / "empty.csv")
+    with pytest.raises(InputFileError, match="unknown table format"):
+        _table().write(tmp_path / "t.txt")
+    assert not (tmp_path / "t.txt").exists()
