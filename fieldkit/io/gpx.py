@@ -1,0 +1,289 @@
+"""GPX 1.0 / 1.1 waypoints in and out.
+
+Reads with the standard-library XML parser and matches elements by local name, so both
+namespaces (``http://www.topografix.com/GPX/1/0`` and ``.../1/1``), files without a
+namespace, a UTF-8 byte-order mark and vendor ``<extensions>`` all work.
+
+Which points are read
+    ``points="waypoints"`` (default) reads ``<wpt>``: mapped impacts are waypoints. A
+    file without waypoints raises an error that says how many track and route points it
+    has. ``points="route"`` reads ``<rtept>``, ``points="track"`` reads ``<trkpt>`` of
+    every segment in order, and ``points="auto"`` takes waypoints, else route points,
+    else track points.
+
+Names
+    A point without ``<name>`` is called ``wpt7`` / ``rtept7`` / ``trkpt7`` (1-based
+    position among points of its kind).
+
+Heights
+    ``<ele>`` is kept as given (usually metres above sea level from the receiver's geoid
+    model; GPX does not say) and never converted. A missing ``<ele>`` gives NaN here;
+    :func:`fieldkit.io.points.read_impacts` refuses it and names the waypoint.
+"""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ElementTree
+from os import PathLike
+from xml.sax.saxutils import escape, quoteattr
+
+import pandas as pd
+
+from fieldkit.errors import ArgumentError, InputFileError
+from fieldkit.io.atomic import write_text_atomic
+from fieldkit.io.csv_table import check_readable
+
+GPX_11_NAMESPACE = "http://www.topografix.com/GPX/1/1"
+_KINDS = {"waypoints": "wpt", "route": "rtept", "track": "trkpt"}
+COLUMNS = ("point", "lat_deg", "lon_deg", "elev_m", "time")
+
+
+def _local(tag: str) -> str:
+    return tag.rsplit("}", 1)[-1] if isinstance(tag, str) else ""
+
+
+def _child_text(element: ElementTree.Element, name: str) -> str | None:
+    for child in element:
+        if _local(child.tag) == name:
+            return (child.text or "").strip()
+    return None
+
+
+def parse_gpx_root(path: str | PathLike[str]) -> ElementTree.Element:
+    """Parse a GPX file and return its ``<gpx>`` root element.
+
+    Raises :class:`InputFileError`: file missing or empty, binary ("not a GPX file"),
+    XML errors ("GPX is truncated or malformed (XML error at line N)"), or another
+    root element.
+    """
+    file = check_readable(path)
+    data = file.read_bytes()
+    head = data[:4096]
+    stripped = head.lstrip(b"\xef\xbb\xbf \t\r\n")
+    if b"\x00" in head or not stripped.startswith(b"<"):
+        raise InputFileError("not a GPX file (it does not start with XML)", source=path)
+    try:
+        root = ElementTree.fromstring(data)
+    except ElementTree.ParseError as error:
+        line = error.position[0] if error.position else "?"
+        raise InputFileError(
+            f"GPX is truncated or malformed (XML error at line {line})", source=path
+        ) from None
+    if _local(root.tag) != "gpx":
+        raise InputFileError(
+            f"not a GPX file (root element is <{_local(root.tag)}>, not <gpx>)",
+            source=path,
+        )
+    return root
+
+
+def _collect(root: ElementTree.Element, kind: str) -> list[ElementTree.Element]:
+    tag = _KINDS[kind]
+    if kind == "waypoints":
+        return [e for e in root if _local(e.tag) == tag]
+    return [e for e in root.iter() if _local(e.tag) == tag]
+
+
+def read_gpx_waypoints(
+    path: str | PathLike[str], *, points: str = "waypoints"
+) -> pd.DataFrame:
+    """Read GPX points into a table.
+
+    Parameters
+    ----------
+    path
+        GPX 1.0 or 1.1 file.
+    points
+        ``"waypoints"`` (default), ``"route"``, ``"track"`` or ``"auto"`` (see module
+        docstring).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``point`` (str), ``lat_deg``, ``lon_deg``, ``elev_m`` (NaN where the
+        point has no ``<ele>``), ``time`` (UTC timestamps, NaT where absent), in file
+        order.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> frame = pd.DataFrame({"point": ["A1"], "lat_deg": [49.1], "lon_deg": [-117.2],
+    ...                       "elev_m": [1510.25]})
+    >>> _ = write_gpx_waypoints(folder / "a.gpx", frame)
+    >>> read_gpx_waypoints(folder / "a.gpx")[["point", "elev_m"]].to_dict("records")
+    [{'point': 'A1', 'elev_m': 1510.25}]
+    """
+    if points not in (*_KINDS, "auto"):
+        raise ArgumentError(
+            f"points must be one of waypoints, route, track, auto (not '{points}')",
+            source="--gpx-points",
+        )
+    root = parse_gpx_root(path)
+    counts = {kind: len(_collect(root, kind)) for kind in _KINDS}
+    kind = points
+    if points == "auto":
+        kind = next(
+            (k for k in ("waypoints", "route", "track") if counts[k]), "waypoints"
+        )
+    elements = _collect(root, kind)
+    if not elements:
+        if points == "waypoints":
+            raise InputFileError(
+                f"no waypoints (<wpt>) in this GPX; it has {counts['track']} track "
+                f"points and {counts['route']} route points (ask for them with "
+                "points='track' or 'route', --gpx-points on the command line)",
+                source=path,
+            )
+        raise InputFileError(
+            f"no {kind} points (<{_KINDS[kind]}>) in this GPX "
+            f"({counts['waypoints']} waypoints, {counts['route']} route points, "
+            f"{counts['track']} track points)",
+            source=path,
+        )
+    tag = _KINDS[kind]
+    records = []
+    for number, element in enumerate(elements, start=1):
+        name = _child_text(element, "name") or f"{tag}{number}"
+        where = f"{'waypoint' if tag == 'wpt' else tag} {number} ('{name}')"
+        lat = _coordinate(element, "lat", -90.0, 90.0, path, where)
+        lon = _coordinate(element, "lon", -180.0, 180.0, path, where)
+        ele_text = _child_text(element, "ele")
+        elev = math.nan
+        if ele_text:
+            try:
+                elev = float(ele_text)
+            except ValueError:
+                raise InputFileError(
+                    f"<ele> '{ele_text}' is not a number", source=path, where=where
+                ) from None
+            if not math.isfinite(elev):
+                raise InputFileError(
+                    f"<ele> '{ele_text}' is not a finite number",
+                    source=path,
+                    where=where,
+                )
+        time_text = _child_text(element, "time") or None
+        records.append((name, lat, lon, elev, time_text, where))
+    frame = pd.DataFrame(
+        {
+            "point": pd.Series([r[0] for r in records], dtype="str"),
+            "lat_deg": [r[1] for r in records],
+            "lon_deg": [r[2] for r in records],
+            "elev_m": [r[3] for r in records],
+        }
+    )
+    frame["time"] = _parse_times([r[4] for r in records], [r[5] for r in records], path)
+    return frame
+
+
+def _coordinate(
+    element: ElementTree.Element,
+    name: str,
+    low: float,
+    high: float,
+    path: str | PathLike[str],
+    where: str,
+) -> float:
+    text = element.get(name)
+    if text is None:
+        raise InputFileError(f"no {name} attribute", source=path, where=where)
+    try:
+        value = float(text)
+    except ValueError:
+        raise InputFileError(
+            f"{name} '{text}' is not a number", source=path, where=where
+        ) from None
+    if not low <= value <= high:
+        raise InputFileError(
+            f"{name} {text} is outside [{low:g}, {high:g}]", source=path, where=where
+        )
+    return value
+
+
+def _parse_times(
+    texts: list[str | None], wheres: list[str], path: str | PathLike[str]
+) -> pd.Series:
+    try:
+        return pd.Series(pd.to_datetime(texts, utc=True, format="ISO8601"))
+    except (ValueError, TypeError):
+        for text, where in zip(texts, wheres, strict=True):
+            if text is None:
+                continue
+            try:
+                pd.to_datetime(text, utc=True, format="ISO8601")
+            except (ValueError, TypeError):
+                raise InputFileError(
+                    f"<time> '{text}' is not an ISO 8601 time", source=path, where=where
+                ) from None
+        raise  # pragma: no cover - every single value parsed
+
+
+def _format_time(value: object) -> str | None:
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return None
+    stamp = pd.Timestamp(value)
+    if pd.isna(stamp):
+        return None
+    stamp = (
+        stamp.tz_localize("UTC") if stamp.tzinfo is None else stamp.tz_convert("UTC")
+    )
+    text = stamp.strftime("%Y-%m-%dT%H:%M:%S")
+    if stamp.microsecond:
+        text += f".{stamp.microsecond:06d}".rstrip("0")
+    return text + "Z"
+
+
+def gpx_waypoints_text(frame: pd.DataFrame, *, creator: str = "fieldkit") -> str:
+    """GPX 1.1 document with one ``<wpt>`` per row of ``frame``.
+
+    ``frame`` needs ``point``, ``lat_deg``, ``lon_deg``; ``elev_m`` and ``time`` are
+    optional (a NaN elevation or time is left out). Latitude and longitude get 9
+    decimals (0.1 mm), elevation 3 (1 mm).
+    """
+    for column in ("point", "lat_deg", "lon_deg"):
+        if column not in frame.columns:
+            raise ArgumentError(f"waypoint table needs a '{column}' column")
+    lines = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        f'<gpx version="1.1" creator={quoteattr(creator)} xmlns="{GPX_11_NAMESPACE}" '
+        'xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" '
+        f'xsi:schemaLocation="{GPX_11_NAMESPACE} {GPX_11_NAMESPACE}/gpx.xsd">',
+    ]
+    has_elev = "elev_m" in frame.columns
+    has_time = "time" in frame.columns
+    for row in frame.itertuples(index=False):
+        lat = float(row.lat_deg)
+        lon = float(row.lon_deg)
+        if not (math.isfinite(lat) and math.isfinite(lon)):
+            raise ArgumentError(f"waypoint '{row.point}' has no latitude/longitude")
+        lines.append(f'  <wpt lat="{lat:.9f}" lon="{lon:.9f}">')
+        if has_elev and math.isfinite(float(row.elev_m)):
+            lines.append(f"    <ele>{float(row.elev_m):.3f}</ele>")
+        if has_time:
+            text = _format_time(row.time)
+            if text:
+                lines.append(f"    <time>{text}</time>")
+        lines.append(f"    <name>{escape(str(row.point))}</name>")
+        lines.append("  </wpt>")
+    lines.append("</gpx>")
+    return "\n".join(lines) + "\n"
+
+
+def write_gpx_waypoints(
+    path: str | PathLike[str], frame: pd.DataFrame, *, creator: str = "fieldkit"
+) -> None:
+    """Write ``frame`` as GPX 1.1 waypoints atomically (:func:`gpx_waypoints_text`).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> target = pathlib.Path(tempfile.mkdtemp()) / "s.gpx"
+    >>> write_gpx_waypoints(target, pd.DataFrame(
+    ...     {"point": ["S1"], "lat_deg": [49.0], "lon_deg": [-117.0],
+    ...      "elev_m": [1500.0]}))
+    >>> "<ele>1500.000</ele>" in target.read_text()
+    True
+    """
+    write_text_atomic(path, gpx_waypoints_text(frame, creator=creator))
