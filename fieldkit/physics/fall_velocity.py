@@ -139,7 +139,7 @@ def velocity_ratio_from_friction(
     psi = np.asarray(slope_deg, float)
     _check_slope(psi)
     tan_psi = np.tan(np.radians(psi))
-    held = np.asarray(mu > tan_psi)
+    held = np.asarray(mu > tan_psi * (1.0 + 1e-12))  # tolerate rounding of tan(psi)
     if held.any():
         m, p = first_values(held, mu, psi)
         raise PhysicsError(
@@ -147,7 +147,7 @@ def velocity_ratio_from_friction(
             f"{np.tan(np.radians(p)):.2f}: a block on this slope does not accelerate",
             where=where_first(held),
         )
-    return as_output(np.sqrt(1.0 - mu / tan_psi))
+    return as_output(np.sqrt(np.maximum(1.0 - mu / tan_psi, 0.0)))
 
 
 def fall_velocity(
