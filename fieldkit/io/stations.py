@@ -1,0 +1,116 @@
+"""Instrument stations for rangefinder shots: GPS positions from a GPX or a CSV.
+
+* GPX: each waypoint is a station, its ``<name>`` the station id; ``<ele>`` required for
+  any station a shot uses.
+* CSV: ``station, lat, lon, elev_m`` (aliases: ``name``/``id``/``point`` for the id,
+  the latitude/longitude/elevation aliases of :mod:`fieldkit.io.points_csv`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from os import PathLike
+
+import numpy as np
+import pandas as pd
+
+from fieldkit.errors import InputFileError
+from fieldkit.io.csv_table import check_readable, length_factor, read_csv_table
+from fieldkit.io.points import GPX_HEIGHT_REFERENCE, check_unique_points
+from fieldkit.io.points_csv import ELEVATION_ALIASES, LAT_ALIASES, LON_ALIASES
+
+STATION_ALIASES = ("station", "station_id", "stn", "name", "id", "point", "point_id")
+
+
+@dataclass(frozen=True)
+class Stations:
+    """Station positions: frame with ``station`` (str), ``lat_deg``, ``lon_deg``,
+    ``elev_m`` (NaN when a GPX waypoint has no ``<ele>``), indexed by nothing."""
+
+    frame: pd.DataFrame
+    source: str
+    height_reference: str
+
+    def lookup(self, station: str) -> pd.Series | None:
+        """The row of ``station``, or None."""
+        match = self.frame[self.frame["station"] == station]
+        return None if match.empty else match.iloc[0]
+
+
+def read_stations(path: str | PathLike[str], *, units: str = "m") -> Stations:
+    """Read stations from a GPX (waypoints) or CSV file (by content, then extension).
+
+    ``units="ft"`` applies to a CSV elevation column without a unit in its name.
+    """
+    file = check_readable(path)
+    with file.open("rb") as handle:
+        head = handle.read(512).lstrip(b"\xef\xbb\xbf \t\r\n")
+    source = str(path)
+    if head.startswith(b"<") or file.suffix.lower() == ".gpx":
+        from fieldkit.io.gpx import read_gpx_waypoints
+
+        table = read_gpx_waypoints(path)
+        names = [str(n) for n in table["point"]]
+        check_unique_points(
+            names, [f"waypoint {i}" for i in range(1, len(names) + 1)], source
+        )
+        frame = pd.DataFrame(
+            {
+                "station": pd.Series(names, dtype="str"),
+                "lat_deg": table["lat_deg"].to_numpy(float),
+                "lon_deg": table["lon_deg"].to_numpy(float),
+                "elev_m": table["elev_m"].to_numpy(float),
+            }
+        )
+        return Stations(frame, source, GPX_HEIGHT_REFERENCE)
+    table = read_csv_table(path)
+    wanted = {
+        "station": table.find(STATION_ALIASES),
+        "lat": table.find(LAT_ALIASES),
+        "lon": table.find(LON_ALIASES),
+        "elev": table.find(ELEVATION_ALIASES),
+    }
+    missing = [key for key, column in wanted.items() if column is None]
+    if missing:
+        have = ", ".join(c.header.strip() for c in table.columns)
+        raise InputFileError(
+            f"stations CSV needs columns station, lat, lon, elev_m; missing "
+            f"{', '.join(missing)} (have: {have})",
+            source=source,
+            where="row 1",
+        )
+    names, lats, lons, elevs, wheres = [], [], [], [], []
+    elev_factor = length_factor(table, wanted["elev"], units)
+    for number, row in table.rows:
+        name = table.cell(row, wanted["station"])
+        if not name:
+            raise InputFileError(
+                "station id is empty", source=source, where=f"row {number}"
+            )
+        lat = table.number(number, row, wanted["lat"])
+        lon = table.number(number, row, wanted["lon"])
+        if not (-90.0 <= lat <= 90.0 and -180.0 <= lon <= 180.0):
+            raise InputFileError(
+                f"station '{name}': latitude/longitude {lat:g}, {lon:g} out of range",
+                source=source,
+                where=f"row {number}",
+            )
+        names.append(name)
+        lats.append(lat)
+        lons.append(lon)
+        elevs.append(table.number(number, row, wanted["elev"]) * elev_factor)
+        wheres.append(f"row {number}")
+    check_unique_points(names, wheres, source)
+    frame = pd.DataFrame(
+        {
+            "station": pd.Series(names, dtype="str"),
+            "lat_deg": np.asarray(lats, dtype=float),
+            "lon_deg": np.asarray(lons, dtype=float),
+            "elev_m": np.asarray(elevs, dtype=float),
+        }
+    )
+    reference = (
+        f"column '{wanted['elev'].header.strip()}' of {source} as given; "
+        "no geoid conversion"
+    )
+    return Stations(frame, source, reference)
