@@ -1,0 +1,627 @@
+"""Impact of a rough, rotating body on the slope in local N/T axes (ch. 4, App. C).
+
+Axes (ARCHITECTURE §2, thesis Fig. 4.6): T along the ground down-slope, N out of the
+ground; the impact normal velocity is negative, ``omega`` is negative clockwise (the
+usual spin for travel down-slope). Impulses are the thesis's: ``p`` is the normal
+impulse, the independent variable of the [p_N - v] diagram (eq. 4.3).
+
+The body is given by its contact radius ``r`` (= ``r_N``, the height of the centre of
+mass above the contact point), its radius of gyration ``k`` and, for an eccentric
+impact, the tangential offset ``r_T`` of the centre of mass from the contact point
+(positive when the centre lies down-slope of the contact). ``r_T = 0`` is the thesis's
+collinear impact of a sphere (App. C.3), for which eqs. 4.20-4.22 hold whenever slip
+stops before separation.
+
+The general solution (:func:`rough_body_impact`) follows App. C: Coulomb friction
+``dp_T = -mu dp_N`` while the contact slips (C.12-C.15), rolling (no slip) once the slip
+velocity vanishes if friction can hold it, otherwise slip reverses (eccentric impacts
+only); the end of compression ``p_c`` is where the contact normal velocity vanishes
+(C.16) and the impact ends at ``p_f = (1 + e_N) p_c`` (C.17, Poisson's hypothesis).
+Everything is mass-independent; impulses are reported per unit mass unless
+``mass_kg`` is given.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from fieldkit.errors import ArgumentError
+
+
+def _check(bad: np.ndarray, name: str, requirement: str, value: ArrayLike) -> None:
+    """Raise ArgumentError naming ``name`` if any element of ``bad`` is true."""
+    bad = np.atleast_1d(bad)
+    if np.any(bad):
+        values = np.atleast_1d(np.asarray(value, float))
+        shape = np.broadcast_shapes(bad.shape, values.shape)
+        first = np.broadcast_to(values, shape)[np.broadcast_to(bad, shape)]
+        raise ArgumentError(f"{name} must be {requirement} (got {first.flat[0]:g})")
+
+
+def _array(name: str, value: ArrayLike) -> np.ndarray:
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ArgumentError(f"{name} must be a number (got {value!r})") from None
+    _check(np.isnan(array), name, "a number", array)
+    return array
+
+
+def slip_velocity(
+    v_t_mps: ArrayLike, omega_radps: ArrayLike, radius_m: ArrayLike
+) -> np.ndarray:
+    """Slip velocity of the contact point ``v_s = v_T + r omega`` [m/s] (eq. 4.15).
+
+    Zero means rolling without slip (``omega = -v_T / r``).
+
+    Examples
+    --------
+    Worked example 4A at impact: 19.9 m/s and -15 rad/s on a 0.75 m radius sphere.
+
+    >>> round(float(slip_velocity(19.9, -15.0, 0.75)), 2)
+    8.65
+    """
+    return np.asarray(v_t_mps, float) + np.asarray(radius_m, float) * np.asarray(
+        omega_radps, float
+    )
+
+
+def inertial_coefficients(
+    gyration_m: ArrayLike, r_t_m: ArrayLike, r_n_m: ArrayLike
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Inertial coefficients beta1, beta2, beta3 for plane impact (eq. C.11).
+
+    ``beta1 = 1 + r_N^2/k^2``, ``beta2 = r_N r_T / k^2``, ``beta3 = 1 + r_T^2/k^2``
+    (slope of infinite mass). They give the relative velocity of the contact point:
+    ``m dv_T = beta1 dp_T - beta2 dp_N`` and ``m dv_N = -beta2 dp_T + beta3 dp_N``
+    (C.6a, b).
+
+    Parameters
+    ----------
+    gyration_m
+        Radius of gyration k [m].
+    r_t_m
+        Tangential distance r_T from the contact point to the centre of mass [m]
+        (0 for a collinear impact, e.g. a sphere).
+    r_n_m
+        Normal distance r_N from the contact point to the centre of mass [m] (the
+        contact radius r of a sphere).
+
+    Examples
+    --------
+    Worked example 6B (boulder A, k = 0.46, r_T = 0.8, r_N = 0.65): 3.00, 2.46, 4.02.
+
+    >>> [round(float(b), 2) for b in inertial_coefficients(0.46, 0.8, 0.65)]
+    [3.0, 2.46, 4.02]
+    """
+    k2 = np.asarray(gyration_m, float) ** 2
+    r_t = np.asarray(r_t_m, float)
+    r_n = np.asarray(r_n_m, float)
+    return 1.0 + r_n**2 / k2, r_n * r_t / k2, 1.0 + r_t**2 / k2
+
+
+def compression_impulse(
+    v_in_mps: ArrayLike,
+    mass_kg: ArrayLike,
+    beta2: ArrayLike = 0.0,
+    beta3: ArrayLike = 1.0,
+    friction: ArrayLike = 0.0,
+) -> np.ndarray:
+    """Normal impulse at maximum compression for constant slip [N s] (eqs. 4.4, C.16).
+
+    ``p_c = -m v_iN / (beta3 + mu beta2)``; with the defaults (collinear impact)
+    ``p_c = -m v_iN`` (eq. 4.4).
+
+    Examples
+    --------
+    Worked example 6B: 3750 kg, v_iN = -4.4 m/s, mu = 0.68 -> 2898 kg m/s.
+
+    >>> round(float(compression_impulse(-4.4, 3750, 2.46, 4.02, 0.68)))
+    2898
+    """
+    return (
+        -np.asarray(mass_kg, float)
+        * np.asarray(v_in_mps, float)
+        / (np.asarray(beta3, float) + np.asarray(friction, float) * np.asarray(beta2))
+    )
+
+
+def final_impulse(p_c: ArrayLike, e_n: ArrayLike) -> np.ndarray:
+    """Normal impulse at separation ``p_f = (1 + e_N) p_c`` (eqs. 4.12, C.17, C.18).
+
+    Examples
+    --------
+    >>> round(float(final_impulse(2898.0, 1.30)))
+    6665
+    """
+    return (1.0 + np.asarray(e_n, float)) * np.asarray(p_c, float)
+
+
+def slip_stop_impulse_ratio(
+    v_it_mps: ArrayLike,
+    v_in_mps: ArrayLike,
+    omega_i_radps: ArrayLike,
+    *,
+    radius_m: ArrayLike,
+    gyration_m: ArrayLike,
+    friction: ArrayLike,
+) -> np.ndarray:
+    """Impulse ratio ``p_s / p_c`` at which slip stops, collinear impact (eq. C.26).
+
+    ``p_s/p_c = -(v_iT + r omega_i) / (v_iN mu (1 + r^2/k^2))``. Slip stops before
+    separation when this is below ``1 + e_N``. Written for ``v_iT + r omega_i >= 0``
+    (down-slope slip), as in the thesis; :func:`rough_body_impact` handles both signs.
+
+    Examples
+    --------
+    >>> round(float(slip_stop_impulse_ratio(19.9, -9.3, -15.0, radius_m=0.75,
+    ...                                     gyration_m=0.4743, friction=0.5)), 3)
+    0.531
+    """
+    r = np.asarray(radius_m, float)
+    k = np.asarray(gyration_m, float)
+    v_s = slip_velocity(v_it_mps, omega_i_radps, r)
+    mu = np.asarray(friction, float)
+    return -v_s / (np.asarray(v_in_mps, float) * mu * (1 + r**2 / k**2))
+
+
+def rolling_final_velocities(
+    v_it_mps: ArrayLike,
+    v_in_mps: ArrayLike,
+    omega_i_radps: ArrayLike,
+    *,
+    radius_m: ArrayLike,
+    gyration_m: ArrayLike,
+    e_n: ArrayLike,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Final velocities when slip stops during the impact (eqs. 4.20-4.22, C.27-C.29).
+
+    ``v_fT = v_iT - (v_iT + r omega_i) / (1 + r^2/k^2)``, ``v_fN = -e_N v_iN``,
+    ``omega_f = omega_i - (r/k^2) (v_iT + r omega_i) / (1 + r^2/k^2)``.
+    Independent of the friction coefficient, provided it is large enough for slip to
+    stop before separation (see :func:`minimum_friction_to_stop_slip`).
+
+    Returns
+    -------
+    v_ft_mps, v_fn_mps, omega_f_radps
+
+    Examples
+    --------
+    Worked example 4A (v_i = 22 m/s at 25 deg, omega_i = -15 rad/s, 1.5 m sphere,
+    e_N = 0.708 from eq. 5.4): thesis v_fT 17.5, v_fN 6.6, omega_f -23.3.
+
+    >>> v_ft, v_fn, w_f = rolling_final_velocities(19.939, -9.298, -15.0,
+    ...     radius_m=0.75, gyration_m=0.75 * 0.4 ** 0.5, e_n=0.708)
+    >>> round(float(v_ft), 1), round(float(v_fn), 1), round(float(w_f), 1)
+    (17.5, 6.6, -23.3)
+    """
+    r = np.asarray(radius_m, float)
+    k2 = np.asarray(gyration_m, float) ** 2
+    v_it = np.asarray(v_it_mps, float)
+    change = slip_velocity(v_it, omega_i_radps, r) / (1.0 + r**2 / k2)
+    v_ft = v_it - change
+    v_fn = -np.asarray(e_n, float) * np.asarray(v_in_mps, float)
+    omega_f = np.asarray(omega_i_radps, float) - r / k2 * change
+    return v_ft, v_fn, omega_f
+
+
+def final_speed_and_angle(
+    v_ft_mps: ArrayLike, v_fn_mps: ArrayLike
+) -> tuple[np.ndarray, np.ndarray]:
+    """Restitution speed and angle to the ground (eqs. 4.23, 4.24).
+
+    ``v_f = sqrt(v_fT^2 + v_fN^2)``; ``theta_f = atan(v_fN / v_fT)`` in degrees, taken
+    with ``atan2`` so a rebound up-slope (``v_fT < 0``) gives an angle above 90.
+
+    Examples
+    --------
+    >>> [round(float(x), 1) for x in final_speed_and_angle(17.46, 6.60)]
+    [18.7, 20.7]
+    """
+    v_ft = np.asarray(v_ft_mps, float)
+    v_fn = np.asarray(v_fn_mps, float)
+    return np.hypot(v_ft, v_fn), np.degrees(np.arctan2(v_fn, v_ft))
+
+
+def minimum_friction_to_stop_slip(
+    v_it_mps: ArrayLike,
+    v_in_mps: ArrayLike,
+    omega_i_radps: ArrayLike,
+    *,
+    radius_m: ArrayLike,
+    gyration_m: ArrayLike,
+    e_n: ArrayLike,
+) -> np.ndarray:
+    """Smallest mu for which slip stops before separation, collinear impact (eq. C.26).
+
+    From ``p_s/p_c <= p_f/p_c = 1 + e_N``:
+    ``mu_min = |v_iT + r omega_i| / (-(1 + e_N) v_iN (1 + r^2/k^2))``. Above it the
+    thesis's eqs. 4.20-4.22 apply; below it the body slips throughout the impact.
+
+    Examples
+    --------
+    >>> round(float(minimum_friction_to_stop_slip(19.939, -9.298, -15.0,
+    ...     radius_m=0.75, gyration_m=0.75 * 0.4 ** 0.5, e_n=0.708)), 3)
+    0.156
+    """
+    r = np.asarray(radius_m, float)
+    k = np.asarray(gyration_m, float)
+    v_s = np.abs(slip_velocity(v_it_mps, omega_i_radps, r))
+    q_f = -(1.0 + np.asarray(e_n, float)) * np.asarray(v_in_mps, float)
+    return v_s / (q_f * (1.0 + r**2 / k**2))
+
+
+@dataclass(frozen=True)
+class ContactPhases:
+    """The piecewise-linear [p_N - v] lines of one impact, per unit mass (App. C).
+
+    ``q`` is the normal impulse per unit mass ``p_N / m`` [m/s]. Phase 1 slips in
+    direction ``direction`` (sign of the initial slip velocity) with
+    ``dp_T/dp_N = ratio_1``; at ``q_slip_stop`` (``inf`` if it never stops) the contact
+    either rolls (``ratio_2 = beta2/beta1``, always for collinear impacts) or slips the
+    other way (eccentric impacts with ``mu beta1 < |beta2|``). Use
+    :func:`contact_phases` to build it.
+    """
+
+    v_it: np.ndarray
+    v_in: np.ndarray
+    omega_i: np.ndarray
+    r_t: np.ndarray
+    r_n: np.ndarray
+    k2: np.ndarray
+    slip_i: np.ndarray
+    normal_i: np.ndarray
+    direction: np.ndarray
+    ratio_1: np.ndarray
+    slope_t_1: np.ndarray
+    slope_n_1: np.ndarray
+    q_slip_stop: np.ndarray
+    p_t_slip_stop: np.ndarray
+    normal_slip_stop: np.ndarray
+    rolls: np.ndarray
+    ratio_2: np.ndarray
+    slope_t_2: np.ndarray
+    slope_n_2: np.ndarray
+    q_c: np.ndarray
+    q_f: np.ndarray
+
+    def tangential_impulse(self, q: ArrayLike) -> np.ndarray:
+        """Tangential impulse per unit mass ``p_T/m`` at normal impulse ``q`` [m/s]."""
+        q = np.asarray(q, float)
+        with np.errstate(invalid="ignore"):
+            early = self.ratio_1 * q
+            late = self.p_t_slip_stop + self.ratio_2 * (q - self.q_slip_stop)
+        return np.where(q < self.q_slip_stop, early, late)
+
+    def contact_velocities(self, q: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """Slip (tangential) and normal velocity of the contact point at ``q`` [m/s]."""
+        q = np.asarray(q, float)
+        with np.errstate(invalid="ignore"):
+            early = q < self.q_slip_stop
+            v_t = np.where(
+                early,
+                self.slip_i + self.slope_t_1 * q,
+                self.slope_t_2 * (q - self.q_slip_stop),
+            )
+            v_n = np.where(
+                early,
+                self.normal_i + self.slope_n_1 * q,
+                self.normal_slip_stop + self.slope_n_2 * (q - self.q_slip_stop),
+            )
+        return v_t, v_n
+
+    def body_velocities(
+        self, q: ArrayLike
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Centre-of-mass velocities ``V_T, V_N`` [m/s] and spin [rad/s] at ``q``."""
+        q = np.asarray(q, float)
+        p_t = self.tangential_impulse(q)
+        omega = self.omega_i + (self.r_n * p_t - self.r_t * q) / self.k2
+        return self.v_it + p_t, self.v_in + q, omega
+
+    def normal_work(self, q: ArrayLike) -> np.ndarray:
+        """``int_0^q v_N dp_N`` per unit mass [J/kg] (area under the v_N line)."""
+        q = np.asarray(q, float)
+        with np.errstate(invalid="ignore"):
+            q1 = np.minimum(q, self.q_slip_stop)
+            v1 = self.normal_i + self.slope_n_1 * q1
+            part1 = np.where(q1 > 0, 0.5 * (self.normal_i + v1) * q1, 0.0)
+            q2 = np.maximum(q - self.q_slip_stop, 0.0)
+            part2 = np.where(
+                q2 > 0,
+                self.normal_slip_stop * q2 + 0.5 * self.slope_n_2 * q2**2,
+                0.0,
+            )
+        return part1 + part2
+
+    def friction_work(self, q: ArrayLike) -> np.ndarray:
+        """``int_0^q v_T dp_T`` per unit mass [J/kg] (always <= 0: friction)."""
+        q = np.asarray(q, float)
+        v_t, _ = self.contact_velocities(q)
+        p_t = self.tangential_impulse(q)
+        with np.errstate(invalid="ignore"):
+            finished = q >= self.q_slip_stop
+            first = np.where(
+                finished,
+                0.5 * self.slip_i * self.p_t_slip_stop,
+                0.5 * (self.slip_i + v_t) * p_t,
+            )
+            second = np.where(
+                finished & ~self.rolls, 0.5 * v_t * (p_t - self.p_t_slip_stop), 0.0
+            )
+        return first + second
+
+
+def contact_phases(
+    v_it_mps: ArrayLike,
+    v_in_mps: ArrayLike,
+    omega_i_radps: ArrayLike,
+    *,
+    radius_m: ArrayLike,
+    gyration_m: ArrayLike,
+    e_n: ArrayLike,
+    friction: ArrayLike = np.inf,
+    offset_m: ArrayLike = 0.0,
+) -> ContactPhases:
+    """Solve the [p_N - v] lines of a rough rotating body impact (eqs. C.12-C.18).
+
+    Arguments as :func:`rough_body_impact`. Raises :class:`ArgumentError` naming the
+    argument for out-of-range input.
+    """
+    v_it = _array("v_it_mps", v_it_mps)
+    v_in = _array("v_in_mps", v_in_mps)
+    omega_i = _array("omega_i_radps", omega_i_radps)
+    r_n = _array("radius_m", radius_m)
+    k = _array("gyration_m", gyration_m)
+    e = _array("e_n", e_n)
+    mu = _array("friction", friction)
+    r_t = _array("offset_m", offset_m)
+    _check(~np.isfinite(v_it), "v_it_mps", "finite", v_it)
+    _check(~np.isfinite(v_in), "v_in_mps", "finite", v_in)
+    _check(~np.isfinite(omega_i), "omega_i_radps", "finite", omega_i)
+    _check(~(r_n > 0) | ~np.isfinite(r_n), "radius_m", "> 0", r_n)
+    _check(~(k > 0) | ~np.isfinite(k), "gyration_m", "> 0", k)
+    _check(~(e >= 0) | ~np.isfinite(e), "e_n", ">= 0", e)
+    _check(~(mu >= 0), "friction", ">= 0 (inf = slip always stops)", mu)
+    _check(~np.isfinite(r_t), "offset_m", "finite", r_t)
+    _check(
+        np.isinf(mu) & (r_t != 0),
+        "friction",
+        "finite for an eccentric impact (offset_m != 0)",
+        mu,
+    )
+    _check(~(v_in < 0), "v_in_mps", "< 0 (moving into the ground)", v_in)
+
+    v_it, v_in, omega_i, r_n, k, e, mu, r_t = np.broadcast_arrays(
+        v_it, v_in, omega_i, r_n, k, e, mu, r_t
+    )
+    k2 = k**2
+    beta1, beta2, beta3 = inertial_coefficients(k, r_t, r_n)
+    slip_i = v_it + omega_i * r_n  # eq. 4.15 / C.21 (contact tangential velocity)
+    normal_i = v_in - omega_i * r_t  # contact normal velocity (= v_in when collinear)
+    _check(
+        ~(normal_i < 0),
+        "v_in_mps",
+        "such that the contact point moves into the ground (v_in - omega_i r_T < 0)",
+        v_in,
+    )
+    s = np.sign(slip_i)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        # phase 1: slip in direction s, dp_T = -s mu dp_N (C.12-C.14)
+        ratio_1 = -s * mu
+        slope_t_1 = beta1 * ratio_1 - beta2
+        slope_n_1 = beta3 - beta2 * ratio_1
+        retard = mu * beta1 + s * beta2  # > 0: friction brings the slip to a stop
+        q_s = np.where(retard > 0, np.abs(slip_i) / retard, np.inf)  # C.26
+        q_s = np.where(s == 0, 0.0, q_s)  # rolling at impact; mu = inf gives 0 too
+        p_t_s = (beta2 * q_s - slip_i) / beta1  # from v_T(q_s) = 0 (C.6a integrated)
+        normal_s = normal_i - beta2 * p_t_s + beta3 * q_s  # C.6b integrated
+        # phase 2: roll if friction can hold it (4.14b), else slip the other way
+        rolls = mu * beta1 >= np.abs(beta2)
+        s_2 = np.where(s != 0, -s, -np.sign(beta2))
+        ratio_2 = np.where(rolls, beta2 / beta1, -s_2 * mu)
+        slope_t_2 = np.where(rolls, 0.0, beta1 * ratio_2 - beta2)
+        slope_n_2 = beta3 - beta2 * ratio_2
+        # maximum compression: contact normal velocity = 0 (C.16, piecewise)
+        q_c1 = np.where(slope_n_1 > 0, -normal_i / slope_n_1, np.inf)
+        q_c2 = q_s - normal_s / slope_n_2
+        q_c = np.where(q_c1 < q_s, q_c1, q_c2)
+    q_f = (1.0 + e) * q_c  # C.17 (Poisson)
+    q_s = np.where(q_s < q_f, q_s, np.inf)  # slip that would stop after separation
+    return ContactPhases(
+        v_it=v_it,
+        v_in=v_in,
+        omega_i=omega_i,
+        r_t=r_t,
+        r_n=r_n,
+        k2=k2,
+        slip_i=slip_i,
+        normal_i=normal_i,
+        direction=s,
+        ratio_1=ratio_1,
+        slope_t_1=slope_t_1,
+        slope_n_1=slope_n_1,
+        q_slip_stop=q_s,
+        p_t_slip_stop=p_t_s,
+        normal_slip_stop=normal_s,
+        rolls=rolls,
+        ratio_2=ratio_2,
+        slope_t_2=slope_t_2,
+        slope_n_2=slope_n_2,
+        q_c=q_c,
+        q_f=q_f,
+    )
+
+
+@dataclass(frozen=True)
+class ImpactResult:
+    """Outcome of :func:`rough_body_impact` (arrays broadcast over the inputs).
+
+    Velocities are of the centre of mass in local axes [m/s], spin [rad/s] (thesis
+    signs). Impulses ``p_c``, ``p_f``, ``p_slip_stop`` are in N s when a mass was given,
+    otherwise per unit mass (N s/kg = m/s). Energies [J] are NaN without a mass.
+
+    Attributes
+    ----------
+    v_ft_mps, v_fn_mps, omega_f_radps
+        Final tangential and normal velocity and spin (eqs. 4.20-4.22 when slip stops).
+    v_f_mps, theta_f_deg
+        Final speed and angle to the ground (eqs. 4.23, 4.24).
+    e_n, e_t
+        ``-v_fN/v_iN`` (= the e_N used, for a collinear impact) and ``v_fT/v_iT``.
+    slip_velocity_i_mps, slip_velocity_f_mps
+        Contact slip velocity ``v_T + r omega`` before and after (eq. 4.15).
+    p_c, p_f
+        Normal impulse at maximum compression and at separation (C.16-C.18).
+    slip_stops, p_slip_stop
+        Whether slip stops before separation, and the normal impulse where it does
+        (C.26; NaN if it does not). A body rolling at impact has ``p_slip_stop = 0``.
+    ke_i_j, ke_f_j, re_i_j, re_f_j
+        Kinetic and rotational energy before and after.
+    energy_change_j
+        ``(ke_f + re_f) - (ke_i + re_i)``; negative = loss.
+    work_compression_j, work_restitution_j, work_friction_j
+        Work of the contact force: normal impulse up to ``p_c`` (<= 0), normal impulse
+        from ``p_c`` to ``p_f`` (>= 0), and friction (<= 0); they sum to
+        ``energy_change_j`` (thesis eqs. 6.7-6.9, generalised; see THESIS-NOTES for the
+        eq. 6.7 factor 1/2).
+    """
+
+    v_ft_mps: np.ndarray
+    v_fn_mps: np.ndarray
+    omega_f_radps: np.ndarray
+    v_f_mps: np.ndarray
+    theta_f_deg: np.ndarray
+    e_n: np.ndarray
+    e_t: np.ndarray
+    slip_velocity_i_mps: np.ndarray
+    slip_velocity_f_mps: np.ndarray
+    p_c: np.ndarray
+    p_f: np.ndarray
+    slip_stops: np.ndarray
+    p_slip_stop: np.ndarray
+    ke_i_j: np.ndarray
+    ke_f_j: np.ndarray
+    re_i_j: np.ndarray
+    re_f_j: np.ndarray
+    energy_change_j: np.ndarray
+    work_compression_j: np.ndarray
+    work_restitution_j: np.ndarray
+    work_friction_j: np.ndarray
+
+
+def rough_body_impact(
+    v_it_mps: ArrayLike,
+    v_in_mps: ArrayLike,
+    omega_i_radps: ArrayLike,
+    *,
+    radius_m: ArrayLike,
+    gyration_m: ArrayLike,
+    e_n: ArrayLike,
+    friction: ArrayLike = np.inf,
+    offset_m: ArrayLike = 0.0,
+    mass_kg: ArrayLike | None = None,
+) -> ImpactResult:
+    """Impact of a rough, rotating body on the slope (thesis §4.6, App. C).
+
+    Parameters
+    ----------
+    v_it_mps, v_in_mps
+        Impact velocity of the centre of mass along T (down-slope) and N [m/s];
+        ``v_in_mps < 0``.
+    omega_i_radps
+        Spin at impact [rad/s], negative clockwise (thesis Fig. 4.6).
+    radius_m
+        Contact radius r = r_N [m], > 0.
+    gyration_m
+        Radius of gyration k [m], > 0.
+    e_n
+        Normal coefficient of restitution (>= 0; > 1 is allowed, eq. 5.4 gives it at
+        shallow impacts). Applied as ``p_f = (1 + e_N) p_c`` (C.17).
+    friction
+        Coulomb friction coefficient mu >= 0 at the contact. ``inf`` (default) is the
+        thesis's assumption for eqs. 4.20-4.22: slip always stops before separation
+        (collinear impacts only: infinite friction has no meaning when the impulse is
+        eccentric). ``0`` is a smooth contact.
+    offset_m
+        Tangential offset r_T of the centre of mass from the contact point [m]
+        (eccentric impact, C.11); 0 = collinear impact (thesis ch. 4).
+    mass_kg
+        Mass [kg]; optional, only scales impulses and energies.
+
+    Returns
+    -------
+    ImpactResult
+
+    Examples
+    --------
+    Worked example 4A: thesis v_fT 17.5, v_fN 6.6, omega_f -23.3, theta_f 20.7 deg.
+
+    >>> import numpy as np
+    >>> th = np.radians(25.0)
+    >>> res = rough_body_impact(22 * np.cos(th), -22 * np.sin(th), -15.0,
+    ...     radius_m=0.75, gyration_m=0.75 * np.sqrt(0.4), e_n=19.5 * 25 ** -1.03)
+    >>> [round(float(x), 1) for x in (res.v_ft_mps, res.v_fn_mps, res.omega_f_radps,
+    ...                               res.theta_f_deg)]
+    [17.5, 6.6, -23.3, 20.7]
+    """
+    ph = contact_phases(
+        v_it_mps,
+        v_in_mps,
+        omega_i_radps,
+        radius_m=radius_m,
+        gyration_m=gyration_m,
+        e_n=e_n,
+        friction=friction,
+        offset_m=offset_m,
+    )
+    if mass_kg is None:
+        mass = np.ones_like(ph.q_f)
+        energy_scale = np.full_like(ph.q_f, np.nan)
+    else:
+        mass = _array("mass_kg", mass_kg)
+        _check(~(mass > 0) | ~np.isfinite(mass), "mass_kg", "> 0", mass)
+        mass = np.broadcast_to(mass, ph.q_f.shape)
+        energy_scale = mass
+    v_ft, v_fn, omega_f = ph.body_velocities(ph.q_f)
+    v_f, theta_f = final_speed_and_angle(v_ft, v_fn)
+    speed2_i = ph.v_it**2 + ph.v_in**2
+    ke_i = 0.5 * energy_scale * speed2_i
+    ke_f = 0.5 * energy_scale * v_f**2
+    re_i = 0.5 * energy_scale * ph.k2 * ph.omega_i**2
+    re_f = 0.5 * energy_scale * ph.k2 * omega_f**2
+    w_c = ph.normal_work(ph.q_c)
+    w_f = ph.normal_work(ph.q_f)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        e_t = v_ft / ph.v_it
+    slip_stops = np.isfinite(ph.q_slip_stop)
+
+    def out(x: np.ndarray) -> np.ndarray:
+        return np.asarray(x)[()]
+
+    return ImpactResult(
+        v_ft_mps=out(v_ft),
+        v_fn_mps=out(v_fn),
+        omega_f_radps=out(omega_f),
+        v_f_mps=out(v_f),
+        theta_f_deg=out(theta_f),
+        e_n=out(-v_fn / ph.v_in),
+        e_t=out(e_t),
+        slip_velocity_i_mps=out(ph.slip_i),
+        slip_velocity_f_mps=out(ph.contact_velocities(ph.q_f)[0]),
+        p_c=out(mass * ph.q_c),
+        p_f=out(mass * ph.q_f),
+        slip_stops=out(slip_stops),
+        p_slip_stop=out(np.where(slip_stops, mass * ph.q_slip_stop, np.nan)),
+        ke_i_j=out(ke_i),
+        ke_f_j=out(ke_f),
+        re_i_j=out(re_i),
+        re_f_j=out(re_f),
+        energy_change_j=out(ke_f + re_f - ke_i - re_i),
+        work_compression_j=out(energy_scale * w_c),
+        work_restitution_j=out(energy_scale * (w_f - w_c)),
+        work_friction_j=out(energy_scale * ph.friction_work(ph.q_f)),
+    )
