@@ -33,11 +33,13 @@ def as_output(value: np.ndarray) -> np.ndarray:
 
 
 def check_gravity(g: float) -> None:
+    """ArgumentError unless ``g > 0``."""
     if not np.all(np.asarray(g, float) > 0):
         raise ArgumentError(f"gravity g must be positive, got {g}", source="g")
 
 
 def check_nonnegative(value: np.ndarray, name: str, unit: str) -> None:
+    """ArgumentError naming ``name`` if any element is negative."""
     bad = np.asarray(value < 0)
     if bad.any():
         (v,) = first_values(bad, value)
@@ -49,6 +51,7 @@ def check_nonnegative(value: np.ndarray, name: str, unit: str) -> None:
 
 
 def check_positive(value: np.ndarray, name: str, unit: str) -> None:
+    """ArgumentError naming ``name`` if any element is zero or negative."""
     bad = np.asarray(value <= 0)
     if bad.any():
         (v,) = first_values(bad, value)
@@ -60,6 +63,7 @@ def check_positive(value: np.ndarray, name: str, unit: str) -> None:
 
 
 def check_forward_angle(alpha_deg: np.ndarray) -> None:
+    """ArgumentError unless -90° < alpha < 90° (travel toward +x)."""
     bad = np.asarray(np.abs(alpha_deg) >= 90)
     if bad.any():
         (a,) = first_values(bad, alpha_deg)
@@ -72,6 +76,7 @@ def check_forward_angle(alpha_deg: np.ndarray) -> None:
 
 
 def check_into_slope(theta0_deg: np.ndarray, psi_deg: np.ndarray) -> None:
+    """ArgumentError for |psi| >= 90°; PhysicsError for a launch into the slope."""
     steep = np.asarray(np.abs(psi_deg) >= 90)
     if steep.any():
         (p,) = first_values(steep, psi_deg)

@@ -128,6 +128,10 @@ def test_example_3b_impact_velocity_unrounded(example_3b):
     assert float(f.arrival_speed_mps) == pytest.approx(27.93, abs=0.01)
     assert float(f.arrival_angle_deg) == pytest.approx(52.73, abs=0.01)
     assert float(f.theta0_deg) == pytest.approx(20.0)
+    # angle to the 40° ground at the next impact (theta_i): 52.73 - 40
+    assert float(f.arrival_angle_to_chord_deg) == pytest.approx(12.73, abs=0.01)
+    x, z = f.position_at_time(f.time_s)
+    assert (float(x), float(z)) == pytest.approx((float(f.dx_m), float(f.dz_m)))
 
 
 def test_example_3b_printed_numbers_come_from_the_rounded_parabola():
