@@ -1,0 +1,377 @@
+"""Split a track into ballistic flights and the contacts between them, from the data.
+
+No contact times are given: a sample belongs to a flight when it lies on the same
+parabola as its neighbours (constant acceleration, ``x`` linear in time), and a contact
+is wherever the motion is not free flight (a bounce: a jump in velocity; a net or a
+rolling phase: a sustained non-ballistic acceleration).
+
+Method (region growing from the cleanest seeds):
+
+1. **Noise.** A quadratic is fitted to ``x(t)`` and ``z(t)`` in every window of
+   ``window`` consecutive samples; the median residual RMS is the position noise
+   ``sigma`` (robust because contacts are a minority of the windows).
+2. **Growth.** Seeds are windows in increasing order of residual. A seed grows one
+   sample at a time, right then left, while the next sample agrees with the current
+   free-g ballistic fit within a chi-square test on its prediction variance
+   (``chi2 <= threshold``). An isolated bad sample (a detection outlier) is skipped
+   when the two following samples agree again; two rejections in a row end the flight.
+3. **Validation.** Every flight's free-g fit gives ``g`` and its standard error.
+   The track's gravity ``g_common`` is their inverse-variance weighted median. A
+   segment is a flight only if its ``g`` is determined (SE < 25 % of ``g_common``) and
+   consistent with ``g_common`` (within 4 SE + 5 %). This rejects pieces of a net
+   contact or a rolling phase that look ballistic over a few frames. Because the test
+   is against the track's own ``g``, flights are still found when the capture rate is
+   wrong (their common ``g`` is then wrong, which :mod:`flight_fit` warns about).
+4. **Extension.** Accepted flights grow again into samples freed by rejected
+   segments.
+
+Everything between two consecutive flights is a :class:`ContactSpan`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from fieldkit.tracking.flight_fit import fit_flight
+
+#: Chi-square (2 d.o.f.) bound for a sample to join a flight (p ~ 4e-6 for pure noise).
+CHI2_JOIN = 25.0
+
+
+@dataclass(frozen=True)
+class ContactSpan:
+    """The samples between two consecutive flights.
+
+    Attributes
+    ----------
+    before, after
+        Indices of the flights before and after the contact.
+    rows
+        Track positions of the samples in contact (may be empty for an impact
+        shorter than a frame interval).
+    t_last_before_s, t_first_after_s
+        Time of the last sample of the flight before and the first of the flight after.
+    """
+
+    before: int
+    after: int
+    rows: np.ndarray
+    t_last_before_s: float
+    t_first_after_s: float
+
+    @property
+    def gap_s(self) -> float:
+        """Time from the last flight sample before to the first after [s]."""
+        return self.t_first_after_s - self.t_last_before_s
+
+
+@dataclass
+class Segmentation:
+    """Flights found in a track.
+
+    Attributes
+    ----------
+    flights
+        For each flight (in time order) the track positions of its samples.
+    contacts
+        The spans between consecutive flights.
+    noise_m
+        Estimated position noise per coordinate [m].
+    g_common_mps2
+        The track's apparent gravity (weighted median of the flights) [m/s^2].
+    frame_interval_s
+        Median time between samples [s].
+    """
+
+    flights: list[np.ndarray]
+    contacts: list[ContactSpan]
+    noise_m: float
+    g_common_mps2: float
+    frame_interval_s: float
+
+
+def estimate_noise(
+    t: np.ndarray, x: np.ndarray, z: np.ndarray, window: int
+) -> np.ndarray:
+    """Residual RMS of a local quadratic in each window of ``window`` samples [m].
+
+    Returns one value per window start (``len(t) - window + 1`` values).
+    """
+    n = len(t)
+    if n < window:
+        return np.empty(0)
+    idx = np.arange(window)[None, :] + np.arange(n - window + 1)[:, None]
+    tau = t[idx] - t[idx].mean(axis=1, keepdims=True)
+    scale = np.abs(tau).max(axis=1, keepdims=True)
+    scale[scale == 0] = 1.0
+    tau = tau / scale
+    design = np.stack([np.ones_like(tau), tau, tau**2], axis=2)  # (m, w, 3)
+    pinv = np.linalg.pinv(design)  # (m, 3, w)
+    out = np.zeros(len(idx))
+    for values in (x[idx], z[idx]):
+        coef = np.einsum("mkw,mw->mk", pinv, values)
+        resid = values - np.einsum("mwk,mk->mw", design, coef)
+        out += (resid**2).sum(axis=1)
+    return np.sqrt(out / (2 * (window - 3)))
+
+
+class _Grower:
+    """Incremental least squares of x = a + b tau, z = c + d tau + e tau^2.
+
+    Sums of powers of ``tau = (t - t0) / span`` are accumulated; when the samples
+    outgrow twice the current span the sums are rebuilt around the new centre so
+    the 3x3 normal equations stay well conditioned.
+    """
+
+    def __init__(self, t: np.ndarray, x: np.ndarray, z: np.ndarray, members: list[int]):
+        self.t, self.x, self.z = t, x, z
+        self.members = list(members)
+        self._rebuild()
+
+    def _rebuild(self) -> None:
+        tm = self.t[self.members]
+        self.t0 = 0.5 * (tm.min() + tm.max())
+        self.span = max(0.5 * (tm.max() - tm.min()), 1e-12)
+        tau = (tm - self.t0) / self.span
+        p = tau[:, None] ** np.arange(5)[None, :]
+        self.s = p.sum(axis=0)
+        self.sx = (self.x[self.members][:, None] * p[:, :2]).sum(axis=0)
+        self.sz = (self.z[self.members][:, None] * p[:, :3]).sum(axis=0)
+
+    def _tau(self, i: int) -> float:
+        return (self.t[i] - self.t0) / self.span
+
+    def add(self, i: int) -> None:
+        self.members.append(i)
+        tau = self._tau(i)
+        if abs(tau) > 2.0:
+            self._rebuild()
+            return
+        p = tau ** np.arange(5)
+        self.s += p
+        self.sx += self.x[i] * p[:2]
+        self.sz += self.z[i] * p[:3]
+
+    def chi2(self, i: int, sigma: float) -> float:
+        """Prediction chi-square of sample ``i`` against the current fit."""
+        s = self.s
+        mx = np.array([[s[0], s[1]], [s[1], s[2]]])
+        mz = np.array([[s[0], s[1], s[2]], [s[1], s[2], s[3]], [s[2], s[3], s[4]]])
+        try:
+            ix = np.linalg.inv(mx)
+            iz = np.linalg.inv(mz)
+        except np.linalg.LinAlgError:
+            return np.inf
+        tau = self._tau(i)
+        fx = np.array([1.0, tau])
+        fz = np.array([1.0, tau, tau * tau])
+        rx = self.x[i] - fx @ (ix @ self.sx)
+        rz = self.z[i] - fz @ (iz @ self.sz)
+        vx = sigma**2 * (1.0 + fx @ ix @ fx)
+        vz = sigma**2 * (1.0 + fz @ iz @ fz)
+        return float(rx * rx / vx + rz * rz / vz)
+
+
+def _grow(
+    t, x, z, lo: int, hi: int, free: np.ndarray, sigma: float, exclude=()
+) -> tuple[int, int, list[int]]:
+    """Grow the inclusive range ``[lo, hi]`` over samples with ``free`` true.
+
+    Returns the new range and the positions of skipped outliers inside it.
+    """
+    outliers: list[int] = list(exclude)
+    g = _Grower(t, x, z, [i for i in range(lo, hi + 1) if i not in set(exclude)])
+    n = len(t)
+    for step in (1, -1):
+        edge = hi if step == 1 else lo
+        while True:
+            j = edge + step
+            if j < 0 or j >= n or not free[j]:
+                break
+            if g.chi2(j, sigma) <= CHI2_JOIN:
+                g.add(j)
+                edge = j
+                continue
+            # one outlier tolerated if the next two samples agree
+            k1, k2 = j + step, j + 2 * step
+            if (
+                0 <= k2 < n
+                and free[k1]
+                and free[k2]
+                and g.chi2(k1, sigma) <= CHI2_JOIN
+                and g.chi2(k2, sigma) <= CHI2_JOIN
+            ):
+                outliers.append(j)
+                g.add(k1)
+                edge = k1
+                continue
+            break
+        if step == 1:
+            hi = edge
+        else:
+            lo = edge
+    return lo, hi, outliers
+
+
+def find_flights(
+    t_s: np.ndarray,
+    x_m: np.ndarray,
+    z_m: np.ndarray,
+    *,
+    window: int = 9,
+    min_samples: int = 8,
+) -> Segmentation:
+    """Find the ballistic flights of a track (see the module docstring for the method).
+
+    Parameters
+    ----------
+    t_s, x_m, z_m
+        Sample times [s] (increasing) and centre positions [m]; NaN positions are
+        ignored (never part of a flight).
+    window
+        Samples per local window for the noise estimate and the seeds.
+    min_samples
+        Fewest samples a flight may have.
+
+    Returns
+    -------
+    Segmentation
+        ``flights`` hold positions into the input arrays.
+
+    Examples
+    --------
+    >>> t = np.arange(200) / 1000.0
+    >>> tc = 0.1
+    >>> x = 2.0 * t
+    >>> z = np.where(t < tc, 0.6 - 4.905 * t**2 - 0.05,
+    ...              -0.05 + 0.5 * 0.981 * (t - tc) - 4.905 * (t - tc) ** 2)
+    >>> seg = find_flights(t, x, z)
+    >>> len(seg.flights), len(seg.contacts)
+    (2, 1)
+    """
+    t_all = np.asarray(t_s, float)
+    x_all = np.asarray(x_m, float)
+    z_all = np.asarray(z_m, float)
+    valid = np.flatnonzero(np.isfinite(t_all) & np.isfinite(x_all) & np.isfinite(z_all))
+    t, x, z = t_all[valid], x_all[valid], z_all[valid]
+    n = len(t)
+    dt = float(np.median(np.diff(t))) if n > 1 else float("nan")
+    window = max(5, min(window, n))
+    empty = Segmentation([], [], float("nan"), float("nan"), dt)
+    if n < max(min_samples, window):
+        return empty
+
+    local = estimate_noise(t, x, z, window)
+    extent = max(np.ptp(x), np.ptp(z), 1e-9)
+    sigma = max(float(np.median(local)) * 1.05, 1e-9 * extent)
+
+    free = np.ones(n, bool)
+    segments: list[tuple[int, int, list[int]]] = []
+    for start in np.argsort(local, kind="stable"):
+        if local[start] > 3.0 * sigma:
+            break
+        stop = start + window - 1
+        if not free[start : stop + 1].all():
+            continue
+        lo, hi, outl = _grow(t, x, z, start, stop, free, sigma)
+        free[lo : hi + 1] = False
+        segments.append((lo, hi, outl))
+
+    fits = []
+    for lo, hi, outl in segments:
+        rows = np.setdiff1d(np.arange(lo, hi + 1), outl)
+        fits.append(
+            fit_flight(t[rows], x[rows], z[rows]) if len(rows) >= min_samples else None
+        )
+    g_common = _common_gravity([f for f in fits if f is not None])
+
+    accepted: list[tuple[int, int, list[int]]] = []
+    free = np.ones(n, bool)
+    for (lo, hi, outl), fit in zip(segments, fits, strict=True):
+        if fit is None or not _is_flight(fit, g_common):
+            continue
+        accepted.append((lo, hi, outl))
+        free[lo : hi + 1] = False
+    # let accepted flights take back samples held by rejected segments
+    extended = []
+    for lo, hi, outl in sorted(accepted):
+        free[lo : hi + 1] = True
+        lo2, hi2, outl2 = _grow(t, x, z, lo, hi, free, sigma, exclude=outl)
+        free[lo2 : hi2 + 1] = False
+        extended.append((lo2, hi2, sorted(set(outl) | set(outl2))))
+    extended.sort()
+
+    flights: list[np.ndarray] = []
+    for lo, hi, outl in extended:
+        rows = np.setdiff1d(np.arange(lo, hi + 1), outl)
+        rows = _trim_ends(t, x, z, rows, sigma)
+        if len(rows) >= min_samples:
+            flights.append(rows)
+
+    contacts = []
+    for k in range(len(flights) - 1):
+        a, b = flights[k], flights[k + 1]
+        inside = np.arange(a[-1] + 1, b[0])
+        contacts.append(
+            ContactSpan(
+                before=k,
+                after=k + 1,
+                rows=valid[inside],
+                t_last_before_s=float(t[a[-1]]),
+                t_first_after_s=float(t[b[0]]),
+            )
+        )
+    return Segmentation(
+        flights=[valid[r] for r in flights],
+        contacts=contacts,
+        noise_m=sigma,
+        g_common_mps2=g_common,
+        frame_interval_s=dt,
+    )
+
+
+def _common_gravity(fits) -> float:
+    good = [f for f in fits if np.isfinite(f.g_se_mps2) and f.g_se_mps2 > 0]
+    if not good:
+        return float("nan")
+    g = np.array([f.g_mps2 for f in good])
+    w = np.array([1.0 / f.g_se_mps2**2 for f in good])
+    order = np.argsort(g)
+    cum = np.cumsum(w[order])
+    return float(g[order][np.searchsorted(cum, 0.5 * cum[-1])])
+
+
+def _is_flight(fit, g_common: float) -> bool:
+    if not np.isfinite(g_common):
+        return True
+    scale = abs(g_common)
+    if not fit.g_se_mps2 < 0.25 * scale:
+        return False
+    return abs(fit.g_mps2 - g_common) <= 4.0 * fit.g_se_mps2 + 0.05 * scale
+
+
+def _trim_ends(t, x, z, rows: np.ndarray, sigma: float) -> np.ndarray:
+    """Drop end samples further than 3.5 sigma from the flight's own free-g fit."""
+    while len(rows) >= 6:
+        fit = fit_flight_free(t[rows], x[rows], z[rows])
+        limit = 3.5 * sigma * np.sqrt(2.0)
+        if fit[0] > limit:
+            rows = rows[1:]
+        elif fit[-1] > limit:
+            rows = rows[:-1]
+        else:
+            break
+    return rows
+
+
+def fit_flight_free(t: np.ndarray, x: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """Distance of each sample from the free-g ballistic least-squares fit [m]."""
+    tau = t - t.mean()
+    one = np.ones_like(tau)
+    ax = np.column_stack([one, tau])
+    az = np.column_stack([one, tau, tau**2])
+    rx = x - ax @ np.linalg.lstsq(ax, x, rcond=None)[0]
+    rz = z - az @ np.linalg.lstsq(az, z, rcond=None)[0]
+    return np.hypot(rx, rz)
