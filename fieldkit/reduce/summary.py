@@ -11,7 +11,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import pandas as pd
 
 from fieldkit.impact_table import ImpactTable
 from fieldkit.physics.constants import G

@@ -1,0 +1,154 @@
+"""Coefficients of restitution as the thesis plots them (Figs. 5.7 and 5.8).
+
+* :func:`plot_en_theta` -- [theta_i - e_N] scatter by slope material with the power law
+  of eq. 5.4, ``e_N = 19.5 theta_i^-1.03`` (Fig. 5.7). Reusable: takes plain arrays, so
+  video tracks, simulations and fits can draw the same figure with their own law.
+* :func:`plot_et_impacts` -- e_T against impact number, with the mean per material in
+  the legend (Fig. 5.8).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+from numpy.typing import ArrayLike
+
+from fieldkit.impact_table import ImpactTable
+from fieldkit.viz.figure_files import save_png
+
+#: Eq. 5.4 (thesis Fig. 5.7): e_N = a * theta_i**(-b), theta_i in degrees.
+THESIS_EN_LAW = (19.5, 1.03)
+
+MARKERS = {"rock": "s", "talus": "^", "colluvium": "o", "asphalt": "D",
+           "concrete": "v", "bench": "P"}
+
+
+def _groups(material: Sequence[str] | None, n: int) -> tuple[np.ndarray, list[str]]:
+    labels = np.array(["all impacts"] * n if material is None else
+                      ["unknown" if m is None or m != m else str(m) for m in material])
+    return labels, list(dict.fromkeys(labels.tolist()))
+
+
+def _figure() -> tuple[Figure, object]:
+    fig = Figure(figsize=(7.5, 5.0), layout="constrained")
+    ax = fig.add_subplot()
+    ax.grid(True, alpha=0.3)
+    return fig, ax
+
+
+def plot_en_theta(
+    theta_i_deg: ArrayLike,
+    e_n: ArrayLike,
+    *,
+    material: Sequence[str] | None = None,
+    law: tuple[float, float] | None = THESIS_EN_LAW,
+    law_label: str | None = None,
+    title: str | None = None,
+) -> Figure:
+    """[theta_i - e_N] scatter with a power law ``e_N = a theta_i^-b`` (Fig. 5.7).
+
+    Parameters
+    ----------
+    theta_i_deg
+        Impact angle to the ground [deg].
+    e_n
+        Normal coefficient of restitution.
+    material
+        Slope material per point (one marker per material), or None.
+    law
+        ``(a, b)`` of the power law to draw, default the thesis eq. 5.4
+        ``(19.5, 1.03)``; None draws no curve.
+    law_label, title
+        Legend text for the curve and figure title (defaults describe eq. 5.4).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    theta = np.asarray(theta_i_deg, float)
+    en = np.asarray(e_n, float)
+    ok = np.isfinite(theta) & np.isfinite(en)
+    labels, names = _groups(material, len(theta))
+    fig, ax = _figure()
+    for name in names:
+        sel = ok & (labels == name)
+        ax.scatter(theta[sel], en[sel], marker=MARKERS.get(name, "o"), s=28,
+                   edgecolor="black", linewidth=0.5, label=f"{name} ({sel.sum()})",
+                   zorder=3)
+    if law is not None:
+        a, b = law
+        t = np.linspace(3.0, 90.0, 300)
+        ax.plot(t, a * t ** (-b), color="black", lw=1.2,
+                label=law_label or f"eq. 5.4: $e_N$ = {a:g}·$\\theta_i^{{-{b:g}}}$")
+    top = np.nanmax(en[ok]) if ok.any() else 2.0
+    ax.set_xlim(0, 90)
+    ax.set_ylim(0, max(2.0, min(top * 1.1, 8.0)))
+    ax.axhline(1.0, color="0.5", lw=0.8, ls=":")
+    ax.set_xlabel(r"impact angle $\theta_i$ [deg]")
+    ax.set_ylabel(r"normal coefficient of restitution $e_N$")
+    ax.set_title(title or r"[$\theta_i$ - $e_N$] relationship (thesis Fig. 5.7)")
+    ax.legend(fontsize=8)
+    return fig
+
+
+def plot_et_impacts(
+    e_t: ArrayLike,
+    *,
+    impact_number: ArrayLike | None = None,
+    material: Sequence[str] | None = None,
+    title: str | None = None,
+) -> Figure:
+    """Tangential coefficient of restitution per impact (thesis Fig. 5.8).
+
+    Parameters
+    ----------
+    e_t
+        Tangential coefficient of restitution per impact.
+    impact_number
+        Horizontal axis ("calculation #"); default 1, 2, ...
+    material
+        Slope material per impact; the legend gives each material's mean e_T.
+    """
+    et = np.asarray(e_t, float)
+    number = (np.arange(1, len(et) + 1) if impact_number is None
+              else np.asarray(impact_number, float))
+    ok = np.isfinite(et)
+    labels, names = _groups(material, len(et))
+    fig, ax = _figure()
+    for name in names:
+        sel = ok & (labels == name)
+        mean = float(np.mean(et[sel])) if sel.any() else float("nan")
+        ax.plot(number[sel], et[sel], marker=MARKERS.get(name, "o"), ls="-", lw=0.6,
+                ms=5, mec="black", mew=0.5,
+                label=f"{name}: {sel.sum()} impacts, mean $e_T$ = {mean:.2f}")
+    ax.axhline(1.0, color="0.5", lw=0.8, ls=":")
+    ax.set_ylim(0, max(1.4, float(np.nanmax(et)) * 1.1 if ok.any() else 1.4))
+    ax.set_xlabel("impact (calculation #)")
+    ax.set_ylabel(r"tangential coefficient of restitution $e_T$")
+    ax.set_title(title or r"$e_T$ per impact (thesis Fig. 5.8)")
+    ax.legend(fontsize=8)
+    return fig
+
+
+def write_restitution_figures(
+    table: ImpactTable,
+    en_path: str | os.PathLike[str],
+    et_path: str | os.PathLike[str],
+    *,
+    law: tuple[float, float] | None = THESIS_EN_LAW,
+) -> tuple[Path, Path]:
+    """Write the Fig. 5.7 and Fig. 5.8 PNGs of an ImpactTable's impacts."""
+    f = table.frame
+    impacts = f[np.isfinite(f["e_n"].to_numpy(float)) | np.isfinite(f["e_t"].to_numpy(float))]
+    material = impacts["material"].astype(object).where(impacts["material"].notna(), None)
+    mat = None if impacts["material"].isna().all() else material.tolist()
+    name = ", ".join(table.paths())
+    en_fig = plot_en_theta(impacts["theta_i_deg"], impacts["e_n"], material=mat, law=law,
+                           title=f"{name}: [θi - eN] with eq. 5.4 (thesis Fig. 5.7)")
+    et_fig = plot_et_impacts(impacts["e_t"], material=mat,
+                             title=f"{name}: $e_T$ per impact (thesis Fig. 5.8)")
+    return save_png(en_fig, en_path), save_png(et_fig, et_path)

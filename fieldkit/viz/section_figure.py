@@ -1,0 +1,173 @@
+"""Section of a reduced path: impacts, flights, trees and velocity vectors (Fig. 2.8).
+
+Left: the whole section at true scale -- ground line through the impact points, each
+flight's parabola (solid where a tree strike fixed it, dashed where the restitution
+angle was assumed), broken trees as down arrows, impact numbers. Right: the detail the
+thesis draws as an inset -- one impact with its impact and restitution velocity
+vectors, their N and T components on the local ground, and e_N, e_T.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+
+from fieldkit.impact_table import ImpactTable
+from fieldkit.physics.constants import G
+from fieldkit.viz.figure_files import save_png
+
+TREE_COLOUR = "#2e7d32"
+FLIGHT_COLOUR = "#1f4e9c"
+IMPACT_COLOUR = "#b22222"
+
+
+def flight_paths(table: ImpactTable, n_samples: int = 40) -> list[tuple]:
+    """``(x, z, source)`` samples of each flight's parabola (eqs. 3.1, 3.2)."""
+    f = table.frame
+    out = []
+    for row in f.itertuples(index=False):
+        if not np.isfinite(row.flight_time_s):
+            continue
+        t = np.linspace(0.0, row.flight_time_s, n_samples)
+        x = row.x_m + row.vf_x_mps * t
+        z = row.z_m + row.vf_z_mps * t - 0.5 * G * t**2
+        out.append((x, z, str(row.theta0_source)))
+    return out
+
+
+def detail_row(table: ImpactTable) -> int | None:
+    """Index of the impact to draw in detail: of the impacts whose restitution a tree
+    fixed, the one with the steepest restitution (thesis: #A26, θ0 = 62°); else the
+    impact with the largest theta_f."""
+    f = table.frame
+    ok = np.isfinite(f["e_n"].to_numpy(float)) & np.isfinite(f["theta_f_deg"].to_numpy(float))
+    if not ok.any():
+        return None
+    theta_f = np.where(ok, f["theta_f_deg"].to_numpy(float), -np.inf)
+    tree = (f["theta0_source"] == "tree").fillna(False).to_numpy(bool) & ok
+    if tree.any():
+        theta_f = np.where(tree, theta_f, -np.inf)
+    return int(np.argmax(theta_f))
+
+
+def _trees_xy(table: ImpactTable, trees: object | None) -> list[tuple[float, float, float]]:
+    """(x, ground z, strike z) of each tree strike."""
+    if trees is None:
+        return []
+    f = table.frame.set_index(table.frame["point"].astype(str))
+    out = []
+    for row in trees.frame.itertuples(index=False):  # type: ignore[attr-defined]
+        key = str(row.after_impact)
+        if key not in f.index:
+            continue
+        x = float(f.loc[key, "x_m"]) + float(row.horizontal_distance_m)
+        out.append((x, float(row.ground_z_m), float(row.ground_z_m + row.strike_height_m)))
+    return out
+
+
+def plot_section(table: ImpactTable, trees: object | None = None) -> Figure:
+    """Draw the section figure and return it (see the module docstring)."""
+    f = table.frame
+    fig = Figure(figsize=(13.0, 6.2), layout="constrained")
+    grid = fig.add_gridspec(1, 2, width_ratios=[2.1, 1.0])
+    ax = fig.add_subplot(grid[0, 0])
+    detail = fig.add_subplot(grid[0, 1])
+    x, z = f["x_m"].to_numpy(float), f["z_m"].to_numpy(float)
+
+    ax.fill_between(x, z, z.min() - 0.05 * np.ptp(z), color="#d9c7a7", alpha=0.6, lw=0)
+    ax.plot(x, z, color="#6b4f2a", lw=1.0, label="ground (chords between impacts)")
+    for xs, zs, source in flight_paths(table):
+        style = "-" if source in ("tree", "given", "video") else "--"
+        ax.plot(xs, zs, style, color=FLIGHT_COLOUR, lw=0.9)
+    ax.plot([], [], "-", color=FLIGHT_COLOUR, label="flight fixed by a tree strike")
+    ax.plot([], [], "--", color=FLIGHT_COLOUR, label="flight with assumed θ0")
+    ax.plot(x, z, "o", ms=3.5, color=IMPACT_COLOUR, label="impact point", zorder=5)
+    step = max(1, len(f) // 15)
+    for i, row in enumerate(f.itertuples(index=False)):
+        if i % step == 0 or i == len(f) - 1:
+            ax.annotate(str(row.point), (row.x_m, row.z_m), textcoords="offset points",
+                        xytext=(4, 5), fontsize=7, color=IMPACT_COLOUR)
+    tree_xy = _trees_xy(table, trees)
+    if tree_xy:
+        span = np.ptp(z) * 0.035
+        for xt, zg, zs in tree_xy:
+            ax.annotate("", xy=(xt, zs), xytext=(xt, zs + span),
+                        arrowprops={"arrowstyle": "->", "color": TREE_COLOUR, "lw": 1.2})
+            ax.plot([xt, xt], [zg, zs], color=TREE_COLOUR, lw=1.5)
+        ax.plot([], [], color=TREE_COLOUR, lw=1.5, label="broken tree (strike ↓)")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x, horizontal distance along the path [m]")
+    ax.set_ylabel("z, elevation [m]")
+    ax.set_title(f"{', '.join(table.paths())}: mapped impact points "
+                 f"({len(f)}) and trajectories")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="upper right", fontsize=8)
+
+    i = detail_row(table)
+    if i is not None:
+        _draw_detail(detail, f.iloc[i], f, i)
+    else:
+        detail.set_axis_off()
+    return fig
+
+
+def _draw_detail(ax: Axes, row, f, i: int) -> None:
+    """Inset: impact ``row`` with v_i, v_f and their N/T components."""
+    psi = np.radians(float(row.slope_deg))
+    tangent = np.array([np.cos(psi), -np.sin(psi)])
+    normal = np.array([np.sin(psi), np.cos(psi)])
+    p = np.array([row.x_m, row.z_m])
+    vi = np.array([row.vi_x_mps, row.vi_z_mps])
+    vf = np.array([row.vf_x_mps, row.vf_z_mps])
+    scale = 1.0 / max(np.hypot(*vi), np.hypot(*vf))  # longest vector = 1 unit
+    ground = np.array([p - 1.4 * tangent, p + 1.4 * tangent])
+    ax.fill([*ground[:, 0], ground[1, 0], ground[0, 0]],
+            [*ground[:, 1], ground[1, 1] - 0.5, ground[0, 1] - 0.5],
+            color="#d9c7a7", alpha=0.6, lw=0)
+    ax.plot(ground[:, 0], ground[:, 1], color="#6b4f2a", lw=1.5)
+
+    def arrow(start, vec, colour, style="-", width=2.0):
+        ax.annotate("", xy=start + vec, xytext=start,
+                    arrowprops={"arrowstyle": "-|>", "color": colour, "lw": width,
+                                "linestyle": style, "shrinkA": 0, "shrinkB": 0})
+
+    vi_s, vf_s = vi * scale, vf * scale
+    arrow(p - vi_s, vi_s, IMPACT_COLOUR)
+    arrow(p, vf_s, FLIGHT_COLOUR)
+    comps = ((p - vi_s, float(row.vit_mps) * scale * tangent, IMPACT_COLOUR),
+             (p - float(row.vin_mps) * scale * normal,
+              float(row.vin_mps) * scale * normal, IMPACT_COLOUR),
+             (p, float(row.vft_mps) * scale * tangent, FLIGHT_COLOUR),
+             (p, float(row.vfn_mps) * scale * normal, FLIGHT_COLOUR))
+    for start, vec, colour in comps:
+        arrow(start, vec, colour, style=(0, (3, 2)), width=1.0)
+    ax.text(*(p - vi_s + 0.08 * normal), f"$v_i$ = {row.vi_mps:.1f} m/s\n"
+            f"$\\theta_i$ = {row.theta_i_deg:.0f}°", color=IMPACT_COLOUR, fontsize=9,
+            ha="right", va="bottom")
+    ax.text(*(p + vf_s + 0.06 * tangent), f"$v_f$ = {row.vf_mps:.1f} m/s\n"
+            f"$\\theta_f$ = {row.theta_f_deg:.0f}°", color=FLIGHT_COLOUR, fontsize=9,
+            ha="left", va="center")
+    ax.text(0.03, 0.04,
+            f"$v_{{iN}}$ = {row.vin_mps:.1f}, $v_{{iT}}$ = {row.vit_mps:.1f} m/s\n"
+            f"$v_{{fN}}$ = {row.vfn_mps:.1f}, $v_{{fT}}$ = {row.vft_mps:.1f} m/s\n"
+            f"$e_N$ = {row.e_n:.2f}, $e_T$ = {row.e_t:.2f}\n"
+            f"ψ = {row.slope_deg:.1f}° ({row.theta0_source} θ0)",
+            transform=ax.transAxes, fontsize=9, va="bottom",
+            bbox={"boxstyle": "round", "fc": "white", "ec": "0.7"})
+    ax.set_aspect("equal")
+    ax.set_xlim(p[0] - 1.7, p[0] + 1.7)
+    ax.set_ylim(p[1] - 1.6, p[1] + 1.3)
+    ax.set_xticks([])
+    ax.set_yticks([])
+    ax.set_title(f"velocities at impact {row.point} (arrows ∝ speed)")
+
+
+def write_section_figure(
+    table: ImpactTable, path: str | os.PathLike[str], trees: object | None = None
+) -> Path:
+    """Draw :func:`plot_section` and save it as a PNG (atomically)."""
+    return save_png(plot_section(table, trees=trees), path)
