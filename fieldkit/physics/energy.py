@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike
 
 from fieldkit.errors import ArgumentError
 from fieldkit.physics.constants import G
+from fieldkit.physics.impact_mechanics import compression_impulse, final_impulse
 
 
 def kinetic_energy(mass_kg: ArrayLike, speed_mps: ArrayLike) -> np.ndarray:
@@ -345,8 +346,8 @@ def oblique_impact_energies(
     beta = b3 + mu * b2
     if np.any(beta <= 0):
         raise ArgumentError("beta3 + friction * beta2 must be positive", source="beta3")
-    p_c = -mass * vin / beta
-    p_f = p_c * (1.0 + e_n)
+    p_c = compression_impulse(vin, mass, b2, b3, mu)  # eqs. 6.6, C.16
+    p_f = final_impulse(p_c, e_n)  # eqs. C.17, C.18
     compression = -mass * vin**2 / (2.0 * beta)
     restitution = beta * (p_f - p_c) ** 2 / (2.0 * mass)
     tangential = friction_energy if slip_stops else sliding_friction_energy

@@ -43,6 +43,11 @@ import numpy as np
 from fieldkit.errors import ArgumentError
 from fieldkit.impact_table import ImpactTable
 from fieldkit.physics.energy import friction_energy, normal_energy_change
+from fieldkit.physics.impact_mechanics import (
+    compression_impulse,
+    final_impulse,
+    inertial_coefficients,
+)
 
 __all__ = ["DEFAULT_FRICTION", "add_theory_columns"]
 
@@ -113,10 +118,10 @@ def add_theory_columns(
         m, r, k = mass[usable], radius[usable], gyration[usable]
         vn, e = v_in[usable], e_n[usable]
         slip = v_it[usable] + r * omega[usable]  # eq. 4.15
-        beta1 = 1.0 + r**2 / k**2  # eq. C.11 with r_N = r, r_T = 0
-        final_impulse = -m * vn * (1.0 + e)  # eqs. 4.12, C.18 (beta3 = 1, beta2 = 0)
+        beta1, _, _ = inertial_coefficients(k, 0.0, r)  # eq. C.11, r_N = r, r_T = 0
+        p_f = final_impulse(compression_impulse(vn, m), e)  # eqs. 4.4, 4.12, C.18
         theory[usable] = normal_energy_change(m, vn, e) + friction_energy(
-            m, slip, final_impulse, mu, beta1
+            m, slip, p_f, mu, beta1
         )
     measured = col("dke_j")
     with np.errstate(divide="ignore", invalid="ignore"):
