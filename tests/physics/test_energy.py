@@ -29,6 +29,8 @@ from fieldkit.physics.energy import (
     sliding_friction_energy,
     total_kinetic_energy,
 )
+from fieldkit.physics.impact_mechanics import inertial_coefficients, rough_body_impact
+from fieldkit.physics.impulse_history import impulse_history
 
 G = 9.81
 
@@ -286,3 +288,58 @@ def test_bad_input_names_the_argument(call, argument):
 def test_bad_input_in_array_names_the_element():
     with pytest.raises(ArgumentError, match="element 1"):
         normal_energy_change([1.0, -1.0], -3.0, 0.5)
+
+
+# ------------------------------------------ against the impact solution (ch. 4, App. C)
+def test_6b_against_eccentric_rigid_body_solution():
+    """Worked example 6B's body (r_T = 0.8, r_N = 0.65, k = 0.46, no spin) solved by
+    impact_mechanics: its kinematic energy change (KE + RE after minus before) equals
+    the sum of the energy integrals 6.7 (corrected) + 6.8 + 6.9."""
+    from fieldkit.physics.impact_mechanics import (
+        rough_body_impact,
+    )
+
+    res = rough_body_impact(
+        10.8,
+        -4.4,
+        0.0,
+        radius_m=0.65,
+        gyration_m=0.46,
+        e_n=1.30,
+        friction=0.68,
+        offset_m=0.8,
+        mass_kg=3750.0,
+    )
+    betas = inertial_coefficients(0.46, 0.8, 0.65)
+    mine = oblique_impact_energies(3750.0, -4.4, 10.8, 1.30, 0.68, *betas)
+    assert not res.slip_stops  # eq. 6.9's constant-slip assumption holds here
+    assert mine.compression_impulse_ns == pytest.approx(res.p_c, rel=1e-12)
+    assert mine.compression_j == pytest.approx(res.work_compression_j, rel=1e-9)
+    assert mine.total_j == pytest.approx(res.energy_change_j, rel=1e-9)
+    assert mine.total_j / 1e3 == pytest.approx(-26.4, abs=0.05)  # thesis -33.5
+
+
+@pytest.mark.parametrize(
+    ("v_it", "v_in", "omega", "e_n", "mu"),
+    [
+        (19.9, -9.3, -15.0, 0.71, 0.5),  # worked example 4A impact, slip stops
+        (19.9, -9.3, 0.0, 0.71, 0.1),  # slips throughout
+        (3.0, -9.0, -25.0, 0.4, 0.68),
+    ],  # over-spinning body, backward slip
+)
+def test_energy_integrals_match_numerical_integration_of_impulse_history(
+    v_it, v_in, omega, e_n, mu
+):
+    """Eq. 6.1 along the [p_N - v] lines sampled by impulse_history (Figs. 4.4/4.5):
+    the normal area and -mu * the slip area equal the closed forms, and their sum is the
+    rigid-body change of KE + RE."""
+    m, r, k = 1000.0, 0.75, 0.47
+    kwargs = dict(radius_m=r, gyration_m=k, e_n=e_n, friction=mu, mass_kg=m)
+    h = impulse_history(v_it, v_in, omega, points=2001, **kwargs)
+    normal = _trapezoid(h.v_n_mps, h.p)
+    friction = -mu * _trapezoid(np.abs(h.v_slip_mps), h.p)
+    mine = oblique_impact_energies(m, v_in, v_it + r * omega, e_n, mu, 1 + r**2 / k**2)
+    assert mine.compression_j + mine.restitution_j == pytest.approx(normal, rel=1e-6)
+    assert mine.friction_j == pytest.approx(friction, rel=1e-6)
+    res = rough_body_impact(v_it, v_in, omega, **kwargs)
+    assert mine.total_j == pytest.approx(res.energy_change_j, rel=1e-9)
