@@ -1,0 +1,295 @@
+"""Image pixels (u right, v down) -> world metres (x horizontal, z up).
+
+Two ways to calibrate a video:
+
+* **Two scale points** ``U1,V1,U2,V2`` a known distance ``L`` apart (a scale bar in the
+  scene). The camera is taken as level and upright: ``x = s (u - U1)``,
+  ``z = s (V1 - v)`` with ``s = L / |P2 - P1|`` metres per pixel; the world origin is
+  the first scale point. For a tilted, rotated or mirrored camera use a homography.
+* **A homography file** with at least four image <-> world points (not three on a line),
+  in the world frame the user chose (z up). Formats:
+
+  JSON ::
+
+      {"points": [{"u_px": 40, "v_px": 440, "x_m": 0.0, "z_m": 0.0}, ...]}
+
+  (a bare list of such objects, or of ``[u_px, v_px, x_m, z_m]`` rows, also works)
+
+  CSV with a header ``u_px,v_px,x_m,z_m`` (one point per row; ``#`` comments allowed).
+
+Pixel centres sit at integer (u, v), as in OpenCV. Both calibrations become one 3x3
+matrix ``H`` mapping ``(u, v, 1)`` to ``(x, z, 1)``, so world z is up whatever the
+image orientation: a camera on its side or mirrored just has a different ``H``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from fieldkit.errors import ArgumentError, InputFileError
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """A plane-to-plane mapping from image pixels to world metres.
+
+    Examples
+    --------
+    >>> cal = two_point_scale((100, 30, 700, 30), 1.2)
+    >>> [round(float(c), 6) for c in cal.to_world(400.0, 130.0)]
+    [0.6, -0.2]
+    """
+
+    homography: np.ndarray
+    description: str = ""
+    residual_m: float = 0.0  # RMS fit residual of the calibration points [m]
+    meta: dict = field(default_factory=dict)
+
+    def to_world(self, u, v) -> tuple[np.ndarray, np.ndarray]:
+        """Map pixel coordinates [px] to world ``(x, z)`` [m] (arrays broadcast)."""
+        u = np.asarray(u, dtype=float)
+        v = np.asarray(v, dtype=float)
+        h = self.homography
+        w = h[2, 0] * u + h[2, 1] * v + h[2, 2]
+        x = (h[0, 0] * u + h[0, 1] * v + h[0, 2]) / w
+        z = (h[1, 0] * u + h[1, 1] * v + h[1, 2]) / w
+        return x, z
+
+    def metres_per_pixel(self, u, v) -> np.ndarray:
+        """Local scale sqrt(|det J|) of the mapping at ``(u, v)`` [m/px]."""
+        step = 0.5
+        x0, z0 = self.to_world(u, v)
+        xu, zu = self.to_world(np.asarray(u, float) + step, v)
+        xv, zv = self.to_world(u, np.asarray(v, float) + step)
+        det = ((xu - x0) * (zv - z0) - (zu - z0) * (xv - x0)) / (step * step)
+        return np.sqrt(np.abs(det))
+
+    def to_dict(self) -> dict:
+        return {
+            "homography": self.homography.tolist(),
+            "description": self.description,
+            "residual_m": self.residual_m,
+            **self.meta,
+        }
+
+
+def parse_scale_points(text: str) -> tuple[float, float, float, float]:
+    """Parse ``"U1,V1,U2,V2"`` (pixels) for ``--scale-points``.
+
+    Examples
+    --------
+    >>> parse_scale_points("100,30, 700,30")
+    (100.0, 30.0, 700.0, 30.0)
+    """
+    parts = [p for p in str(text).replace(";", ",").split(",") if p.strip()]
+    try:
+        values = tuple(float(p) for p in parts)
+    except ValueError:
+        raise ArgumentError(
+            f"expected four numbers U1,V1,U2,V2 (pixels), got {text!r}",
+            source="--scale-points",
+        ) from None
+    if len(values) != 4 or not all(np.isfinite(values)):
+        raise ArgumentError(
+            f"expected four numbers U1,V1,U2,V2 (pixels), got {text!r}",
+            source="--scale-points",
+        )
+    return values  # type: ignore[return-value]
+
+
+def _check_inside(u: float, v: float, image_size, source: str, where: str) -> None:
+    if image_size is None:
+        return
+    width, height = image_size
+    if not (-0.5 <= u <= width - 0.5 and -0.5 <= v <= height - 0.5):
+        raise ArgumentError(
+            f"({u:g}, {v:g}) px lies outside the {width}x{height} frame",
+            source=source,
+            where=where,
+        )
+
+
+def two_point_scale(
+    points: tuple[float, float, float, float],
+    length_m: float,
+    image_size: tuple[int, int] | None = None,
+) -> Calibration:
+    """Calibration from two image points a known distance apart (level camera).
+
+    Parameters
+    ----------
+    points
+        ``(U1, V1, U2, V2)`` [px].
+    length_m
+        Their distance in the scene [m].
+    image_size
+        ``(width, height)`` [px]; when given, both points must lie inside the frame.
+    """
+    u1, v1, u2, v2 = (float(p) for p in points)
+    if length_m is None or not np.isfinite(length_m) or length_m <= 0:
+        raise ArgumentError(
+            f"must be a positive length in metres, got {length_m}",
+            source="--scale-length",
+        )
+    _check_inside(u1, v1, image_size, "--scale-points", "point 1")
+    _check_inside(u2, v2, image_size, "--scale-points", "point 2")
+    distance = float(np.hypot(u2 - u1, v2 - v1))
+    if distance < 1.0:
+        raise ArgumentError(
+            f"the two scale points are identical ({distance:.2g} px apart)",
+            source="--scale-points",
+        )
+    s = length_m / distance
+    h = np.array([[s, 0.0, -s * u1], [0.0, -s, s * v1], [0.0, 0.0, 1.0]])
+    return Calibration(
+        h,
+        f"two-point scale {s * 1000:.4g} mm/px, origin at ({u1:g}, {v1:g}) px",
+        meta={"scale_points_px": [u1, v1, u2, v2], "scale_length_m": float(length_m)},
+    )
+
+
+def homography_from_points(
+    image_points: np.ndarray,
+    world_points: np.ndarray,
+    *,
+    image_size: tuple[int, int] | None = None,
+    source: str = "homography",
+) -> Calibration:
+    """Least-squares homography from >= 4 image <-> world point pairs.
+
+    Raises :class:`~fieldkit.errors.InputFileError` naming the point when there are too
+    few points, a point lies outside the frame, points repeat, or the points are
+    degenerate (three or more on a line leaves the mapping undetermined).
+    """
+    img = np.asarray(image_points, dtype=float).reshape(-1, 2)
+    wld = np.asarray(world_points, dtype=float).reshape(-1, 2)
+    if len(img) < 4:
+        raise InputFileError(
+            f"needs at least 4 image<->world points, found {len(img)}", source=source
+        )
+    bad = ~np.all(np.isfinite(np.hstack([img, wld])), axis=1)
+    if bad.any():
+        raise InputFileError(
+            "non-numeric or missing value",
+            source=source,
+            where=f"point {int(np.flatnonzero(bad)[0]) + 1}",
+        )
+    for i, (u, v) in enumerate(img):
+        if image_size is not None:
+            width, height = image_size
+            if not (-0.5 <= u <= width - 0.5 and -0.5 <= v <= height - 0.5):
+                raise InputFileError(
+                    f"({u:g}, {v:g}) px lies outside the {width}x{height} frame",
+                    source=source,
+                    where=f"point {i + 1}",
+                )
+        for j in range(i):
+            if (
+                np.hypot(*(img[i] - img[j])) < 1.0
+                or np.hypot(*(wld[i] - wld[j])) < 1e-9
+            ):
+                raise InputFileError(
+                    f"same position as point {j + 1}",
+                    source=source,
+                    where=f"point {i + 1}",
+                )
+    centred = img - img.mean(axis=0)
+    singular = np.linalg.svd(centred, compute_uv=False)
+    if singular[-1] < 1e-3 * singular[0]:
+        raise InputFileError(
+            "the image points lie on one line; the mapping is undetermined",
+            source=source,
+        )
+    h, _ = cv2.findHomography(img.astype(np.float64), wld.astype(np.float64), 0)
+    if h is None or not np.all(np.isfinite(h)):
+        raise InputFileError(
+            "no homography fits these points (degenerate layout)", source=source
+        )
+    cal = Calibration(np.asarray(h, float))
+    x, z = cal.to_world(img[:, 0], img[:, 1])
+    residual = float(np.sqrt(np.mean((x - wld[:, 0]) ** 2 + (z - wld[:, 1]) ** 2)))
+    return Calibration(
+        cal.homography,
+        f"homography from {len(img)} points (RMS residual {residual * 1000:.3g} mm)",
+        residual,
+        {"homography_points": int(len(img))},
+    )
+
+
+def read_homography_file(
+    path: str | os.PathLike[str], image_size: tuple[int, int] | None = None
+) -> Calibration:
+    """Read image <-> world points (JSON or CSV, see the module docstring) and fit."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputFileError("homography file not found", source=path)
+    text = path.read_text(encoding="utf-8-sig")
+    rows: list[list[float]] = []
+    if path.suffix.lower() == ".json" or text.lstrip().startswith(("{", "[")):
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise InputFileError(
+                f"not valid JSON ({exc.msg})", source=path, where=f"line {exc.lineno}"
+            ) from None
+        items = data.get("points") if isinstance(data, dict) else data
+        if not isinstance(items, list):
+            raise InputFileError(
+                'expected {"points": [{"u_px", "v_px", "x_m", "z_m"}, ...]}',
+                source=path,
+            )
+        for i, item in enumerate(items):
+            try:
+                if isinstance(item, dict):
+                    rows.append(
+                        [float(item[k]) for k in ("u_px", "v_px", "x_m", "z_m")]
+                    )
+                else:
+                    rows.append([float(v) for v in item][:4])
+                    if len(rows[-1]) != 4:
+                        raise ValueError
+            except (KeyError, TypeError, ValueError):
+                raise InputFileError(
+                    "needs numbers u_px, v_px, x_m, z_m",
+                    source=path,
+                    where=f"point {i + 1}",
+                ) from None
+    else:
+        lines = [
+            ln
+            for ln in text.splitlines()
+            if ln.strip() and not ln.lstrip().startswith("#")
+        ]
+        if not lines:
+            raise InputFileError("file is empty", source=path)
+        header = [h.strip().lower() for h in lines[0].split(",")]
+        wanted = ("u_px", "v_px", "x_m", "z_m")
+        if not all(w in header for w in wanted):
+            raise InputFileError(
+                f"CSV header must name {', '.join(wanted)}", source=path, where="row 1"
+            )
+        cols = [header.index(w) for w in wanted]
+        for i, line in enumerate(lines[1:], start=2):
+            cells = line.split(",")
+            try:
+                rows.append([float(cells[c]) for c in cols])
+            except (IndexError, ValueError):
+                raise InputFileError(
+                    "needs numbers u_px, v_px, x_m, z_m", source=path, where=f"row {i}"
+                ) from None
+    points = np.array(rows, dtype=float).reshape(-1, 4)
+    cal = homography_from_points(
+        points[:, :2], points[:, 2:], image_size=image_size, source=str(path)
+    )
+    return Calibration(
+        cal.homography,
+        cal.description,
+        cal.residual_m,
+        {**cal.meta, "homography_file": str(path)},
+    )

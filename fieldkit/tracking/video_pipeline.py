@@ -1,0 +1,299 @@
+"""Video file -> Track: background model, detection, calibration, marker spin.
+
+:func:`track_video` reads the clip once (plus a few random-access frames for the
+background model), so tracking costs about as much as decoding. Times are
+``frame / fps`` with the *capture* rate, never the container's playback rate.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+
+import numpy as np
+import pandas as pd
+
+from fieldkit.errors import ArgumentError, InputFileError
+from fieldkit.tracking.calibration import Calibration
+from fieldkit.tracking.detection import BallDetector, median_background, noise_threshold
+from fieldkit.tracking.spin import (
+    angular_velocity,
+    marker_angle_world,
+    marker_offset_px,
+    unwrap_angle,
+)
+from fieldkit.tracking.track import Track
+from fieldkit.tracking.video_reader import VideoReader
+
+#: frames sampled across the clip for the median background
+BACKGROUND_SAMPLES = 11
+#: a body missing for more frames than this between detections is reported
+MAX_SILENT_GAP = 2
+#: frames decoded ahead in a background thread (0 = decode in the calling thread)
+PREFETCH = 4
+
+
+def frame_ranges(frames: np.ndarray) -> str:
+    """Compact text for a set of frame numbers, e.g. ``"10-20, 31"``.
+
+    Examples
+    --------
+    >>> frame_ranges(np.array([3, 4, 5, 9]))
+    '3-5, 9'
+    """
+    frames = np.unique(np.asarray(frames, dtype=int))
+    if frames.size == 0:
+        return ""
+    breaks = np.flatnonzero(np.diff(frames) > 1)
+    starts = np.r_[frames[0], frames[breaks + 1]]
+    ends = np.r_[frames[breaks], frames[-1]]
+    parts = [
+        f"{a}" if a == b else f"{a}-{b}" for a, b in zip(starts, ends, strict=True)
+    ]
+    if len(parts) > 6:
+        parts = parts[:6] + [f"... ({len(parts) - 6} more)"]
+    return ", ".join(parts)
+
+
+def parse_roi(
+    text: str | None, image_size: tuple[int, int]
+) -> tuple[int, int, int, int] | None:
+    """Parse ``--roi U,V,WIDTH,HEIGHT`` [px] and check it overlaps the frame.
+
+    Examples
+    --------
+    >>> parse_roi("10,20,300,200", (800, 480))
+    (10, 20, 300, 200)
+    """
+    if text is None:
+        return None
+    try:
+        values = [int(round(float(p))) for p in str(text).split(",")]
+    except ValueError:
+        values = []
+    if len(values) != 4 or values[2] <= 0 or values[3] <= 0:
+        raise ArgumentError(
+            f"expected U,V,WIDTH,HEIGHT in pixels, got {text!r}", source="--roi"
+        )
+    u, v, w, h = values
+    width, height = image_size
+    if u >= width or v >= height or u + w <= 0 or v + h <= 0:
+        raise ArgumentError(f"lies outside the {width}x{height} frame", source="--roi")
+    return u, v, w, h
+
+
+def track_video(
+    path: str | os.PathLike[str],
+    *,
+    fps: float,
+    calibration: Calibration,
+    roi: tuple[int, int, int, int] | None = None,
+    radius_m: float | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    reader: VideoReader | None = None,
+) -> tuple[Track, pd.DataFrame]:
+    """Track one ball through a video.
+
+    Parameters
+    ----------
+    path
+        Video file.
+    fps
+        Capture rate [frames/s] (the time base; the container's rate is ignored).
+    calibration
+        Pixels -> world metres (:mod:`fieldkit.tracking.calibration`).
+    roi
+        ``(u, v, width, height)`` [px] search region.
+    radius_m
+        Body radius [m] when known: sharpens the shape test.
+    progress
+        Called as ``progress(frames_done, frames_total)``.
+
+    Returns
+    -------
+    track, detections
+        The :class:`~fieldkit.tracking.track.Track` (one row per frame with a body;
+        extra columns ``omega_sd_radps, u_px, v_px, radius_px, radius_m, partial,
+        visible_fraction``; ``meta["warnings"]`` lists one-line warnings) and a
+        per-frame
+        table (every decoded frame; ``found`` False where no body was seen).
+
+    Raises
+    ------
+    InputFileError
+        The video cannot be read, or no body is found in any frame.
+    """
+    if fps is None or not np.isfinite(fps) or fps <= 0:
+        raise ArgumentError(
+            f"the capture rate must be positive, got {fps}", source="--fps"
+        )
+    reader = reader or VideoReader(path)
+    info = reader.info
+    warnings: list[str] = []
+
+    declared = info.frame_count if info.frame_count > 0 else BACKGROUND_SAMPLES
+    indices = np.unique(
+        np.linspace(0, max(declared - 1, 0), BACKGROUND_SAMPLES).astype(int)
+    )
+    samples = [img for _, img in reader.read_frames(list(indices))]
+    if len(samples) < 3:  # seeking failed (damaged index): read the first frames
+        samples = [img for _, img in reader.frames(0, BACKGROUND_SAMPLES)]
+    background = median_background(samples)
+    threshold = noise_threshold(samples, background)
+    centre = (info.width / 2.0, info.height / 2.0)
+    expected = None
+    if radius_m is not None and radius_m > 0:
+        expected = float(radius_m / calibration.metres_per_pixel(*centre))
+    detector = BallDetector(background, threshold, roi=roi, expected_radius_px=expected)
+
+    rows = []
+    last: list[tuple[int, float, float, float]] = []
+    total = max(info.frame_count, 1)
+    for index, image in reader.frames(prefetch=PREFETCH):
+        prediction = None
+        if last and index - last[-1][0] <= 3:
+            k, u, v, r = last[-1]
+            vu = vv = 0.0
+            if len(last) >= 2 and last[-1][0] - last[-2][0] <= 3:
+                dk = last[-1][0] - last[-2][0]
+                vu, vv = (u - last[-2][1]) / dk, (v - last[-2][2]) / dk
+            gap = index - k
+            prediction = (
+                u + vu * gap,
+                v + vv * gap,
+                2.5 * r + 3.0 * np.hypot(vu, vv) * gap + 8.0,
+            )
+        det = detector.detect(image, prediction)
+        if det is None:
+            rows.append({"frame": index, "found": False})
+        else:
+            du, dv = (np.nan, np.nan)
+            if not det.partial:
+                du, dv = marker_offset_px(
+                    image, det.u_px, det.v_px, det.radius_px, det.colour_bgr
+                )
+            rows.append(
+                {
+                    "frame": index,
+                    "found": True,
+                    "u_px": det.u_px,
+                    "v_px": det.v_px,
+                    "radius_px": det.radius_px,
+                    "partial": det.partial,
+                    "visible_fraction": det.visible_fraction,
+                    "fit_residual_px": det.fit_residual_px,
+                    "marker_du_px": du,
+                    "marker_dv_px": dv,
+                }
+            )
+            last = (last + [(index, det.u_px, det.v_px, det.radius_px)])[-2:]
+        if progress is not None and (index % 25 == 0):
+            progress(index + 1, total)
+    if progress is not None:
+        progress(total, total)
+    message = reader.truncation_message()
+    if message:
+        warnings.append(message)
+    detections = pd.DataFrame(rows)
+    decoded = len(detections)
+    if decoded == 0:
+        raise InputFileError("no frame could be decoded", source=path)
+    found = detections[detections["found"]].copy()
+    if found.empty:
+        raise InputFileError(
+            "no body found in any frame (check --roi, the contrast and that the "
+            "body moves)",
+            source=path,
+            where=f"frames 0-{decoded - 1}",
+        )
+    first, last_frame = int(found["frame"].min()), int(found["frame"].max())
+    missing = detections.loc[
+        (detections["frame"] > first)
+        & (detections["frame"] < last_frame)
+        & ~detections["found"],
+        "frame",
+    ].to_numpy()
+    if missing.size:
+        warnings.append(
+            f"{path}: frames {frame_ranges(missing)}: body lost (not detected); "
+            "those frames are left out of the track"
+        )
+
+    u, v = found["u_px"].to_numpy(float), found["v_px"].to_numpy(float)
+    x, z = calibration.to_world(u, v)
+    scale = calibration.metres_per_pixel(u, v)
+    angle = marker_angle_world(
+        calibration,
+        u,
+        v,
+        found["marker_du_px"].to_numpy(float),
+        found["marker_dv_px"].to_numpy(float),
+    )
+    frames = found["frame"].to_numpy(int)
+    t = frames / float(fps)
+    mirrored = _travels_toward_negative_x(x)
+    if mirrored:
+        x = -x
+        angle = np.pi - angle
+        warnings.append(
+            f"{path}: the body travels toward -x in the calibrated frame; x is "
+            "mirrored (x -> -x, spin sign flipped) so x increases along travel"
+        )
+    angle = unwrap_angle(angle)
+    omega, omega_sd = angular_velocity(t, angle)
+    whole = ~found["partial"].to_numpy(bool)
+    no_marker = frames[whole & ~np.isfinite(angle)]
+    if whole.any() and np.isfinite(angle[whole]).mean() < 0.2:
+        warnings.append(
+            f"{path}: no marker could be followed on the body; omega is NaN "
+            "(needs a spot or stripe off the centre, contrasting with the body)"
+        )
+        angle[:] = np.nan
+        omega[:] = np.nan
+        omega_sd[:] = np.nan
+    elif no_marker.size:
+        warnings.append(
+            f"{path}: frames {frame_ranges(no_marker)}: marker not seen; "
+            "angle and omega are NaN there"
+        )
+    frame = pd.DataFrame(
+        {
+            "frame": frames,
+            "t_s": t,
+            "x_m": x,
+            "z_m": z,
+            "angle_rad": angle,
+            "omega_radps": omega,
+            "omega_sd_radps": omega_sd,
+            "u_px": u,
+            "v_px": v,
+            "radius_px": found["radius_px"].to_numpy(float),
+            "radius_m": found["radius_px"].to_numpy(float) * scale,
+            "partial": found["partial"].to_numpy(bool),
+            "visible_fraction": found["visible_fraction"].to_numpy(float),
+        }
+    )
+    meta = {
+        "video": str(path),
+        "width_px": info.width,
+        "height_px": info.height,
+        "container_fps": info.container_fps,
+        "codec": info.codec,
+        "frames_declared": info.frame_count,
+        "frames_decoded": decoded,
+        "calibration": calibration.description,
+        "threshold": threshold,
+        "roi": list(roi) if roi else None,
+        "mirrored_x": mirrored,
+        "warnings": warnings,
+    }
+    return Track(frame, source=str(path), fps=float(fps), meta=meta), detections
+
+
+def _travels_toward_negative_x(x: np.ndarray) -> bool:
+    """Direction of travel from the first tenth of the track (at least 5 samples)."""
+    if x.size < 2:
+        return False
+    n = max(5, x.size // 10)
+    head = x[:n]
+    return bool(head[-1] - head[0] < 0)
