@@ -111,7 +111,8 @@ def reduce(
     else:
         from fieldkit.io.fieldbook import read_fieldbook
 
-        points = read_fieldbook(fieldbook, stations, declination_deg=declination)
+        points = read_fieldbook(fieldbook, stations, declination_deg=declination,
+                                units=units)
         name = fieldbook.stem
     tree_set = None
     if trees is not None:

@@ -11,11 +11,11 @@ than the two end points; in order of preference:
     accelerometers), ``alpha = theta0 - psi`` (eq. 3.6);
 ``assumed``
     the ``--theta0`` of the command line (thesis: the 33° mean of the tree-defined
-    flights at Tornado Mountain) with ``alpha = theta0 - psi``. For the flight that
-    leaves the source, where no ground slope is known, "assumed" means the least-speed
-    launch that reaches the first impact (eq. 3.5 minimised over alpha:
-    ``alpha = 45° + beta/2`` with ``beta`` the elevation angle of the chord) -- the
-    rock leaves the cliff with as little energy as the geometry allows.
+    flights at Tornado Mountain) with ``alpha = theta0 - psi``. The flight that leaves
+    the source is a rock detaching from a cliff, not a rebound, so there "assumed"
+    means the least-speed launch that reaches the first impact (eq. 3.5 minimised over
+    alpha: ``alpha = 45° + beta/2`` with ``beta`` the elevation angle of the chord) --
+    the rock leaves with as little energy as the geometry allows.
 
 Launch speed and velocities then follow from eq. 3.5 through the two impacts
 (:func:`fieldkit.physics.flight.flight_between`). Impossible geometry (a tree strike no
@@ -164,9 +164,9 @@ def solve_flights(
         if math.isfinite(given[j]) and math.isfinite(psi):
             theta0, source = float(given[j]), "given"
             alpha = theta0 - psi
-        elif j == 0 and not math.isfinite(psi):
-            theta0, source = math.nan, "assumed"
+        elif j == 0:
             alpha = least_speed_launch_angle_deg(dx, dz)
+            theta0, source = alpha + psi, "assumed"
         elif theta0_deg is not None and math.isfinite(psi):
             theta0, source = float(theta0_deg), "assumed"
             alpha = theta0 - psi

@@ -81,23 +81,43 @@ def section_slopes(
     return psi, source
 
 
-def tree_strikes_by_launch(trees: object | None) -> dict[str, TreeStrike]:
+def tree_strikes_by_launch(
+    trees: object | None, points: list[str], x_m: np.ndarray, z_m: np.ndarray
+) -> dict[str, TreeStrike]:
     """Tree strikes keyed by the launch impact of the flight they fix.
 
     ``trees`` is a :class:`fieldkit.io.trees.TreeStrikes` (``frame`` with
     ``after_impact, horizontal_distance_m, strike_height_m, ground_z_m`` and, when the
-    reader keeps it, the file ``row``). Two strikes on one flight over-determine the
-    parabola and raise :class:`InputFileError` naming both rows.
+    reader keeps it, the file ``row``). Where ``ground_z_m`` is not given, the ground
+    at the tree is interpolated on the straight line between the two impacts. Two
+    strikes on one flight over-determine the parabola and raise
+    :class:`InputFileError` naming both rows.
     """
     if trees is None:
         return {}
     frame: pd.DataFrame = trees.frame  # type: ignore[attr-defined]
     source = getattr(trees, "source", None)
+    index = {name: i for i, name in enumerate(points)}
     out: dict[str, TreeStrike] = {}
     for i, row in enumerate(frame.itertuples(index=False)):
         number = getattr(row, "row", None)
         where = f"row {int(number) if number is not None else i + 2}"
         key = str(row.after_impact)
+        j = index.get(key)
+        if j is None or j == len(points) - 1:
+            what = "is not a point of" if j is None else "is the last point of"
+            raise InputFileError(
+                f"tree strike after impact {key}, which {what} the path "
+                "(no flight leaves it)",
+                source=source,
+                where=where,
+            )
+        distance = float(row.horizontal_distance_m)
+        ground = float(row.ground_z_m)
+        if not math.isfinite(ground):
+            dx = x_m[j + 1] - x_m[j]
+            ground = float(z_m[j] + (z_m[j + 1] - z_m[j]) * distance / dx) if dx > 0 \
+                else math.nan
         if key in out:
             raise InputFileError(
                 f"a second tree strike on the flight after point {key} "
@@ -108,9 +128,9 @@ def tree_strikes_by_launch(trees: object | None) -> dict[str, TreeStrike]:
             )
         out[key] = TreeStrike(
             after_impact=key,
-            distance_m=float(row.horizontal_distance_m),
+            distance_m=distance,
             height_m=float(row.strike_height_m),
-            ground_z_m=float(row.ground_z_m),
+            ground_z_m=ground,
             where=where,
         )
     return out
@@ -242,9 +262,10 @@ def reduce_survey(
     given = frame["theta0_deg"].to_numpy(float) if "theta0_deg" in frame else None
 
     slope, slope_source = section_slopes(x, z, surveyed)
-    by_launch = tree_strikes_by_launch(trees)
+    names = frame["point"].astype(str).tolist()
+    by_launch = tree_strikes_by_launch(trees, names, x, z)
     flights = solve_flights(
-        frame["point"].astype(str).tolist(), x, z, slope,
+        names, x, z, slope,
         theta0_deg=options.theta0_deg, given_theta0_deg=given, trees=by_launch,
         points_source=source, trees_source=getattr(trees, "source", None),
     )
