@@ -226,8 +226,8 @@ def length_factor(
 ) -> float:
     """Factor converting ``column`` to metres.
 
-    A unit in the column name (``x_m``, ``Elevation (ft)``) wins; it must not
-    contradict an explicit ``units="ft"``. Without one, ``units`` applies.
+    A unit in the column name (``x_m``, ``Elevation (ft)``) wins over ``units``
+    (the file says what it holds); ``units`` applies to columns without one.
     """
     flag = units_factor(units)
     if column.unit is None or column.unit == "deg":
@@ -235,13 +235,6 @@ def length_factor(
     if column.unit not in LENGTH_UNITS:
         raise InputFileError(
             f"column '{column.header.strip()}': unknown unit '{column.unit}'",
-            source=table.source,
-            where=where,
-        )
-    if units == "ft" and column.unit == "m":
-        raise InputFileError(
-            f"column '{column.header.strip()}' is in metres but units ft was asked "
-            "for; drop --units ft or rename the column",
             source=table.source,
             where=where,
         )

@@ -143,8 +143,9 @@ def destination(
 def utm_crs_for(lat_deg: ArrayLike, lon_deg: ArrayLike) -> pyproj.CRS:
     """WGS 84 / UTM CRS for a site, chosen from the point nearest its centre.
 
-    Uses ``pyproj.database.query_utm_crs_info`` (which knows the Norway and Svalbard
-    exceptions) with the mean position of the points.
+    Uses ``pyproj.database.query_utm_crs_info`` at the mean position of the points,
+    with the Norway (32V) and Svalbard (31X-37X) zone exceptions applied on top (the
+    EPSG areas of use are plain 6° bands).
 
     Examples
     --------
@@ -183,11 +184,27 @@ def _utm_crs(lat: float, lon: float) -> pyproj.CRS:
     )
     if not infos:  # pragma: no cover - every valid lat/lon has a zone
         raise ArgumentError(f"no UTM zone found for latitude {lat}, longitude {lon}")
-    zone = int((lon + 180.0) // 6.0) % 60 + 1
+    zone = _utm_zone_number(lat, lon)
     standard = str((32600 if lat >= 0 else 32700) + zone)
     codes = [info.code for info in infos]
-    code = standard if standard in codes else codes[0]
-    return pyproj.CRS.from_epsg(int(code))
+    if standard in codes or _is_exception_zone(lat, lon):
+        return pyproj.CRS.from_epsg(int(standard))
+    return pyproj.CRS.from_epsg(int(codes[0]))  # pragma: no cover - defensive
+
+
+def _is_exception_zone(lat: float, lon: float) -> bool:
+    return (56.0 <= lat < 64.0 and 3.0 <= lon < 12.0) or (
+        72.0 <= lat < 84.0 and 0.0 <= lon < 42.0
+    )
+
+
+def _utm_zone_number(lat: float, lon: float) -> int:
+    """UTM zone with the Norway (32V) and Svalbard (31X-37X) exceptions."""
+    if 56.0 <= lat < 64.0 and 3.0 <= lon < 12.0:
+        return 32
+    if 72.0 <= lat < 84.0 and 0.0 <= lon < 42.0:
+        return 31 if lon < 9.0 else 33 if lon < 21.0 else 35 if lon < 33.0 else 37
+    return int((lon + 180.0) // 6.0) % 60 + 1
 
 
 def projected_crs(epsg: int | str) -> pyproj.CRS:

@@ -129,6 +129,12 @@ def read_points_csv(
     check_unique_points(names, wheres, source)
     extra = _optional_columns(table, units)
     notes = list(extra.pop("_notes", []))
+    labelled = [c.header.strip() for c in table.columns if c.unit in ("m", "mm", "cm")]
+    if units != "m" and labelled:
+        notes.append(
+            f"units {units} not applied to {', '.join(labelled)}: the column names "
+            "say metres"
+        )
     if name_column is None:
         notes.append("no point-name column; points are named 1, 2, 3 … in file order")
 
