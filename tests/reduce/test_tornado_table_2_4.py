@@ -85,7 +85,7 @@ NOT_REPRODUCIBLE_KE = {
     "B": "thesis uses free fall from rest, sqrt(2 g 34 m) = 25.8 m/s, at B; no "
          "ballistic path from rest reaches a point 8 m out (least-speed path: -615 kJ "
          "vs -597 kJ printed)",
-    "27": "a 6 kJ loss, the difference of two ~150 kJ energies: rounding alpha_f to "
+    "27": "a 6 kJ loss, the difference of two ~185 kJ energies: rounding alpha_f to "
           "0.1° moves it between -5.8 and -6.4 kJ, wider than 1 %",
     "44": "no KE loss printed",
 }
