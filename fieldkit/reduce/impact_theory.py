@@ -27,6 +27,15 @@ For every impact of an :class:`~fieldkit.impact_table.ImpactTable` where the dat
     impact where the theory predicts a loss (e.g. spin converted into translation, a
     shallow impact with ``e_n > 1``, or survey error).
 
+The friction term depends on the initial slip ``v_iT + r omega_i``, which field surveys
+do not measure: with the spin estimated as ``omega = -v/r`` (eq. 3.17, as ``fieldkit
+reduce`` does) the contact is close to rolling and friction takes little; ignoring the
+spin (6B) maximises it. On Tornado Mountain boulder A (thesis Table 2-4 reduced by
+``fieldkit reduce``, mu = 0.68) the median fraction over the impacts that lost energy
+is about 0.01 with the estimated spin and 0.46 with ``ignore_spin=True``; the thesis's
+0.19 (6B, eccentric ellipsoid, slip throughout) lies between. Read the fraction as a
+bracket, not a measurement.
+
 Both are NaN where the data do not allow them:
 
 * ``mass_kg``, ``radius_m`` or ``gyration_m`` missing;
