@@ -307,6 +307,8 @@ def find_flights(
     for lo, hi, outl in extended:
         rows = np.setdiff1d(np.arange(lo, hi + 1), outl)
         rows = _trim_ends(t, x, z, rows, sigma)
+        if np.isfinite(g_common):
+            rows = _trim_biased_ends(t, x, z, rows, sigma, g_common)
         if len(rows) >= min_samples:
             flights.append(rows)
 
@@ -363,6 +365,32 @@ def _trim_ends(t, x, z, rows: np.ndarray, sigma: float) -> np.ndarray:
             rows = rows[:-1]
         else:
             break
+    return rows
+
+
+def _trim_biased_ends(
+    t, x, z, rows: np.ndarray, sigma: float, g: float, run: int = 6
+) -> np.ndarray:
+    """Drop end samples while the last ``run`` residuals are biased.
+
+    With gravity fixed at the track's own ``g``, the residuals of a clean flight
+    average to zero over any ``run`` samples (standard error ``sigma / sqrt(run)``);
+    the tail of a soft contact (a net letting go) pulls them off systematically.
+    """
+    limit = 3.5 * sigma / np.sqrt(run)
+    for _ in range(len(rows)):
+        if len(rows) < 3 * run:
+            break
+        tau = t[rows] - t[rows].mean()
+        design = np.column_stack([np.ones_like(tau), tau])
+        zc = z[rows] + 0.5 * g * tau**2
+        rx = x[rows] - design @ np.linalg.lstsq(design, x[rows], rcond=None)[0]
+        rz = zc - design @ np.linalg.lstsq(design, zc, rcond=None)[0]
+        head = max(abs(rx[:run].mean()), abs(rz[:run].mean()))
+        tail = max(abs(rx[-run:].mean()), abs(rz[-run:].mean()))
+        if max(head, tail) <= limit:
+            break
+        rows = rows[1:] if head > tail else rows[:-1]
     return rows
 
 

@@ -180,7 +180,7 @@ def net_capture(
     damping_nspm: float = 4.0,
     noise_m: float = 0.0,
     rng: np.random.Generator | None = None,
-    step_s: float = 2e-6,
+    step_s: float = 1e-5,
 ) -> SyntheticTrack:
     """A ball caught and redirected by a spring-damper net (thesis §8.5 model tests).
 
@@ -246,6 +246,7 @@ def net_capture(
                 z_end_m=state[1],
                 vf_x_mps=state[2],
                 vf_z_mps=state[3],
+                spring_j=0.5 * stiffness_npm * max(d, 0.0) ** 2,
             )
         if in_contact:
             damper += damping_nspm * d_dot**2 * step_s

@@ -5,9 +5,9 @@ For each contact between two fitted flights (:mod:`fieldkit.tracking.contacts`):
 * **Contact time.** A short contact (fewer than ``EXTENDED_CONTACT_SAMPLES`` measured
   samples off both parabolas) is treated as instantaneous: the impact instant is where
   the two fixed-g parabolas come closest (both share ``g``, so their separation is
-  linear in time and the instant has a closed form), searched within one frame
-  interval of the gap. An extended contact (a net, a rolling phase) starts at the last
-  sample of the flight before and ends at the first sample of the flight after.
+  linear in time and the instant has a closed form), searched near the gap. An
+  extended contact (a net, a rolling phase) starts at the last sample of the flight
+  before and ends at the first sample of the flight after.
 * **Velocities.** Impact velocity from the flight before, restitution velocity from the
   flight after, both evaluated at the contact time(s) (fixed-g fits).
 * **Surface angle** ``slope_deg`` (psi, positive descending in the direction of
@@ -47,6 +47,10 @@ from fieldkit.tracking.contacts import ContactSpan
 from fieldkit.tracking.flight_fit import FlightFit
 from fieldkit.tracking.track import Track
 
+#: Frames beyond the gap searched for the closest approach of the two parabolas (the
+#: samples next to a soft impact fit either parabola within the noise).
+SEARCH_FRAMES = 4
+
 #: A contact with at least this many measured samples is extended (net, rolling).
 EXTENDED_CONTACT_SAMPLES = 5
 
@@ -78,13 +82,14 @@ class ContactEvent:
 def contact_instant(
     before: FlightFit, after: FlightFit, span: ContactSpan, dt: float
 ) -> float:
-    """Time where the two fitted parabolas are closest, within the gap +- one frame [s].
+    """Time where the two fitted parabolas are closest, near the gap [s].
 
     Both fits share the fixed ``g``, so ``p_after(t) - p_before(t)`` is linear in t and
-    the closest approach is ``t* = -d0.dv / |dv|^2`` (clipped to the search window).
+    the closest approach is ``t* = -d0.dv / |dv|^2``, clipped to the gap widened by
+    ``SEARCH_FRAMES`` frame intervals on each side.
     """
-    lo = span.t_last_before_s - dt
-    hi = span.t_first_after_s + dt
+    lo = span.t_last_before_s - SEARCH_FRAMES * dt
+    hi = span.t_first_after_s + SEARCH_FRAMES * dt
     t0 = 0.5 * (lo + hi)
     xa, za = before.position(t0)
     xb, zb = after.position(t0)

@@ -1,0 +1,94 @@
+"""Splitting a track into flights: contacts found from the data, never given."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from fieldkit.tracking.contacts import estimate_noise, find_flights
+from fieldkit.tracking.synthetic import bouncing_ball
+
+FPS = 1205.0
+
+
+def bounces(seed: int, noise_m: float = 4e-4, **kw):
+    rng = np.random.default_rng(seed)
+    kw.setdefault("duration_s", 0.8)
+    kw.setdefault("start_velocity_mps", (1.5, 0.5))
+    kw.setdefault("surface_angle_deg", 12.0)
+    return bouncing_ball(fps=FPS, noise_m=noise_m, rng=rng, **kw)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_every_true_impact_falls_in_a_found_contact(seed):
+    s = bounces(seed)
+    tr = s.track
+    seg = find_flights(tr.t, tr.x, tr.z)
+    assert len(seg.flights) == len(s.truth) + 1
+    assert len(seg.contacts) == len(s.truth)
+    for span, t_impact in zip(seg.contacts, s.truth["t_s"], strict=True):
+        # the impact lies between the last sample before and the first after, give
+        # or take the samples next to the kink that fit either parabola within the
+        # noise (the softest impact here changes v_N by only 1.3 m/s: 3 frames);
+        # the impact *instant* comes from the fits (test_video_impacts)
+        dt = 1.0 / FPS
+        assert (
+            span.t_last_before_s - 3 * dt <= t_impact <= span.t_first_after_s + 3 * dt
+        )
+        assert span.gap_s <= 3.5 * dt
+    # flights are disjoint, in time order, and cover nearly every sample
+    covered = np.concatenate(seg.flights)
+    assert len(np.unique(covered)) == len(covered)
+    assert len(covered) >= len(tr) - 2 * len(s.truth)
+
+
+def test_noise_estimate_matches_the_added_noise():
+    s = bounces(3, noise_m=5e-4)
+    seg = find_flights(s.track.t, s.track.x, s.track.z)
+    assert seg.noise_m == pytest.approx(5e-4, rel=0.15)
+    assert seg.g_common_mps2 == pytest.approx(9.81, rel=0.01)
+
+
+def test_local_noise_flags_the_windows_across_an_impact():
+    s = bounces(4, noise_m=2e-4)
+    tr = s.track
+    local = estimate_noise(tr.t, tr.x, tr.z, 9)
+    k = int(np.searchsorted(tr.t, s.truth["t_s"].iloc[0]))
+    # windows straddling the impact stand out against the median (pure noise)
+    assert local[k - 8 : k].max() > 3 * np.median(local)
+    far = np.r_[local[: k - 20], local[k + 20 : k + 200]]
+    assert np.quantile(far, 0.95) < 2 * np.median(local)
+
+
+def test_an_outlier_does_not_split_a_flight():
+    s = bounces(5, duration_s=0.28)  # one flight, no impact yet
+    assert len(s.truth) == 0
+    tr = s.track
+    z = tr.z.copy()
+    z[150] += 0.01  # a 10 mm mis-detection
+    seg = find_flights(tr.t, tr.x, z)
+    assert len(seg.flights) == 1 and seg.contacts == []
+    assert 150 not in seg.flights[0]
+
+
+def test_missing_detections_inside_a_flight_are_bridged():
+    s = bounces(6)
+    tr = s.track
+    x = tr.x.copy()
+    x[100:130] = np.nan  # body hidden for 30 frames mid-flight
+    seg = find_flights(tr.t, x, tr.z)
+    assert len(seg.flights) == len(s.truth) + 1
+    assert not np.isin(np.arange(100, 130), np.concatenate(seg.flights)).any()
+
+
+def test_flights_found_even_with_the_wrong_capture_rate():
+    s = bounces(7, fps_reported=30.0)  # playback rate given instead of 1205
+    seg = find_flights(s.track.t, s.track.x, s.track.z)
+    assert len(seg.flights) == len(s.truth) + 1
+    assert seg.g_common_mps2 == pytest.approx(9.81 * (30.0 / FPS) ** 2, rel=0.02)
+
+
+def test_too_short_a_track_has_no_flight():
+    t = np.arange(5) / FPS
+    seg = find_flights(t, t, t)
+    assert seg.flights == [] and seg.contacts == []
