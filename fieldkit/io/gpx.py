@@ -36,7 +36,7 @@ from fieldkit.io.csv_table import check_readable
 
 GPX_11_NAMESPACE = "http://www.topografix.com/GPX/1/1"
 _KINDS = {"waypoints": "wpt", "route": "rtept", "track": "trkpt"}
-COLUMNS = ("point", "lat_deg", "lon_deg", "elev_m", "time")
+COLUMNS = ("point", "lat_deg", "lon_deg", "elev_m", "time", "type")
 
 
 def _local(tag: str) -> str:
@@ -102,8 +102,9 @@ def read_gpx_waypoints(
     -------
     pandas.DataFrame
         Columns ``point`` (str), ``lat_deg``, ``lon_deg``, ``elev_m`` (NaN where the
-        point has no ``<ele>``), ``time`` (UTC timestamps, NaT where absent), in file
-        order.
+        point has no ``<ele>``), ``time`` (UTC timestamps, NaT where absent), ``type``
+        (the GPX ``<type>`` classification, e.g. a slope material; NaN where absent),
+        in file order.
 
     Examples
     --------
@@ -131,9 +132,9 @@ def read_gpx_waypoints(
     if not elements:
         if points == "waypoints":
             raise InputFileError(
-                f"no waypoints (<wpt>) in this GPX; it has {counts['track']} track "
-                f"points and {counts['route']} route points (ask for them with "
-                "points='track' or 'route', --gpx-points on the command line)",
+                f"no waypoints (<wpt>) in this GPX (it has {counts['track']} track "
+                f"points and {counts['route']} route points); impacts must be "
+                "waypoints, or ask for track/route points explicitly (gpx_points=)",
                 source=path,
             )
         raise InputFileError(
@@ -165,7 +166,8 @@ def read_gpx_waypoints(
                     where=where,
                 )
         time_text = _child_text(element, "time") or None
-        records.append((name, lat, lon, elev, time_text, where))
+        type_text = _child_text(element, "type") or None
+        records.append((name, lat, lon, elev, time_text, where, type_text))
     frame = pd.DataFrame(
         {
             "point": pd.Series([r[0] for r in records], dtype="str"),
@@ -175,6 +177,7 @@ def read_gpx_waypoints(
         }
     )
     frame["time"] = _parse_times([r[4] for r in records], [r[5] for r in records], path)
+    frame["type"] = pd.Series([r[6] for r in records], dtype="str")
     return frame
 
 
@@ -238,8 +241,9 @@ def _format_time(value: object) -> str | None:
 def gpx_waypoints_text(frame: pd.DataFrame, *, creator: str = "fieldkit") -> str:
     """GPX 1.1 document with one ``<wpt>`` per row of ``frame``.
 
-    ``frame`` needs ``point``, ``lat_deg``, ``lon_deg``; ``elev_m`` and ``time`` are
-    optional (a NaN elevation or time is left out). Latitude and longitude get 9
+    ``frame`` needs ``point``, ``lat_deg``, ``lon_deg``; ``elev_m``, ``time`` and
+    ``type`` (or ``material``, written as ``<type>``) are optional (missing values are
+    left out). Latitude and longitude get 9
     decimals (0.1 mm), elevation 3 (1 mm).
     """
     for column in ("point", "lat_deg", "lon_deg"):
@@ -253,6 +257,7 @@ def gpx_waypoints_text(frame: pd.DataFrame, *, creator: str = "fieldkit") -> str
     ]
     has_elev = "elev_m" in frame.columns
     has_time = "time" in frame.columns
+    type_column = next((c for c in ("type", "material") if c in frame.columns), None)
     for row in frame.itertuples(index=False):
         lat = float(row.lat_deg)
         lon = float(row.lon_deg)
@@ -266,6 +271,10 @@ def gpx_waypoints_text(frame: pd.DataFrame, *, creator: str = "fieldkit") -> str
             if text:
                 lines.append(f"    <time>{text}</time>")
         lines.append(f"    <name>{escape(str(row.point))}</name>")
+        if type_column is not None:
+            value = getattr(row, type_column)
+            if isinstance(value, str) and value:
+                lines.append(f"    <type>{escape(value)}</type>")
         lines.append("  </wpt>")
     lines.append("</gpx>")
     return "\n".join(lines) + "\n"

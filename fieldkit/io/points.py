@@ -90,8 +90,15 @@ def check_unique_points(
 
 def _optional(frame: pd.DataFrame, extra: dict[str, Sequence] | None) -> pd.DataFrame:
     for column in OPTIONAL_COLUMNS:
-        if extra and column in extra:
-            frame[column] = list(extra[column]) if column != "time" else extra[column]
+        if not extra or column not in extra:
+            continue
+        values = extra[column]
+        if column == "material":
+            frame[column] = pd.Series(list(values), dtype="str", index=frame.index)
+        elif column == "slope_deg":
+            frame[column] = np.asarray(list(values), dtype=float)
+        else:
+            frame[column] = pd.Series(values).to_numpy()
     return frame
 
 
@@ -204,7 +211,8 @@ def read_gpx_impacts(
 ) -> PointSet:
     """Impact points from GPX waypoints (or route/track points if asked).
 
-    Every point needs an ``<ele>``; names must be unique. ``<ele>`` is metres by the
+    Every point needs an ``<ele>``; names must be unique. A waypoint ``<type>`` becomes
+    the ``material`` column. ``<ele>`` is metres by the
     GPX standard, so ``units="ft"`` does not apply (a note says so).
     """
     from fieldkit.io.gpx import read_gpx_waypoints
@@ -225,7 +233,12 @@ def read_gpx_impacts(
     notes = []
     if units != "m":
         notes.append(f"units {units} ignored: GPX <ele> is in metres by definition")
-    extra = {"time": table["time"]} if table["time"].notna().any() else None
+    extra: dict[str, Sequence] = {}
+    if table["time"].notna().any():
+        extra["time"] = table["time"]
+    if table["type"].notna().any():
+        extra["material"] = [None if pd.isna(t) else str(t) for t in table["type"]]
+        notes.append("GPX <type> read as the slope material")
     return point_set_from_geographic(
         names,
         table["lat_deg"],
@@ -235,7 +248,7 @@ def read_gpx_impacts(
         height_reference=GPX_HEIGHT_REFERENCE,
         epsg=epsg,
         notes=notes,
-        extra=extra,
+        extra=extra or None,
     )
 
 

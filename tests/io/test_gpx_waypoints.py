@@ -287,3 +287,33 @@ def test_text_in_elevation_named(tmp_path):
     )
     with pytest.raises(InputFileError, match="waypoint 1 \\('B12'\\): <ele> '12O5.3'"):
         read_impacts(write(tmp_path, "ele.gpx", text))
+
+
+def test_waypoint_type_round_trips_as_material(tmp_path):
+    frame = sample_frame()
+    frame["material"] = ["rock", "talus", None, "rock"]
+    path = tmp_path / "typed.gpx"
+    write_gpx_waypoints(path, frame)
+    assert path.read_text().count("<type>") == 3
+    assert read_gpx_waypoints(path)["type"].isna().tolist() == [
+        False,
+        False,
+        True,
+        False,
+    ]
+    points = read_impacts(path)
+    assert points.frame["material"].tolist()[:2] == ["rock", "talus"]
+    assert pd.isna(points.frame["material"].iloc[2])
+    assert any("<type>" in note for note in points.notes)
+
+
+def test_bundled_tornado_survey_reads(repo):
+    folder = repo / "surveys" / "tornado_mountain"
+    if not (folder / "boulder_a_impacts.gpx").exists():
+        pytest.skip("surveys not generated")
+    points = read_impacts(folder / "boulder_a_impacts.gpx")
+    section = read_impacts(folder / "boulder_a_section.csv")
+    assert points.names == section.names
+    assert "material" in points.frame and points.frame["material"].notna().all()
+    # GPX positions were placed from the section x: x must come back to 1 cm.
+    np.testing.assert_allclose(points.frame["x_m"], section.frame["x_m"], atol=0.01)
