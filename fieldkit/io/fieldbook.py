@@ -28,7 +28,7 @@ from os import PathLike
 
 import numpy as np
 
-from fieldkit.errors import InputFileError
+from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.io import geodesy
 from fieldkit.io.csv_table import Column, CsvTable, length_factor, read_csv_table
 from fieldkit.io.points import PointSet, check_unique_points, point_set_from_geographic
@@ -103,7 +103,7 @@ def read_fieldbook(
     (0.000899, 1483.87)
     """
     if not math.isfinite(declination_deg) or abs(declination_deg) > 180.0:
-        raise InputFileError(
+        raise ArgumentError(
             f"declination {declination_deg} is not in [-180, 180] degrees",
             source="--declination",
         )
@@ -160,6 +160,13 @@ def read_fieldbook(
         th = table.number(number, row, columns["target_height_m"], where=where)
         ih *= ih_factor
         th *= th_factor
+        if ih < 0 or th < 0:
+            raise InputFileError(
+                f"instrument and target heights must not be negative (got {ih:g} m "
+                f"and {th:g} m)",
+                source=source,
+                where=where_point,
+            )
         try:
             text = _sentence(table, row, columns["sentence"])
             shot = parse_trupulse(text, lenient=lenient)

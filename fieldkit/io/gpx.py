@@ -59,6 +59,8 @@ def parse_gpx_root(path: str | PathLike[str]) -> ElementTree.Element:
     """
     file = check_readable(path)
     data = file.read_bytes()
+    if not data.strip():
+        raise InputFileError("file is empty", source=path)
     head = data[:4096]
     stripped = head.lstrip(b"\xef\xbb\xbf \t\r\n")
     if b"\x00" in head or not stripped.startswith(b"<"):

@@ -317,3 +317,8 @@ def test_bundled_tornado_survey_reads(repo):
     assert "material" in points.frame and points.frame["material"].notna().all()
     # GPX positions were placed from the section x: x must come back to 1 cm.
     np.testing.assert_allclose(points.frame["x_m"], section.frame["x_m"], atol=0.01)
+
+
+def test_whitespace_only_gpx_is_empty(tmp_path):
+    with pytest.raises(InputFileError, match="blank.gpx: file is empty"):
+        read_gpx_waypoints(write(tmp_path, "blank.gpx", "  \n\n"))
