@@ -291,7 +291,7 @@ class ContactPhases:
     def tangential_impulse(self, q: ArrayLike) -> np.ndarray:
         """Tangential impulse per unit mass ``p_T/m`` at normal impulse ``q`` [m/s]."""
         q = np.asarray(q, float)
-        with np.errstate(invalid="ignore"):
+        with np.errstate(invalid="ignore", over="ignore"):
             early = self.ratio_1 * q
             late = self.p_t_slip_stop + self.ratio_2 * (q - self.q_slip_stop)
         return np.where(q < self.q_slip_stop, early, late)
@@ -299,7 +299,7 @@ class ContactPhases:
     def contact_velocities(self, q: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """Slip (tangential) and normal velocity of the contact point at ``q`` [m/s]."""
         q = np.asarray(q, float)
-        with np.errstate(invalid="ignore"):
+        with np.errstate(invalid="ignore", over="ignore"):
             early = q < self.q_slip_stop
             v_t = np.where(
                 early,
@@ -325,7 +325,7 @@ class ContactPhases:
     def normal_work(self, q: ArrayLike) -> np.ndarray:
         """``int_0^q v_N dp_N`` per unit mass [J/kg] (area under the v_N line)."""
         q = np.asarray(q, float)
-        with np.errstate(invalid="ignore"):
+        with np.errstate(invalid="ignore", over="ignore"):
             q1 = np.minimum(q, self.q_slip_stop)
             v1 = self.normal_i + self.slope_n_1 * q1
             part1 = np.where(q1 > 0, 0.5 * (self.normal_i + v1) * q1, 0.0)
@@ -342,7 +342,7 @@ class ContactPhases:
         q = np.asarray(q, float)
         v_t, _ = self.contact_velocities(q)
         p_t = self.tangential_impulse(q)
-        with np.errstate(invalid="ignore"):
+        with np.errstate(invalid="ignore", over="ignore"):
             finished = q >= self.q_slip_stop
             first = np.where(
                 finished,
@@ -409,7 +409,7 @@ def contact_phases(
         v_in,
     )
     s = np.sign(slip_i)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         # phase 1: slip in direction s, dp_T = -s mu dp_N (C.12-C.14)
         ratio_1 = -s * mu
         slope_t_1 = beta1 * ratio_1 - beta2
@@ -595,7 +595,7 @@ def rough_body_impact(
     re_f = 0.5 * energy_scale * ph.k2 * omega_f**2
     w_c = ph.normal_work(ph.q_c)
     w_f = ph.normal_work(ph.q_f)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         e_t = v_ft / ph.v_it
     slip_stops = np.isfinite(ph.q_slip_stop)
 
