@@ -27,6 +27,7 @@ from fieldkit.physics.energy import (
     rotational_energy,
     rotational_energy_change,
     sliding_friction_energy,
+    total_energy_change,
     total_kinetic_energy,
 )
 from fieldkit.physics.impact_mechanics import inertial_coefficients, rough_body_impact
@@ -343,3 +344,18 @@ def test_energy_integrals_match_numerical_integration_of_impulse_history(
     assert mine.friction_j == pytest.approx(friction, rel=1e-6)
     res = rough_body_impact(v_it, v_in, omega, **kwargs)
     assert mine.total_j == pytest.approx(res.energy_change_j, rel=1e-9)
+
+
+def test_total_energy_change_section_6_3_and_8b():
+    # Section 6.3, #A26 field values: Delta KE = -180 kJ (v 11.7 -> 6.4, 3750 kg) plus
+    # Delta RE = -18.3 kJ (6C) -> -198 kJ measured in total.
+    total = total_energy_change(3750.0, 11.7, 6.4, 797.0, -8.07 / 0.725, -6.4 / 0.725)
+    assert total / 1e3 == pytest.approx(-179.9 - 18.3, abs=0.1)
+    # Worked example 8B: the change equals minus the energy the net absorbs (97.4 kJ).
+    fence = total_energy_change(520.0, 22.0, 11.5, 520 * 0.35**2, 18.0, -11.6)
+    assert fence == pytest.approx(
+        total_kinetic_energy(520.0, 11.5, 63.7, -11.6)
+        - total_kinetic_energy(520.0, 22.0, 63.7, 18.0),
+        rel=1e-12,
+    )
+    assert -fence / 1e3 == pytest.approx(97.4, abs=0.1)
