@@ -16,7 +16,7 @@ import typer
 from fieldkit.cli.common import GyrationOpt, MassOpt, RadiusOpt, one_line_errors
 from fieldkit.errors import ArgumentError
 
-_LAW_HELP = "as COEFFICIENT,EXPONENT for F = c t^x [N, s]"
+_LAW_HELP = "as COEFFICIENT,EXPONENT for F = c t^x (N, s)"
 _SLIP_STOPS = "slip stops (rolls off the net)"
 
 
@@ -27,26 +27,26 @@ def fence(
     inertia: Annotated[
         float | None,
         typer.Option(
-            "--inertia", help="Moment of inertia I [kg m^2], instead of --gyration."
+            "--inertia", help="Moment of inertia I (kg m^2), instead of --gyration."
         ),
     ] = None,
     radius: RadiusOpt = None,
     speed_in: Annotated[
-        float | None, typer.Option("--speed-in", help="Impact speed v_i [m/s].")
+        float | None, typer.Option("--speed-in", help="Impact speed v_i (m/s).")
     ] = None,
     angle_in: Annotated[
         float | None,
         typer.Option(
             "--angle-in",
             help="Impact angle theta_i between the velocity and the net "
-            "[deg], 90 = normal impact.",
+            "(deg), 90 = normal impact.",
         ),
     ] = None,
     spin_in: Annotated[
         float,
         typer.Option(
             "--spin-in",
-            help="Spin at impact omega_i [rad/s]; positive when it moves the "
+            help="Spin at impact omega_i (rad/s); positive when it moves the "
             "contact point down the net (thesis Fig. 8.3).",
         ),
     ] = 0.0,
@@ -54,7 +54,7 @@ def fence(
         float | None,
         typer.Option(
             "--speed-out",
-            help="Measured speed leaving the net v_f [m/s]. Omit it (and "
+            help="Measured speed leaving the net v_f (m/s). Omit it (and "
             "give --radius, --angle-in) to compute the rebound by impact mechanics.",
         ),
     ] = None,
@@ -62,14 +62,14 @@ def fence(
         float | None,
         typer.Option(
             "--angle-out",
-            help="Measured angle leaving the net theta_f [deg] (reported only).",
+            help="Measured angle leaving the net theta_f (deg) (reported only).",
         ),
     ] = None,
     spin_out: Annotated[
         float | None,
         typer.Option(
             "--spin-out",
-            help="Measured spin leaving the net omega_f [rad/s] "
+            help="Measured spin leaving the net omega_f (rad/s) "
             "(default 0 with --speed-out).",
         ),
     ] = None,
@@ -93,7 +93,7 @@ def fence(
         float | None,
         typer.Option(
             "--impulse",
-            help="Impulse the structures must absorb [N s] (default m v_i).",
+            help="Impulse the structures must absorb (N s) (default m v_i).",
         ),
     ] = None,
     rigid: Annotated[
@@ -120,14 +120,14 @@ def fence(
 ) -> None:
     """Energy a fence absorbs from an oblique rock impact, and structure forces.
 
-    The rock's energy 1/2 m v^2 + 1/2 I omega^2 before and after the net gives the
-    energy absorbed and the efficiency E_f/E_i (eq. 8.1). The rebound is either
-    measured (--speed-out, --spin-out) or computed by impact mechanics from --radius
-    and --angle-in (eqs. 4.20-4.24 in axes along the net, worked example 8A). For the
-    impulse m v_i the rigid, flexible and stiff time-force laws (eqs. 8.2-8.7) give
-    the contact time and peak force.
+    The rock's energy 1/2 m v^2 + 1/2 I omega^2 before and after the net gives
+    the energy absorbed and the efficiency E_f/E_i (eq. 8.1). The rebound is
+    either measured (--speed-out, --spin-out) or computed by impact mechanics
+    from --radius and --angle-in (eqs. 4.20-4.24 in axes along the net, worked
+    example 8A). For the impulse m v_i, the rigid, flexible and stiff
+    time-force laws (eqs. 8.2-8.7) give the contact time and peak force.
 
-    Example (thesis worked example 8B: absorbs 97.4 kJ, 72 %):
+    Example (thesis worked example 8B: the net absorbs 97.4 kJ, 72 %):
 
         fieldkit fence --mass 520 --gyration 0.35 --speed-in 22 --spin-in 18
         --speed-out 11.5 --spin-out=-11.6 --figure fence.png
