@@ -18,6 +18,12 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from fieldkit.errors import ArgumentError
+from fieldkit.physics._validate import (
+    as_output,
+    check_nonnegative,
+    check_positive,
+    where_first,
+)
 from fieldkit.physics.constants import G
 from fieldkit.physics.impact_mechanics import compression_impulse, final_impulse
 
@@ -392,40 +398,22 @@ def oblique_impact_energies(
 
 
 # ------------------------------------------------------------------ argument checks
-def _out(value: np.ndarray) -> np.ndarray:
-    """0-d arrays come back as numpy scalars, arrays unchanged."""
-    value = np.asarray(value)
-    return value[()] if value.ndim == 0 else value
-
-
-def _first_bad(bad: np.ndarray) -> str | None:
-    if bad.ndim == 0:
-        return None
-    return f"element {int(np.flatnonzero(bad.ravel())[0])}"
+_out = as_output
 
 
 def _check_not_negative(value: np.ndarray, name: str) -> None:
-    bad = np.asarray(value < 0)
-    if bad.any():
-        v = float(np.asarray(value)[np.unravel_index(bad.argmax(), bad.shape)])
-        message = f"{name} must not be negative, got {v:g}"
-        raise ArgumentError(message, source=name, where=_first_bad(bad))
+    check_nonnegative(np.asarray(value, float), name, "")
 
 
 def _not_negative(value: ArrayLike, name: str) -> np.ndarray:
     arr = np.asarray(value, float)
-    _check_not_negative(arr, name)
+    check_nonnegative(arr, name, "")
     return arr
 
 
 def _positive(value: ArrayLike, name: str) -> np.ndarray:
     arr = np.asarray(value, float)
-    bad = np.asarray(arr <= 0)
-    if bad.any():
-        v = float(arr[np.unravel_index(bad.argmax(), bad.shape)] if arr.ndim else arr)
-        raise ArgumentError(
-            f"{name} must be positive, got {v:g}", source=name, where=_first_bad(bad)
-        )
+    check_positive(arr, name, "")
     return arr
 
 
@@ -438,7 +426,8 @@ def _normal_args(
     if bad.any():
         raise ArgumentError(
             "normal impact velocity v_iN must be <= 0 (toward the ground)",
-            source="vin_mps", where=_first_bad(bad),
+            source="vin_mps",
+            where=where_first(bad),
         )
     return mass, vin, _positive(beta, "beta")
 
