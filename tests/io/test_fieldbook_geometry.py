@@ -264,3 +264,23 @@ def test_negative_heights_and_bad_declination(tmp_path):
         read_fieldbook(book, stations_csv(tmp_path))
     with pytest.raises(ArgumentError, match="--declination"):
         read_fieldbook(book, stations_csv(tmp_path), declination_deg=400.0)
+
+
+def test_stations_csv_aliases_and_duplicates(tmp_path):
+    from fieldkit.io.stations import read_stations
+
+    path = tmp_path / "st.csv"
+    path.write_text("Name;Latitude;Longitude;Elevation (ft)\nS1;49,5;-117,25;5000\n")
+    stations = read_stations(path)
+    row = stations.lookup("S1")
+    assert (row["lat_deg"], row["lon_deg"]) == (49.5, -117.25)
+    assert row["elev_m"] == pytest.approx(5000 * 0.3048)
+    assert stations.lookup("S2") is None
+    path.write_text("station,lat,lon,elev\nS1,49,-117,1\nS1,49.1,-117,2\n")
+    with pytest.raises(
+        InputFileError, match="'S1' appears twice \\(row 2 and row 3\\)"
+    ):
+        read_stations(path)
+    path.write_text("station,lat,lon\nS1,49,-117\n")
+    with pytest.raises(InputFileError, match="missing elev"):
+        read_stations(path)

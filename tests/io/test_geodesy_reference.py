@@ -146,3 +146,13 @@ def test_to_projected_in_a_foot_crs_matches_pyproj():
 def test_svalbard_zone_exception():
     assert geodesy.utm_crs_for([78.2], [15.6]).to_epsg() == 32633  # Longyearbyen
     assert geodesy.utm_crs_for([78.2], [8.0]).to_epsg() == 32631
+
+
+@settings(max_examples=40, deadline=None)
+@given(lat=st.floats(-79.5, 83.5), lon=st.floats(-179.5, 179.5))
+def test_utm_round_trip(lat, lon):
+    easting, northing, label = geodesy.to_utm([lat], [lon])
+    assert 100_000 < float(easting[0]) < 900_000  # inside its zone's usual range
+    back_lat, back_lon = geodesy.from_projected(easting, northing, label)
+    assert float(back_lat[0]) == pytest.approx(lat, abs=1e-9)
+    assert float(back_lon[0]) == pytest.approx(lon, abs=1e-9)
