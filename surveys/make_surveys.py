@@ -125,8 +125,17 @@ barrier 117.00 8.00 - - - - - barrier
 
 def parse(table: str) -> list[dict]:
     """Rows of a typed table as dicts (``-`` becomes NaN)."""
-    keys = ("point", "x_m", "z_m", "alpha_f_deg", "psi_deg", "e_n", "e_t", "dke_j",
-            "material")
+    keys = (
+        "point",
+        "x_m",
+        "z_m",
+        "alpha_f_deg",
+        "psi_deg",
+        "e_n",
+        "e_t",
+        "dke_j",
+        "material",
+    )
     rows = []
     for line in table.strip().splitlines():
         cells = line.split()
@@ -206,7 +215,7 @@ def write(path: Path, text: str) -> None:
 
 # --------------------------------------------------------------------------- Tornado
 def tornado_positions(rows: list[dict]) -> list[tuple[float, float]]:
-    """Lat/lon of each point: geodesic steps of dx on a fixed azimuth from the origin."""
+    """Lat/lon of each point: geodesic steps of dx on a fixed azimuth from origin."""
     lat, lon = TORNADO_ORIGIN
     out = [(lat, lon)]
     for prev, row in zip(rows[:-1], rows[1:], strict=True):
@@ -216,9 +225,9 @@ def tornado_positions(rows: list[dict]) -> list[tuple[float, float]]:
 
 
 def tornado_trees(rows: list[dict], rng: np.random.Generator) -> list[list]:
-    """One tree strike on each flight whose printed alpha_f does not give theta0 = 32.6°.
+    """One tree strike on each flight whose printed alpha_f gives theta0 != 32.6°.
 
-    The strike sits on the thesis's own parabola (eq. 3.5 with that flight's alpha) at a
+    The strike sits on the thesis's own parabola (eq. 3.5 with that flight's alpha) at
     random 35-65 % of the flight, distance rounded to 0.1 m (tape) and height to 0.01 m.
     """
     x = np.array([r["x_m"] for r in rows])
@@ -245,28 +254,49 @@ def tornado(rows: list[dict]) -> None:
     positions = tornado_positions(rows)
     waypoints = [
         {
-            "lat": lat, "lon": lon, "ele": r["z_m"] + TORNADO_DATUM_M, "name": r["point"],
+            "lat": lat,
+            "lon": lon,
+            "ele": r["z_m"] + TORNADO_DATUM_M,
+            "name": r["point"],
             "type": r["material"],
             "desc": "source" if i == 0 else ("stopped" if i == len(rows) - 1 else ""),
         }
         for i, (r, (lat, lon)) in enumerate(zip(rows, positions, strict=True))
     ]
-    write(folder / "boulder_a_impacts.gpx", gpx_text(
-        "Tornado Mountain boulder A impacts",
-        "Thesis Table 2-4 x,z placed on a plausible site; elevation = z + "
-        f"{TORNADO_DATUM_M:.1f} m; WGS 84 ellipsoidal positions, heights as given.",
-        waypoints,
-    ))
+    write(
+        folder / "boulder_a_impacts.gpx",
+        gpx_text(
+            "Tornado Mountain boulder A impacts",
+            "Thesis Table 2-4 x,z placed on a plausible site; elevation = z + "
+            f"{TORNADO_DATUM_M:.1f} m; WGS 84 ellipsoidal positions, heights as given.",
+            waypoints,
+        ),
+    )
     rng = np.random.default_rng(2004)
     trees = tornado_trees(rows, rng)
-    write(folder / "boulder_a_trees.csv", csv_text(
-        ["after_impact", "horizontal_distance_m", "strike_height_m", "species", "dbh_mm"],
-        trees,
-    ))
-    write(folder / "boulder_a_section.csv", csv_text(
-        ["point", "x_m", "z_m", "material"],
-        [[r["point"], fmt(r["x_m"], 2), fmt(r["z_m"], 2), r["material"]] for r in rows],
-    ))
+    write(
+        folder / "boulder_a_trees.csv",
+        csv_text(
+            [
+                "after_impact",
+                "horizontal_distance_m",
+                "strike_height_m",
+                "species",
+                "dbh_mm",
+            ],
+            trees,
+        ),
+    )
+    write(
+        folder / "boulder_a_section.csv",
+        csv_text(
+            ["point", "x_m", "z_m", "material"],
+            [
+                [r["point"], fmt(r["x_m"], 2), fmt(r["z_m"], 2), r["material"]]
+                for r in rows
+            ],
+        ),
+    )
     write(folder / "table_2_4_thesis.csv", thesis_csv(rows))
     rangefinder(rows, positions, folder)
 
@@ -279,21 +309,44 @@ def rangefinder(rows: list[dict], positions: list, folder: Path) -> None:
     z = np.array([r["z_m"] for r in rows])
     lat0, lon0 = TORNADO_ORIGIN
     # Stations every ~55 m along the path, 7 m to alternate sides, on the ground.
-    station_x = [14.0, 60.0, 110.0, 165.0, 220.0, 275.0, 330.0, 385.0, 440.0, 495.0,
-                 550.0, 600.0]
+    station_x = [
+        14.0,
+        60.0,
+        110.0,
+        165.0,
+        220.0,
+        275.0,
+        330.0,
+        385.0,
+        440.0,
+        495.0,
+        550.0,
+        600.0,
+    ]
     stations = []
     for k, sx in enumerate(station_x):
         lon, lat, _ = GEOD.fwd(lon0, lat0, TORNADO_AZIMUTH_DEG, sx)
         side = 90.0 if k % 2 == 0 else -90.0
         lon, lat, _ = GEOD.fwd(lon, lat, TORNADO_AZIMUTH_DEG + side, 7.0)
         ground = float(np.interp(sx, x, z)) + TORNADO_DATUM_M
-        stations.append({"name": f"S{k + 1}", "lat": round(lat, 9), "lon": round(lon, 9),
-                         "ele": round(ground, 2), "x": sx, "desc": "GPS station"})
-    write(folder / "boulder_a_stations.gpx", gpx_text(
-        "Tornado Mountain boulder A rangefinder stations",
-        "GNSS-fixed instrument stations; elevation on the same datum as the impacts.",
-        stations,
-    ))
+        stations.append(
+            {
+                "name": f"S{k + 1}",
+                "lat": round(lat, 9),
+                "lon": round(lon, 9),
+                "ele": round(ground, 2),
+                "x": sx,
+                "desc": "GPS station",
+            }
+        )
+    write(
+        folder / "boulder_a_stations.gpx",
+        gpx_text(
+            "Tornado Mountain boulder A rangefinder stations",
+            "GNSS-fixed instrument stations; elevation on the impacts' datum.",
+            stations,
+        ),
+    )
     book = []
     for i, (row, (lat, lon)) in enumerate(zip(rows, positions, strict=True)):
         st = min(stations, key=lambda s: abs(s["x"] - row["x_m"]))
@@ -305,31 +358,60 @@ def rangefinder(rows: list[dict], positions: list, folder: Path) -> None:
         inc = math.degrees(math.atan2(dz, hd))
         sd = math.hypot(hd, dz)
         az_mag = (az_fwd - TORNADO_DECLINATION_DEG) % 360.0
-        sentence = format_trupulse_hv(round(hd, 1), round(az_mag, 1), round(inc, 1),
-                                      round(sd, 1), units="M")
-        book.append([row["point"], st["name"], fmt(instrument_h, 2), fmt(target_h, 2),
-                     sentence])
-    write(folder / "boulder_a_fieldbook.csv", csv_text(
-        ["point", "station", "instrument_height_m", "target_height_m", "sentence"], book,
-    ))
+        sentence = format_trupulse_hv(
+            round(hd, 1), round(az_mag, 1), round(inc, 1), round(sd, 1), units="M"
+        )
+        book.append(
+            [row["point"], st["name"], fmt(instrument_h, 2), fmt(target_h, 2), sentence]
+        )
+    write(
+        folder / "boulder_a_fieldbook.csv",
+        csv_text(
+            ["point", "station", "instrument_height_m", "target_height_m", "sentence"],
+            book,
+        ),
+    )
 
 
 def thesis_csv(rows: list[dict]) -> str:
     """The typed thesis table itself, for reference (not an input format)."""
+
     def cell(v: float, d: int) -> str:
         return "" if not np.isfinite(v) else fmt(v, d)
+
     return csv_text(
-        ["point", "x_m", "z_m", "alpha_f_deg", "slope_deg", "e_n", "e_t", "dke_j",
-         "material"],
-        [[r["point"], cell(r["x_m"], 2), cell(r["z_m"], 2), cell(r["alpha_f_deg"], 1),
-          cell(r["psi_deg"], 1), cell(r["e_n"], 2), cell(r["e_t"], 2),
-          cell(r["dke_j"], 0), r["material"]] for r in rows],
+        [
+            "point",
+            "x_m",
+            "z_m",
+            "alpha_f_deg",
+            "slope_deg",
+            "e_n",
+            "e_t",
+            "dke_j",
+            "material",
+        ],
+        [
+            [
+                r["point"],
+                cell(r["x_m"], 2),
+                cell(r["z_m"], 2),
+                cell(r["alpha_f_deg"], 1),
+                cell(r["psi_deg"], 1),
+                cell(r["e_n"], 2),
+                cell(r["e_t"], 2),
+                cell(r["dke_j"], 0),
+                r["material"],
+            ]
+            for r in rows
+        ],
     )
 
 
 # --------------------------------------------------------------------------- others
-def section_with_angles(rows: list[dict], *, surveyed_slope: bool, ft: bool = False
-                        ) -> str:
+def section_with_angles(
+    rows: list[dict], *, surveyed_slope: bool, ft: bool = False
+) -> str:
     """Section CSV: x, z, material, surveyed slope (optional) and given theta0.
 
     ``theta0_deg`` is the thesis's restitution angle to the ground for the flight that
@@ -348,8 +430,12 @@ def section_with_angles(rows: list[dict], *, surveyed_slope: bool, ft: bool = Fa
     for i, r in enumerate(rows):
         psi = r["psi_deg"] if surveyed_slope else chord[i]
         theta0 = 180.0 - r["alpha_f_deg"] + psi
-        line = [r["point"], fmt(r["x_m"] * scale, 3 if ft else 2),
-                fmt(r["z_m"] * scale, 3 if ft else 2), r["material"]]
+        line = [
+            r["point"],
+            fmt(r["x_m"] * scale, 3 if ft else 2),
+            fmt(r["z_m"] * scale, 3 if ft else 2),
+            r["material"],
+        ]
         if surveyed_slope:
             line.append("" if not np.isfinite(r["psi_deg"]) else fmt(r["psi_deg"], 1))
         line.append("" if not np.isfinite(theta0) else fmt(theta0, 2))
@@ -360,20 +446,28 @@ def section_with_angles(rows: list[dict], *, surveyed_slope: bool, ft: bool = Fa
 def main() -> None:
     tornado(parse(TABLE_2_4))
     ehime = parse(TABLE_2_3)
-    write(HERE / "ehime" / "cube_section.csv", section_with_angles(ehime,
-                                                                  surveyed_slope=False))
+    write(
+        HERE / "ehime" / "cube_section.csv",
+        section_with_angles(ehime, surveyed_slope=False),
+    )
     write(HERE / "ehime" / "table_2_3_thesis.csv", thesis_csv(ehime))
     asphalt = parse(TABLE_2_5)
-    write(HERE / "asphalt" / "asphalt_section.csv",
-          section_with_angles(asphalt, surveyed_slope=True))
+    write(
+        HERE / "asphalt" / "asphalt_section.csv",
+        section_with_angles(asphalt, surveyed_slope=True),
+    )
     write(HERE / "asphalt" / "table_2_5_thesis.csv", thesis_csv(asphalt))
     kreuger = parse(TABLE_2_2)
-    write(HERE / "kreuger_quarry" / "kreuger_section_ft.csv",
-          section_with_angles(kreuger, surveyed_slope=True, ft=True))
+    write(
+        HERE / "kreuger_quarry" / "kreuger_section_ft.csv",
+        section_with_angles(kreuger, surveyed_slope=True, ft=True),
+    )
     write(HERE / "kreuger_quarry" / "table_2_2_thesis.csv", thesis_csv(kreuger))
     stephen = parse(TABLE_2_1)
-    write(HERE / "mt_stephen" / "stephen_section.csv",
-          section_with_angles(stephen, surveyed_slope=True))
+    write(
+        HERE / "mt_stephen" / "stephen_section.csv",
+        section_with_angles(stephen, surveyed_slope=True),
+    )
     write(HERE / "mt_stephen" / "table_2_1_thesis.csv", thesis_csv(stephen))
 
 

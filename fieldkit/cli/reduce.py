@@ -13,50 +13,112 @@ from fieldkit.errors import ArgumentError
 from fieldkit.impact_table import FORMATS
 from fieldkit.io.atomic import refuse_input_overwrite
 
-FIGURE_NAMES = ("section.png", "en_theta.png", "et_impacts.png",
-                "energy_partition.png", "energy_head.png")
+FIGURE_NAMES = (
+    "section.png",
+    "en_theta.png",
+    "et_impacts.png",
+    "energy_partition.png",
+    "energy_head.png",
+)
 
 
 @one_line_errors
 def reduce(
-    impacts: Annotated[Path | None, typer.Option(
-        "--impacts", help="Impact points in order of travel: GPX waypoints, or CSV of "
-        "x,z (section) / lat,lon,elev / easting,northing,elevation.")] = None,
-    fieldbook: Annotated[Path | None, typer.Option(
-        "--fieldbook", help="Rangefinder field book CSV (point, station, "
-        "instrument_height_m, target_height_m, TruPulse $PLTIT,HV sentence).")] = None,
-    stations: Annotated[Path | None, typer.Option(
-        "--stations", help="GPS stations of the field book (GPX or CSV).")] = None,
-    trees: Annotated[Path | None, typer.Option(
-        "--trees", help="Tree strikes CSV (after_impact, horizontal_distance_m, "
-        "strike_height_m): each fixes its flight exactly (three-point solve).")] = None,
-    theta0: Annotated[float | None, typer.Option(
-        "--theta0", help="Restitution angle to the ground [deg] assumed for flights "
-        "no tree defines (thesis: 32.6 at Tornado Mountain).")] = None,
+    impacts: Annotated[
+        Path | None,
+        typer.Option(
+            "--impacts",
+            help="Impact points in order of travel: GPX waypoints, or CSV of "
+            "x,z (section) / lat,lon,elev / easting,northing,elevation.",
+        ),
+    ] = None,
+    fieldbook: Annotated[
+        Path | None,
+        typer.Option(
+            "--fieldbook",
+            help="Rangefinder field book CSV (point, station, "
+            "instrument_height_m, target_height_m, TruPulse $PLTIT,HV sentence).",
+        ),
+    ] = None,
+    stations: Annotated[
+        Path | None,
+        typer.Option("--stations", help="GPS stations of the field book (GPX or CSV)."),
+    ] = None,
+    trees: Annotated[
+        Path | None,
+        typer.Option(
+            "--trees",
+            help="Tree strikes CSV (after_impact, horizontal_distance_m, "
+            "strike_height_m): each fixes its flight exactly (three-point solve).",
+        ),
+    ] = None,
+    theta0: Annotated[
+        float | None,
+        typer.Option(
+            "--theta0",
+            help="Restitution angle to the ground [deg] assumed for flights "
+            "no tree defines (thesis: 32.6 at Tornado Mountain).",
+        ),
+    ] = None,
     mass: MassOpt = None,
     radius: RadiusOpt = None,
     gyration: GyrationOpt = None,
-    shape: Annotated[str | None, typer.Option(
-        "--shape", help="Body from thesis Table 4-1 instead of --mass/--gyration: "
-        "cube, sphere, cylinder or ellipsoid.")] = None,
-    dimensions: Annotated[str | None, typer.Option(
-        "--dimensions", help="Shape dimensions [m], comma separated: cube L; sphere r "
-        "(radius); cylinder L,r; ellipsoid 2a,2b,2c (full axis lengths).")] = None,
-    unit_weight: Annotated[float | None, typer.Option(
-        "--unit-weight", help="Rock unit weight for --shape [kN/m3] (default 26).")] = None,
-    units: Annotated[str, typer.Option(
-        "--units", help="Length unit of CSV inputs without units in their column "
-        "names: m or ft.")] = "m",
-    path_id: Annotated[str | None, typer.Option(
-        "--path-id", help="Rock / path identifier (default: the input file name).")] = None,
-    declination: Annotated[float, typer.Option(
-        "--declination", help="Magnetic declination [deg, east positive] added to "
-        "field-book azimuths.")] = 0.0,
-    out: Annotated[Path | None, typer.Option(
-        "-o", "--out", help="Output table: .csv, .parquet or .xlsx.")] = None,
-    figures: Annotated[Path | None, typer.Option(
-        "--figures", help="Folder for PNG figures: section, [theta_i-e_N], e_T, "
-        "energy partition, energy head.")] = None,
+    shape: Annotated[
+        str | None,
+        typer.Option(
+            "--shape",
+            help="Body from thesis Table 4-1 instead of --mass/--gyration: "
+            "cube, sphere, cylinder or ellipsoid.",
+        ),
+    ] = None,
+    dimensions: Annotated[
+        str | None,
+        typer.Option(
+            "--dimensions",
+            help="Shape dimensions [m], comma separated: cube L; sphere r "
+            "(radius); cylinder L,r; ellipsoid 2a,2b,2c (full axis lengths).",
+        ),
+    ] = None,
+    unit_weight: Annotated[
+        float | None,
+        typer.Option(
+            "--unit-weight", help="Rock unit weight for --shape [kN/m3] (default 26)."
+        ),
+    ] = None,
+    units: Annotated[
+        str,
+        typer.Option(
+            "--units",
+            help="Length unit of CSV inputs without units in their column "
+            "names: m or ft.",
+        ),
+    ] = "m",
+    path_id: Annotated[
+        str | None,
+        typer.Option(
+            "--path-id", help="Rock / path identifier (default: the input file name)."
+        ),
+    ] = None,
+    declination: Annotated[
+        float,
+        typer.Option(
+            "--declination",
+            help="Magnetic declination [deg, east positive] added to "
+            "field-book azimuths.",
+        ),
+    ] = 0.0,
+    out: Annotated[
+        Path | None,
+        typer.Option("-o", "--out", help="Output table: .csv, .parquet or .xlsx."),
+    ] = None,
+    figures: Annotated[
+        Path | None,
+        typer.Option(
+            "--figures",
+            help="Folder for PNG figures: section, [theta_i-e_N], e_T, "
+            "energy partition, energy head.",
+        ),
+    ] = None,
 ) -> None:
     """Reduce a rockfall survey to a per-impact table (thesis §2, §3, §7.1).
 
@@ -76,33 +138,45 @@ def reduce(
     from fieldkit.reduce.summary import format_summary, summarize
 
     if (impacts is None) == (fieldbook is None):
-        raise ArgumentError("give either --impacts FILE or --fieldbook FILE --stations "
-                            "FILE", source="--impacts" if impacts else "--fieldbook")
+        raise ArgumentError(
+            "give either --impacts FILE or --fieldbook FILE --stations FILE",
+            source="--impacts" if impacts else "--fieldbook",
+        )
     if fieldbook is not None and stations is None:
-        raise ArgumentError("--fieldbook needs --stations (the GPS stations file)",
-                            source="--stations")
+        raise ArgumentError(
+            "--fieldbook needs --stations (the GPS stations file)", source="--stations"
+        )
     if stations is not None and fieldbook is None:
         raise ArgumentError("--stations goes with --fieldbook", source="--stations")
     if units not in ("m", "ft"):
         raise ArgumentError(f"must be m or ft (got {units!r})", source="--units")
     if theta0 is not None and not (math.isfinite(theta0) and 0.0 < theta0 < 180.0):
-        raise ArgumentError(f"must be between 0 and 180 degrees (got {theta0:g})",
-                            source="--theta0")
+        raise ArgumentError(
+            f"must be between 0 and 180 degrees (got {theta0:g})", source="--theta0"
+        )
     if out is None and figures is None:
-        typer.echo("note: no -o/--out or --figures given; printing the summary only",
-                   err=True)
+        typer.echo(
+            "note: no -o/--out or --figures given; printing the summary only", err=True
+        )
     if out is not None and out.suffix.lower() not in FORMATS:
-        raise ArgumentError(f"unknown table format {out.suffix!r}; use one of "
-                            f"{', '.join(FORMATS)}", source=str(out))
+        raise ArgumentError(
+            f"unknown table format {out.suffix!r}; use one of {', '.join(FORMATS)}",
+            source=str(out),
+        )
     inputs = [impacts, fieldbook, stations, trees]
     outputs: list[Path | None] = [out]
     if figures is not None:
         outputs += [figures / name for name in FIGURE_NAMES]
     refuse_input_overwrite(outputs, inputs)
 
-    body = resolve_body(mass_kg=mass, radius_m=radius, gyration_m=gyration, shape=shape,
-                        dimensions_m=parse_dimensions(dimensions),
-                        unit_weight_kn_m3=unit_weight)
+    body = resolve_body(
+        mass_kg=mass,
+        radius_m=radius,
+        gyration_m=gyration,
+        shape=shape,
+        dimensions_m=parse_dimensions(dimensions),
+        unit_weight_kn_m3=unit_weight,
+    )
     if impacts is not None:
         from fieldkit.io.points import read_impacts
 
@@ -111,8 +185,9 @@ def reduce(
     else:
         from fieldkit.io.fieldbook import read_fieldbook
 
-        points = read_fieldbook(fieldbook, stations, declination_deg=declination,
-                                units=units)
+        points = read_fieldbook(
+            fieldbook, stations, declination_deg=declination, units=units
+        )
         name = fieldbook.stem
     tree_set = None
     if trees is not None:
@@ -130,9 +205,12 @@ def reduce(
         from fieldkit.viz.section_figure import write_section_figure
 
         write_section_figure(table, figures / FIGURE_NAMES[0], trees=tree_set)
-        write_restitution_figures(table, figures / FIGURE_NAMES[1],
-                                  figures / FIGURE_NAMES[2])
-        write_energy_figures(table, figures / FIGURE_NAMES[3], figures / FIGURE_NAMES[4])
+        write_restitution_figures(
+            table, figures / FIGURE_NAMES[1], figures / FIGURE_NAMES[2]
+        )
+        write_energy_figures(
+            table, figures / FIGURE_NAMES[3], figures / FIGURE_NAMES[4]
+        )
     typer.echo(f"body: {body.description}")
     typer.echo(format_summary(summarize(table)))
     if out is not None:

@@ -123,8 +123,11 @@ def resolve_body(
                 Body(mass_kg=m, radius_m=r, gyration_m=k)
             except FieldkitError as exc:
                 raise ArgumentError(exc.message, source="--gyration") from None
-        given = [f"{name} {value:g} {unit}" for name, value, unit in
-                 (("m", m, "kg"), ("r", r, "m"), ("k", k, "m")) if math.isfinite(value)]
+        given = [
+            f"{name} {value:g} {unit}"
+            for name, value, unit in (("m", m, "kg"), ("r", r, "m"), ("k", k, "m"))
+            if math.isfinite(value)
+        ]
         text = ", ".join(given) if given else "no body given"
         return BodyProperties(m, r, k, text)
 
@@ -141,17 +144,25 @@ def resolve_body(
             )
     if dimensions_m is None:
         names = ", ".join(SHAPES[name].dimension_names)
-        raise ArgumentError(f"--shape {name} needs --dimensions ({names} in metres)",
-                            source="--shape")
-    gamma = UNIT_WEIGHT_KN_M3 if unit_weight_kn_m3 is None else _check(
-        unit_weight_kn_m3, "--unit-weight")
+        raise ArgumentError(
+            f"--shape {name} needs --dimensions ({names} in metres)", source="--shape"
+        )
+    gamma = (
+        UNIT_WEIGHT_KN_M3
+        if unit_weight_kn_m3 is None
+        else _check(unit_weight_kn_m3, "--unit-weight")
+    )
     r_override = None if radius_m is None else _check(radius_m, "--radius")
     try:
         body = shape_body(name, dimensions_m, gamma, radius_m=r_override)
     except FieldkitError as exc:
-        option = "--radius" if "radius_m" in exc.message and r_override else "--dimensions"
+        option = (
+            "--radius" if "radius_m" in exc.message and r_override else "--dimensions"
+        )
         raise ArgumentError(exc.message, source=option) from None
     dims = " x ".join(f"{d:g}" for d in dimensions_m)
-    text = (f"{name} {dims} m at {gamma:g} kN/m3: m {body.mass_kg:.0f} kg, "
-            f"r {body.radius_m:.3f} m, k {body.gyration_m:.3f} m")
+    text = (
+        f"{name} {dims} m at {gamma:g} kN/m3: m {body.mass_kg:.0f} kg, "
+        f"r {body.radius_m:.3f} m, k {body.gyration_m:.3f} m"
+    )
     return BodyProperties(body.mass_kg, body.radius_m, body.gyration_m, text)

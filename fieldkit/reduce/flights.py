@@ -141,9 +141,14 @@ def solve_flights(
 
     Examples
     --------
-    >>> f = solve_flights(["1", "2"], np.array([0.0, 14.0]), np.array([0.0, -8.0]),
-    ...                   np.array([30.0, 29.7]), theta0_deg=15.0)
-    >>> round(float(f[0].flight.v0_mps), 2), f[0].theta0_source
+    Section 3.3.1: the second flight reaches (14, -8) from a 30° slope with
+    theta0 = 15°; the first (from the source) is the least-speed launch.
+
+    >>> import numpy as np
+    >>> x, z = np.array([0.0, 10.0, 24.0]), np.array([6.0, 0.0, -8.0])
+    >>> f = solve_flights(["0", "1", "2"], x, z, np.array([np.nan, 30.0, 29.7]),
+    ...                   theta0_deg=15.0)
+    >>> round(float(f[1].flight.v0_mps), 2), f[1].theta0_source
     (15.57, 'assumed')
     """
     trees = trees or {}
@@ -158,8 +163,9 @@ def solve_flights(
         if tree is not None:
             flight = _tree_flight(tree, x_m, z_m, j, launch, arrival, trees_source)
             alpha = float(flight.alpha_deg)
-            out.append(SolvedFlight(launch, arrival, alpha, alpha + psi, "tree",
-                                    flight, tree))
+            out.append(
+                SolvedFlight(launch, arrival, alpha, alpha + psi, "tree", flight, tree)
+            )
             continue
         if math.isfinite(given[j]) and math.isfinite(psi):
             theta0, source = float(given[j]), "given"
@@ -217,8 +223,8 @@ def _tree_flight(
     except FieldkitError as exc:
         raise PhysicsError(
             f"tree strike {tree.height_m:.2f} m high, {tree.distance_m:.2f} m after "
-            f"point {launch}: no parabola through points {launch} and {arrival} reaches "
-            f"it ({exc.message})",
+            f"point {launch}: no parabola through points {launch} and {arrival} "
+            f"reaches it ({exc.message})",
             source=trees_source,
             where=tree.where,
         ) from None

@@ -63,8 +63,10 @@ def section_slopes(
 
     Examples
     --------
-    >>> psi, src = section_slopes(np.array([0.0, 10.0, 20.0]), np.array([10.0, 0.0, 0.0]))
-    >>> psi.round(1).tolist(), src
+    >>> import numpy as np
+    >>> x, z = np.array([0.0, 10.0, 20.0]), np.array([10.0, 0.0, 0.0])
+    >>> psi, src = section_slopes(x, z)
+    >>> (psi + 0.0).round(1).tolist(), src
     ([nan, 45.0, 0.0], [None, 'chord', 'chord'])
     """
     x = np.asarray(x_m, float)
@@ -116,8 +118,11 @@ def tree_strikes_by_launch(
         ground = float(row.ground_z_m)
         if not math.isfinite(ground):
             dx = x_m[j + 1] - x_m[j]
-            ground = float(z_m[j] + (z_m[j + 1] - z_m[j]) * distance / dx) if dx > 0 \
+            ground = (
+                float(z_m[j] + (z_m[j + 1] - z_m[j]) * distance / dx)
+                if dx > 0
                 else math.nan
+            )
         if key in out:
             raise InputFileError(
                 f"a second tree strike on the flight after point {key} "
@@ -177,27 +182,35 @@ def impact_rows(
     omega_f = -speed_f / r if math.isfinite(r) else nan.copy()
     omega_i = np.concatenate([[np.nan], omega_f[:-1]])
 
-    out = pd.DataFrame({
-        "path_id": options.path_id,
-        "point": frame["point"].astype(str).to_numpy(),
-        "x_m": frame["x_m"].to_numpy(float),
-        "z_m": frame["z_m"].to_numpy(float),
-        "slope_deg": slope_deg,
-        "material": (frame["material"] if "material" in frame else pd.NA),
-        "mass_kg": body.mass_kg,
-        "radius_m": body.radius_m,
-        "gyration_m": body.gyration_m,
-        "theta0_deg": theta0,
-        "theta0_source": pd.array(theta0_source, dtype="string"),
-        "vi_x_mps": vi_x, "vi_z_mps": vi_z, "vf_x_mps": vf_x, "vf_z_mps": vf_z,
-        "omega_i_radps": omega_i, "omega_f_radps": omega_f,
-        "flight_time_s": t_flight, "flight_length_m": length,
-        "hmax_vertical_m": h_vert, "hmax_normal_m": h_norm,
-        "tree_strike": pd.array(tree_strike, dtype="boolean"),
-        "t_s": t_s,
-        "omega_source": "estimated" if math.isfinite(r) else "none",
-        "slope_source": pd.array(slope_source, dtype="string"),
-    })
+    out = pd.DataFrame(
+        {
+            "path_id": options.path_id,
+            "point": frame["point"].astype(str).to_numpy(),
+            "x_m": frame["x_m"].to_numpy(float),
+            "z_m": frame["z_m"].to_numpy(float),
+            "slope_deg": slope_deg,
+            "material": (frame["material"] if "material" in frame else pd.NA),
+            "mass_kg": body.mass_kg,
+            "radius_m": body.radius_m,
+            "gyration_m": body.gyration_m,
+            "theta0_deg": theta0,
+            "theta0_source": pd.array(theta0_source, dtype="string"),
+            "vi_x_mps": vi_x,
+            "vi_z_mps": vi_z,
+            "vf_x_mps": vf_x,
+            "vf_z_mps": vf_z,
+            "omega_i_radps": omega_i,
+            "omega_f_radps": omega_f,
+            "flight_time_s": t_flight,
+            "flight_length_m": length,
+            "hmax_vertical_m": h_vert,
+            "hmax_normal_m": h_norm,
+            "tree_strike": pd.array(tree_strike, dtype="boolean"),
+            "t_s": t_s,
+            "omega_source": "estimated" if math.isfinite(r) else "none",
+            "slope_source": pd.array(slope_source, dtype="string"),
+        }
+    )
     out["material"] = out["material"].astype("string")
     return out
 
@@ -211,7 +224,9 @@ def add_flight_energy(table: ImpactTable) -> ImpactTable:
     f = table.frame.copy()
     m = f["mass_kg"].to_numpy(float)
     ke_i = kinetic_energy(m, f["vi_mps"].to_numpy(float))
-    ke_f_prev = np.concatenate([[np.nan], kinetic_energy(m, f["vf_mps"].to_numpy(float))[:-1]])
+    ke_f_prev = np.concatenate(
+        [[np.nan], kinetic_energy(m, f["vf_mps"].to_numpy(float))[:-1]]
+    )
     gained = ke_i - ke_f_prev
     same_path = f["path_id"].eq(f["path_id"].shift()).fillna(False).to_numpy(bool)
     f["flight_dke_j"] = np.where(same_path, gained, np.nan)
@@ -253,7 +268,8 @@ def reduce_survey(
     options = options or ReduceOptions(path_id="path")
     if len(frame) < 2:
         raise InputFileError(
-            f"a path needs at least two points (a source and an impact); got {len(frame)}",
+            "a path needs at least two points (a source and an impact); "
+            f"got {len(frame)}",
             source=source,
         )
     x = frame["x_m"].to_numpy(float)
@@ -265,12 +281,19 @@ def reduce_survey(
     names = frame["point"].astype(str).tolist()
     by_launch = tree_strikes_by_launch(trees, names, x, z)
     flights = solve_flights(
-        names, x, z, slope,
-        theta0_deg=options.theta0_deg, given_theta0_deg=given, trees=by_launch,
-        points_source=source, trees_source=getattr(trees, "source", None),
+        names,
+        x,
+        z,
+        slope,
+        theta0_deg=options.theta0_deg,
+        given_theta0_deg=given,
+        trees=by_launch,
+        points_source=source,
+        trees_source=getattr(trees, "source", None),
     )
-    rows = impact_rows(frame, slope, slope_source, flights, options,
-                       trees_given=trees is not None)
+    rows = impact_rows(
+        frame, slope, slope_source, flights, options, trees_given=trees is not None
+    )
     table = ImpactTable(rows, source=source).derive()
     table = add_flight_energy(table)
     # Further per-impact steps (e.g. theoretical impact energies) chain on here.

@@ -56,6 +56,7 @@ def summarize(table: ImpactTable) -> ReductionSummary:
 
     Examples
     --------
+    >>> import numpy as np, pandas as pd
     >>> frame = pd.DataFrame({"path_id": "A", "point": ["1", "2"], "x_m": [0.0, 1.0],
     ...     "z_m": [0.0, -1.0], "slope_deg": [0.0, 45.0], "vi_x_mps": [np.nan, 3.0],
     ...     "vi_z_mps": [np.nan, -4.0], "vf_x_mps": [3.0, 2.0], "vf_z_mps": [0.0, 1.0]})
@@ -64,7 +65,9 @@ def summarize(table: ImpactTable) -> ReductionSummary:
     (1, 'unknown')
     """
     f = table.frame
-    impacts = f[np.isfinite(f["e_n"].to_numpy(float)) | np.isfinite(f["e_t"].to_numpy(float))]
+    impacts = f[
+        np.isfinite(f["e_n"].to_numpy(float)) | np.isfinite(f["e_t"].to_numpy(float))
+    ]
     material = impacts["material"].astype("string").fillna("unknown")
     stats = []
     for name in dict.fromkeys(material.tolist()):
@@ -72,8 +75,16 @@ def summarize(table: ImpactTable) -> ReductionSummary:
         en = part["e_n"].to_numpy(float)
         et = part["e_t"].to_numpy(float)
         en, et = en[np.isfinite(en)], et[np.isfinite(et)]
-        stats.append(MaterialStats(str(name), len(part), float(np.mean(en)), _sd(en),
-                                   float(np.mean(et)), _sd(et)))
+        stats.append(
+            MaterialStats(
+                str(name),
+                len(part),
+                float(np.mean(en)),
+                _sd(en),
+                float(np.mean(et)),
+                _sd(et),
+            )
+        )
     sources = f["theta0_source"].dropna().value_counts()
     potential = 0.0
     for _, path in f.groupby("path_id", sort=False):
@@ -89,7 +100,8 @@ def summarize(table: ImpactTable) -> ReductionSummary:
         by_material=tuple(stats),
         impact_ke_change_j=float(np.nansum(f["dke_j"].to_numpy(float))),
         flight_ke_gain_j=float(np.nansum(f["flight_dke_j"].to_numpy(float)))
-        if "flight_dke_j" in f else float("nan"),
+        if "flight_dke_j" in f
+        else float("nan"),
         potential_released_j=float(potential),
         rotational_change_j=float(re_change),
     )
@@ -101,7 +113,8 @@ def format_summary(summary: ReductionSummary) -> str:
         f"path {', '.join(summary.path_ids)}: {summary.n_points} points, "
         f"{summary.n_impacts} impacts; flights fixed by "
         + ", ".join(f"{k} {v}" for k, v in sorted(summary.flight_sources.items())),
-        f"{'material':<12} {'n':>3}  {'e_n mean':>8} {'sd':>5}  {'e_t mean':>8} {'sd':>5}",
+        f"{'material':<12} {'n':>3}  {'e_n mean':>8} {'sd':>5}  "
+        f"{'e_t mean':>8} {'sd':>5}",
     ]
     for s in summary.by_material:
         lines.append(
@@ -109,8 +122,10 @@ def format_summary(summary: ReductionSummary) -> str:
             f"{s.e_t_mean:8.2f} {s.e_t_sd:5.2f}"
         )
     if np.isfinite(summary.potential_released_j) and summary.potential_released_j:
+        change = summary.impact_ke_change_j / 1e3
+        verb = "lost on impacts" if change <= 0 else "GAINED on impacts"
         lines += [
-            f"energy: lost on impacts {-summary.impact_ke_change_j / 1e3:,.0f} kJ, "
+            f"energy: {verb} {abs(change):,.0f} kJ, "
             f"gained in flights {summary.flight_ke_gain_j / 1e3:,.0f} kJ, "
             f"potential released {summary.potential_released_j / 1e3:,.0f} kJ",
         ]

@@ -48,9 +48,14 @@ def energy_profile(table: ImpactTable, n_samples: int = 30) -> dict[str, np.ndar
         speeds.extend(np.hypot(row.vf_x_mps, row.vf_z_mps - G * t))
         res.extend(np.full(n_samples, row.re_f_j))
     x, z, v = np.asarray(xs), np.asarray(zs), np.asarray(speeds)
-    return {"x_m": x, "z_m": z, "pe_j": m * G * (z - z_stop),
-            "ke_j": kinetic_energy(m, v), "re_j": np.nan_to_num(np.asarray(res)),
-            "head_m": energy_head(z, v)}
+    return {
+        "x_m": x,
+        "z_m": z,
+        "pe_j": m * G * (z - z_stop),
+        "ke_j": kinetic_energy(m, v),
+        "re_j": np.nan_to_num(np.asarray(res)),
+        "head_m": energy_head(z, v),
+    }
 
 
 def plot_energy_partition(table: ImpactTable) -> Figure:
@@ -60,8 +65,14 @@ def plot_energy_partition(table: ImpactTable) -> Figure:
     fig = Figure(figsize=(8.0, 7.0), layout="constrained")
     ax = fig.add_subplot()
     if not np.isfinite(p["pe_j"]).any():
-        ax.text(0.5, 0.5, "no mass given (--mass or --shape):\nno energies to partition",
-                ha="center", va="center", transform=ax.transAxes)
+        ax.text(
+            0.5,
+            0.5,
+            "no mass given (--mass or --shape):\nno energies to partition",
+            ha="center",
+            va="center",
+            transform=ax.transAxes,
+        )
         ax.set_axis_off()
         return fig
     z = p["z_m"]
@@ -69,10 +80,19 @@ def plot_energy_partition(table: ImpactTable) -> Figure:
     total = float(pe[0] + ke[0] + re[0])
     ax.fill_betweenx(z, 0, pe, color="#9ecae1", label="potential energy PE", lw=0)
     ax.fill_betweenx(z, pe, pe + ke, color="#fdae6b", label="kinetic energy KE", lw=0)
-    ax.fill_betweenx(z, pe + ke, pe + ke + re, color="#a1d99b",
-                     label="rotational energy RE", lw=0)
-    ax.fill_betweenx(z, pe + ke + re, total, color="#e0e0e0", hatch="///",
-                     edgecolor="#9e9e9e", label="lost on impacts (cumulative)", lw=0)
+    ax.fill_betweenx(
+        z, pe + ke, pe + ke + re, color="#a1d99b", label="rotational energy RE", lw=0
+    )
+    ax.fill_betweenx(
+        z,
+        pe + ke + re,
+        total,
+        color="#e0e0e0",
+        hatch="///",
+        edgecolor="#9e9e9e",
+        label="lost on impacts (cumulative)",
+        lw=0,
+    )
     ax.plot(pe + ke + re, z, color="black", lw=0.6)
     impacts = f[np.isfinite(f["dke_j"].to_numpy(float))]
     step = max(1, len(impacts) // 12)
@@ -84,8 +104,10 @@ def plot_energy_partition(table: ImpactTable) -> Figure:
     ax.set_ylim(z.min(), z.max())
     ax.set_xlabel("energy [kJ]")
     ax.set_ylabel("elevation [m]")
-    ax.set_title(f"{table.paths()[0]}: energy partition (thesis Fig. 6.5), "
-                 f"m = {f['mass_kg'].iloc[0]:.0f} kg")
+    ax.set_title(
+        f"{table.paths()[0]}: energy partition (thesis Fig. 6.5), "
+        f"m = {f['mass_kg'].iloc[0]:.0f} kg"
+    )
     ax.legend(loc="lower right", fontsize=8)
     return fig
 
@@ -99,8 +121,13 @@ def plot_energy_head(table: ImpactTable) -> Figure:
     x, z = f["x_m"].to_numpy(float), f["z_m"].to_numpy(float)
     ax.fill_between(x, z, z.min() - 5, color="#d9c7a7", alpha=0.6, lw=0)
     ax.plot(x, z, color="#6b4f2a", lw=1.0, label="ground (impact points)")
-    ax.plot(p["x_m"], p["head_m"], color="#c62828", lw=1.3,
-            label=r"energy head $E = z + v^2/2g$ (eq. 6.14)")
+    ax.plot(
+        p["x_m"],
+        p["head_m"],
+        color="#c62828",
+        lw=1.3,
+        label=r"energy head $E = z + v^2/2g$ (eq. 6.14)",
+    )
     ax.plot(p["x_m"], p["z_m"], color="#1f4e9c", lw=0.7, ls="--", label="flight paths")
     head_i = energy_head(z, f["vi_mps"].to_numpy(float))
     ax.plot(x, head_i, "v", color="#c62828", ms=3.5, label="before impact")
@@ -121,5 +148,7 @@ def write_energy_figures(
 
     Without a mass the partition diagram has no energies; the energy head needs none.
     """
-    return (save_png(plot_energy_partition(table), partition_path),
-            save_png(plot_energy_head(table), head_path))
+    return (
+        save_png(plot_energy_partition(table), partition_path),
+        save_png(plot_energy_head(table), head_path),
+    )

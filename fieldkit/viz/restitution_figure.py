@@ -23,13 +23,22 @@ from fieldkit.viz.figure_files import save_png
 #: Eq. 5.4 (thesis Fig. 5.7): e_N = a * theta_i**(-b), theta_i in degrees.
 THESIS_EN_LAW = (19.5, 1.03)
 
-MARKERS = {"rock": "s", "talus": "^", "colluvium": "o", "asphalt": "D",
-           "concrete": "v", "bench": "P"}
+MARKERS = {
+    "rock": "s",
+    "talus": "^",
+    "colluvium": "o",
+    "asphalt": "D",
+    "concrete": "v",
+    "bench": "P",
+}
 
 
 def _groups(material: Sequence[str] | None, n: int) -> tuple[np.ndarray, list[str]]:
-    labels = np.array(["all impacts"] * n if material is None else
-                      ["unknown" if m is None or m != m else str(m) for m in material])
+    labels = np.array(
+        ["all impacts"] * n
+        if material is None
+        else ["unknown" if m is None or m != m else str(m) for m in material]
+    )
     return labels, list(dict.fromkeys(labels.tolist()))
 
 
@@ -76,14 +85,26 @@ def plot_en_theta(
     fig, ax = _figure()
     for name in names:
         sel = ok & (labels == name)
-        ax.scatter(theta[sel], en[sel], marker=MARKERS.get(name, "o"), s=28,
-                   edgecolor="black", linewidth=0.5, label=f"{name} ({sel.sum()})",
-                   zorder=3)
+        ax.scatter(
+            theta[sel],
+            en[sel],
+            marker=MARKERS.get(name, "o"),
+            s=28,
+            edgecolor="black",
+            linewidth=0.5,
+            label=f"{name} ({sel.sum()})",
+            zorder=3,
+        )
     if law is not None:
         a, b = law
         t = np.linspace(3.0, 90.0, 300)
-        ax.plot(t, a * t ** (-b), color="black", lw=1.2,
-                label=law_label or f"eq. 5.4: $e_N$ = {a:g}·$\\theta_i^{{-{b:g}}}$")
+        ax.plot(
+            t,
+            a * t ** (-b),
+            color="black",
+            lw=1.2,
+            label=law_label or f"eq. 5.4: $e_N$ = {a:g}·$\\theta_i^{{-{b:g}}}$",
+        )
     top = np.nanmax(en[ok]) if ok.any() else 2.0
     ax.set_xlim(0, 90)
     ax.set_ylim(0, max(2.0, min(top * 1.1, 8.0)))
@@ -114,17 +135,28 @@ def plot_et_impacts(
         Slope material per impact; the legend gives each material's mean e_T.
     """
     et = np.asarray(e_t, float)
-    number = (np.arange(1, len(et) + 1) if impact_number is None
-              else np.asarray(impact_number, float))
+    number = (
+        np.arange(1, len(et) + 1)
+        if impact_number is None
+        else np.asarray(impact_number, float)
+    )
     ok = np.isfinite(et)
     labels, names = _groups(material, len(et))
     fig, ax = _figure()
     for name in names:
         sel = ok & (labels == name)
         mean = float(np.mean(et[sel])) if sel.any() else float("nan")
-        ax.plot(number[sel], et[sel], marker=MARKERS.get(name, "o"), ls="-", lw=0.6,
-                ms=5, mec="black", mew=0.5,
-                label=f"{name}: {sel.sum()} impacts, mean $e_T$ = {mean:.2f}")
+        ax.plot(
+            number[sel],
+            et[sel],
+            marker=MARKERS.get(name, "o"),
+            ls="-",
+            lw=0.6,
+            ms=5,
+            mec="black",
+            mew=0.5,
+            label=f"{name}: {sel.sum()} impacts, mean $e_T$ = {mean:.2f}",
+        )
     ax.axhline(1.0, color="0.5", lw=0.8, ls=":")
     ax.set_ylim(0, max(1.4, float(np.nanmax(et)) * 1.1 if ok.any() else 1.4))
     ax.set_xlabel("impact (calculation #)")
@@ -143,12 +175,24 @@ def write_restitution_figures(
 ) -> tuple[Path, Path]:
     """Write the Fig. 5.7 and Fig. 5.8 PNGs of an ImpactTable's impacts."""
     f = table.frame
-    impacts = f[np.isfinite(f["e_n"].to_numpy(float)) | np.isfinite(f["e_t"].to_numpy(float))]
-    material = impacts["material"].astype(object).where(impacts["material"].notna(), None)
+    impacts = f[
+        np.isfinite(f["e_n"].to_numpy(float)) | np.isfinite(f["e_t"].to_numpy(float))
+    ]
+    material = (
+        impacts["material"].astype(object).where(impacts["material"].notna(), None)
+    )
     mat = None if impacts["material"].isna().all() else material.tolist()
     name = ", ".join(table.paths())
-    en_fig = plot_en_theta(impacts["theta_i_deg"], impacts["e_n"], material=mat, law=law,
-                           title=f"{name}: [θi - eN] with eq. 5.4 (thesis Fig. 5.7)")
-    et_fig = plot_et_impacts(impacts["e_t"], material=mat,
-                             title=f"{name}: $e_T$ per impact (thesis Fig. 5.8)")
+    en_fig = plot_en_theta(
+        impacts["theta_i_deg"],
+        impacts["e_n"],
+        material=mat,
+        law=law,
+        title=f"{name}: [θi - eN] with eq. 5.4 (thesis Fig. 5.7)",
+    )
+    et_fig = plot_et_impacts(
+        impacts["e_t"],
+        material=mat,
+        title=f"{name}: $e_T$ per impact (thesis Fig. 5.8)",
+    )
     return save_png(en_fig, en_path), save_png(et_fig, et_path)

@@ -44,7 +44,9 @@ def detail_row(table: ImpactTable) -> int | None:
     fixed, the one with the steepest restitution (thesis: #A26, θ0 = 62°); else the
     impact with the largest theta_f."""
     f = table.frame
-    ok = np.isfinite(f["e_n"].to_numpy(float)) & np.isfinite(f["theta_f_deg"].to_numpy(float))
+    ok = np.isfinite(f["e_n"].to_numpy(float)) & np.isfinite(
+        f["theta_f_deg"].to_numpy(float)
+    )
     if not ok.any():
         return None
     theta_f = np.where(ok, f["theta_f_deg"].to_numpy(float), -np.inf)
@@ -54,7 +56,9 @@ def detail_row(table: ImpactTable) -> int | None:
     return int(np.argmax(theta_f))
 
 
-def _trees_xy(table: ImpactTable, trees: object | None) -> list[tuple[float, float, float]]:
+def _trees_xy(
+    table: ImpactTable, trees: object | None
+) -> list[tuple[float, float, float]]:
     """(x, ground z, strike z) of each tree strike."""
     if trees is None:
         return []
@@ -65,7 +69,9 @@ def _trees_xy(table: ImpactTable, trees: object | None) -> list[tuple[float, flo
         if key not in f.index:
             continue
         x = float(f.loc[key, "x_m"]) + float(row.horizontal_distance_m)
-        out.append((x, float(row.ground_z_m), float(row.ground_z_m + row.strike_height_m)))
+        out.append(
+            (x, float(row.ground_z_m), float(row.ground_z_m + row.strike_height_m))
+        )
     return out
 
 
@@ -89,21 +95,32 @@ def plot_section(table: ImpactTable, trees: object | None = None) -> Figure:
     step = max(1, len(f) // 15)
     for i, row in enumerate(f.itertuples(index=False)):
         if i % step == 0 or i == len(f) - 1:
-            ax.annotate(str(row.point), (row.x_m, row.z_m), textcoords="offset points",
-                        xytext=(4, 5), fontsize=7, color=IMPACT_COLOUR)
+            ax.annotate(
+                str(row.point),
+                (row.x_m, row.z_m),
+                textcoords="offset points",
+                xytext=(4, 5),
+                fontsize=7,
+                color=IMPACT_COLOUR,
+            )
     tree_xy = _trees_xy(table, trees)
     if tree_xy:
         span = np.ptp(z) * 0.035
         for xt, zg, zs in tree_xy:
-            ax.annotate("", xy=(xt, zs), xytext=(xt, zs + span),
-                        arrowprops={"arrowstyle": "->", "color": TREE_COLOUR, "lw": 1.2})
+            ax.annotate(
+                "",
+                xy=(xt, zs),
+                xytext=(xt, zs + span),
+                arrowprops={"arrowstyle": "->", "color": TREE_COLOUR, "lw": 1.2},
+            )
             ax.plot([xt, xt], [zg, zs], color=TREE_COLOUR, lw=1.5)
         ax.plot([], [], color=TREE_COLOUR, lw=1.5, label="broken tree (strike ↓)")
     ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("x, horizontal distance along the path [m]")
     ax.set_ylabel("z, elevation [m]")
-    ax.set_title(f"{', '.join(table.paths())}: mapped impact points "
-                 f"({len(f)}) and trajectories")
+    ax.set_title(
+        f"{', '.join(table.paths())}: mapped impact points ({len(f)}) and trajectories"
+    )
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper right", fontsize=8)
 
@@ -125,39 +142,73 @@ def _draw_detail(ax: Axes, row, f, i: int) -> None:
     vf = np.array([row.vf_x_mps, row.vf_z_mps])
     scale = 1.0 / max(np.hypot(*vi), np.hypot(*vf))  # longest vector = 1 unit
     ground = np.array([p - 1.4 * tangent, p + 1.4 * tangent])
-    ax.fill([*ground[:, 0], ground[1, 0], ground[0, 0]],
-            [*ground[:, 1], ground[1, 1] - 0.5, ground[0, 1] - 0.5],
-            color="#d9c7a7", alpha=0.6, lw=0)
+    ax.fill(
+        [*ground[:, 0], ground[1, 0], ground[0, 0]],
+        [*ground[:, 1], ground[1, 1] - 0.5, ground[0, 1] - 0.5],
+        color="#d9c7a7",
+        alpha=0.6,
+        lw=0,
+    )
     ax.plot(ground[:, 0], ground[:, 1], color="#6b4f2a", lw=1.5)
 
     def arrow(start, vec, colour, style="-", width=2.0):
-        ax.annotate("", xy=start + vec, xytext=start,
-                    arrowprops={"arrowstyle": "-|>", "color": colour, "lw": width,
-                                "linestyle": style, "shrinkA": 0, "shrinkB": 0})
+        ax.annotate(
+            "",
+            xy=start + vec,
+            xytext=start,
+            arrowprops={
+                "arrowstyle": "-|>",
+                "color": colour,
+                "lw": width,
+                "linestyle": style,
+                "shrinkA": 0,
+                "shrinkB": 0,
+            },
+        )
 
     vi_s, vf_s = vi * scale, vf * scale
     arrow(p - vi_s, vi_s, IMPACT_COLOUR)
     arrow(p, vf_s, FLIGHT_COLOUR)
-    comps = ((p - vi_s, float(row.vit_mps) * scale * tangent, IMPACT_COLOUR),
-             (p - float(row.vin_mps) * scale * normal,
-              float(row.vin_mps) * scale * normal, IMPACT_COLOUR),
-             (p, float(row.vft_mps) * scale * tangent, FLIGHT_COLOUR),
-             (p, float(row.vfn_mps) * scale * normal, FLIGHT_COLOUR))
+    comps = (
+        (p - vi_s, float(row.vit_mps) * scale * tangent, IMPACT_COLOUR),
+        (
+            p - float(row.vin_mps) * scale * normal,
+            float(row.vin_mps) * scale * normal,
+            IMPACT_COLOUR,
+        ),
+        (p, float(row.vft_mps) * scale * tangent, FLIGHT_COLOUR),
+        (p, float(row.vfn_mps) * scale * normal, FLIGHT_COLOUR),
+    )
     for start, vec, colour in comps:
         arrow(start, vec, colour, style=(0, (3, 2)), width=1.0)
-    ax.text(*(p - vi_s + 0.08 * normal), f"$v_i$ = {row.vi_mps:.1f} m/s\n"
-            f"$\\theta_i$ = {row.theta_i_deg:.0f}°", color=IMPACT_COLOUR, fontsize=9,
-            ha="right", va="bottom")
-    ax.text(*(p + vf_s + 0.06 * tangent), f"$v_f$ = {row.vf_mps:.1f} m/s\n"
-            f"$\\theta_f$ = {row.theta_f_deg:.0f}°", color=FLIGHT_COLOUR, fontsize=9,
-            ha="left", va="center")
-    ax.text(0.03, 0.04,
-            f"$v_{{iN}}$ = {row.vin_mps:.1f}, $v_{{iT}}$ = {row.vit_mps:.1f} m/s\n"
-            f"$v_{{fN}}$ = {row.vfn_mps:.1f}, $v_{{fT}}$ = {row.vft_mps:.1f} m/s\n"
-            f"$e_N$ = {row.e_n:.2f}, $e_T$ = {row.e_t:.2f}\n"
-            f"ψ = {row.slope_deg:.1f}° ({row.theta0_source} θ0)",
-            transform=ax.transAxes, fontsize=9, va="bottom",
-            bbox={"boxstyle": "round", "fc": "white", "ec": "0.7"})
+    ax.text(
+        *(p - vi_s + 0.08 * normal),
+        f"$v_i$ = {row.vi_mps:.1f} m/s\n$\\theta_i$ = {row.theta_i_deg:.0f}°",
+        color=IMPACT_COLOUR,
+        fontsize=9,
+        ha="right",
+        va="bottom",
+    )
+    ax.text(
+        *(p + vf_s + 0.06 * tangent),
+        f"$v_f$ = {row.vf_mps:.1f} m/s\n$\\theta_f$ = {row.theta_f_deg:.0f}°",
+        color=FLIGHT_COLOUR,
+        fontsize=9,
+        ha="left",
+        va="center",
+    )
+    ax.text(
+        0.03,
+        0.04,
+        f"$v_{{iN}}$ = {row.vin_mps:.1f}, $v_{{iT}}$ = {row.vit_mps:.1f} m/s\n"
+        f"$v_{{fN}}$ = {row.vfn_mps:.1f}, $v_{{fT}}$ = {row.vft_mps:.1f} m/s\n"
+        f"$e_N$ = {row.e_n:.2f}, $e_T$ = {row.e_t:.2f}\n"
+        f"ψ = {row.slope_deg:.1f}° ({row.theta0_source} θ0)",
+        transform=ax.transAxes,
+        fontsize=9,
+        va="bottom",
+        bbox={"boxstyle": "round", "fc": "white", "ec": "0.7"},
+    )
     ax.set_aspect("equal")
     ax.set_xlim(p[0] - 1.7, p[0] + 1.7)
     ax.set_ylim(p[1] - 1.6, p[1] + 1.3)

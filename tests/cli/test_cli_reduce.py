@@ -44,9 +44,22 @@ def test_help_has_a_runnable_example(cli):
     result = cli("reduce", "--help")
     assert result.exit_code == 0
     text = " ".join(result.stdout.split())
-    assert "fieldkit reduce --impacts surveys/tornado_mountain/boulder_a_impacts.gpx" in text
-    for option in ("--fieldbook", "--stations", "--trees", "--theta0", "--shape",
-                   "--units", "--path-id", "--declination", "--figures", "--out"):
+    assert (
+        "fieldkit reduce --impacts surveys/tornado_mountain/boulder_a_impacts.gpx"
+        in text
+    )
+    for option in (
+        "--fieldbook",
+        "--stations",
+        "--trees",
+        "--theta0",
+        "--shape",
+        "--units",
+        "--path-id",
+        "--declination",
+        "--figures",
+        "--out",
+    ):
         assert option in text
 
 
@@ -54,8 +67,18 @@ def test_help_has_a_runnable_example(cli):
 def test_every_output_format(cli, survey, tmp_path, suffix):
     impacts, trees = survey
     out = tmp_path / f"table{suffix}"
-    result = cli("reduce", "--impacts", impacts, "--trees", trees, "--theta0", "30",
-                 *BODY, "-o", out)
+    result = cli(
+        "reduce",
+        "--impacts",
+        impacts,
+        "--trees",
+        trees,
+        "--theta0",
+        "30",
+        *BODY,
+        "-o",
+        out,
+    )
     assert result.exit_code == 0, result.stderr
     table = ImpactTable.read(out).frame
     assert table["point"].tolist() == ["P0", "P1", "P2", "P3", "P4"]
@@ -70,12 +93,31 @@ def test_every_output_format(cli, survey, tmp_path, suffix):
 def test_figures_are_written(cli, survey, tmp_path):
     impacts, trees = survey
     figures = tmp_path / "figs"
-    result = cli("reduce", "--impacts", impacts, "--trees", trees, "--theta0", "30",
-                 *BODY, "--figures", figures, "-o", tmp_path / "t.csv")
+    result = cli(
+        "reduce",
+        "--impacts",
+        impacts,
+        "--trees",
+        trees,
+        "--theta0",
+        "30",
+        *BODY,
+        "--figures",
+        figures,
+        "-o",
+        tmp_path / "t.csv",
+    )
     assert result.exit_code == 0, result.stderr
     names = sorted(p.name for p in figures.iterdir())
-    assert names == sorted(["section.png", "en_theta.png", "et_impacts.png",
-                            "energy_partition.png", "energy_head.png"])
+    assert names == sorted(
+        [
+            "section.png",
+            "en_theta.png",
+            "et_impacts.png",
+            "energy_partition.png",
+            "energy_head.png",
+        ]
+    )
     for p in figures.iterdir():
         assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and p.stat().st_size > 10_000
 
@@ -83,9 +125,21 @@ def test_figures_are_written(cli, survey, tmp_path):
 def test_shape_option_gives_the_table_4_1_body(cli, survey, tmp_path):
     impacts, _ = survey
     out = tmp_path / "t.csv"
-    result = cli("reduce", "--impacts", impacts, "--theta0", "30", "--shape",
-                 "ellipsoid", "--dimensions", "1.6,1.3,1.3", "--unit-weight", "26",
-                 "-o", out)
+    result = cli(
+        "reduce",
+        "--impacts",
+        impacts,
+        "--theta0",
+        "30",
+        "--shape",
+        "ellipsoid",
+        "--dimensions",
+        "1.6,1.3,1.3",
+        "--unit-weight",
+        "26",
+        "-o",
+        out,
+    )
     assert result.exit_code == 0, result.stderr
     t = pd.read_csv(out)
     assert t["mass_kg"].iloc[0] == pytest.approx(3752, abs=1)  # Table 4-1: ~3750 kg
@@ -97,7 +151,9 @@ def test_units_ft_converts_at_the_edge(cli, tmp_path):
     feet = tmp_path / "feet.csv"
     feet.write_text("point,x,z\nP0,0,328.084\nP1,32.8084,308.399\nP2,65.6168,288.714\n")
     out = tmp_path / "t.csv"
-    result = cli("reduce", "--impacts", feet, "--units", "ft", "--theta0", "30", "-o", out)
+    result = cli(
+        "reduce", "--impacts", feet, "--units", "ft", "--theta0", "30", "-o", out
+    )
     assert result.exit_code == 0, result.stderr
     t = pd.read_csv(out)
     assert t["x_m"].tolist() == pytest.approx([0.0, 10.0, 20.0], abs=1e-4)
@@ -109,12 +165,24 @@ def test_tree_strike_no_parabola_can_reach(cli, survey, tmp_path):
     """A strike below the chord between the impacts: no downward parabola."""
     impacts, _ = survey
     trees = tmp_path / "low_tree.csv"
-    trees.write_text("after_impact,horizontal_distance_m,strike_height_m,ground_z_m\n"
-                     "P2,5.0,1.0,80.0\n")  # strike at 81 m, chord there at 85 m
+    trees.write_text(
+        "after_impact,horizontal_distance_m,strike_height_m,ground_z_m\n"
+        "P2,5.0,1.0,80.0\n"
+    )  # strike at 81 m, chord there at 85 m
     before = digest(trees), digest(impacts)
     out = tmp_path / "t.csv"
-    result = cli("reduce", "--impacts", impacts, "--trees", trees, "--theta0", "30",
-                 *BODY, "-o", out)
+    result = cli(
+        "reduce",
+        "--impacts",
+        impacts,
+        "--trees",
+        trees,
+        "--theta0",
+        "30",
+        *BODY,
+        "-o",
+        out,
+    )
     fails(result, "low_tree.csv", "row 2", "P2", "no parabola")
     assert not out.exists()
     assert (digest(trees), digest(impacts)) == before
@@ -138,12 +206,47 @@ def test_uphill_flight_no_ballistic_path_makes(cli, tmp_path):
         (("--impacts", "{impacts}", "--theta0", "-5"), ("--theta0",)),
         (("--impacts", "{impacts}", "--theta0", "30", "--units", "yd"), ("--units",)),
         (("--impacts", "{impacts}", "--theta0", "30", "--mass", "-1"), ("--mass",)),
-        (("--impacts", "{impacts}", "--theta0", "30", "--shape", "ellipsoid",
-          "--dimensions", "1.6,1.3,1.3", "--mass", "10"), ("--mass",)),
-        (("--impacts", "{impacts}", "--theta0", "30", "--shape", "egg",
-          "--dimensions", "1"), ("--shape", "egg")),
-        (("--impacts", "{impacts}", "--theta0", "30", "--shape", "cube",
-          "--dimensions", "1,x"), ("--dimensions",)),
+        (
+            (
+                "--impacts",
+                "{impacts}",
+                "--theta0",
+                "30",
+                "--shape",
+                "ellipsoid",
+                "--dimensions",
+                "1.6,1.3,1.3",
+                "--mass",
+                "10",
+            ),
+            ("--mass",),
+        ),
+        (
+            (
+                "--impacts",
+                "{impacts}",
+                "--theta0",
+                "30",
+                "--shape",
+                "egg",
+                "--dimensions",
+                "1",
+            ),
+            ("--shape", "egg"),
+        ),
+        (
+            (
+                "--impacts",
+                "{impacts}",
+                "--theta0",
+                "30",
+                "--shape",
+                "cube",
+                "--dimensions",
+                "1,x",
+            ),
+            ("--dimensions",),
+        ),
         (("--impacts", "{impacts}"), ("impacts.csv", "point P1", "--theta0")),
     ],
 )
@@ -185,11 +288,13 @@ def test_empty_and_binary_inputs(cli, tmp_path):
 def test_two_tree_strikes_on_one_flight(cli, survey, tmp_path):
     impacts, _ = survey
     trees = tmp_path / "two.csv"
-    trees.write_text("after_impact,horizontal_distance_m,strike_height_m\n"
-                     "P1,4.0,1.0\nP1,6.0,1.1\n")
+    trees.write_text(
+        "after_impact,horizontal_distance_m,strike_height_m\nP1,4.0,1.0\nP1,6.0,1.1\n"
+    )
     out = tmp_path / "t.csv"
-    result = cli("reduce", "--impacts", impacts, "--trees", trees, "--theta0", "30",
-                 "-o", out)
+    result = cli(
+        "reduce", "--impacts", impacts, "--trees", trees, "--theta0", "30", "-o", out
+    )
     fails(result, "two.csv", "row 3", "P1")
     assert not out.exists()
 
@@ -199,8 +304,9 @@ def test_tree_after_unknown_impact(cli, survey, tmp_path):
     trees = tmp_path / "unknown.csv"
     trees.write_text("after_impact,horizontal_distance_m,strike_height_m\nQ9,4.0,1.0\n")
     out = tmp_path / "t.csv"
-    result = cli("reduce", "--impacts", impacts, "--trees", trees, "--theta0", "30",
-                 "-o", out)
+    result = cli(
+        "reduce", "--impacts", impacts, "--trees", trees, "--theta0", "30", "-o", out
+    )
     fails(result, "unknown.csv", "Q9")
     assert not out.exists()
 
@@ -209,6 +315,9 @@ def test_duplicated_point(cli, tmp_path):
     impacts = tmp_path / "dup.csv"
     impacts.write_text("point,x_m,z_m\nP0,0,100\nP1,10,94\nP1,20,88\n")
     out = tmp_path / "t.csv"
-    fails(cli("reduce", "--impacts", impacts, "--theta0", "30", "-o", out),
-          "dup.csv", "P1")
+    fails(
+        cli("reduce", "--impacts", impacts, "--theta0", "30", "-o", out),
+        "dup.csv",
+        "P1",
+    )
     assert not out.exists()

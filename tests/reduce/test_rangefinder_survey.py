@@ -23,9 +23,11 @@ DECLINATION = 14.2
 def both(repo):
     folder = repo / "surveys" / "tornado_mountain"
     gpx = read_impacts(folder / "boulder_a_impacts.gpx").frame
-    book = read_fieldbook(folder / "boulder_a_fieldbook.csv",
-                          folder / "boulder_a_stations.gpx",
-                          declination_deg=DECLINATION).frame
+    book = read_fieldbook(
+        folder / "boulder_a_fieldbook.csv",
+        folder / "boulder_a_stations.gpx",
+        declination_deg=DECLINATION,
+    ).frame
     return gpx, book
 
 
@@ -36,8 +38,9 @@ def test_same_points_in_the_same_order(both):
 
 def test_positions_within_0_15_m(both):
     gpx, book = both
-    plan, _, _ = geodesic_inverse(gpx["lat_deg"], gpx["lon_deg"], book["lat_deg"],
-                                  book["lon_deg"])
+    plan, _, _ = geodesic_inverse(
+        gpx["lat_deg"], gpx["lon_deg"], book["lat_deg"], book["lon_deg"]
+    )
     assert plan.max() < 0.15
     assert np.abs(book["z_m"] - gpx["z_m"]).max() < 0.15
     assert np.abs(book["x_m"] - gpx["x_m"]).max() < 0.15
@@ -47,23 +50,49 @@ def test_without_declination_the_positions_are_wrong(both, repo):
     """The declination matters: ignoring it swings every shot by 14°."""
     gpx, _ = both
     folder = repo / "surveys" / "tornado_mountain"
-    raw = read_fieldbook(folder / "boulder_a_fieldbook.csv",
-                         folder / "boulder_a_stations.gpx").frame
-    plan, _, _ = geodesic_inverse(gpx["lat_deg"], gpx["lon_deg"], raw["lat_deg"],
-                                  raw["lon_deg"])
+    raw = read_fieldbook(
+        folder / "boulder_a_fieldbook.csv", folder / "boulder_a_stations.gpx"
+    ).frame
+    plan, _, _ = geodesic_inverse(
+        gpx["lat_deg"], gpx["lon_deg"], raw["lat_deg"], raw["lon_deg"]
+    )
     assert plan.max() > 5.0
 
 
 def test_reduction_from_the_field_book_matches_the_gpx_one(cli, repo, tmp_path):
     folder = repo / "surveys" / "tornado_mountain"
-    common = ["--trees", folder / "boulder_a_trees.csv", "--theta0", "32.6",
-              "--mass", "3750", "--radius", "0.725", "--gyration", "0.46"]
-    from_book = cli("reduce", "--fieldbook", folder / "boulder_a_fieldbook.csv",
-                    "--stations", folder / "boulder_a_stations.gpx",
-                    "--declination", str(DECLINATION), *common,
-                    "-o", tmp_path / "book.csv")
-    from_gpx = cli("reduce", "--impacts", folder / "boulder_a_impacts.gpx", *common,
-                   "-o", tmp_path / "gpx.csv")
+    common = [
+        "--trees",
+        folder / "boulder_a_trees.csv",
+        "--theta0",
+        "32.6",
+        "--mass",
+        "3750",
+        "--radius",
+        "0.725",
+        "--gyration",
+        "0.46",
+    ]
+    from_book = cli(
+        "reduce",
+        "--fieldbook",
+        folder / "boulder_a_fieldbook.csv",
+        "--stations",
+        folder / "boulder_a_stations.gpx",
+        "--declination",
+        str(DECLINATION),
+        *common,
+        "-o",
+        tmp_path / "book.csv",
+    )
+    from_gpx = cli(
+        "reduce",
+        "--impacts",
+        folder / "boulder_a_impacts.gpx",
+        *common,
+        "-o",
+        tmp_path / "gpx.csv",
+    )
     assert from_book.exit_code == 0, from_book.stderr
     assert from_gpx.exit_code == 0, from_gpx.stderr
     a = pd.read_csv(tmp_path / "gpx.csv")

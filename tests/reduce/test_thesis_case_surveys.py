@@ -33,7 +33,7 @@ def reduce_section(path, mass_kg):
 
 
 def test_asphalt_impact_2(repo):
-    """Table 2-5 #2 (asphalt, psi 0): e_N 0.38, e_T 0.24; §2.3: V_i 21.5, theta_i 50°."""
+    """Table 2-5 #2 (asphalt, psi 0): e_N 0.38, e_T 0.24; §2.3: V_i 21.5, 50°."""
     t = reduce_section(repo / "surveys" / "asphalt" / "asphalt_section.csv", 500)
     row = t.loc["2"]
     assert row["e_n"] == pytest.approx(0.38, abs=0.005)
@@ -47,8 +47,9 @@ def test_asphalt_impact_2(repo):
 
 def test_kreuger_ditch_impact_3_from_a_feet_survey(repo):
     """Table 2-2 #3 (ditch, psi 0): e_N 0.24, e_T 0.55; the file is in feet."""
-    t = reduce_section(repo / "surveys" / "kreuger_quarry" / "kreuger_section_ft.csv",
-                       580)
+    t = reduce_section(
+        repo / "surveys" / "kreuger_quarry" / "kreuger_section_ft.csv", 580
+    )
     assert t.loc["ditch", "x_m"] == pytest.approx(6.25, abs=1e-3)
     assert t.loc["ditch", "e_n"] == pytest.approx(0.24, abs=0.005)
     assert t.loc["ditch", "e_t"] == pytest.approx(0.55, abs=0.005)
@@ -68,7 +69,15 @@ def test_every_survey_reduces_from_the_command_line(cli, repo, tmp_path):
     }
     for name, body in surveys.items():
         out = tmp_path / (name.replace("/", "_") + ".csv")
-        result = cli("reduce", "--impacts", repo / "surveys" / name, "--theta0", "30",
-                     *body, "-o", out)
+        result = cli(
+            "reduce",
+            "--impacts",
+            repo / "surveys" / name,
+            "--theta0",
+            "30",
+            *body,
+            "-o",
+            out,
+        )
         assert result.exit_code == 0, (name, result.stderr)
         assert len(pd.read_csv(out)) == len(pd.read_csv(repo / "surveys" / name))

@@ -83,10 +83,10 @@ TYPOS = {"22", "23", "32", "33"}
 NOT_REPRODUCIBLE_KE = {
     **dict.fromkeys(TYPOS, "coordinate typo in Table 2-4 (THESIS-NOTES errata)"),
     "B": "thesis uses free fall from rest, sqrt(2 g 34 m) = 25.8 m/s, at B; no "
-         "ballistic path from rest reaches a point 8 m out (least-speed path: -615 kJ "
-         "vs -597 kJ printed)",
+    "ballistic path from rest reaches a point 8 m out (least-speed path: -615 kJ "
+    "vs -597 kJ printed)",
     "27": "a 6 kJ loss, the difference of two ~185 kJ energies: rounding alpha_f to "
-          "0.1° moves it between -5.8 and -6.4 kJ, wider than 1 %",
+    "0.1° moves it between -5.8 and -6.4 kJ, wider than 1 %",
     "44": "no KE loss printed",
 }
 NOT_REPRODUCIBLE_ET = {
@@ -96,7 +96,7 @@ NOT_REPRODUCIBLE_ET = {
     "42": "recomputes to 1.15 vs 1.22 printed (insensitive to rounding)",
     "43": "recomputes to 0.64 vs 0.73 printed (insensitive to rounding)",
     "44": "recomputes to 0.87 vs 0.12 printed: the last flight (44 -> stop at 45) "
-          "is not the one the spreadsheet used",
+    "is not the one the spreadsheet used",
 }
 NOT_REPRODUCIBLE_EN = {
     **dict.fromkeys(TYPOS, "coordinate typo in Table 2-4"),
@@ -120,9 +120,16 @@ def thesis_rows() -> pd.DataFrame:
     rows = []
     for line in TABLE_2_4.strip().splitlines():
         p, af, psi, en, et, dke = line.split()
-        rows.append({"point": p, "alpha_f": float(af), "psi": float(psi),
-                     "e_n": float(en), "e_t": float(et),
-                     "dke": math.nan if dke == "-" else float(dke)})
+        rows.append(
+            {
+                "point": p,
+                "alpha_f": float(af),
+                "psi": float(psi),
+                "e_n": float(en),
+                "e_t": float(et),
+                "dke": math.nan if dke == "-" else float(dke),
+            }
+        )
     return pd.DataFrame(rows).set_index("point")
 
 
@@ -133,11 +140,26 @@ def reduced(repo, tmp_path_factory) -> pd.DataFrame:
 
     out = tmp_path_factory.mktemp("tornado") / "t.csv"
     folder = repo / "surveys" / "tornado_mountain"
-    result = CliRunner().invoke(app, [
-        "reduce", "--impacts", str(folder / "boulder_a_impacts.gpx"),
-        "--trees", str(folder / "boulder_a_trees.csv"), "--theta0", "32.6",
-        "--mass", "3750", "--radius", "0.725", "--gyration", "0.46", "-o", str(out),
-    ])
+    result = CliRunner().invoke(
+        app,
+        [
+            "reduce",
+            "--impacts",
+            str(folder / "boulder_a_impacts.gpx"),
+            "--trees",
+            str(folder / "boulder_a_trees.csv"),
+            "--theta0",
+            "32.6",
+            "--mass",
+            "3750",
+            "--radius",
+            "0.725",
+            "--gyration",
+            "0.46",
+            "-o",
+            str(out),
+        ],
+    )
     assert result.exit_code == 0, result.stderr
     return pd.read_csv(out, dtype={"point": str}).set_index("point")
 
@@ -181,12 +203,15 @@ def test_e_n_within_0_06_for_reproducible_rows(reduced):
 
 def test_listed_rows_are_exactly_the_ones_that_do_not_reproduce(reduced):
     """The exclusion lists are not padding: every listed row really misses."""
-    assert _outside(reduced, "dke_j", "dke",
-                    lambda v, p: abs(v / p - 1) < 0.01) == set(NOT_REPRODUCIBLE_KE)
-    assert _outside(reduced, "e_t", "e_t",
-                    lambda v, p: abs(v - p) <= 0.05) == set(NOT_REPRODUCIBLE_ET)
-    assert _outside(reduced, "e_n", "e_n",
-                    lambda v, p: abs(v - p) <= 0.06) == set(NOT_REPRODUCIBLE_EN)
+    assert _outside(reduced, "dke_j", "dke", lambda v, p: abs(v / p - 1) < 0.01) == set(
+        NOT_REPRODUCIBLE_KE
+    )
+    assert _outside(reduced, "e_t", "e_t", lambda v, p: abs(v - p) <= 0.05) == set(
+        NOT_REPRODUCIBLE_ET
+    )
+    assert _outside(reduced, "e_n", "e_n", lambda v, p: abs(v - p) <= 0.06) == set(
+        NOT_REPRODUCIBLE_EN
+    )
 
 
 def test_impact_26_matches_the_thesis_detail(reduced):
@@ -214,11 +239,12 @@ def test_theta0_is_assumed_or_from_the_tree_strike(reduced):
 
 
 def test_energy_in_flight_is_conserved(reduced):
-    """KE gained in each flight equals m g times the drop (drag-free flight, eq. 3.1)."""
+    """KE gained in each flight is m g times the drop (drag-free flight, eq. 3.1)."""
     z = reduced["z_m"].to_numpy()
     expected = 3750 * 9.81 * (z[:-1] - z[1:])
-    np.testing.assert_allclose(reduced["flight_dke_j"].to_numpy()[1:], expected,
-                               rtol=1e-9)
+    np.testing.assert_allclose(
+        reduced["flight_dke_j"].to_numpy()[1:], expected, rtol=1e-9
+    )
     assert math.isnan(reduced["flight_dke_j"].iloc[0])
 
 
@@ -241,14 +267,18 @@ def test_spin_is_v_over_r_and_constant_in_flight(reduced):
 
 
 def test_flight_heights_and_times(reduced):
-    """Flight columns describe the flight leaving each point; hmax' = hmax cos(chord)."""
+    """Flight columns describe the flight leaving each point; h' = h cos(chord)."""
     dx = np.diff(reduced["x_m"].to_numpy())
     dz = np.diff(reduced["z_m"].to_numpy())
     np.testing.assert_allclose(reduced["flight_length_m"].to_numpy()[:-1], dx)
     np.testing.assert_allclose(
-        reduced["flight_time_s"].to_numpy()[:-1], dx / reduced["vf_x_mps"].to_numpy()[:-1]
+        reduced["flight_time_s"].to_numpy()[:-1],
+        dx / reduced["vf_x_mps"].to_numpy()[:-1],
     )
-    ratio = reduced["hmax_normal_m"].to_numpy()[:-1] / reduced["hmax_vertical_m"].to_numpy()[:-1]
+    ratio = (
+        reduced["hmax_normal_m"].to_numpy()[:-1]
+        / reduced["hmax_vertical_m"].to_numpy()[:-1]
+    )
     np.testing.assert_allclose(ratio, dx / np.hypot(dx, dz))
     # Thesis §2.2.2: average normal trajectory height about 1.3 m (impacts 1-44).
     mean = reduced.loc[[str(i) for i in range(1, 45)], "hmax_normal_m"].mean()
