@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fieldkit.errors import ArgumentError
-from fieldkit.physics.impact_mechanics import contact_phases
+from fieldkit.physics.contact_phases import contact_phases
 
 
 @dataclass(frozen=True)
