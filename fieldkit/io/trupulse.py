@@ -24,7 +24,7 @@ import math
 from dataclasses import dataclass
 from functools import reduce
 
-from fieldkit.errors import InputFileError
+from fieldkit.errors import ArgumentError, InputFileError
 
 #: Metres per instrument length unit.
 TRUPULSE_UNITS: dict[str, float] = {"M": 1.0, "F": 0.3048, "Y": 0.9144}
@@ -219,7 +219,7 @@ def format_trupulse_hv(
     """
     unit = units.strip().upper()
     if unit not in TRUPULSE_UNITS:
-        raise ValueError(f"units must be M, F or Y, not '{units}'")
+        raise ArgumentError(f"units must be M, F or Y, not '{units}'", source="units")
     scale = TRUPULSE_UNITS[unit]
 
     def length(value: float) -> tuple[str, str]:

@@ -138,3 +138,10 @@ def test_format_then_parse_round_trip(hd, azimuth, inclination, unit):
     assert min(
         abs(shot.azimuth_deg - azimuth), 360 - abs(shot.azimuth_deg - azimuth)
     ) <= (0.005 + 1e-9)
+
+
+def test_format_rejects_unknown_units():
+    from fieldkit.errors import ArgumentError
+
+    with pytest.raises(ArgumentError, match="units must be M, F or Y"):
+        format_trupulse_hv(10.0, 0.0, 0.0, 10.0, units="KM")
