@@ -11,7 +11,7 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from fieldkit.cli.common import GyrationOpt, MassOpt, RadiusOpt, one_line_errors
+from fieldkit.cli.common import GyrationOpt, MassOpt, RadiusOpt, one_line_errors, warn
 from fieldkit.errors import ArgumentError
 from fieldkit.io.atomic import write_text_atomic
 from fieldkit.physics.bodies import SHAPES, UNIT_WEIGHT_KN_M3, Body, shape_body
@@ -386,6 +386,15 @@ def impact(
         _report(res, body, mass_known, v_it, v_in, spin, e_n, e_source, friction,
                 offset, mu_min)
     )  # fmt: skip
+    k2 = body.gyration_m**2
+    before = v_it**2 + v_in**2 + k2 * spin**2
+    after = float(res.v_f_mps) ** 2 + k2 * float(res.omega_f_radps) ** 2
+    if after > before * (1 + 1e-12):
+        warn(
+            f"the rock leaves with more energy than it arrived with (e_N = {e_n:.2f} "
+            "> 1): the thesis's e_N > 1 at shallow impacts reflects eccentric "
+            "geometry, which a collinear impact with this e_N does not model"
+        )
 
     if figure is not None and history is not None:
         from fieldkit.viz.pnv_figure import save_pnv_figure

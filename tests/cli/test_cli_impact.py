@@ -172,3 +172,16 @@ def test_bad_combinations(cli, args, message):
     assert result.exit_code != 0
     assert result.stderr.startswith(message), result.stderr
     assert len(result.stderr.strip().splitlines()) == 1
+
+
+def test_energy_gain_is_flagged(cli):
+    # eq. 5.4 gives e_N = 1.82 at 10 deg; with a smooth contact the collinear model
+    # then returns more energy than came in: the command warns (and still answers).
+    result = cli(
+        "impact", "--speed", "10", "--angle", "10", "--radius", "0.5",
+        "--gyration", "0.3", "--law", "angle", "--friction", "0",
+    )  # fmt: skip
+    assert result.exit_code == 0
+    assert result.stderr.startswith("warning: the rock leaves with more energy")
+    quiet = cli(*EXAMPLE_4A)
+    assert quiet.exit_code == 0 and quiet.stderr == ""

@@ -440,3 +440,24 @@ def test_bad_input_names_the_argument(kwargs, message):
             args.pop("omega_i_radps"),
             **args,
         )
+
+
+# ---------------------------------------------------------------- docstring examples
+
+
+@pytest.mark.parametrize(
+    "module",
+    [
+        "fieldkit.physics.bodies",
+        "fieldkit.physics.contact_phases",
+        "fieldkit.physics.impact_mechanics",
+        "fieldkit.physics.impulse_history",
+        "fieldkit.physics.restitution",
+    ],
+)
+def test_docstring_examples_run(module):
+    import doctest
+    import importlib
+
+    result = doctest.testmod(importlib.import_module(module))
+    assert result.failed == 0
