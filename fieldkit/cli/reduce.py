@@ -56,7 +56,7 @@ def reduce(
         float | None,
         typer.Option(
             "--theta0",
-            help="Restitution angle to the ground [deg] assumed for flights "
+            help="Restitution angle to the ground (degrees) assumed for flights "
             "no tree defines (thesis: 32.6 at Tornado Mountain).",
         ),
     ] = None,
@@ -75,14 +75,14 @@ def reduce(
         str | None,
         typer.Option(
             "--dimensions",
-            help="Shape dimensions [m], comma separated: cube L; sphere r "
+            help="Shape dimensions in metres, comma separated: cube L; sphere r "
             "(radius); cylinder L,r; ellipsoid 2a,2b,2c (full axis lengths).",
         ),
     ] = None,
     unit_weight: Annotated[
         float | None,
         typer.Option(
-            "--unit-weight", help="Rock unit weight for --shape [kN/m3] (default 26)."
+            "--unit-weight", help="Rock unit weight for --shape, kN/m3 (default 26)."
         ),
     ] = None,
     units: Annotated[
@@ -103,7 +103,7 @@ def reduce(
         float,
         typer.Option(
             "--declination",
-            help="Magnetic declination [deg, east positive] added to "
+            help="Magnetic declination (degrees, east positive) added to "
             "field-book azimuths.",
         ),
     ] = 0.0,
@@ -115,7 +115,7 @@ def reduce(
         Path | None,
         typer.Option(
             "--figures",
-            help="Folder for PNG figures: section, [theta_i-e_N], e_T, "
+            help="Folder for PNG figures: section, theta_i-e_N, e_T, "
             "energy partition, energy head.",
         ),
     ] = None,
@@ -129,8 +129,8 @@ def reduce(
 
     Example (thesis Table 2-4, Tornado Mountain boulder A):
 
-        fieldkit reduce --impacts surveys/tornado_mountain/boulder_a_impacts.gpx
-        --trees surveys/tornado_mountain/boulder_a_trees.csv --theta0 32.6
+        fieldkit reduce --impacts surveys/tornado_mountain/boulder_a_impacts.gpx \\
+        --trees surveys/tornado_mountain/boulder_a_trees.csv --theta0 32.6 \\
         --mass 3750 --radius 0.725 --gyration 0.46 -o t.csv --figures figs
     """
     from fieldkit.reduce.body import parse_dimensions, resolve_body

@@ -283,3 +283,11 @@ def test_flight_heights_and_times(reduced):
     # Thesis §2.2.2: average normal trajectory height about 1.3 m (impacts 1-44).
     mean = reduced.loc[[str(i) for i in range(1, 45)], "hmax_normal_m"].mean()
     assert 1.0 < mean < 2.0
+
+
+def test_colluvium_averages_match_section_2_2_2(reduced):
+    """§2.2.2: mean e_N 1.02 and e_T 0.65 over the colluvium impacts of boulders A and
+    B (114 impacts); boulder A's impacts 1-42 alone must land close to both."""
+    colluvium = reduced.loc[[str(i) for i in range(1, 43)]]
+    assert colluvium["e_n"].mean() == pytest.approx(1.02, abs=0.05)
+    assert colluvium["e_t"].mean() == pytest.approx(0.65, abs=0.05)
