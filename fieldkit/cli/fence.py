@@ -137,7 +137,7 @@ def fence(
         fieldkit fence --mass 520 --gyration 0.35 --radius 0.43 --speed-in 22
         --angle-in 50 --spin-in 18
     """
-    from fieldkit.io.atomic import refuse_input_overwrite, write_text_atomic
+    from fieldkit.io.atomic import write_text_atomic
     from fieldkit.physics.fences import fence_energy_split, fence_redirection
     from fieldkit.physics.structure_forces import StructureLaw, contact_time, peak_force
 
@@ -156,8 +156,6 @@ def fence(
     if impulse is not None:
         _require(impulse > 0, "--impulse", f"must be positive, got {impulse:g}")
     p = mass * speed_in if impulse is None else impulse
-    if figure is not None and out is not None:
-        refuse_input_overwrite([figure], [out])
     if figure is not None and figure.suffix.lower() != ".png":
         raise ArgumentError("the figure must be a .png file", source="--figure")
 
@@ -172,6 +170,15 @@ def fence(
         f"{_fmt(mass * k * k if k is not None else None)} kg m^2"
     ]
     rebound = None
+    for option, value in (("--spin-out", spin_out), ("--angle-out", angle_out)):
+        if value is not None and speed_out is None:
+            raise ArgumentError(
+                "a measured rebound needs --speed-out too", source=option
+            )
+    if figure is not None and out is not None and figure.resolve() == out.resolve():
+        raise ArgumentError(
+            "--figure and --out must be different files", source="--out"
+        )
     if speed_out is not None:
         _require(
             speed_out >= 0, "--speed-out", f"must not be negative, got {speed_out:g}"

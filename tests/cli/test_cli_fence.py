@@ -202,6 +202,19 @@ def test_time_force_only(cli):
         (["--mass", "520", "--speed-in", "22", "--speed-out", "10"], "--gyration"),
         (["--mass", "520", "--speed-in", "22", "--stiff", "3e4"], "--stiff"),
         (["--mass", "520", "--speed-in", "22", "--rigid", "-1e6,1"], "--rigid"),
+        (
+            [
+                "--mass",
+                "520",
+                "--speed-in",
+                "22",
+                "--gyration",
+                "0.3",
+                "--spin-out",
+                "4",
+            ],
+            "--spin-out: a measured rebound needs --speed-out",
+        ),
     ],
 )
 def test_bad_input_one_line_error(cli, args, message):
@@ -226,3 +239,11 @@ def test_figure_must_be_png(cli, tmp_path):
     result = cli(*EXAMPLE_8B, "--figure", tmp_path / "fence.jpg")
     assert result.exit_code != 0
     assert "--figure" in result.stderr
+
+
+def test_figure_and_out_must_differ(cli, tmp_path):
+    same = tmp_path / "x.png"
+    result = cli(*EXAMPLE_8B, "--figure", same, "-o", same)
+    assert result.exit_code != 0
+    assert "--out" in result.stderr
+    assert not same.exists()
