@@ -1,0 +1,403 @@
+"""Rerun recordings (.rrd) of tracks, flights, impacts and net contacts.
+
+Every rerun call of fieldkit lives in this module (the rerun API changes between
+minor versions; this file is pinned to rerun-sdk 0.41). Recordings are written
+without a viewer: ``RecordingStream`` -> ``save`` -> log -> ``disconnect`` (the footer
+is written only then), to a temporary file renamed into place when complete. Log and
+tick times are disabled and the recording id is fixed, so the same input gives the
+same content.
+
+Entity layout
+-------------
+``video/frame``                  subsampled, downscaled frames (JPEG)
+``video/frame/centre``, ``/marker``  detected centre and spin marker on each frame
+``video/frame/flights``          fitted flights projected into the image
+``world/track``                  tracked centre (x, 0, z) in metres, z up
+``world/flights``                fitted parabolas; ``world/velocity`` vectors
+``world/impacts``                impact points labelled with e_n, e_t
+``plots/speed/{measured,fitted}``, ``plots/spin``, ``plots/residual_mm``  time series
+``contacts/<i>/speed``           speed through each net contact
+``section/<path>/...``           an ImpactTable: impacts, velocity arrows, slope ticks
+
+Timelines: ``frame`` (video frame index), ``t`` (seconds); ImpactTables use
+``impact`` (row order).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import rerun as rr
+import rerun.blueprint as rrb
+
+from fieldkit.impact_table import ImpactTable
+from fieldkit.io.atomic import atomic_path
+from fieldkit.tracking.analysis import TrackAnalysis
+from fieldkit.tracking.net_contact import local_velocity
+from fieldkit.viz.image_projection import project, world_to_image
+
+#: At most this many video frames go into a recording.
+MAX_FRAMES = 120
+#: Frames are downscaled so their longer side is at most this many pixels.
+MAX_FRAME_SIDE_PX = 480
+#: Frames are stored as JPEG of this quality (keeps a recording to a few MB).
+JPEG_QUALITY = 80
+#: Velocity arrows are drawn as the distance travelled in this time [s].
+ARROW_TIME_S = 0.02
+
+_FLIGHT_COLOUR = (40, 120, 220)
+_TRACK_COLOUR = (230, 230, 230)
+_IMPACT_COLOUR = (220, 60, 40)
+
+
+def _open(path: Path, name: str) -> rr.RecordingStream:
+    rec = rr.RecordingStream(
+        "fieldkit", recording_id=f"fieldkit-{name}", send_properties=False
+    )
+    rr.set_log_time_enabled(False, recording=rec)
+    rr.set_log_tick_enabled(False, recording=rec)
+    rec.save(path)
+    return rec
+
+
+def write_recording(
+    path: str | os.PathLike[str],
+    analysis: TrackAnalysis,
+    frames: Iterable[tuple[int, np.ndarray]] | None = None,
+    detections: pd.DataFrame | None = None,
+) -> Path:
+    """Write a rerun recording of a track analysis (and optionally its video frames).
+
+    Parameters
+    ----------
+    path
+        Output ``.rrd`` file (written atomically).
+    analysis
+        From :func:`fieldkit.tracking.analysis.analyse_track`.
+    frames
+        ``(frame_index, BGR image)`` pairs; at most :data:`MAX_FRAMES` evenly spaced
+        frames are kept, downscaled to :data:`MAX_FRAME_SIDE_PX`.
+    detections
+        Per-frame detections with ``frame``, ``u_px``, ``v_px`` and optionally
+        ``marker_du_px``, ``marker_dv_px`` (offset of the marker from the centre).
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
+    out = Path(path)
+    with atomic_path(out) as tmp:
+        rec = _open(tmp, "track")
+        try:
+            rec.send_blueprint(_track_blueprint(frames is not None))
+            _log_world(rec, analysis)
+            _log_series(rec, analysis)
+            _log_contacts(rec, analysis)
+            if frames is not None:
+                _log_frames(rec, analysis, frames, detections)
+        finally:
+            rec.disconnect()
+    return out
+
+
+def write_impact_recording(path: str | os.PathLike[str], table: ImpactTable) -> Path:
+    """Write a rerun recording of an ImpactTable: the section view of every path.
+
+    Impact points (labelled with point, e_n, e_t), impact and restitution velocity
+    arrows, a short slope tick at each impact (``slope_deg``), and e_n, e_t, speeds
+    against the impact order.
+    """
+    out = Path(path)
+    with atomic_path(out) as tmp:
+        rec = _open(tmp, "impacts")
+        try:
+            rec.log("section", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+            for path_id in table.paths():
+                _log_section(
+                    rec, table.frame[table.frame["path_id"] == path_id], str(path_id)
+                )
+        finally:
+            rec.disconnect()
+    return out
+
+
+# ---------------------------------------------------------------- track pieces
+def _track_blueprint(with_video: bool) -> rrb.Blueprint:
+    views = [rrb.Spatial3DView(origin="world", name="section (x, z)")]
+    if with_video:
+        views.insert(0, rrb.Spatial2DView(origin="video", name="video"))
+    plots = rrb.Vertical(
+        rrb.TimeSeriesView(origin="plots/speed", name="speed [m/s]"),
+        rrb.TimeSeriesView(origin="plots/spin", name="spin [rad/s]"),
+        rrb.TimeSeriesView(origin="plots/residual_mm", name="flight residual [mm]"),
+    )
+    return rrb.Blueprint(rrb.Horizontal(rrb.Vertical(*views), plots))
+
+
+def _xyz(x, z) -> np.ndarray:
+    x = np.asarray(x, float)
+    return np.column_stack([x, np.zeros_like(x), np.asarray(z, float)])
+
+
+def _log_world(rec: rr.RecordingStream, analysis: TrackAnalysis) -> None:
+    f = analysis.track.frame
+    rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+    ok = np.isfinite(f["x_m"]) & np.isfinite(f["z_m"])
+    rec.log(
+        "world/track",
+        rr.Points3D(
+            _xyz(f.loc[ok, "x_m"], f.loc[ok, "z_m"]), radii=0.002, colors=_TRACK_COLOUR
+        ),
+        static=True,
+    )
+    strips, labels = [], []
+    for fl in analysis.flights:
+        t = np.linspace(fl.t_start_s, fl.t_end_s, 60)
+        strips.append(_xyz(*fl.position(t)))
+        labels.append(f"flight {fl.index}: g = {fl.g_mps2:.2f} ± {fl.g_se_mps2:.2f}")
+    if strips:
+        rec.log(
+            "world/flights",
+            rr.LineStrips3D(strips, radii=0.001, labels=labels, colors=_FLIGHT_COLOUR),
+            static=True,
+        )
+    imp = analysis.impacts.frame
+    if len(imp):
+        labels = [
+            f"{p}: e_n {en:.2f}, e_t {et:.2f}"
+            for p, en, et in zip(imp["point"], imp["e_n"], imp["e_t"], strict=True)
+        ]
+        sx = _table_mirror(analysis)
+        rec.log(
+            "world/impacts",
+            rr.Points3D(
+                _xyz(sx * imp["x_m"], imp["z_m"]),
+                radii=0.006,
+                colors=_IMPACT_COLOUR,
+                labels=labels,
+            ),
+            static=True,
+        )
+        for row in imp.itertuples():
+            rec.set_time("t", duration=float(row.t_s))
+            rec.log(
+                "events",
+                rr.TextLog(
+                    f"impact {row.point}: v_i {row.vi_mps:.2f} -> "
+                    f"v_f {row.vf_mps:.2f} m/s, "
+                    f"e_n {row.e_n:.2f}, e_t {row.e_t:.2f}, psi {row.slope_deg:.1f} deg"
+                ),
+            )
+    for fl in analysis.flights:
+        rows = fl.rows[:: max(1, fl.n_samples // 12)]
+        for r in rows:
+            t = float(f["t_s"].iloc[r])
+            _set_times(rec, int(f["frame"].iloc[r]), t)
+            vx, vz = fl.velocity(t)
+            px, pz = fl.position(t)
+            rec.log(
+                "world/velocity",
+                rr.Arrows3D(
+                    origins=_xyz([px], [pz]),
+                    vectors=_xyz(
+                        [ARROW_TIME_S * float(vx)], [ARROW_TIME_S * float(vz)]
+                    ),
+                    colors=_FLIGHT_COLOUR,
+                ),
+            )
+
+
+def _table_mirror(analysis: TrackAnalysis) -> float:
+    return -1.0 if any("mirrored" in w for w in analysis.warnings) else 1.0
+
+
+def _set_times(rec: rr.RecordingStream, frame: int, t_s: float) -> None:
+    rec.set_time("frame", sequence=frame)
+    rec.set_time("t", duration=t_s)
+
+
+def _series(rec, entity: str, frames, t, values, name: str) -> None:
+    ok = np.isfinite(values)
+    if not ok.any():
+        return
+    rec.log(entity, rr.SeriesLines(names=name), static=True)
+    rec.send_columns(
+        entity,
+        indexes=[
+            rr.TimeColumn("frame", sequence=np.asarray(frames)[ok]),
+            rr.TimeColumn("t", duration=np.asarray(t)[ok]),
+        ],
+        columns=rr.Scalars.columns(scalars=np.asarray(values)[ok]),
+    )
+
+
+def _log_series(rec: rr.RecordingStream, analysis: TrackAnalysis) -> None:
+    f = analysis.track.frame
+    frames = f["frame"].to_numpy(int)
+    t = f["t_s"].to_numpy(float)
+    ok = np.isfinite(t) & np.isfinite(f["x_m"]) & np.isfinite(f["z_m"])
+    measured = np.full(len(f), np.nan)
+    if ok.sum() >= 5:
+        vx = local_velocity(t[ok], f.loc[ok, "x_m"].to_numpy(float))
+        vz = local_velocity(t[ok], f.loc[ok, "z_m"].to_numpy(float))
+        measured[ok] = np.hypot(vx, vz)
+    fitted = np.full(len(f), np.nan)
+    for fl in analysis.flights:
+        vx, vz = fl.velocity(t[fl.rows])
+        fitted[fl.rows] = np.hypot(vx, vz)
+    _series(rec, "plots/speed/measured", frames, t, measured, "measured")
+    _series(rec, "plots/speed/fitted", frames, t, fitted, "fitted flights")
+    _series(rec, "plots/spin", frames, t, f["omega_radps"].to_numpy(float), "omega")
+    if "residual_m" in f:
+        _series(
+            rec,
+            "plots/residual_mm",
+            frames,
+            t,
+            1e3 * f["residual_m"].to_numpy(float),
+            "residual",
+        )
+
+
+def _log_contacts(rec: rr.RecordingStream, analysis: TrackAnalysis) -> None:
+    for c in analysis.contacts:
+        base = f"contacts/{c.index}"
+        rec.log(
+            base,
+            rr.TextDocument(
+                f"contact {c.index}: {c.duration_s * 1e3:.1f} ms, "
+                f"v_i {c.vi_mps:.2f} -> "
+                f"v_min {c.v_min_mps:.2f} -> v_f {c.vf_mps:.2f} m/s, "
+                f"efficiency (eq. 8.1) {100 * c.efficiency:.0f} %"
+            ),
+            static=True,
+        )
+        frames = np.round((c.t_s - c.t_s[0]) / max(np.median(np.diff(c.t_s)), 1e-12))
+        _series(rec, f"{base}/speed", frames.astype(int), c.t_s, c.speed_mps, "speed")
+        _series(
+            rec,
+            f"{base}/impulse_absorbed_pct",
+            frames.astype(int),
+            c.t_s,
+            100 * c.impulse_absorbed_fraction,
+            "impulse absorbed %",
+        )
+
+
+def _log_frames(rec, analysis: TrackAnalysis, frames, detections) -> None:
+    f = analysis.track.frame
+    times = dict(zip(f["frame"].to_numpy(int), f["t_s"].to_numpy(float), strict=False))
+    det = detections if detections is not None else f
+    det = det.set_index("frame") if "frame" in det else det
+    homography = world_to_image(f)
+    pairs = list(frames)
+    step = max(1, int(np.ceil(len(pairs) / MAX_FRAMES)))
+    fps = analysis.track.fps or 1.0
+    for index, image in pairs[::step]:
+        h, w = image.shape[:2]
+        s = min(1.0, MAX_FRAME_SIDE_PX / max(h, w))
+        if s < 1.0:
+            image = _downscale(image, s)
+        _set_times(rec, int(index), times.get(int(index), index / fps))
+        colour = "BGR" if image.ndim == 3 else "L"
+        rec.log(
+            "video/frame", rr.Image(image, color_model=colour).compress(JPEG_QUALITY)
+        )
+        if int(index) in det.index and {"u_px", "v_px"} <= set(det.columns):
+            row = det.loc[int(index)]
+            if isinstance(row, pd.DataFrame):
+                row = row.iloc[0]
+            u, v = float(row["u_px"]), float(row["v_px"])
+            if np.isfinite(u) and np.isfinite(v):
+                rec.log("video/frame/centre", rr.Points2D([[s * u, s * v]], radii=2.0))
+                du, dv = (
+                    row.get("marker_du_px", np.nan),
+                    row.get("marker_dv_px", np.nan),
+                )
+                if np.isfinite(du) and np.isfinite(dv):
+                    rec.log(
+                        "video/frame/marker",
+                        rr.Points2D(
+                            [[s * (u + du), s * (v + dv)]],
+                            radii=2.0,
+                            colors=(255, 200, 0),
+                        ),
+                    )
+        if homography is not None and analysis.flights:
+            strips = []
+            for fl in analysis.flights:
+                t = np.linspace(fl.t_start_s, fl.t_end_s, 40)
+                strips.append(s * project(homography, *fl.position(t)))
+            rec.log(
+                "video/frame/flights", rr.LineStrips2D(strips, colors=_FLIGHT_COLOUR)
+            )
+
+
+def _downscale(image: np.ndarray, s: float) -> np.ndarray:
+    import cv2
+
+    return cv2.resize(image, None, fx=s, fy=s, interpolation=cv2.INTER_AREA)
+
+
+# ---------------------------------------------------------------- impact tables
+def _log_section(rec: rr.RecordingStream, f: pd.DataFrame, path_id: str) -> None:
+    base = f"section/{rr.escape_entity_path_part(path_id)}"
+    x, z = f["x_m"].to_numpy(float), f["z_m"].to_numpy(float)
+    labels = [
+        f"{p}: e_n {en:.2f}, e_t {et:.2f}"
+        for p, en, et in zip(f["point"], f["e_n"], f["e_t"], strict=True)
+    ]
+    rec.log(
+        f"{base}/impacts",
+        rr.Points3D(
+            _xyz(x, z),
+            radii=0.05 * _scale(x, z) / 10,
+            colors=_IMPACT_COLOUR,
+            labels=labels,
+        ),
+        static=True,
+    )
+    rec.log(
+        f"{base}/path", rr.LineStrips3D([_xyz(x, z)], colors=_TRACK_COLOUR), static=True
+    )
+    length = 0.05 * _scale(x, z)
+    psi = np.radians(f["slope_deg"].to_numpy(float))
+    tick = np.column_stack([np.cos(psi), -np.sin(psi)]) * length
+    strips = [
+        _xyz([xi - tx, xi + tx], [zi - tz, zi + tz])
+        for xi, zi, (tx, tz) in zip(x, z, tick, strict=True)
+    ]
+    rec.log(f"{base}/slope", rr.LineStrips3D(strips, colors=(120, 90, 60)), static=True)
+    vmax = np.nanmax(
+        np.abs(f[["vi_x_mps", "vi_z_mps", "vf_x_mps", "vf_z_mps"]].to_numpy())
+    )
+    k = length / vmax if np.isfinite(vmax) and vmax > 0 else 0.0
+    for key, colour in (("vi", (200, 80, 80)), ("vf", (80, 160, 80))):
+        vec = _xyz(k * f[f"{key}_x_mps"], k * f[f"{key}_z_mps"])
+        origins = _xyz(x, z) - (vec if key == "vi" else 0.0)
+        rec.log(
+            f"{base}/{key}",
+            rr.Arrows3D(origins=origins, vectors=vec, colors=colour),
+            static=True,
+        )
+    order = np.arange(len(f))
+    for col in ("e_n", "e_t", "vi_mps", "vf_mps"):
+        values = f[col].to_numpy(float)
+        ok = np.isfinite(values)
+        if ok.any():
+            rec.log(f"{base}/plots/{col}", rr.SeriesLines(names=col), static=True)
+            rec.send_columns(
+                f"{base}/plots/{col}",
+                indexes=[rr.TimeColumn("impact", sequence=order[ok])],
+                columns=rr.Scalars.columns(scalars=values[ok]),
+            )
+
+
+def _scale(x: np.ndarray, z: np.ndarray) -> float:
+    extent = max(np.nanmax(x) - np.nanmin(x), np.nanmax(z) - np.nanmin(z), 1e-3)
+    return float(extent)
