@@ -87,13 +87,14 @@ class Ball:
 class BounceScene:
     surface_deg: float = 15.0  # plate dip, descending toward +x
     plate_point_m: tuple = (0.0, 0.40)  # a point on the plate surface
-    start_m: tuple = (-0.02, 0.62)  # enters partly outside the left edge
+    plate_end_x_m: float = 1.40  # the plate ends here: the ball flies off its edge
+    start_m: tuple = (-0.07, 0.62)  # enters partly outside the left edge
     start_velocity_mps: tuple = (1.6, 0.3)
     start_omega_radps: float = 30.0  # back-spin: the first impact reverses it
     start_angle_rad: float = 0.3
-    e_n: tuple = (0.7, 0.65, 0.6, 0.55)  # prescribed, impact by impact
+    e_n: tuple = (0.7, 0.65, 0.6, 0.55, 0.5)  # prescribed, impact by impact
     friction: float = 0.3  # Coulomb coefficient at the contact
-    duration_s: float = 0.93
+    duration_s: float = 0.95
 
 
 @dataclass
@@ -148,8 +149,6 @@ def bounce_motion(scene: BounceScene, ball: Ball, times: np.ndarray):
     segments, impacts = [], []
     for i in range(len(scene.e_n) + 1):
         segments.append((t0, pos.copy(), vel.copy(), omega, angle))
-        if i == len(scene.e_n):
-            break
         # distance to plate d(t) = d0 + vN t - g cos(psi) t^2 / 2 = r
         d0, vn, an = (
             float((pos - p0) @ normal),
@@ -160,8 +159,11 @@ def bounce_motion(scene: BounceScene, ball: Ball, times: np.ndarray):
         roots = np.roots([a, b, c])
         roots = np.sort(roots[np.isreal(roots)].real)
         dt = roots[roots > 1e-9][0]
-        if t0 + dt > scene.duration_s:
+        contact_x = (pos + vel * dt + 0.5 * gvec * dt * dt - ball.radius_m * normal)[0]
+        if t0 + dt > scene.duration_s or contact_x > scene.plate_end_x_m:
             break
+        if i == len(scene.e_n):
+            raise ValueError("bounce scene: more impacts than e_n values; add some")
         pos = pos + vel * dt + 0.5 * gvec * dt * dt
         vel_i = vel + gvec * dt
         angle = angle + omega * dt
@@ -346,10 +348,11 @@ def background(camera: Camera, rng: np.random.Generator, scene) -> np.ndarray:
     if isinstance(scene, BounceScene):
         tangent, normal = _plate_axes(scene.surface_deg)
         p0 = np.array(scene.plate_point_m)
-        a, b = p0 - 2.0 * tangent, p0 + 3.0 * tangent
+        a = p0 - 2.0 * tangent
+        b = p0 + (scene.plate_end_x_m - p0[0]) / tangent[0] * tangent
         ua, va = camera.to_image(*a)
         ub, vb = camera.to_image(*b)
-        poly = np.array([[ua, va], [ub, vb], [ub, vb + 2000], [ua, va + 2000]])
+        poly = np.array([[ua, va], [ub, vb], [ub, va + 2000], [ua, va + 2000]])
         plate = np.zeros((h, w), np.uint8)
         cv2.fillPoly(plate, [np.round(poly * 16).astype(np.int32)], 255, cv2.LINE_AA, 4)
         alpha = (plate.astype(np.float32) / 255.0)[:, :, None]
@@ -419,7 +422,8 @@ def draw_ball(
     colour = (
         body[None, None, :] * (cover - mcover)[:, :, None] + mark * mcover[:, :, None]
     )
-    patch[:] = patch * (1.0 - cover[:, :, None]) + colour
+    mixed = patch.astype(np.float32) * (1.0 - cover[:, :, None]) + colour
+    patch[:] = np.clip(mixed + 0.5, 0, 255).astype(frame.dtype)
 
 
 def draw_net(frame, camera: Camera, scene: NetScene, ball: Ball, x_m, z_m) -> None:
@@ -443,6 +447,30 @@ def draw_net(frame, camera: Camera, scene: NetScene, ball: Ball, x_m, z_m) -> No
     )
 
 
+def _short_bounce_camera() -> Camera:
+    return Camera(width=480, height=320, origin_u_px=30.0, origin_v_px=300.0)
+
+
+def _short_bounce_scene() -> BounceScene:
+    return BounceScene(
+        plate_point_m=(0.0, 0.30),
+        plate_end_x_m=0.85,
+        start_m=(-0.06, 0.40),  # centre on the left border: half the ball visible
+        start_velocity_mps=(1.4, 0.0),
+        e_n=(0.75, 0.7, 0.65, 0.6),
+        duration_s=0.45,
+    )
+
+
+#: clip name -> (camera factory, scene factory). ``bounce_short`` (480x320, 542
+#: frames, 3 impacts) is the reduced clip the fast tests render.
+PRESETS = {
+    "bounce": (Camera, BounceScene),
+    "net": (Camera, NetScene),
+    "bounce_short": (_short_bounce_camera, _short_bounce_scene),
+}
+
+
 def render(
     name: str,
     out_dir: Path,
@@ -456,7 +484,9 @@ def render(
     extension: str = ".avi",
 ) -> dict:
     """Render one clip plus its calibration and truth files; returns the truth dict."""
-    camera = camera or Camera()
+    preset_camera, preset_scene = PRESETS.get(name, (Camera, None))
+    camera = camera or preset_camera()
+    scene = scene or (preset_scene() if preset_scene else None)
     ball = ball or Ball()
     if scene is None:
         scene = BounceScene() if name.startswith("bounce") else NetScene()
@@ -471,7 +501,7 @@ def render(
     else:
         states, in_contact, contact = net_motion(scene, ball, times)
         impacts = []
-    bg = background(camera, rng, scene)
+    bg = np.clip(background(camera, rng, scene) + 0.5, 0, 255).astype(np.uint8)
     path = out_dir / f"{name}{extension}"
     writer = cv2.VideoWriter(
         str(path),
@@ -483,16 +513,25 @@ def render(
         raise RuntimeError(f"cannot open a {codec} writer for {path}")
     writer.set(cv2.VIDEOWRITER_PROP_QUALITY, camera.jpeg_quality)
     us, vs = camera.to_image(states[:, 0], states[:, 1])
+    # sensor noise: windows at random offsets into one seeded noise field, applied
+    # with saturating uint8 add/subtract (grey noise, same on the three channels)
+    pad = 64
+    field = camera.noise_sd * rng.standard_normal(
+        (camera.height + pad, camera.width + pad), np.float32
+    )
+    field = np.repeat(np.round(field)[:, :, None], 3, axis=2)
+    noise_up = np.clip(field, 0, 255).astype(np.uint8)
+    noise_down = np.clip(-field, 0, 255).astype(np.uint8)
     for i in range(n):
         frame = bg.copy()
         if isinstance(scene, NetScene):
             draw_net(frame, camera, scene, ball, states[i, 0], states[i, 1])
         draw_ball(frame, camera, ball, states[i, 0], states[i, 1], states[i, 4])
-        frame += (
-            camera.noise_sd
-            * rng.standard_normal(frame.shape[:2], np.float32)[:, :, None]
-        )
-        writer.write(np.clip(frame + 0.5, 0, 255).astype(np.uint8))
+        dv, du = (int(k) for k in rng.integers(0, pad, 2))
+        window = (slice(dv, dv + camera.height), slice(du, du + camera.width))
+        cv2.add(frame, noise_up[window], dst=frame)
+        cv2.subtract(frame, noise_down[window], dst=frame)
+        writer.write(frame)
     writer.release()
     visible = (
         (us + ball.radius_m / camera.scale_m_per_px > 0)
@@ -524,15 +563,17 @@ def render(
         note="--scale-points puts the world origin at the first scale point; the "
         "homography file uses the scene's world frame (origin at the truth's (0, 0)).",
     )
-    corners = [(0.0, 0.0), (1.4, 0.0), (1.4, 0.8), (0.0, 0.8), (0.7, 0.4)]
+    # five reference marks inside the frame (corners of a 40 px inset and the centre)
+    w, h, sc = camera.width, camera.height, camera.scale_m_per_px
+    marks = [(40, h - 40), (w - 40, h - 40), (w - 40, 40), (40, 40), (w // 2, h // 2)]
     hpoints = [
         dict(
-            u_px=float(camera.to_image(x, z)[0]),
-            v_px=float(camera.to_image(x, z)[1]),
-            x_m=x,
-            z_m=z,
+            u_px=float(u),
+            v_px=float(v),
+            x_m=round((u - camera.origin_u_px) * sc, 9),
+            z_m=round((camera.origin_v_px - v) * sc, 9),
         )
-        for x, z in corners
+        for u, v in marks
     ]
     (out_dir / f"{name}.homography.json").write_text(
         json.dumps({"points": hpoints}, indent=1)
@@ -562,7 +603,7 @@ def render(
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
-        "clips", nargs="*", default=["bounce", "net"], choices=["bounce", "net"]
+        "clips", nargs="*", default=["bounce", "net"], choices=sorted(PRESETS)
     )
     parser.add_argument("--out", type=Path, default=HERE)
     parser.add_argument("--frames", type=int, default=None)

@@ -1,11 +1,301 @@
-"""`fieldkit track` (being built; see the issue tracker)."""
+"""`fieldkit track`: a high-speed video -> track, flights, impacts (ImpactTable)."""
 
 from __future__ import annotations
 
+import math
+import sys
+from pathlib import Path
+from typing import Annotated
+
 import typer
 
+from fieldkit.cli.common import GyrationOpt, MassOpt, RadiusOpt, one_line_errors, warn
+from fieldkit.errors import ArgumentError
+from fieldkit.impact_table import FORMATS
+from fieldkit.io.atomic import atomic_path, refuse_input_overwrite, write_atomic
 
-def track() -> None:
-    """Not built yet."""
-    typer.echo("fieldkit track: not built yet", err=True)
-    raise typer.Exit(3)
+#: show a progress bar for videos longer than this many frames
+PROGRESS_MIN_FRAMES = 300
+
+
+@one_line_errors
+def track(
+    video: Annotated[
+        Path,
+        typer.Argument(
+            help="High-speed video (AVI/MP4/MKV: MJPG, FFV1, mp4v, ...).",
+            show_default=False,
+        ),
+    ],
+    fps: Annotated[
+        float | None,
+        typer.Option(
+            "--fps",
+            help="Capture rate [frames/s] (required: high-speed cameras store a "
+            "different playback rate, e.g. 30).",
+        ),
+    ] = None,
+    scale_points: Annotated[
+        str | None,
+        typer.Option(
+            "--scale-points",
+            metavar="U1,V1,U2,V2",
+            help="Two image points [px] a known distance apart (level camera; the "
+            "world origin is the first point).",
+        ),
+    ] = None,
+    scale_length: Annotated[
+        float | None,
+        typer.Option("--scale-length", help="Distance between the scale points [m]."),
+    ] = None,
+    homography: Annotated[
+        Path | None,
+        typer.Option(
+            "--homography",
+            help="JSON or CSV of >= 4 image<->world points (u_px,v_px,x_m,z_m; z up) "
+            "instead of --scale-points.",
+        ),
+    ] = None,
+    radius: RadiusOpt = None,
+    surface_angle: Annotated[
+        float | None,
+        typer.Option(
+            "--surface-angle",
+            help="Dip of the impact surface [deg], positive descending along travel "
+            "(default: estimated from the contact points).",
+        ),
+    ] = None,
+    mass: MassOpt = None,
+    gyration: GyrationOpt = None,
+    roi: Annotated[
+        str | None,
+        typer.Option(
+            "--roi",
+            metavar="U,V,WIDTH,HEIGHT",
+            help="Search only this image region [px].",
+        ),
+    ] = None,
+    path_id: Annotated[
+        str | None,
+        typer.Option("--path-id", help="Test identifier (default: the video's name)."),
+    ] = None,
+    out: Annotated[
+        Path | None,
+        typer.Option(
+            "-o",
+            "--out",
+            help="Track CSV (t_s, x_m, z_m, angle_rad, omega_radps, flight, "
+            "residual_m, pixels).",
+        ),
+    ] = None,
+    impacts: Annotated[
+        Path | None,
+        typer.Option("--impacts", help="ImpactTable: .csv, .parquet or .xlsx."),
+    ] = None,
+    rrd: Annotated[
+        Path | None,
+        typer.Option("--rrd", help="Rerun recording of frames, detections and fits."),
+    ] = None,
+    figures: Annotated[
+        Path | None,
+        typer.Option("--figures", help="Folder for PNG figures of the track."),
+    ] = None,
+    quiet: Annotated[
+        bool, typer.Option("--quiet", "-q", help="No progress bar.")
+    ] = False,
+) -> None:
+    """Track a ball in a high-speed video; find its flights, impacts and net contacts.
+
+    The body is found against the static background (median of frames), its centre to
+    a fraction of a pixel; a marker spot gives its spin. Flights are fitted with
+    ballistic parabolas (fitted g is checked against 9.81: a wrong --fps or scale shows
+    there); impact and restitution velocities come from the fits at each contact.
+
+    Example (render the synthetic clips first with `make video`):
+
+        fieldkit track video/bounce.avi --fps 1205 --scale-points 100,30,700,30
+        --scale-length 1.2 --radius 0.0375 --mass 0.14 --surface-angle 15
+        -o out/bounce_track.csv --impacts out/bounce_impacts.csv --figures out/bounce
+    """
+    from fieldkit.tracking.analysis import analyse_track
+    from fieldkit.tracking.calibration import (
+        parse_scale_points,
+        read_homography_file,
+        two_point_scale,
+    )
+    from fieldkit.tracking.video_pipeline import parse_roi
+    from fieldkit.tracking.video_reader import VideoReader, fps_mismatch_message
+
+    if fps is None:
+        raise ArgumentError(
+            "the capture rate is required (the file's own rate is usually the "
+            "playback rate)",
+            source="--fps",
+        )
+    if not math.isfinite(fps) or fps <= 0:
+        raise ArgumentError(
+            f"must be a positive frame rate, got {fps:g}", source="--fps"
+        )
+    for name, value in (
+        ("--radius", radius),
+        ("--mass", mass),
+        ("--gyration", gyration),
+    ):
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise ArgumentError(f"must be positive, got {value:g}", source=name)
+    if surface_angle is not None and not (
+        math.isfinite(surface_angle) and -90 < surface_angle < 90
+    ):
+        raise ArgumentError(
+            f"must be between -90 and 90 degrees, got {surface_angle:g}",
+            source="--surface-angle",
+        )
+    if homography is not None and (scale_points or scale_length is not None):
+        raise ArgumentError(
+            "give either --homography or --scale-points/--scale-length, not both",
+            source="--homography",
+        )
+    if homography is None and (scale_points is None or scale_length is None):
+        missing = "--scale-points" if scale_points is None else "--scale-length"
+        raise ArgumentError(
+            "calibration needed: --scale-points U1,V1,U2,V2 with --scale-length L, "
+            "or --homography FILE",
+            source=missing,
+        )
+    if impacts is not None and impacts.suffix.lower() not in FORMATS:
+        raise ArgumentError(
+            f"unknown table format {impacts.suffix!r}; use one of {', '.join(FORMATS)}",
+            source=str(impacts),
+        )
+    refuse_input_overwrite([out, impacts, rrd], [video, homography])
+    if out is None and impacts is None and rrd is None and figures is None:
+        typer.echo(
+            "note: no -o, --impacts, --rrd or --figures given; printing the "
+            "summary only",
+            err=True,
+        )
+
+    reader = VideoReader(video)
+    info = reader.info
+    message = fps_mismatch_message(info, fps)
+    if message:
+        warn(message)
+    size = (info.width, info.height)
+    if homography is not None:
+        calibration = read_homography_file(homography, size)
+    else:
+        calibration = two_point_scale(
+            parse_scale_points(scale_points), scale_length, size
+        )
+    search = parse_roi(roi, size)
+
+    track_data, detections = _run_tracking(
+        video, reader, fps, calibration, search, radius, show=not quiet
+    )
+    for message in track_data.meta.get("warnings", []):
+        warn(message)
+    radius_m = radius
+    if radius_m is None:
+        whole = track_data.frame.loc[~track_data.frame["partial"], "radius_m"]
+        radius_m = float(whole.median()) if len(whole) else float("nan")
+        typer.echo(
+            f"note: --radius not given; using the measured {radius_m:.4g} m", err=True
+        )
+    analysis = analyse_track(
+        track_data,
+        radius_m=radius_m,
+        surface_angle_deg=surface_angle,
+        mass_kg=mass,
+        gyration_m=gyration,
+        path_id=path_id or video.stem,
+    )
+    for message in analysis.warnings:
+        warn(message)
+
+    if out is not None:
+        frame = analysis.track.frame
+        write_atomic(
+            out, lambda tmp: frame.to_csv(tmp, index=False, float_format="%.9g")
+        )
+    if impacts is not None:
+        analysis.impacts.write(impacts)
+    if rrd is not None:
+        from fieldkit.viz.rerun_log import write_recording
+
+        with atomic_path(rrd) as tmp:
+            write_recording(
+                tmp, analysis, frames=reader.frames(), detections=detections
+            )
+    written = []
+    if figures is not None:
+        from fieldkit.viz.track_figure import write_track_figures
+
+        middle = reader.read_frames([max(len(detections) // 2, 0)])
+        background = middle[0][1] if middle else None
+        written = write_track_figures(figures, analysis, background_frame=background)
+    _summary(video, track_data, detections, analysis, calibration.description)
+    for path in [out, impacts, rrd, *written]:
+        if path is not None:
+            typer.echo(f"wrote {path}")
+
+
+def _run_tracking(video, reader, fps, calibration, roi, radius, *, show: bool):
+    """track_video with a rich progress bar on stderr for long videos."""
+    from fieldkit.tracking.video_pipeline import track_video
+
+    total = reader.info.frame_count
+    if not show or total < PROGRESS_MIN_FRAMES:
+        return track_video(
+            video,
+            fps=fps,
+            calibration=calibration,
+            roi=roi,
+            radius_m=radius,
+            reader=reader,
+        )
+    from rich.console import Console
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TimeRemainingColumn,
+    )
+
+    console = Console(file=sys.stderr)
+    with Progress(
+        "[progress.description]{task.description}",
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeRemainingColumn(),
+        console=console,
+        transient=True,
+    ) as bar:
+        task = bar.add_task("tracking", total=total)
+        return track_video(
+            video,
+            fps=fps,
+            calibration=calibration,
+            roi=roi,
+            radius_m=radius,
+            reader=reader,
+            progress=lambda done, n: bar.update(task, completed=done, total=n),
+        )
+
+
+def _summary(video, track_data, detections, analysis, calibration_text) -> None:
+    frame = analysis.impacts.frame
+    typer.echo(
+        f"{video}: {len(detections)} frames, body in {len(track_data)}; "
+        f"{calibration_text}"
+    )
+    typer.echo(
+        f"{len(analysis.flights)} flights, {len(frame)} impacts, "
+        f"{len(analysis.contacts)} extended contacts"
+    )
+    for _, row in frame.iterrows():
+        typer.echo(
+            f"  impact {row['point']}: t={row['t_s']:.4f} s  vi={row['vi_mps']:.3f} "
+            f"vf={row['vf_mps']:.3f} m/s  e_n={row['e_n']:.3f} e_t={row['e_t']:.3f}  "
+            f"omega {row['omega_i_radps']:.1f} -> {row['omega_f_radps']:.1f} rad/s  "
+            f"slope {row['slope_deg']:.2f} deg"
+        )

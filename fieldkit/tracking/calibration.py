@@ -29,7 +29,6 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import cv2
 import numpy as np
 
 from fieldkit.errors import ArgumentError, InputFileError
@@ -206,7 +205,7 @@ def homography_from_points(
             "the image points lie on one line; the mapping is undetermined",
             source=source,
         )
-    h, _ = cv2.findHomography(img.astype(np.float64), wld.astype(np.float64), 0)
+    h = _direct_linear_transform(img, wld)
     if h is None or not np.all(np.isfinite(h)):
         raise InputFileError(
             "no homography fits these points (degenerate layout)", source=source
@@ -220,6 +219,33 @@ def homography_from_points(
         residual,
         {"homography_points": int(len(img))},
     )
+
+
+def _normalising_transform(points: np.ndarray) -> np.ndarray:
+    centre = points.mean(axis=0)
+    spread = np.sqrt(np.mean(np.sum((points - centre) ** 2, axis=1)))
+    s = np.sqrt(2.0) / max(spread, 1e-300)
+    return np.array(
+        [[s, 0.0, -s * centre[0]], [0.0, s, -s * centre[1]], [0.0, 0.0, 1.0]]
+    )
+
+
+def _direct_linear_transform(src: np.ndarray, dst: np.ndarray) -> np.ndarray | None:
+    """Least-squares homography src -> dst (Hartley-normalised DLT, numpy SVD)."""
+    ts, td = _normalising_transform(src), _normalising_transform(dst)
+    a = (ts @ np.column_stack([src, np.ones(len(src))]).T).T
+    b = (td @ np.column_stack([dst, np.ones(len(dst))]).T).T
+    rows = []
+    for (x, y, _), (u, v, _) in zip(a, b, strict=True):
+        rows.append([-x, -y, -1, 0, 0, 0, u * x, u * y, u])
+        rows.append([0, 0, 0, -x, -y, -1, v * x, v * y, v])
+    _, singular, vt = np.linalg.svd(np.asarray(rows, float))
+    if singular[-2] < 1e-12 * singular[0]:
+        return None
+    h = np.linalg.inv(td) @ vt[-1].reshape(3, 3) @ ts
+    if abs(h[2, 2]) < 1e-300:
+        return None
+    return h / h[2, 2]
 
 
 def read_homography_file(

@@ -180,7 +180,19 @@ class BallDetector:
             cut |= (pts[:, 1] < 0.5) | (pts[:, 1] > v1 - v0 - 1.5)
             if (cut & inner).any() or inner.sum() < 10:
                 continue  # cut by the search window, not the frame: search wider
+            partial = not bool(inner.all())  # touches the frame border
             uc, vc, r, rms = fit_circle(u[inner], v[inner])
+            if rms > 0.5:  # outliers (low-contrast patch, a strand): trim and refit
+                keep = inner.copy()
+                for _ in range(3):
+                    dev = np.abs(np.hypot(u - uc, v - vc) - r)
+                    keep = inner & (dev < max(1.0, 2.0 * rms))
+                    if keep.sum() < 0.6 * inner.sum():
+                        break
+                    uc, vc, r, rms = fit_circle(u[keep], v[keep])
+                if keep.sum() < 0.6 * inner.sum():
+                    continue
+                inner = keep
             # boundary pixels sit ~0.5 px inside the true rim
             r_rim = r + 0.5
             if not (s.min_radius_px <= r_rim <= s.max_radius_px):
@@ -192,7 +204,6 @@ class BallDetector:
             visible = len(bins) / 36.0
             if visible < s.min_visible_fraction:
                 continue
-            partial = not bool(inner.all())
             if not partial and not 0.7 <= area / (np.pi * r * r) <= 1.3:
                 continue
             if not (
@@ -224,20 +235,29 @@ class BallDetector:
         return best
 
     # ---------------------------------------------------------------- refinement
-    def _refine(self, frame: np.ndarray, uc: float, vc: float, r: float):
+    def _coverage(self, frame: np.ndarray, uc: float, vc: float, r: float):
+        """Unmixed body coverage ``alpha`` of the pixels around (uc, vc).
+
+        Returns ``(uu, vv, alpha, usable, colour)`` or None when the patch is too
+        small; ``usable`` marks pixels whose background differs enough from the body
+        colour for ``alpha`` to be trusted.
+        """
         w, h = self.size
         half = int(np.ceil(r + 3))
         iu, iv = int(round(uc)), int(round(vc))
         u0, u1 = max(iu - half, 0), min(iu + half + 1, w)
         v0, v1 = max(iv - half, 0), min(iv + half + 1, h)
+        if u1 - u0 < 4 or v1 - v0 < 4:
+            return None
         patch = frame[v0:v1, u0:u1].astype(np.float32)
         bg = self.background_f[v0:v1, u0:u1]
-        uu = np.arange(u0, u1, dtype=np.float32)[None, :]
-        vv = np.arange(v0, v1, dtype=np.float32)[:, None]
-        dist = np.sqrt((uu - uc) ** 2 + (vv - vc) ** 2)
+        shape = patch.shape[:2]
+        uu = np.broadcast_to(np.arange(u0, u1, dtype=np.float64)[None, :], shape)
+        vv = np.broadcast_to(np.arange(v0, v1, dtype=np.float64)[:, None], shape)
+        dist = np.hypot(uu - uc, vv - vc)
         ring = (dist > 0.8 * r) & (dist < 0.92 * r)
         if ring.sum() < 8:
-            return uc, vc, r, (np.nan, np.nan, np.nan)
+            return None
         ring_pixels = patch[ring]
         colour = ring_pixels.mean(axis=0)  # trimmed mean: drop marker/rim outliers
         near = np.abs(ring_pixels - colour).max(axis=1) < 40.0
@@ -246,24 +266,54 @@ class BallDetector:
         contrast = colour[None, None, :] - bg
         c2 = np.sum(contrast * contrast, axis=2)
         alpha = np.sum((patch - bg) * contrast, axis=2) / np.maximum(c2, 1.0)
-        alpha = np.clip(alpha, 0.0, 1.0)
-        weak = (
-            c2 < (2.0 * self.threshold) ** 2
-        )  # body and background alike: trust the shape
-        alpha = np.where(weak, (dist <= r).astype(np.float32), alpha)
-        alpha[dist < 0.85 * r] = 1.0
+        usable = c2 >= (2.0 * self.threshold) ** 2
+        return uu, vv, np.clip(alpha, 0.0, 1.0), usable, colour
+
+    def _refine(self, frame: np.ndarray, uc: float, vc: float, r: float):
+        """Coverage-weighted centroid of a whole disc: (uc, vc, r, body colour)."""
+        cov = self._coverage(frame, uc, vc, r)
+        if cov is None:
+            return uc, vc, r, (np.nan, np.nan, np.nan)
+        uu, vv, alpha, usable, colour = cov
+        dist = np.hypot(uu - uc, vv - vc)
+        # where body and background look alike, trust the fitted shape instead
+        alpha = np.where(usable, alpha, (dist <= r).astype(np.float64))
+        alpha[dist < 0.85 * r] = 1.0  # interior, marker included
         alpha[dist > r + 2.5] = 0.0
         total = float(alpha.sum())
+        body = tuple(float(c) for c in colour)
         if total <= 0:
-            return uc, vc, r, tuple(float(c) for c in colour)
+            return uc, vc, r, body
         u_new = float((alpha * uu).sum() / total)
         v_new = float((alpha * vv).sum() / total)
-        return (
-            u_new,
-            v_new,
-            float(np.sqrt(total / np.pi)),
-            tuple(float(c) for c in colour),
-        )
+        return u_new, v_new, float(np.sqrt(total / np.pi)), body
+
+    def _refine_partial(self, frame: np.ndarray, uc: float, vc: float, r: float):
+        """Centre of a disc of known radius cut by the frame border.
+
+        Gauss-Newton fit of the rim coverage ``clip(r + 0.5 - d, 0, 1)`` to the
+        unmixed coverage of the visible pixels near the rim.
+        """
+        cov = self._coverage(frame, uc, vc, r)
+        if cov is None:
+            return uc, vc
+        uu, vv, alpha, usable, _ = cov
+        for _ in range(6):
+            dist = np.maximum(np.hypot(uu - uc, vv - vc), 1e-6)
+            model = np.clip(r + 0.5 - dist, 0.0, 1.0)
+            band = usable & (np.abs(dist - r) < 2.5)
+            edge = band & (model > 0.0) & (model < 1.0)
+            if edge.sum() < 6:
+                break
+            resid = (alpha - model)[band]
+            ju = np.where(edge, (uu - uc) / dist, 0.0)[band]
+            jv = np.where(edge, (vv - vc) / dist, 0.0)[band]
+            step, *_ = np.linalg.lstsq(np.column_stack([ju, jv]), resid, rcond=None)
+            step = np.clip(step, -1.0, 1.0)
+            uc, vc = uc + float(step[0]), vc + float(step[1])
+            if np.hypot(*step) < 1e-3:
+                break
+        return uc, vc
 
     # ---------------------------------------------------------------- public
     def detect(
@@ -307,6 +357,13 @@ class BallDetector:
             uc, vc, r, colour = self._refine(frame, uc, vc, r)
             uc, vc, r, colour = self._refine(frame, uc, vc, r)
             self._radii.append(r)
+        else:
+            known = self.expected_radius_px
+            if known is None and len(self._radii) >= 5:
+                known = float(np.median(self._radii[-25:]))
+            if known is not None:
+                uc, vc = self._refine_partial(frame, uc, vc, known)
+                r = known
         return Detection(
             float(uc), float(vc), float(r), partial, float(visible), float(rms), colour
         )
