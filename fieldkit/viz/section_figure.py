@@ -59,19 +59,19 @@ def detail_row(table: ImpactTable) -> int | None:
 def _trees_xy(
     table: ImpactTable, trees: object | None
 ) -> list[tuple[float, float, float]]:
-    """(x, ground z, strike z) of each tree strike."""
+    """(x, ground z, strike z) of each tree strike (ground interpolated if missing)."""
     if trees is None:
         return []
-    f = table.frame.set_index(table.frame["point"].astype(str))
+    from fieldkit.reduce.pipeline import tree_strikes_by_launch
+
+    f = table.frame
+    names = f["point"].astype(str).tolist()
+    x, z = f["x_m"].to_numpy(float), f["z_m"].to_numpy(float)
+    index = {name: i for i, name in enumerate(names)}
     out = []
-    for row in trees.frame.itertuples(index=False):  # type: ignore[attr-defined]
-        key = str(row.after_impact)
-        if key not in f.index:
-            continue
-        x = float(f.loc[key, "x_m"]) + float(row.horizontal_distance_m)
-        out.append(
-            (x, float(row.ground_z_m), float(row.ground_z_m + row.strike_height_m))
-        )
+    for key, tree in tree_strikes_by_launch(trees, names, x, z).items():
+        xt = float(x[index[key]]) + tree.distance_m
+        out.append((xt, tree.ground_z_m, tree.ground_z_m + tree.height_m))
     return out
 
 
@@ -92,6 +92,13 @@ def plot_section(table: ImpactTable, trees: object | None = None) -> Figure:
     ax.plot([], [], "-", color=FLIGHT_COLOUR, label="flight fixed by a tree strike")
     ax.plot([], [], "--", color=FLIGHT_COLOUR, label="flight with assumed θ0")
     ax.plot(x, z, "o", ms=3.5, color=IMPACT_COLOUR, label="impact point", zorder=5)
+    vfx, vfz = f["vf_x_mps"].to_numpy(float), f["vf_z_mps"].to_numpy(float)
+    ok = np.isfinite(vfx) & np.isfinite(vfz)
+    if ok.any():
+        top = float(np.nanmax(np.hypot(vfx[ok], vfz[ok])))
+        ax.quiver(x[ok], z[ok], vfx[ok], vfz[ok], angles="xy", scale_units="xy",
+                  scale=top / (0.05 * np.ptp(x)), width=0.0022, color=FLIGHT_COLOUR,
+                  alpha=0.8, zorder=6, label="restitution velocity $v_f$ (∝ speed)")
     step = max(1, len(f) // 15)
     for i, row in enumerate(f.itertuples(index=False)):
         if i % step == 0 or i == len(f) - 1:
