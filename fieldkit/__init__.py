@@ -1,8 +1,8 @@
-"""fieldkit: rockfall engineering from field and video measurements to calibrated models.
+"""fieldkit: rockfall engineering, from field and video measurements to models.
 
-The data flow (ARCHITECTURE §1): ``io`` readers -> ``reduce`` (survey) or ``tracking``
-(video) -> :class:`~fieldkit.impact_table.ImpactTable` -> figures (``viz``), reports and,
-later, ``model`` / ``fit`` / ``diagnose`` / ``export``. ``physics`` holds the thesis
+The data flow (ARCHITECTURE §1): ``io`` readers -> ``reduce`` (survey) or
+``tracking`` (video) -> :class:`~fieldkit.impact_table.ImpactTable` -> figures
+(``viz``), reports and, later, ``model`` / ``fit`` / ``diagnose`` / ``export``. ``physics`` holds the thesis
 equations as pure functions.
 """
 

@@ -43,7 +43,12 @@ CONTRACT_COLUMNS: tuple[Column, ...] = (
     Column("mass_kg", "float", False, "body mass [kg]"),
     Column("radius_m", "float", False, "body contact radius [m]"),
     Column("gyration_m", "float", False, "radius of gyration k [m]"),
-    Column("theta0_deg", "float", False, "restitution angle to ground for the next flight [deg]"),
+    Column(
+        "theta0_deg",
+        "float",
+        False,
+        "restitution angle to ground for the next flight [deg]",
+    ),
     Column("theta0_source", "str", False, "tree | assumed | video | given"),
     Column("vi_x_mps", "float", True, "impact velocity, x [m/s]"),
     Column("vi_z_mps", "float", True, "impact velocity, z [m/s]"),
@@ -57,8 +62,12 @@ CONTRACT_COLUMNS: tuple[Column, ...] = (
     Column("vft_mps", "float", False, "restitution tangential velocity [m/s]"),
     Column("theta_i_deg", "float", False, "impact angle to the ground [deg]"),
     Column("theta_f_deg", "float", False, "restitution angle to the ground [deg]"),
-    Column("e_n", "float", False, "normal coefficient of restitution -vfn/vin (eq. 4.6)"),
-    Column("e_t", "float", False, "tangential coefficient of restitution vft/vit (eq. 4.7)"),
+    Column(
+        "e_n", "float", False, "normal coefficient of restitution -vfn/vin (eq. 4.6)"
+    ),
+    Column(
+        "e_t", "float", False, "tangential coefficient of restitution vft/vit (eq. 4.7)"
+    ),
     Column("omega_i_radps", "float", False, "angular velocity before impact [rad/s]"),
     Column("omega_f_radps", "float", False, "angular velocity after impact [rad/s]"),
     Column("ke_i_j", "float", False, "kinetic energy before impact [J]"),
@@ -66,11 +75,20 @@ CONTRACT_COLUMNS: tuple[Column, ...] = (
     Column("dke_j", "float", False, "ke_f - ke_i (negative = loss) [J]"),
     Column("re_i_j", "float", False, "rotational energy before impact [J]"),
     Column("re_f_j", "float", False, "rotational energy after impact [J]"),
-    Column("energy_head_i_m", "float", False, "energy head z + v^2/2g before impact [m]"),
+    Column(
+        "energy_head_i_m", "float", False, "energy head z + v^2/2g before impact [m]"
+    ),
     Column("energy_head_f_m", "float", False, "energy head after impact [m]"),
-    Column("flight_time_s", "float", False, "duration of the flight leaving this impact [s]"),
+    Column(
+        "flight_time_s",
+        "float",
+        False,
+        "duration of the flight leaving this impact [s]",
+    ),
     Column("flight_length_m", "float", False, "horizontal length of that flight [m]"),
-    Column("hmax_vertical_m", "float", False, "max vertical height above the chord [m]"),
+    Column(
+        "hmax_vertical_m", "float", False, "max vertical height above the chord [m]"
+    ),
     Column("hmax_normal_m", "float", False, "max height normal to the chord [m]"),
     Column("tree_strike", "bool", False, "the flight arriving here struck a tree"),
     Column("t_s", "float", False, "time of the impact [s]"),
@@ -81,12 +99,23 @@ EXTENSION_COLUMNS: tuple[Column, ...] = (
     Column("omega_source", "str", False, "measured | estimated (v/r, eq. 3.17) | none"),
     Column("slope_source", "str", False, "chord | surveyed | given | video"),
     Column("flight_dke_j", "float", False, "KE gained in the flight arriving here [J]"),
-    Column("dke_theory_j", "float", False, "impact-mechanics KE change for this impact [J]"),
-    Column("theory_loss_fraction", "float", False, "dke_theory_j / dke_j (thesis §6.3)"),
+    Column(
+        "dke_theory_j",
+        "float",
+        False,
+        "impact-mechanics change of KE + RE from the contact impulse [J] (§6.3)",
+    ),
+    Column(
+        "theory_loss_fraction", "float", False, "dke_theory_j / dke_j (thesis §6.3)"
+    ),
 )
 
-COLUMNS_BY_NAME: dict[str, Column] = {c.name: c for c in CONTRACT_COLUMNS + EXTENSION_COLUMNS}
-REQUIRED_COLUMNS: tuple[str, ...] = tuple(c.name for c in CONTRACT_COLUMNS if c.required)
+COLUMNS_BY_NAME: dict[str, Column] = {
+    c.name: c for c in CONTRACT_COLUMNS + EXTENSION_COLUMNS
+}
+REQUIRED_COLUMNS: tuple[str, ...] = tuple(
+    c.name for c in CONTRACT_COLUMNS if c.required
+)
 THETA0_SOURCES: frozenset[str] = frozenset({"tree", "assumed", "video", "given"})
 FORMATS: dict[str, str] = {".csv": "csv", ".parquet": "parquet", ".xlsx": "xlsx"}
 
@@ -142,7 +171,9 @@ class ImpactTable:
         for key in ("path_id", "point"):
             bad = out.index[out[key].isna()]
             if len(bad):
-                raise InputFileError(f"empty {key}", source=self.source, where=f"row {bad[0] + 1}")
+                raise InputFileError(
+                    f"empty {key}", source=self.source, where=f"row {bad[0] + 1}"
+                )
         dup = out.duplicated(["path_id", "point"])
         if dup.any():
             i = int(np.flatnonzero(dup.to_numpy())[0])
@@ -205,7 +236,10 @@ class ImpactTable:
         f["re_i_j"] = rotational_energy(m, k, f["omega_i_radps"].to_numpy())
         f["re_f_j"] = rotational_energy(m, k, f["omega_f_radps"].to_numpy())
         z = f["z_m"].to_numpy()
-        f["energy_head_i_m"], f["energy_head_f_m"] = energy_head(z, vi), energy_head(z, vf)
+        f["energy_head_i_m"], f["energy_head_f_m"] = (
+            energy_head(z, vi),
+            energy_head(z, vf),
+        )
         return ImpactTable(f, source=self.source)
 
     # ------------------------------------------------------------------ access
@@ -234,8 +268,11 @@ class ImpactTable:
             raise InputFileError("file not found", source=p)
         if p.stat().st_size == 0:
             raise InputFileError("file is empty", source=p)
-        text_cols = {c.name: "string" for c in CONTRACT_COLUMNS + EXTENSION_COLUMNS
-                     if c.kind == "str"}
+        text_cols = {
+            c.name: "string"
+            for c in CONTRACT_COLUMNS + EXTENSION_COLUMNS
+            if c.kind == "str"
+        }
         try:
             if fmt == "csv":
                 frame = pd.read_csv(p, dtype=text_cols)
@@ -244,7 +281,9 @@ class ImpactTable:
             else:
                 frame = pd.read_excel(p, dtype=text_cols)
         except (ValueError, OSError, pd.errors.ParserError) as exc:
-            raise InputFileError(f"cannot read {fmt.upper()}: {exc}", source=p) from None
+            raise InputFileError(
+                f"cannot read {fmt.upper()}: {exc}", source=p
+            ) from None
         if frame.empty:
             raise InputFileError("table has no rows", source=p)
         return cls(frame, source=str(p))

@@ -12,12 +12,21 @@ from fieldkit.physics.local_axes import to_local, to_section
 
 
 def _table(**over):
-    base = {"path_id": ["A", "A"], "point": ["1", "2"], "x_m": [0.0, 10.0],
-            "z_m": [10.0, 5.0], "slope_deg": [30.0, 30.0],
-            "vi_x_mps": [5.0, 6.0], "vi_z_mps": [-8.0, -7.0],
-            "vf_x_mps": [4.0, 5.0], "vf_z_mps": [1.0, 2.0],
-            "mass_kg": [100.0, 100.0], "gyration_m": [0.3, 0.3],
-            "omega_i_radps": [-2.0, np.nan], "omega_f_radps": [-5.0, np.nan]}
+    base = {
+        "path_id": ["A", "A"],
+        "point": ["1", "2"],
+        "x_m": [0.0, 10.0],
+        "z_m": [10.0, 5.0],
+        "slope_deg": [30.0, 30.0],
+        "vi_x_mps": [5.0, 6.0],
+        "vi_z_mps": [-8.0, -7.0],
+        "vf_x_mps": [4.0, 5.0],
+        "vf_z_mps": [1.0, 2.0],
+        "mass_kg": [100.0, 100.0],
+        "gyration_m": [0.3, 0.3],
+        "omega_i_radps": [-2.0, np.nan],
+        "omega_f_radps": [-5.0, np.nan],
+    }
     base.update(over)
     return ImpactTable(pd.DataFrame(base))
 
@@ -74,7 +83,9 @@ def test_missing_required_column_is_named():
 
 
 def test_bad_values_name_the_row(tmp_path):
-    with pytest.raises(InputFileError, match=r"row 2: column x_m: 'abc' is not a number"):
+    with pytest.raises(
+        InputFileError, match=r"row 2: column x_m: 'abc' is not a number"
+    ):
         _table(x_m=["0", "abc"])
     with pytest.raises(InputFileError, match=r"row 2: duplicated point 1"):
         _table(point=["1", "1"])

@@ -1,4 +1,4 @@
-"""What every command shares: one-line errors, and option types used by several commands."""
+"""What every command shares: one-line errors and shared option types."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ R = TypeVar("R")
 
 
 def one_line_errors(func: Callable[P, R]) -> Callable[P, R]:
-    """Turn :class:`FieldkitError` into ``error: <one line>`` on stderr and exit code 1."""
+    """Turn :class:`FieldkitError` into ``error: <one line>`` on stderr, exit 1."""
 
     @functools.wraps(func)
     def wrapper(*args: P.args, **kwargs: P.kwargs) -> R:
@@ -40,8 +40,11 @@ def echo_err(message: str) -> None:
 
 
 # Body options shared by `reduce`, `impact` and `track` (SI units).
-MassOpt = Annotated[float | None, typer.Option("--mass", help="Body mass [kg].")]
-RadiusOpt = Annotated[float | None, typer.Option("--radius", help="Contact radius r [m].")]
+MassOpt = Annotated[float | None, typer.Option("--mass", help="Body mass (kg).")]
+RadiusOpt = Annotated[
+    float | None, typer.Option("--radius", help="Contact radius r (m).")
+]
 GyrationOpt = Annotated[
-    float | None, typer.Option("--gyration", help="Radius of gyration k [m] (I = m k^2).")
+    float | None,
+    typer.Option("--gyration", help="Radius of gyration k (m); I = m k^2."),
 ]

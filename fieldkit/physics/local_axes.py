@@ -14,7 +14,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 
-def to_local(vx: ArrayLike, vz: ArrayLike, slope_deg: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+def to_local(
+    vx: ArrayLike, vz: ArrayLike, slope_deg: ArrayLike
+) -> tuple[np.ndarray, np.ndarray]:
     """Resolve a section-frame velocity into tangential and normal components.
 
     Parameters
@@ -42,7 +44,9 @@ def to_local(vx: ArrayLike, vz: ArrayLike, slope_deg: ArrayLike) -> tuple[np.nda
     return v_t, v_n
 
 
-def to_section(v_t: ArrayLike, v_n: ArrayLike, slope_deg: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+def to_section(
+    v_t: ArrayLike, v_n: ArrayLike, slope_deg: ArrayLike
+) -> tuple[np.ndarray, np.ndarray]:
     """Inverse of :func:`to_local`: local (T, N) components back to (vx, vz) [m/s]."""
     psi = np.radians(np.asarray(slope_deg, dtype=float))
     v_t = np.asarray(v_t, dtype=float)
@@ -59,4 +63,6 @@ def angle_to_ground_deg(v_t: ArrayLike, v_n: ArrayLike) -> np.ndarray:
     (``v_n > 0``) ``theta_f = atan(v_n/v_t)`` (ARCHITECTURE §2). Angles above 90 deg
     mean motion up-slope (``v_t < 0``).
     """
-    return np.degrees(np.arctan2(np.abs(np.asarray(v_n, float)), np.asarray(v_t, float)))
+    return np.degrees(
+        np.arctan2(np.abs(np.asarray(v_n, float)), np.asarray(v_t, float))
+    )

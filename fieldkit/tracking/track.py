@@ -53,7 +53,9 @@ class Track:
             if c in ("frame",):
                 self.frame[c] = -1
             elif c in ("t_s", "x_m", "z_m"):
-                raise InputFileError(f"track lacks column {c}", source=self.source or None)
+                raise InputFileError(
+                    f"track lacks column {c}", source=self.source or None
+                )
             else:
                 self.frame[c] = np.nan
         extras = [c for c in self.frame.columns if c not in TRACK_COLUMNS]
