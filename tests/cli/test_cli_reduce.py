@@ -321,3 +321,30 @@ def test_duplicated_point(cli, tmp_path):
         "P1",
     )
     assert not out.exists()
+
+
+def test_reader_errors_reach_the_command_line_as_one_line(cli, repo, tmp_path):
+    """Issue 2 bad inputs handled by the readers: each stops `reduce` with one line."""
+    out = tmp_path / "t.csv"
+    no_ele = tmp_path / "no_ele.gpx"
+    no_ele.write_text(
+        '<?xml version="1.0"?><gpx version="1.1" '
+        'xmlns="http://www.topografix.com/GPX/1/1">'
+        '<wpt lat="49.0" lon="-114.0"><ele>1500</ele><name>A</name></wpt>'
+        '<wpt lat="49.0001" lon="-114.0"><name>B</name></wpt></gpx>'
+    )
+    fails(cli("reduce", "--impacts", no_ele, "--theta0", "30", "-o", out),
+          "no_ele.gpx", "B")
+    text = tmp_path / "text.csv"
+    text.write_text("point,x_m,z_m\nP0,0,100\nP1,ten,94\n")
+    fails(cli("reduce", "--impacts", text, "--theta0", "30", "-o", out),
+          "text.csv", "row 3")
+    folder = repo / "surveys" / "tornado_mountain"
+    book = tmp_path / "book.csv"
+    lines = (folder / "boulder_a_fieldbook.csv").read_text().splitlines()
+    lines[3] = lines[3][:-3] + "00\""  # corrupt the checksum of point C (row 4)
+    book.write_text("\n".join(lines) + "\n")
+    fails(cli("reduce", "--fieldbook", book, "--stations",
+              folder / "boulder_a_stations.gpx", "--theta0", "30", "-o", out),
+          "book.csv", "row 4")
+    assert not out.exists()
