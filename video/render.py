@@ -447,6 +447,54 @@ def draw_net(frame, camera: Camera, scene: NetScene, ball: Ball, x_m, z_m) -> No
     )
 
 
+def write_clip(
+    path: Path,
+    camera: Camera,
+    ball: Ball,
+    background_bgr: np.ndarray,
+    poses: np.ndarray,
+    rng: np.random.Generator,
+    *,
+    codec: str = "MJPG",
+    draw=None,
+) -> Path:
+    """Write one video: ``poses[i] = (x_m, z_m, angle_rad)`` per frame (NaN: no ball).
+
+    ``background_bgr`` is uint8; ``draw(frame, i)`` may add scene details (a net)
+    before the ball is composited. Sensor noise: windows at random offsets into one
+    seeded noise field, applied with saturating uint8 add/subtract (grey noise).
+    """
+    writer = cv2.VideoWriter(
+        str(path),
+        cv2.VideoWriter.fourcc(*codec),
+        camera.playback_fps,
+        (camera.width, camera.height),
+    )
+    if not writer.isOpened():
+        raise RuntimeError(f"cannot open a {codec} writer for {path}")
+    writer.set(cv2.VIDEOWRITER_PROP_QUALITY, camera.jpeg_quality)
+    pad = 64
+    field = camera.noise_sd * rng.standard_normal(
+        (camera.height + pad, camera.width + pad), np.float32
+    )
+    field = np.repeat(np.round(field)[:, :, None], 3, axis=2)
+    noise_up = np.clip(field, 0, 255).astype(np.uint8)
+    noise_down = np.clip(-field, 0, 255).astype(np.uint8)
+    for i, (x, z, angle) in enumerate(np.asarray(poses, float)):
+        frame = background_bgr.copy()
+        if draw is not None:
+            draw(frame, i)
+        if np.isfinite(x) and np.isfinite(z):
+            draw_ball(frame, camera, ball, x, z, angle)
+        dv, du = (int(k) for k in rng.integers(0, pad, 2))
+        window = (slice(dv, dv + camera.height), slice(du, du + camera.width))
+        cv2.add(frame, noise_up[window], dst=frame)
+        cv2.subtract(frame, noise_down[window], dst=frame)
+        writer.write(frame)
+    writer.release()
+    return Path(path)
+
+
 def _short_bounce_camera() -> Camera:
     return Camera(width=480, height=320, origin_u_px=30.0, origin_v_px=300.0)
 
@@ -503,36 +551,16 @@ def render(
         impacts = []
     bg = np.clip(background(camera, rng, scene) + 0.5, 0, 255).astype(np.uint8)
     path = out_dir / f"{name}{extension}"
-    writer = cv2.VideoWriter(
-        str(path),
-        cv2.VideoWriter.fourcc(*codec),
-        camera.playback_fps,
-        (camera.width, camera.height),
-    )
-    if not writer.isOpened():
-        raise RuntimeError(f"cannot open a {codec} writer for {path}")
-    writer.set(cv2.VIDEOWRITER_PROP_QUALITY, camera.jpeg_quality)
     us, vs = camera.to_image(states[:, 0], states[:, 1])
-    # sensor noise: windows at random offsets into one seeded noise field, applied
-    # with saturating uint8 add/subtract (grey noise, same on the three channels)
-    pad = 64
-    field = camera.noise_sd * rng.standard_normal(
-        (camera.height + pad, camera.width + pad), np.float32
-    )
-    field = np.repeat(np.round(field)[:, :, None], 3, axis=2)
-    noise_up = np.clip(field, 0, 255).astype(np.uint8)
-    noise_down = np.clip(-field, 0, 255).astype(np.uint8)
-    for i in range(n):
-        frame = bg.copy()
-        if isinstance(scene, NetScene):
+    draw = None
+    if isinstance(scene, NetScene):
+
+        def draw(frame, i):
             draw_net(frame, camera, scene, ball, states[i, 0], states[i, 1])
-        draw_ball(frame, camera, ball, states[i, 0], states[i, 1], states[i, 4])
-        dv, du = (int(k) for k in rng.integers(0, pad, 2))
-        window = (slice(dv, dv + camera.height), slice(du, du + camera.width))
-        cv2.add(frame, noise_up[window], dst=frame)
-        cv2.subtract(frame, noise_down[window], dst=frame)
-        writer.write(frame)
-    writer.release()
+
+    write_clip(
+        path, camera, ball, bg, states[:, [0, 1, 4]], rng, codec=codec, draw=draw
+    )
     visible = (
         (us + ball.radius_m / camera.scale_m_per_px > 0)
         & (us - ball.radius_m / camera.scale_m_per_px < camera.width - 1)

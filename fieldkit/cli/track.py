@@ -262,6 +262,15 @@ def _run_tracking(video, reader, fps, calibration, roi, radius, *, show: bool):
     )
 
     console = Console(file=sys.stderr)
+    if not console.is_terminal:  # no bar in logs and pipes
+        return track_video(
+            video,
+            fps=fps,
+            calibration=calibration,
+            roi=roi,
+            radius_m=radius,
+            reader=reader,
+        )
     with Progress(
         "[progress.description]{task.description}",
         BarColumn(),

@@ -21,8 +21,29 @@ import numpy as np
 
 from fieldkit.errors import InputFileError
 
-os.environ.setdefault("OPENCV_LOG_LEVEL", "ERROR")
-os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
+
+def _backend() -> int:
+    """FFmpeg when OpenCV has it (quiet, clean failures), else any backend."""
+    try:
+        if cv2.videoio_registry.hasBackend(cv2.CAP_FFMPEG):
+            return cv2.CAP_FFMPEG
+    except AttributeError:  # very old OpenCV without the registry
+        pass
+    return cv2.CAP_ANY
+
+
+def _open_capture(path: Path) -> cv2.VideoCapture:
+    """Open quietly: OpenCV's own warnings about unreadable files are not ours."""
+    logging = getattr(getattr(cv2, "utils", None), "logging", None)
+    previous = None
+    if logging is not None and hasattr(logging, "getLogLevel"):
+        previous = logging.getLogLevel()
+        logging.setLogLevel(logging.LOG_LEVEL_ERROR)
+    try:
+        return cv2.VideoCapture(str(path), _backend())
+    finally:
+        if previous is not None:
+            logging.setLogLevel(previous)
 
 
 @dataclass(frozen=True)
@@ -69,7 +90,7 @@ class VideoReader:
             raise InputFileError("video file not found", source=self.path)
         if self.path.stat().st_size == 0:
             raise InputFileError("video file is empty (0 bytes)", source=self.path)
-        capture = cv2.VideoCapture(str(self.path))
+        capture = _open_capture(self.path)
         if not capture.isOpened():
             raise InputFileError(
                 "cannot open as a video (unknown format or damaged header)",
@@ -116,7 +137,7 @@ class VideoReader:
         failure: list[BaseException] = []
 
         def produce() -> None:
-            capture = cv2.VideoCapture(str(self.path))
+            capture = _open_capture(self.path)
             try:
                 if start:
                     capture.set(cv2.CAP_PROP_POS_FRAMES, start)
@@ -171,7 +192,7 @@ class VideoReader:
     def _frames_direct(
         self, start: int, stop: int | None
     ) -> Iterator[tuple[int, np.ndarray]]:
-        capture = cv2.VideoCapture(str(self.path))
+        capture = _open_capture(self.path)
         try:
             if start:
                 capture.set(cv2.CAP_PROP_POS_FRAMES, start)
@@ -189,7 +210,7 @@ class VideoReader:
 
     def read_frames(self, indices: list[int]) -> list[tuple[int, np.ndarray]]:
         """Random access to a few frames (seeking); undecodable ones are skipped."""
-        capture = cv2.VideoCapture(str(self.path))
+        capture = _open_capture(self.path)
         out = []
         try:
             for index in sorted(set(int(i) for i in indices)):
