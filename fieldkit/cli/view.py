@@ -1,11 +1,234 @@
-"""`fieldkit view` (being built; see the issue tracker)."""
+"""`fieldkit view`: a rerun recording (.rrd) of an ImpactTable or a track."""
 
 from __future__ import annotations
 
+from enum import StrEnum
+from pathlib import Path
+from typing import Annotated
+
+import pandas as pd
 import typer
 
+from fieldkit.cli.common import GyrationOpt, MassOpt, RadiusOpt, one_line_errors, warn
+from fieldkit.errors import ArgumentError, InputFileError
+from fieldkit.impact_table import ImpactTable
+from fieldkit.io.atomic import refuse_input_overwrite
+from fieldkit.io.delimited_text import detect_delimiter, read_lines, split_row
+from fieldkit.tracking.track import Track
 
-def view() -> None:
-    """Not built yet."""
-    typer.echo("fieldkit view: not built yet", err=True)
-    raise typer.Exit(3)
+
+class InputFormat(StrEnum):
+    auto = "auto"
+    impacts = "impacts"
+    track = "track"
+    tracker = "tracker"
+    kinovea = "kinovea"
+
+
+@one_line_errors
+def view(
+    input_file: Annotated[
+        Path,
+        typer.Argument(
+            metavar="INPUT",
+            help="An ImpactTable (CSV, Parquet, XLSX), a fieldkit track CSV "
+            "(t_s, x_m, z_m, ...), an OSP Tracker data export or a Kinovea CSV.",
+        ),
+    ],
+    out: Annotated[
+        Path, typer.Option("-o", "--out", help="Recording to write (.rrd).")
+    ],
+    input_format: Annotated[
+        InputFormat,
+        typer.Option(
+            "--format", help="What INPUT is; auto detects it from its header."
+        ),
+    ] = InputFormat.auto,
+    radius: RadiusOpt = None,
+    surface_angle: Annotated[
+        float | None,
+        typer.Option(
+            "--surface-angle",
+            help="Dip of the impact surface (deg), positive descending in the "
+            "direction of travel; estimated from the impacts when omitted.",
+        ),
+    ] = None,
+    mass: MassOpt = None,
+    gyration: GyrationOpt = None,
+    unit: Annotated[
+        str | None,
+        typer.Option(
+            "--unit",
+            help="Length unit of a Tracker/Kinovea export: m, cm, mm, in, ft or px "
+            "(Tracker default m; Kinovea: from its header when given).",
+        ),
+    ] = None,
+    metres_per_pixel: Annotated[
+        float | None,
+        typer.Option("--metres-per-pixel", help="Scale for --unit px (m/px)."),
+    ] = None,
+    y_down: Annotated[
+        bool,
+        typer.Option("--y-down", help="Kinovea y grows downward (image coordinates)."),
+    ] = False,
+    fps: Annotated[
+        float | None,
+        typer.Option("--fps", help="True capture rate, frames/s (with --file-fps)."),
+    ] = None,
+    file_fps: Annotated[
+        float | None,
+        typer.Option(
+            "--file-fps",
+            help="Rate the export's times were computed with (e.g. a 30 fps playback "
+            "rate); times are rescaled by file-fps/fps.",
+        ),
+    ] = None,
+    figures: Annotated[
+        Path | None,
+        typer.Option("--figures", help="Also write PNG figures of a track into DIR."),
+    ] = None,
+) -> None:
+    """Write a rerun recording of an impact table or a track, for the rerun viewer.
+
+    An ImpactTable becomes a section view: impact points labelled with e_n and e_t,
+    impact and restitution velocity arrows, slope ticks, and e_n, e_t and speeds
+    against the impact order. A track (fieldkit's track.csv, or an OSP Tracker or
+    Kinovea export) is first analysed like `fieldkit track` does: flights found and
+    fitted (fitted g checked against 9.81), impacts and net contacts; the recording
+    shows the track, the fitted flights, velocity vectors, speed, spin and residuals.
+    A track needs --radius.
+
+    Examples:
+
+        fieldkit view impacts.csv -o impacts.rrd
+
+        fieldkit view track.csv --radius 0.0375 -o track.rrd --figures figs/
+
+        fieldkit view ball.txt --format tracker --unit cm --radius 0.0375
+        --fps 1205 --file-fps 30 -o ball.rrd
+
+    Then open the recording with `rerun impacts.rrd`.
+    """
+    refuse_input_overwrite([out, figures], [input_file])
+    if out.suffix.lower() != ".rrd":
+        raise ArgumentError(
+            f"output must be a .rrd file, got {out.name!r}", source="-o"
+        )
+    fmt = input_format.value
+    if fmt == "auto":
+        fmt = detect_format(input_file)
+    from fieldkit.viz import rerun_log
+
+    if fmt == "impacts":
+        table = ImpactTable.read(input_file)
+        if len(table) == 0:
+            raise InputFileError("table has no rows", source=input_file)
+        rerun_log.write_impact_recording(out, table.derive())
+        typer.echo(f"wrote {out}: {len(table)} impacts, {len(table.paths())} path(s)")
+        return
+    track = _read_track(input_file, fmt, unit, metres_per_pixel, y_down, fps, file_fps)
+    if radius is None:
+        raise ArgumentError(
+            "a track needs the body radius to analyse its impacts", source="--radius"
+        )
+    from fieldkit.tracking.analysis import analyse_track
+
+    analysis = analyse_track(
+        track,
+        radius_m=radius,
+        surface_angle_deg=surface_angle,
+        mass_kg=mass,
+        gyration_m=gyration,
+        path_id=input_file.stem,
+    )
+    for message in analysis.warnings:
+        warn(message)
+    rerun_log.write_recording(out, analysis)
+    if figures is not None:
+        from fieldkit.viz.track_figure import write_track_figures
+
+        write_track_figures(figures, analysis)
+    typer.echo(
+        f"wrote {out}: {len(analysis.track)} samples, {len(analysis.flights)} flights, "
+        f"{len(analysis.impacts)} impacts, {len(analysis.contacts)} net contacts"
+    )
+
+
+def detect_format(path: Path) -> str:
+    """``impacts``, ``track``, ``tracker`` or ``kinovea`` from a file's first lines."""
+    if path.suffix.lower() in (".parquet", ".xlsx"):
+        return "impacts"
+    lines = [ln for ln in read_lines(path)[:3] if ln.strip()]
+    first = lines[0].strip()
+    cells = [c.strip().strip('"') for c in split_row(first, detect_delimiter(first))]
+    if first.lower().startswith("#multi"):
+        return "tracker"
+    if {"path_id", "vi_x_mps"} <= set(cells):
+        return "impacts"
+    if {"t_s", "x_m", "z_m"} <= set(cells):
+        return "track"
+    if (
+        cells
+        and cells[0].lower().startswith("time")
+        and any("x" in c.lower() for c in cells[1:])
+    ):
+        return "kinovea"
+    if len(lines) > 1:
+        second = lines[1]
+        names = {c.strip() for c in split_row(second, detect_delimiter(second))}
+        if {"t", "x", "y"} <= names:
+            return "tracker"
+    raise InputFileError(
+        "cannot tell what this file is (ImpactTable, track CSV, Tracker or Kinovea "
+        "export); give --format",
+        source=path,
+        where="row 1",
+    )
+
+
+def _read_track(path, fmt, unit, metres_per_pixel, y_down, fps, file_fps) -> Track:
+    if fmt == "tracker":
+        from fieldkit.io.osp_tracker import read_osp_tracker
+
+        return read_osp_tracker(
+            path,
+            unit=unit or "m",
+            metres_per_pixel=metres_per_pixel,
+            fps=fps,
+            file_fps=file_fps,
+        )
+    if fmt == "kinovea":
+        from fieldkit.io.kinovea import read_kinovea
+
+        return read_kinovea(
+            path,
+            unit=unit,
+            metres_per_pixel=metres_per_pixel,
+            y_down=y_down,
+            fps=fps,
+            file_fps=file_fps,
+        )
+    try:
+        frame = pd.read_csv(path)
+    except (ValueError, OSError, pd.errors.ParserError) as exc:
+        raise InputFileError(f"cannot read CSV: {exc}", source=path) from None
+    for col in ("t_s", "x_m", "z_m"):
+        if col not in frame:
+            raise InputFileError(
+                f"track lacks column {col}", source=path, where="row 1"
+            )
+        values = pd.to_numeric(frame[col], errors="coerce")
+        bad = frame[col].notna() & values.isna()
+        if bad.any():
+            row = int(bad.to_numpy().nonzero()[0][0]) + 2
+            raise InputFileError(
+                f"column {col}: {frame[col][bad].iloc[0]!r} is not a number",
+                source=path,
+                where=f"row {row}",
+            )
+        frame[col] = values
+    if fps is not None or file_fps is not None:
+        from fieldkit.io.delimited_text import time_factor
+
+        frame["t_s"] = frame["t_s"] * time_factor(file_fps, fps, path)
+    return Track(frame, source=str(path), fps=fps)

@@ -80,7 +80,8 @@ def write_recording(
         From :func:`fieldkit.tracking.analysis.analyse_track`.
     frames
         ``(frame_index, BGR image)`` pairs; at most :data:`MAX_FRAMES` evenly spaced
-        frames are kept, downscaled to :data:`MAX_FRAME_SIDE_PX`.
+        frames are kept (every n-th over the track's frame range; the iterable is
+        consumed lazily), downscaled to :data:`MAX_FRAME_SIDE_PX`.
     detections
         Per-frame detections with ``frame``, ``u_px``, ``v_px`` and optionally
         ``marker_du_px``, ``marker_dv_px`` (offset of the marker from the centre).
@@ -295,10 +296,18 @@ def _log_frames(rec, analysis: TrackAnalysis, frames, detections) -> None:
     det = detections if detections is not None else f
     det = det.set_index("frame") if "frame" in det else det
     homography = world_to_image(f)
-    pairs = list(frames)
-    step = max(1, int(np.ceil(len(pairs) / MAX_FRAMES)))
+    # frames arrive lazily (a video decoder): keep every step-th, never hold them all
+    span = f["frame"].to_numpy(int)
+    expected = int(span.max() - span.min() + 1) if len(span) else MAX_FRAMES
+    step = max(1, int(np.ceil(expected / MAX_FRAMES)))
     fps = analysis.track.fps or 1.0
-    for index, image in pairs[::step]:
+    kept = 0
+    for index, image in frames:
+        if (
+            int(index) - int(span.min() if len(span) else 0)
+        ) % step or kept >= MAX_FRAMES:
+            continue
+        kept += 1
         h, w = image.shape[:2]
         s = min(1.0, MAX_FRAME_SIDE_PX / max(h, w))
         if s < 1.0:

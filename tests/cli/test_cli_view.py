@@ -1,0 +1,145 @@
+"""`fieldkit view`: recordings of impact tables and tracks; bad input."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from rerun.chunk import RrdReader
+
+from fieldkit.tracking.synthetic import bouncing_ball
+
+DATA = Path(__file__).parents[1] / "io" / "data"
+
+
+@pytest.fixture(scope="module")
+def track_csv(tmp_path_factory):
+    s = bouncing_ball(
+        duration_s=0.8,
+        start_velocity_mps=(1.5, 0.5),
+        surface_angle_deg=12.0,
+        omega0_radps=-20.0,
+        noise_m=4e-4,
+        angle_noise_rad=0.02,
+        rng=np.random.default_rng(5),
+    )
+    path = tmp_path_factory.mktemp("track") / "track.csv"
+    s.track.frame.to_csv(path, index=False)
+    return path
+
+
+def summary(path: Path) -> str:
+    return RrdReader(path).store().summary()
+
+
+def test_help_has_an_example(cli):
+    result = cli("view", "--help")
+    assert result.exit_code == 0
+    assert "fieldkit view impacts.csv -o impacts.rrd" in result.stdout
+
+
+def test_track_csv_to_recording_and_figures(cli, track_csv, tmp_path):
+    out, figs = tmp_path / "rec.rrd", tmp_path / "figs"
+    result = cli("view", track_csv, "--radius", "0.0375", "-o", out, "--figures", figs)
+    assert result.exit_code == 0, result.stderr
+    assert "4 flights, 3 impacts" in result.stdout
+    angle = result.stderr.split("3 contact points: ")[1].split(" deg")[0]
+    assert abs(float(angle) - 12.0) < 0.1
+    s = summary(out)
+    assert "/world/flights" in s and "/plots/speed/fitted" in s
+    assert sorted(p.name for p in figs.iterdir()) == [
+        "residuals.png",
+        "speed_spin.png",
+        "track.png",
+    ]
+
+
+def test_impact_table_from_a_track_then_viewed(cli, track_csv, tmp_path):
+    import pandas as pd
+
+    from fieldkit.tracking.analysis import analyse_track
+    from fieldkit.tracking.track import Track
+
+    a = analyse_track(Track(pd.read_csv(track_csv)), radius_m=0.0375)
+    table = tmp_path / "impacts.csv"
+    a.impacts.write(table)
+    out = tmp_path / "impacts.rrd"
+    result = cli("view", table, "-o", out)
+    assert result.exit_code == 0, result.stderr
+    assert "3 impacts, 1 path(s)" in result.stdout
+    assert "/section/video/impacts" in summary(out)
+
+
+@pytest.mark.parametrize(
+    ("sample", "args"),
+    [
+        ("osp_tracker_ball_tab_decimal_comma.txt", []),
+        ("osp_tracker_multi_comma_cm.csv", ["--unit", "cm"]),
+        (
+            "kinovea_raw_semicolon_px.csv",
+            ["--unit", "px", "--metres-per-pixel", "0.002", "--y-down"],
+        ),
+        ("kinovea_kinematics_cm.csv", []),
+    ],
+)
+def test_track_exports_are_detected_and_read(cli, tmp_path, sample, args):
+    out = tmp_path / "x.rrd"
+    result = cli("view", DATA / sample, "--radius", "0.03", "-o", out, *args)
+    assert result.exit_code == 0, result.stderr
+    assert "1 flights" in result.stdout
+    assert "g = " not in result.stderr  # exact parabolas: g = 9.81, no warning
+    assert out.is_file()
+
+
+def test_wrong_playback_rate_is_flagged(cli, tmp_path):
+    out = tmp_path / "x.rrd"
+    result = cli(
+        "view",
+        DATA / "osp_tracker_ball_tab_decimal_comma.txt",
+        "--radius",
+        "0.03",
+        "--fps",
+        "1205",
+        "--file-fps",
+        "240",
+        "-o",
+        out,
+    )
+    assert result.exit_code == 0
+    assert "fitted g = 247" in result.stderr and "--fps" in result.stderr
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["{track}", "-o", "{out}"], "--radius: a track needs the body radius"),
+        (["{track}", "--radius", "0.03", "-o", "{tmp}/x.png"], "must be a .rrd file"),
+        (["{track}", "--radius", "-1", "-o", "{out}"], "radius must be > 0"),
+        (["{tmp}/missing.csv", "-o", "{out}"], "missing.csv: file not found"),
+        (["{track}", "--radius", "0.03", "-o", "{track}"], "overwrite an input"),
+        (["{weird}", "-o", "{out}"], "cannot tell what this file is"),
+        (
+            ["{badtrack}", "--radius", "0.03", "-o", "{out}"],
+            "badtrack.csv: row 3: column x_m: 'oops' is not a number",
+        ),
+    ],
+)
+def test_bad_input_one_line_error_and_no_output(
+    cli, track_csv, tmp_path, args, message
+):
+    (tmp_path / "weird.csv").write_text("a,b\n1,2\n")
+    (tmp_path / "badtrack.csv").write_text("t_s,x_m,z_m\n0,0,0\n0.01,oops,0\n")
+    fill = dict(
+        track=track_csv,
+        out=tmp_path / "out.rrd",
+        tmp=tmp_path,
+        weird=tmp_path / "weird.csv",
+        badtrack=tmp_path / "badtrack.csv",
+    )
+    result = cli("view", *[a.format(**fill) for a in args])
+    assert result.exit_code == 1
+    assert message in result.stderr
+    assert result.stderr.startswith("error: ") and result.stderr.count("\n") == 1
+    assert not (tmp_path / "out.rrd").exists()
+    assert not (tmp_path / "x.png").exists()
