@@ -99,6 +99,35 @@ def reduce(
             "--path-id", help="Rock / path identifier (default: the input file name)."
         ),
     ] = None,
+    epsg: Annotated[
+        int | None,
+        typer.Option(
+            "--epsg",
+            help="EPSG code of easting/northing columns in a CSV (e.g. 32611).",
+        ),
+    ] = None,
+    gpx_points: Annotated[
+        str,
+        typer.Option(
+            "--gpx-points",
+            help="Which GPX points are the impacts: waypoints, route, track or auto.",
+        ),
+    ] = "waypoints",
+    lenient_checksum: Annotated[
+        bool,
+        typer.Option(
+            "--lenient-checksum",
+            help="Accept TruPulse sentences whose checksum does not match.",
+        ),
+    ] = False,
+    friction: Annotated[
+        float,
+        typer.Option(
+            "--friction",
+            help="Contact friction mu for the theoretical impact energy "
+            "(dke_theory_j; default 0.68, thesis §5.3 / example 6B).",
+        ),
+    ] = 0.68,
     declination: Annotated[
         float,
         typer.Option(
@@ -180,13 +209,20 @@ def reduce(
     if impacts is not None:
         from fieldkit.io.points import read_impacts
 
-        points = read_impacts(impacts, units=units)
+        points = read_impacts(
+            impacts, units=units, epsg=epsg, gpx_points=gpx_points
+        )
         name = impacts.stem
     else:
         from fieldkit.io.fieldbook import read_fieldbook
 
         points = read_fieldbook(
-            fieldbook, stations, declination_deg=declination, units=units
+            fieldbook,
+            stations,
+            declination_deg=declination,
+            lenient=lenient_checksum,
+            units=units,
+            epsg=epsg,
         )
         name = fieldbook.stem
     tree_set = None
@@ -194,7 +230,9 @@ def reduce(
         from fieldkit.io.trees import read_trees
 
         tree_set = read_trees(trees, points, units=units)
-    options = ReduceOptions(path_id=path_id or name, theta0_deg=theta0, body=body)
+    options = ReduceOptions(
+        path_id=path_id or name, theta0_deg=theta0, body=body, friction=friction
+    )
     table = reduce_survey(points, tree_set, options)
 
     if out is not None:

@@ -24,7 +24,7 @@ from fieldkit.io.csv_table import check_readable
 #: Columns every PointSet frame has, in this order.
 POINT_COLUMNS = ("point", "x_m", "z_m", "lat_deg", "lon_deg", "easting_m", "northing_m")
 #: Columns a PointSet frame may add when the source has them.
-OPTIONAL_COLUMNS = ("material", "slope_deg", "time")
+OPTIONAL_COLUMNS = ("material", "slope_deg", "theta0_deg", "time")
 
 GPX_HEIGHT_REFERENCE = (
     "GPX <ele> as given (usually above sea level); no geoid conversion"
@@ -95,7 +95,7 @@ def _optional(frame: pd.DataFrame, extra: dict[str, Sequence] | None) -> pd.Data
         values = extra[column]
         if column == "material":
             frame[column] = pd.Series(list(values), dtype="str", index=frame.index)
-        elif column == "slope_deg":
+        elif column in ("slope_deg", "theta0_deg"):
             frame[column] = np.asarray(list(values), dtype=float)
         else:
             frame[column] = pd.Series(values).to_numpy()

@@ -70,6 +70,7 @@ NORTHING_ALIASES = ("northing", "north", "n")
 SECTION_X_ALIASES = ("x", "chainage", "distance", "horizontal_distance")
 MATERIAL_ALIASES = ("material", "surface", "terrain", "slope_material")
 SLOPE_ALIASES = ("slope", "slope_angle", "psi", "ground_slope")
+THETA0_ALIASES = ("theta0", "theta_0", "restitution_angle")
 TIME_ALIASES = ("time", "timestamp", "datetime", "date_time", "utc_time")
 
 
@@ -259,6 +260,11 @@ def _optional_columns(table: CsvTable, units: str) -> dict[str, object]:
     if slope is not None:
         extra["slope_deg"] = [
             table.number(n, row, slope, required=False) for n, row in table.rows
+        ]
+    theta0 = table.find(THETA0_ALIASES)
+    if theta0 is not None:
+        extra["theta0_deg"] = [
+            table.number(n, row, theta0, required=False) for n, row in table.rows
         ]
     time = table.find(TIME_ALIASES)
     if time is not None:

@@ -11,6 +11,8 @@
    flight (impact) and start of the next (restitution), body, spin, flight heights;
 5. :meth:`ImpactTable.derive` -- N/T components, angles, e_n, e_t, energies, heads;
 6. :func:`add_flight_energy` -- KE gained in each flight (``flight_dke_j``).
+7. :func:`~fieldkit.reduce.impact_theory.add_theory_columns` -- impact-mechanics
+   energy change beside the measured one (``dke_theory_j``, thesis §6.3).
 
 The source (first point) has no impact velocity and the stopped point (last) no
 restitution velocity: those stay NaN.
@@ -27,6 +29,7 @@ import pandas as pd
 
 from fieldkit.errors import InputFileError
 from fieldkit.impact_table import ImpactTable
+from fieldkit.reduce.impact_theory import DEFAULT_FRICTION, add_theory_columns
 from fieldkit.physics.energy import kinetic_energy
 from fieldkit.reduce.body import BodyProperties
 from fieldkit.reduce.flights import SolvedFlight, TreeStrike, solve_flights
@@ -45,11 +48,15 @@ class ReduceOptions:
         defines a flight (None: every flight must be defined).
     body
         Mass, contact radius, radius of gyration.
+    friction
+        Contact friction coefficient mu [-] for the impact-mechanics energy beside
+        the measured one (:func:`fieldkit.reduce.impact_theory.add_theory_columns`).
     """
 
     path_id: str
     theta0_deg: float | None = None
     body: BodyProperties = field(default_factory=BodyProperties)
+    friction: float = DEFAULT_FRICTION
 
 
 def section_slopes(
@@ -296,8 +303,7 @@ def reduce_survey(
     )
     table = ImpactTable(rows, source=source).derive()
     table = add_flight_energy(table)
-    # Further per-impact steps (e.g. theoretical impact energies) chain on here.
-    return table
+    return add_theory_columns(table, friction=options.friction)
 
 
 def flights_of(table: ImpactTable) -> Mapping[str, np.ndarray]:

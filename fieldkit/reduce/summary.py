@@ -41,6 +41,11 @@ class ReductionSummary:
     flight_ke_gain_j: float
     potential_released_j: float
     rotational_change_j: float
+    #: Median over impacts that lost energy of ``theory_loss_fraction`` (thesis §6.3).
+    theory_fraction_median: float = float("nan")
+    theory_fraction_n: int = 0
+    #: The spin entering the theory was estimated (omega = v/r, eq. 3.17), not measured.
+    theory_spin_estimated: bool = False
 
 
 def _sd(values: np.ndarray) -> float:
@@ -92,6 +97,11 @@ def summarize(table: ImpactTable) -> ReductionSummary:
         z = path["z_m"].to_numpy(float)
         potential += m * G * (z[0] - z[-1])
     re_change = np.nansum(f["re_f_j"].to_numpy(float) - f["re_i_j"].to_numpy(float))
+    fraction = np.array([], dtype=float)
+    if "theory_loss_fraction" in f:
+        lost = f["dke_j"].to_numpy(float) < 0
+        fraction = f["theory_loss_fraction"].to_numpy(float)[lost]
+        fraction = fraction[np.isfinite(fraction)]
     return ReductionSummary(
         path_ids=tuple(str(p) for p in table.paths()),
         n_points=len(f),
@@ -104,6 +114,11 @@ def summarize(table: ImpactTable) -> ReductionSummary:
         else float("nan"),
         potential_released_j=float(potential),
         rotational_change_j=float(re_change),
+        theory_fraction_median=float(np.median(fraction)) if len(fraction) else np.nan,
+        theory_fraction_n=len(fraction),
+        theory_spin_estimated=bool(
+            "omega_source" in f and f["omega_source"].eq("estimated").any()
+        ),
     )
 
 
@@ -131,4 +146,16 @@ def format_summary(summary: ReductionSummary) -> str:
         ]
     else:
         lines.append("energy: no mass given (--mass or --shape), energies left out")
+    if summary.theory_fraction_n:
+        lines.append(
+            "impact mechanics explains a median "
+            f"{100 * summary.theory_fraction_median:.0f} % of the measured KE loss "
+            f"({summary.theory_fraction_n} impacts; thesis §6.3 finds ~20-30 %; "
+            "see theory_loss_fraction)"
+        )
+        if summary.theory_spin_estimated:
+            lines.append(
+                "  (spin estimated as v/r: a rolling body slips little, so friction "
+                "loss is a lower bound)"
+            )
     return "\n".join(lines)
