@@ -177,9 +177,6 @@ def track(
 
     reader = VideoReader(video)
     info = reader.info
-    message = fps_mismatch_message(info, fps)
-    if message:
-        warn(message)
     size = (info.width, info.height)
     if homography is not None:
         calibration = read_homography_file(homography, size)
@@ -192,8 +189,10 @@ def track(
     track_data, detections = _run_tracking(
         video, reader, fps, calibration, search, radius, show=not quiet
     )
-    for message in track_data.meta.get("warnings", []):
-        warn(message)
+    rate_message = fps_mismatch_message(info, fps)
+    for message in [rate_message, *track_data.meta.get("warnings", [])]:
+        if message:
+            warn(message)
     radius_m = radius
     if radius_m is None:
         whole = track_data.frame.loc[~track_data.frame["partial"], "radius_m"]

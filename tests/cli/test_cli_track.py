@@ -1,0 +1,215 @@
+"""`fieldkit track` on the command line: outputs, warnings and one-line errors.
+
+Small synthetic clips (320x240, ~100 frames, written with video/render.py's
+``write_clip``) keep these fast; accuracy against the rendered truth is in
+tests/tracking/test_video_acceptance.py.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import sys
+
+import numpy as np
+import pandas as pd
+import pytest
+
+G = 9.81
+FPS = 1205.0
+SCALE = ("--scale-points", "20,20,300,20", "--scale-length", "0.56")  # 2 mm/px
+
+
+@pytest.fixture(scope="module")
+def render(repo):
+    name = "fieldkit_video_render_for_cli"
+    spec = importlib.util.spec_from_file_location(name, repo / "video" / "render.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def _clip(render, path, *, frames=110, hide=(), ball_visible=True):
+    """A ball thrown across a 320x240 scene (2 mm/px); ``hide`` frames lack it."""
+    camera = render.Camera(width=320, height=240, origin_u_px=20.0, origin_v_px=220.0)
+    rng = np.random.default_rng(4)
+    scene = render.BounceScene(plate_point_m=(0.0, -1.0))  # plate out of view
+    bg = np.clip(render.background(camera, rng, scene) + 0.5, 0, 255).astype(np.uint8)
+    t = np.arange(frames) / FPS
+    poses = np.column_stack(
+        [0.05 + 2.5 * t, 0.25 + 1.0 * t - 0.5 * G * t**2, 0.2 - 40.0 * t]
+    )
+    if not ball_visible:
+        poses[:] = np.nan
+    for i in hide:
+        poses[i] = np.nan
+    render.write_clip(path, camera, render.Ball(), bg, poses, rng)
+    return path, poses
+
+
+@pytest.fixture(scope="module")
+def clip(render, tmp_path_factory):
+    return _clip(render, tmp_path_factory.mktemp("clip") / "throw.avi")
+
+
+def digest(path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def fails(result, *words: str) -> None:
+    """Exit code != 0 and a single 'error:' line naming every word."""
+    assert result.exit_code != 0
+    lines = [line for line in result.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
+    for word in words:
+        assert word in lines[0], (word, lines[0])
+
+
+def test_help_has_an_example(cli):
+    result = cli("track", "--help")
+    assert result.exit_code == 0
+    assert (
+        "--scale-points" in result.stdout and "fieldkit track video/" in result.stdout
+    )
+
+
+def test_track_writes_track_and_warns_about_playback_rate(cli, clip, tmp_path):
+    video, poses = clip
+    out, table = tmp_path / "track.csv", tmp_path / "impacts.csv"
+    before = digest(video)
+    result = cli(
+        "track",
+        video,
+        "--fps",
+        FPS,
+        *SCALE,
+        "--radius",
+        "0.0375",
+        "-o",
+        out,
+        "--impacts",
+        table,
+    )
+    assert result.exit_code == 0, result.stderr
+    assert "30 frames/s" in result.stderr and "--fps is 1205" in result.stderr
+    track = pd.read_csv(out)
+    for column in ("t_s", "x_m", "z_m", "angle_rad", "omega_radps", "flight"):
+        assert column in track.columns
+    assert len(track) == len(poses)
+    np.testing.assert_allclose(track["t_s"], np.arange(len(poses)) / FPS)
+    # world origin at the first scale point (20, 20) px; truth origin at (20, 220) px
+    err_x = track["x_m"] - poses[:, 0]
+    err_z = track["z_m"] - (poses[:, 1] - 0.4)
+    assert np.sqrt(np.mean(err_x**2 + err_z**2)) < 0.5e-3
+    spin = track["omega_radps"].to_numpy()[10:-10]
+    assert np.nanmedian(spin) == pytest.approx(-40.0, rel=0.02)
+    assert table.exists()  # no impact in a single flight: an empty table
+    assert digest(video) == before
+
+
+def test_homography_file_gives_the_same_track(cli, clip, tmp_path):
+    video, poses = clip
+    h = tmp_path / "h.csv"
+    rows = [(20, 220), (300, 220), (300, 20), (20, 20)]
+    h.write_text(
+        "u_px,v_px,x_m,z_m\n"
+        + "\n".join(f"{u},{v},{(u - 20) * 0.002},{(220 - v) * 0.002}" for u, v in rows)
+    )
+    out = tmp_path / "track.csv"
+    result = cli("track", video, "--fps", FPS, "--homography", h, "-o", out)
+    assert result.exit_code == 0, result.stderr
+    assert "--radius not given" in result.stderr
+    track = pd.read_csv(out)
+    err = np.hypot(track["x_m"] - poses[:, 0], track["z_m"] - poses[:, 1])
+    assert np.sqrt(np.mean(err**2)) < 0.5e-3
+
+
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        ((*SCALE,), ("--fps", "required")),
+        (("--fps", "0", *SCALE), ("--fps", "positive")),
+        (("--fps", "-1205", *SCALE), ("--fps", "positive")),
+        (
+            ("--fps", "1205", "--scale-points", "20,20,20,20", "--scale-length", "1"),
+            ("--scale-points", "identical"),
+        ),
+        (
+            ("--fps", "1205", "--scale-points", "20,20,400,20", "--scale-length", "1"),
+            ("--scale-points", "point 2", "outside the 320x240 frame"),
+        ),
+        (("--fps", "1205", "--scale-points", "20,20,300,20"), ("--scale-length",)),
+        (("--fps", "1205", *SCALE, "--roi", "1,2,3"), ("--roi",)),
+        (("--fps", "1205", *SCALE, "--radius", "-1"), ("--radius",)),
+    ],
+)
+def test_bad_arguments_one_line_and_no_output(cli, clip, tmp_path, args, words):
+    out = tmp_path / "t.csv"
+    fails(cli("track", clip[0], *args, "-o", out), *words)
+    assert not out.exists()
+
+
+def test_unreadable_missing_and_empty_videos(cli, render, tmp_path):
+    import cv2
+
+    junk = tmp_path / "junk.avi"
+    junk.write_bytes(b"not a video at all" * 100)
+    empty = tmp_path / "empty.avi"
+    writer = cv2.VideoWriter(str(empty), cv2.VideoWriter.fourcc(*"MJPG"), 30, (64, 48))
+    writer.release()
+    out = tmp_path / "t.csv"
+    cases = [
+        (junk, ("junk.avi", "cannot open")),
+        (tmp_path / "missing.avi", ("missing.avi", "not found")),
+        (empty, ("empty.avi", "0 frames")),
+    ]
+    for video, words in cases:
+        fails(cli("track", video, "--fps", "1205", *SCALE, "-o", out), *words)
+        assert not out.exists()
+
+
+def test_no_body_found(cli, render, tmp_path):
+    video, _ = _clip(
+        render, tmp_path / "empty_scene.avi", frames=40, ball_visible=False
+    )
+    out = tmp_path / "t.csv"
+    fails(
+        cli("track", video, "--fps", "1205", *SCALE, "-o", out),
+        "empty_scene.avi",
+        "frames 0-39",
+        "no body found",
+    )
+    assert not out.exists()
+
+
+def test_body_lost_mid_flight_names_the_frames(cli, render, tmp_path):
+    video, poses = _clip(render, tmp_path / "lost.avi", hide=range(50, 57))
+    out = tmp_path / "t.csv"
+    result = cli(
+        "track", video, "--fps", "1205", *SCALE, "--radius", "0.0375", "-o", out
+    )
+    assert result.exit_code == 0, result.stderr
+    assert "frames 50-56: body lost" in result.stderr
+    track = pd.read_csv(out)
+    assert not set(range(50, 57)) & set(track["frame"])
+    assert len(track) == len(poses) - 7
+
+
+def test_truncated_video_warns_and_tracks_what_is_there(cli, render, tmp_path):
+    video, _ = _clip(render, tmp_path / "full.avi", frames=110)
+    data = video.read_bytes()
+    cut = tmp_path / "cut.avi"
+    cut.write_bytes(data[: int(len(data) * 0.6)])
+    out = tmp_path / "t.csv"
+    result = cli("track", cut, "--fps", "1205", *SCALE, "--radius", "0.0375", "-o", out)
+    assert result.exit_code == 0, result.stderr
+    assert "truncated" in result.stderr and "-109:" in result.stderr
+    assert 40 < len(pd.read_csv(out)) < 110
+
+
+def test_refuses_to_overwrite_the_video(cli, clip):
+    video = clip[0]
+    before = digest(video)
+    fails(cli("track", video, "--fps", "1205", *SCALE, "-o", video), "overwrite")
+    assert digest(video) == before
