@@ -631,11 +631,17 @@ def render(
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
-        "clips", nargs="*", default=["bounce", "net"], choices=sorted(PRESETS)
+        "clips",
+        nargs="*",
+        help=f"clips to render: {', '.join(sorted(PRESETS))} (default: bounce net)",
     )
     parser.add_argument("--out", type=Path, default=HERE)
     parser.add_argument("--frames", type=int, default=None)
     args = parser.parse_args(argv)
+    args.clips = args.clips or ["bounce", "net"]
+    unknown = sorted(set(args.clips) - set(PRESETS))
+    if unknown:
+        parser.error(f"unknown clip(s) {', '.join(unknown)}")
     for name in args.clips:
         truth = render(name, args.out, frames=args.frames)
         print(

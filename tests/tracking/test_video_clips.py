@@ -115,3 +115,23 @@ def test_truncated_video_reports_the_missing_frames(render, tmp_path):
     assert 20 < n < 80
     message = reader.truncation_message()
     assert f"frames {n}-79" in message and "truncated" in message
+
+
+@pytest.mark.parametrize("name", ["bounce", "net"])
+def test_committed_truth_matches_the_renderer(render, repo, name):
+    committed = json.loads((repo / "video" / f"{name}.truth.json").read_text())
+    ball = render.Ball()
+    scene = render.PRESETS[name][1]()
+    times = np.arange(committed["frames"]) / 1205.0
+    if name == "bounce":
+        states, impacts = render.bounce_motion(scene, ball, times)
+        assert len(impacts) == len(committed["impacts"])
+        for new, old in zip(impacts, committed["impacts"], strict=True):
+            for key in ("t_s", "x_m", "z_m", "vi_x_mps", "vf_z_mps", "omega_f_radps"):
+                assert new[key] == pytest.approx(old[key], rel=1e-9, abs=1e-12)
+    else:
+        states, _, contact = render.net_motion(scene, ball, times)
+        for key in ("t_start_s", "t_end_s", "vi_mps", "vf_mps", "efficiency_percent"):
+            assert contact[key] == pytest.approx(committed["contact"][key], rel=1e-9)
+    table = pd.read_csv(repo / "video" / f"{name}.truth.csv")
+    np.testing.assert_allclose(table["x_m"], states[:, 0], rtol=1e-9, atol=1e-12)
