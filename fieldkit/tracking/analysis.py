@@ -114,7 +114,7 @@ def analyse_track(
             source=track.source or None,
         )
 
-    seg = find_flights(track.t, track.x, track.z)
+    seg = find_flights(track.t, track.x, track.z, noise_floor_m=noise_floor(track))
     flights = [
         fit_flight(track.t[r], track.x[r], track.z[r], index=i, rows=r)
         for i, r in enumerate(seg.flights)
@@ -172,6 +172,22 @@ def analyse_track(
             )
         )
     return TrackAnalysis(track, flights, table, contacts, warnings)
+
+
+def noise_floor(track: Track) -> float:
+    """Smallest position noise to assume [m]: 0.05 px when the pixel scale is known.
+
+    Sub-pixel detectors reach a few hundredths of a pixel at best, and their errors
+    are correlated over several frames; the scale comes from the track's
+    ``radius_m / radius_px`` columns (video tracks) or ``meta["metres_per_pixel"]``.
+    """
+    f = track.frame
+    scale = track.meta.get("metres_per_pixel")
+    if scale is None and {"radius_m", "radius_px"} <= set(f.columns):
+        ratio = (f["radius_m"] / f["radius_px"]).to_numpy(float)
+        ratio = ratio[np.isfinite(ratio) & (ratio > 0)]
+        scale = float(np.median(ratio)) if len(ratio) else None
+    return 0.05 * float(scale) if scale else 0.0
 
 
 def empty_impact_table() -> ImpactTable:

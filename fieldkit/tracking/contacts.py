@@ -36,6 +36,10 @@ import numpy as np
 
 from fieldkit.tracking.flight_fit import fit_flight
 
+#: A contact with at least this many samples off both flights is extended (a net, a
+#: rolling phase) rather than an impact.
+EXTENDED_CONTACT_SAMPLES = 5
+
 #: Chi-square (2 d.o.f.) bound for a sample to join a flight (p ~ 4e-6 for pure noise).
 CHI2_JOIN = 25.0
 
@@ -222,6 +226,7 @@ def find_flights(
     *,
     window: int = 9,
     min_samples: int = 8,
+    noise_floor_m: float = 0.0,
 ) -> Segmentation:
     """Find the ballistic flights of a track (see the module docstring for the method).
 
@@ -234,6 +239,11 @@ def find_flights(
         Samples per local window for the noise estimate and the seeds.
     min_samples
         Fewest samples a flight may have.
+    noise_floor_m
+        Smallest position noise assumed [m]. Detection errors are correlated over
+        several frames (slowly changing background under the rim, compression), so
+        the sample-to-sample scatter understates them; a floor of a few hundredths of
+        a pixel keeps good samples in their flights.
 
     Returns
     -------
@@ -265,7 +275,14 @@ def find_flights(
 
     local = estimate_noise(t, x, z, window)
     extent = max(np.ptp(x), np.ptp(z), 1e-9)
-    sigma = max(float(np.median(local)) * 1.05, 1e-9 * extent)
+    # a 4x longer window also sees errors correlated over a few frames
+    long = estimate_noise(t, x, z, min(4 * window - 3, n))
+    sigma = max(
+        float(np.median(local)) * 1.05,
+        float(np.median(long)) if len(long) else 0.0,
+        noise_floor_m,
+        1e-9 * extent,
+    )
 
     free = np.ones(n, bool)
     segments: list[tuple[int, int, list[int]]] = []
@@ -312,6 +329,11 @@ def find_flights(
         if len(rows) >= min_samples:
             flights.append(rows)
 
+    g_fix = g_common if np.isfinite(g_common) else 9.81
+    for k in range(len(flights) - 1):
+        if flights[k + 1][0] - flights[k][-1] - 1 >= EXTENDED_CONTACT_SAMPLES:
+            flights[k] = _stable_end(t, x, z, flights[k], sigma, g_fix, at_start=False)
+            flights[k + 1] = _stable_end(t, x, z, flights[k + 1], sigma, g_fix, True)
     contacts = []
     for k in range(len(flights) - 1):
         a, b = flights[k], flights[k + 1]
@@ -391,6 +413,43 @@ def _trim_biased_ends(
         if max(head, tail) <= limit:
             break
         rows = rows[1:] if head > tail else rows[:-1]
+    return rows
+
+
+def _stable_end(
+    t, x, z, rows: np.ndarray, sigma: float, g: float, at_start: bool
+) -> np.ndarray:
+    """Drop the samples of a flight still pulled by a fading contact force.
+
+    Next to an extended contact the force fades below what single samples reveal
+    (a net letting go), yet biases the flight's velocity at the contact. The flight
+    is refitted (g fixed) without its first k samples on the contact side, k = 0, 1,
+    ... up to 40 %; the velocity at the contact-side boundary drifts while
+    contaminated samples are dropped and then stays put. The smallest k whose
+    velocity agrees with every later one within 3 standard errors is kept.
+    """
+    n = len(rows)
+    kmax = int(0.4 * n)
+    if kmax < 2:
+        return rows
+    t_b = t[rows[0]] if at_start else t[rows[-1]]
+    v, se = [], []
+    for k in range(kmax + 1):
+        r = rows[k:] if at_start else rows[: n - k]
+        tau = t[r] - t_b
+        design = np.column_stack([np.ones_like(tau), tau])
+        zc = z[r] + 0.5 * g * tau**2
+        cx = np.linalg.lstsq(design, x[r], rcond=None)[0]
+        cz = np.linalg.lstsq(design, zc, rcond=None)[0]
+        cov = np.linalg.inv(design.T @ design)
+        v.append((cx[1], cz[1]))
+        se.append(sigma * np.sqrt(cov[1, 1]))
+    v = np.array(v)
+    se = np.array(se)
+    for k in range(kmax + 1):
+        later = slice(k + 1, kmax + 1)
+        if np.all(np.abs(v[later] - v[k]).max(axis=1) <= 3.0 * se[later]):
+            return rows[k:] if at_start else rows[: n - k]
     return rows
 
 

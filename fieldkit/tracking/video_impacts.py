@@ -43,16 +43,13 @@ import pandas as pd
 
 from fieldkit.impact_table import ImpactTable
 from fieldkit.physics.constants import G
-from fieldkit.tracking.contacts import ContactSpan
+from fieldkit.tracking.contacts import EXTENDED_CONTACT_SAMPLES, ContactSpan
 from fieldkit.tracking.flight_fit import FlightFit
 from fieldkit.tracking.track import Track
 
 #: Frames beyond the gap searched for the closest approach of the two parabolas (the
 #: samples next to a soft impact fit either parabola within the noise).
 SEARCH_FRAMES = 4
-
-#: A contact with at least this many measured samples is extended (net, rolling).
-EXTENDED_CONTACT_SAMPLES = 5
 
 
 @dataclass
