@@ -74,7 +74,8 @@ class Ball:
     radius_m: float = 0.0375
     mass_kg: float = 0.14
     marker_offset: float = 0.55  # marker spot centre, fraction of the radius
-    marker_radius: float = 0.24  # marker spot radius, fraction of the radius
+    marker_radius: float = 0.24  # spot radius (stripe half-width), fraction of r
+    marker: str = "spot"  # "spot" off the centre, or "stripe" through the centre
     colour_bgr: tuple = (70, 175, 240)
     marker_bgr: tuple = (60, 30, 20)
 
@@ -406,9 +407,15 @@ def draw_ball(
     # marker in world orientation: angle counter-clockwise from +x, z up (v down)
     mu_ = uc + ball.marker_offset * r * math.cos(angle_rad)
     mv_ = vc - ball.marker_offset * r * math.sin(angle_rad)
-    mrk = (us[None, :] - mu_) ** 2 + (vs[:, None] - mv_) ** 2 <= (
-        ball.marker_radius * r
-    ) ** 2
+    if ball.marker == "stripe":  # band through the centre along angle_rad
+        across = -(us[None, :] - uc) * math.sin(angle_rad) - (vs[:, None] - vc) * (
+            math.cos(angle_rad)
+        )
+        mrk = np.abs(across) <= ball.marker_radius * r
+    else:
+        mrk = (us[None, :] - mu_) ** 2 + (vs[:, None] - mv_) ** 2 <= (
+            ball.marker_radius * r
+        ) ** 2
     mrk &= inside
     hh, ww = v1c - v0c + 1, u1c - u0c + 1
 

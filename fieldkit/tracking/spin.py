@@ -1,7 +1,9 @@
 """Spin from a marker on the body: marker angle per frame -> unwrapped angle -> omega.
 
-The marker is a spot (or short stripe) off the body's centre whose colour differs from
-the body's. Its angle is the direction from the body's centre to the marker's centroid,
+The marker is a spot (or short stripe) off the body's centre, or a stripe across the
+body through its centre, in a colour that differs from the body's. Its angle is the
+direction from the body's centre to the marker's centroid (for a stripe through the
+centre: its principal axis, known modulo half a turn and unwrapped with that period),
 mapped into world axes (x right, z up, counter-clockwise positive), so a mirrored or
 rotated camera still gives the thesis sign: omega < 0 is clockwise, the rolling sense
 for travel toward +x (ARCHITECTURE §2).
@@ -23,6 +25,31 @@ MIN_MARKER_SHARE = 0.015
 MIN_MARKER_OFFSET = 0.15
 
 
+def _marker_weights(frame, u_px, v_px, radius_px, body_colour_bgr, min_difference):
+    """Offsets (du, dv) [px] of the pixels inside 0.8 r and their marker weight."""
+    colour = np.asarray(body_colour_bgr, dtype=np.float32)
+    if not np.all(np.isfinite(colour)) or not np.isfinite(radius_px) or radius_px < 3:
+        return None
+    h, w = frame.shape[:2]
+    reach = 0.8 * radius_px
+    u0, u1 = max(int(np.floor(u_px - reach)), 0), min(int(np.ceil(u_px + reach)) + 1, w)
+    v0, v1 = max(int(np.floor(v_px - reach)), 0), min(int(np.ceil(v_px + reach)) + 1, h)
+    if u1 - u0 < 3 or v1 - v0 < 3:
+        return None
+    patch = frame[v0:v1, u0:u1].astype(np.float32)
+    du = np.arange(u0, u1, dtype=np.float32)[None, :] - u_px
+    dv = np.arange(v0, v1, dtype=np.float32)[:, None] - v_px
+    inside = du * du + dv * dv <= reach * reach
+    if patch.ndim == 3:
+        difference = np.sqrt(np.sum((patch - colour[None, None, :]) ** 2, axis=2) / 3.0)
+    else:
+        difference = np.abs(patch - float(np.mean(colour)))
+    weight = np.clip((difference - min_difference) / min_difference, 0.0, 1.0) * inside
+    if float(weight.sum()) < MIN_MARKER_SHARE * np.pi * reach * reach:
+        return None
+    return du, dv, weight
+
+
 def marker_offset_px(
     frame: np.ndarray,
     u_px: float,
@@ -32,7 +59,7 @@ def marker_offset_px(
     *,
     min_difference: float = 40.0,
 ) -> tuple[float, float]:
-    """Image offset (du, dv) [px] of the marker centroid from the body centre.
+    """Image offset (du, dv) [px] of a marker spot's centroid from the body centre.
 
     Pixels inside 0.8 r whose colour differs from the body's by more than
     ``min_difference`` grey levels are weighted by how much they differ. Returns
@@ -45,32 +72,70 @@ def marker_offset_px(
     >>> [round(c, 3) for c in marker_offset_px(img, 20.0, 20.0, 15.0, (200, 200, 200))]
     [8.0, 0.0]
     """
-    colour = np.asarray(body_colour_bgr, dtype=np.float32)
-    if not np.all(np.isfinite(colour)) or not np.isfinite(radius_px) or radius_px < 3:
+    grid = _marker_weights(
+        frame, u_px, v_px, radius_px, body_colour_bgr, min_difference
+    )
+    if grid is None:
         return np.nan, np.nan
-    h, w = frame.shape[:2]
-    reach = 0.8 * radius_px
-    u0, u1 = max(int(np.floor(u_px - reach)), 0), min(int(np.ceil(u_px + reach)) + 1, w)
-    v0, v1 = max(int(np.floor(v_px - reach)), 0), min(int(np.ceil(v_px + reach)) + 1, h)
-    if u1 - u0 < 3 or v1 - v0 < 3:
-        return np.nan, np.nan
-    patch = frame[v0:v1, u0:u1].astype(np.float32)
-    du = np.arange(u0, u1, dtype=np.float32)[None, :] - u_px
-    dv = np.arange(v0, v1, dtype=np.float32)[:, None] - v_px
-    inside = du * du + dv * dv <= reach * reach
-    if patch.ndim == 3:
-        difference = np.sqrt(np.sum((patch - colour[None, None, :]) ** 2, axis=2) / 3.0)
-    else:
-        difference = np.abs(patch - float(np.mean(colour)))
-    weight = np.clip((difference - min_difference) / min_difference, 0.0, 1.0) * inside
+    du, dv, weight = grid
     total = float(weight.sum())
-    if total < MIN_MARKER_SHARE * np.pi * reach * reach:
-        return np.nan, np.nan
     mu = float((weight * du).sum() / total)
     mv = float((weight * dv).sum() / total)
     if np.hypot(mu, mv) < MIN_MARKER_OFFSET * radius_px:
         return np.nan, np.nan
     return mu, mv
+
+
+def measure_marker(
+    frame: np.ndarray,
+    u_px: float,
+    v_px: float,
+    radius_px: float,
+    body_colour_bgr,
+    *,
+    min_difference: float = 40.0,
+) -> tuple[float, float, bool]:
+    """Marker direction as an image offset (du, dv) [px] and whether it is axial.
+
+    A spot (or any marker off the centre) gives the offset of its centroid
+    (``axial`` False). A stripe through the centre has a central centroid; its
+    direction is then the principal axis of the marker pixels, known only modulo
+    half a turn (``axial`` True, offset of length 0.5 r along the axis). NaN when
+    neither can be measured.
+
+    Examples
+    --------
+    >>> img = np.full((41, 41, 3), 200, np.uint8)
+    >>> img[19:22, 6:35] = 20                      # a horizontal stripe
+    >>> du, dv, axial = measure_marker(img, 20.0, 20.0, 15.0, (200, 200, 200))
+    >>> round(du, 3), round(dv, 3), axial
+    (7.5, 0.0, True)
+    """
+    du, dv = marker_offset_px(
+        frame, u_px, v_px, radius_px, body_colour_bgr, min_difference=min_difference
+    )
+    if np.isfinite(du):
+        return du, dv, False
+    grid = _marker_weights(
+        frame, u_px, v_px, radius_px, body_colour_bgr, min_difference
+    )
+    if grid is None:
+        return np.nan, np.nan, False
+    gu, gv, weight = grid
+    total = float(weight.sum())
+    suu = float((weight * gu * gu).sum() / total)
+    svv = float((weight * gv * gv).sum() / total)
+    suv = float((weight * gu * gv).sum() / total)
+    spread = np.sqrt((suu - svv) ** 2 + 4 * suv * suv)
+    major, minor = 0.5 * (suu + svv + spread), 0.5 * (suu + svv - spread)
+    if major < 4.0 * max(minor, 1e-9):  # not elongated: a blob at the centre
+        return np.nan, np.nan, False
+    axis = 0.5 * np.arctan2(2 * suv, suu - svv)
+    return (
+        0.5 * radius_px * float(np.cos(axis)),
+        0.5 * radius_px * float(np.sin(axis)),
+        True,
+    )
 
 
 def marker_angle_world(
@@ -82,10 +147,11 @@ def marker_angle_world(
     return np.arctan2(z1 - z0, x1 - x0)
 
 
-def unwrap_angle(angle_rad: np.ndarray) -> np.ndarray:
+def unwrap_angle(angle_rad: np.ndarray, period: float = 2 * np.pi) -> np.ndarray:
     """Unwrap an angle series over its valid (finite) samples; NaN stay NaN.
 
-    The rotation between consecutive valid samples must stay below half a turn.
+    The rotation between consecutive valid samples must stay below half a
+    ``period`` (use ``period=pi`` for an axial stripe, known modulo half a turn).
 
     Examples
     --------
@@ -97,7 +163,8 @@ def unwrap_angle(angle_rad: np.ndarray) -> np.ndarray:
     out = np.full_like(angle, np.nan)
     ok = np.isfinite(angle)
     if ok.any():
-        out[ok] = np.unwrap(angle[ok])
+        scale = 2 * np.pi / period
+        out[ok] = np.unwrap(angle[ok] * scale) / scale
     return out
 
 

@@ -19,7 +19,7 @@ from fieldkit.tracking.detection import BallDetector, median_background, noise_t
 from fieldkit.tracking.spin import (
     angular_velocity,
     marker_angle_world,
-    marker_offset_px,
+    measure_marker,
     unwrap_angle,
 )
 from fieldkit.tracking.track import Track
@@ -167,9 +167,9 @@ def track_video(
         if det is None:
             rows.append({"frame": index, "found": False})
         else:
-            du, dv = (np.nan, np.nan)
+            du, dv, axial = (np.nan, np.nan, False)
             if not det.partial:
-                du, dv = marker_offset_px(
+                du, dv, axial = measure_marker(
                     image, det.u_px, det.v_px, det.radius_px, det.colour_bgr
                 )
             rows.append(
@@ -184,6 +184,7 @@ def track_video(
                     "fit_residual_px": det.fit_residual_px,
                     "marker_du_px": du,
                     "marker_dv_px": dv,
+                    "marker_axial": axial,
                 }
             )
             last = (last + [(index, det.u_px, det.v_px, det.radius_px)])[-2:]
@@ -239,14 +240,18 @@ def track_video(
             f"{path}: the body travels toward -x in the calibrated frame; x is "
             "mirrored (x -> -x, spin sign flipped) so x increases along travel"
         )
-    angle = unwrap_angle(angle)
+    # a stripe through the centre is known modulo half a turn: if most frames see
+    # one, unwrap every marker angle with that period
+    axial = found["marker_axial"].to_numpy(bool) & np.isfinite(angle)
+    period = np.pi if axial.sum() > 0.5 * np.isfinite(angle).sum() else 2 * np.pi
+    angle = unwrap_angle(angle, period=period)
     omega, omega_sd = angular_velocity(t, angle)
     whole = ~found["partial"].to_numpy(bool)
     no_marker = frames[whole & ~np.isfinite(angle)]
     if whole.any() and np.isfinite(angle[whole]).mean() < 0.2:
         warnings.append(
             f"{path}: no marker could be followed on the body; omega is NaN "
-            "(needs a spot or stripe off the centre, contrasting with the body)"
+            "(needs a spot or stripe in a colour contrasting with the body)"
         )
         angle[:] = np.nan
         omega[:] = np.nan
@@ -284,6 +289,7 @@ def track_video(
         "calibration": calibration.description,
         "threshold": threshold,
         "roi": list(roi) if roi else None,
+        "marker": "stripe (angle modulo pi)" if period < 4 else "spot",
         "mirrored_x": mirrored,
         "warnings": warnings,
     }

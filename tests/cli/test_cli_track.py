@@ -30,7 +30,9 @@ def render(repo):
     return module
 
 
-def _clip(render, path, *, frames=110, hide=(), ball_visible=True):
+def _clip(
+    render, path, *, frames=110, hide=(), ball_visible=True, ball=None, leftward=False
+):
     """A ball thrown across a 320x240 scene (2 mm/px); ``hide`` frames lack it."""
     camera = render.Camera(width=320, height=240, origin_u_px=20.0, origin_v_px=220.0)
     rng = np.random.default_rng(4)
@@ -40,11 +42,14 @@ def _clip(render, path, *, frames=110, hide=(), ball_visible=True):
     poses = np.column_stack(
         [0.05 + 2.5 * t, 0.25 + 1.0 * t - 0.5 * G * t**2, 0.2 - 40.0 * t]
     )
+    if leftward:  # thrown toward -x (image left), spinning the other way
+        poses[:, 0] = 0.55 - poses[:, 0]
+        poses[:, 2] = np.pi - poses[:, 2]
     if not ball_visible:
         poses[:] = np.nan
     for i in hide:
         poses[i] = np.nan
-    render.write_clip(path, camera, render.Ball(), bg, poses, rng)
+    render.write_clip(path, camera, ball or render.Ball(), bg, poses, rng)
     return path, poses
 
 
@@ -213,3 +218,32 @@ def test_refuses_to_overwrite_the_video(cli, clip):
     before = digest(video)
     fails(cli("track", video, "--fps", "1205", *SCALE, "-o", video), "overwrite")
     assert digest(video) == before
+
+
+def test_stripe_marker_through_the_centre(cli, render, tmp_path):
+    ball = render.Ball(marker="stripe", marker_radius=0.15)
+    video, poses = _clip(render, tmp_path / "stripe.avi", ball=ball)
+    out = tmp_path / "t.csv"
+    result = cli("track", video, "--fps", FPS, *SCALE, "--radius", "0.0375", "-o", out)
+    assert result.exit_code == 0, result.stderr
+    track = pd.read_csv(out)
+    spin = track["omega_radps"].to_numpy()[10:-10]
+    assert np.nanmedian(spin) == pytest.approx(-40.0, rel=0.02)
+    # the axis is known modulo half a turn
+    offset = np.angle(np.exp(2j * (track["angle_rad"] - poses[:, 2]))) / 2
+    assert np.nanmax(np.abs(offset)) < 0.05
+
+
+def test_travel_toward_image_left_is_mirrored_to_plus_x(cli, render, tmp_path):
+    video, poses = _clip(render, tmp_path / "left.avi", leftward=True)
+    out = tmp_path / "t.csv"
+    result = cli("track", video, "--fps", FPS, *SCALE, "--radius", "0.0375", "-o", out)
+    assert result.exit_code == 0, result.stderr
+    assert "mirrored" in result.stderr
+    track = pd.read_csv(out)
+    assert np.all(np.diff(track["x_m"]) > 0)  # x increases along travel
+    # mirrored x = -(world x - first scale point's x)
+    np.testing.assert_allclose(track["x_m"], -poses[:, 0], atol=0.5e-3)
+    # the ball spins +40 rad/s (counter-clockwise) while moving left: in the
+    # mirrored section it is clockwise, -40 rad/s, the rolling sense for +x travel
+    assert np.nanmedian(track["omega_radps"]) == pytest.approx(-40.0, rel=0.02)

@@ -12,18 +12,24 @@ from fieldkit.tracking.spin import (
     angular_velocity,
     marker_angle_world,
     marker_offset_px,
+    measure_marker,
     unwrap_angle,
 )
 
 
-def _ball_image(angle_rad, *, size=81, r=25.0, offset=0.55, spot=0.25, supersample=8):
-    """A flat-coloured ball with a dark spot at ``angle_rad`` (world sense: v down)."""
+def _ball_image(
+    angle_rad, *, size=81, r=25.0, offset=0.55, spot=0.25, supersample=8, stripe=False
+):
+    """A flat-coloured ball with a dark spot (or stripe) at ``angle_rad`` (v down)."""
     c = (size - 1) / 2
     offs = (np.arange(supersample) + 0.5) / supersample - 0.5
     grid = (np.arange(size)[:, None] + offs[None, :]).ravel()
     du, dv = grid[None, :] - c, grid[:, None] - c
     mu, mv = offset * r * np.cos(angle_rad), -offset * r * np.sin(angle_rad)
     mark = (du - mu) ** 2 + (dv - mv) ** 2 <= (spot * r) ** 2
+    if stripe:
+        across = -du * np.sin(angle_rad) - dv * np.cos(angle_rad)
+        mark = (np.abs(across) <= 0.15 * r) & (du * du + dv * dv <= r * r)
     cover = mark.reshape(size, supersample, size, supersample).mean(axis=(1, 3))
     img = np.empty((size, size, 3), np.float32)
     body, dark = (
@@ -42,6 +48,25 @@ def test_marker_offset_gives_the_marker_direction(angle):
     cal = two_point_scale((0, 0, 100, 0), 0.1)  # level camera: v down is z down
     got = float(marker_angle_world(cal, c, c, du, dv))
     assert np.angle(np.exp(1j * (got - angle))) == pytest.approx(0.0, abs=0.01)
+
+
+@pytest.mark.parametrize("angle", [0.0, 0.7, 1.5, -1.2])
+def test_stripe_through_the_centre_gives_its_axis(angle):
+    img, c, r = _ball_image(angle, stripe=True)
+    du, dv, axial = measure_marker(img, c, c, r, (70, 175, 240))
+    assert axial
+    cal = two_point_scale((0, 0, 100, 0), 0.1)
+    got = float(marker_angle_world(cal, c, c, du, dv))
+    assert np.angle(np.exp(2j * (got - angle))) / 2 == pytest.approx(0.0, abs=0.01)
+    # a spot is not axial
+    img, c, r = _ball_image(angle)
+    assert not measure_marker(img, c, c, r, (70, 175, 240))[2]
+
+
+def test_unwrap_with_half_turn_period():
+    true = np.linspace(0.0, 12.0, 50)  # 0.24 rad per sample
+    axis = np.mod(true, np.pi)  # a stripe's axis angle, modulo pi
+    np.testing.assert_allclose(unwrap_angle(axis, period=np.pi), true, atol=1e-12)
 
 
 def test_marker_angle_follows_a_mirrored_camera():
