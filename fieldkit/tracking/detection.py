@@ -24,6 +24,7 @@ whole region of interest when it is lost.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import cv2
@@ -75,6 +76,76 @@ def median_background(frames: list[np.ndarray]) -> np.ndarray:
     """
     stack = np.stack(frames, axis=0)
     return np.median(stack, axis=0).astype(np.uint8)
+
+
+def clean_background(
+    frames: list[np.ndarray], background: np.ndarray, detections: list
+) -> np.ndarray:
+    """Recompute the median where a slow body spoilt it, leaving the body out.
+
+    ``detections[i]`` is the :class:`Detection` found in ``frames[i]`` against the
+    first ``background`` (or None). Around every detection, each frame's pixels
+    covered by its own body (radius 1.3 r + 2 px) are excluded and the median is
+    taken over the other frames; pixels covered in every frame keep their value.
+    """
+    out = background.copy()
+    h, w = background.shape[:2]
+    discs = [
+        (i, d.u_px, d.v_px, 1.3 * d.radius_px + 2.0)
+        for i, d in enumerate(detections)
+        if d is not None
+    ]
+    if not discs:
+        return out
+    stack = np.stack(frames, axis=0).astype(np.float32)
+    for _, uc, vc, reach in discs:
+        u0, u1 = max(int(uc - 2 * reach), 0), min(int(uc + 2 * reach) + 1, w)
+        v0, v1 = max(int(vc - 2 * reach), 0), min(int(vc + 2 * reach) + 1, h)
+        if u1 <= u0 or v1 <= v0:
+            continue
+        patch = stack[:, v0:v1, u0:u1].copy()
+        uu = np.arange(u0, u1)[None, :]
+        vv = np.arange(v0, v1)[:, None]
+        for j, uj, vj, rj in discs:
+            covered = (uu - uj) ** 2 + (vv - vj) ** 2 <= rj * rj
+            patch[j][covered] = np.nan
+        with warnings.catch_warnings():  # all-NaN columns: covered in every frame
+            warnings.simplefilter("ignore", RuntimeWarning)
+            median = np.nanmedian(patch, axis=0)
+        known = np.isfinite(median)
+        region = out[v0:v1, u0:u1]
+        region[known] = np.clip(median[known] + 0.5, 0, 255).astype(np.uint8)
+    return out
+
+
+def background_model(
+    frames: list[np.ndarray],
+    *,
+    roi: tuple[int, int, int, int] | None = None,
+    expected_radius_px: float | None = None,
+    max_rounds: int = 5,
+) -> tuple[np.ndarray, float]:
+    """Background (uint8 BGR) and difference threshold from frames across a clip.
+
+    The per-pixel median, then rounds of :func:`clean_background`: the body is found
+    in the samples against the current background and left out of the median there,
+    until no more samples show it (a slow body hides in a plain median; each round
+    uncovers more of it).
+    """
+    first = median_background(frames)
+    background, threshold = first, noise_threshold(frames, first)
+    found = -1
+    for _ in range(max_rounds):
+        detector = BallDetector(
+            background, threshold, roi=roi, expected_radius_px=expected_radius_px
+        )
+        detections = [detector.detect(f) for f in frames]
+        count = sum(d is not None for d in detections)
+        if count <= found:
+            break
+        found = count
+        background = clean_background(frames, first, detections)
+    return background, threshold
 
 
 def colour_difference(frame: np.ndarray, background: np.ndarray) -> np.ndarray:

@@ -15,7 +15,10 @@ import pandas as pd
 
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.tracking.calibration import Calibration
-from fieldkit.tracking.detection import BallDetector, median_background, noise_threshold
+from fieldkit.tracking.detection import (
+    BallDetector,
+    background_model,
+)
 from fieldkit.tracking.spin import (
     angular_velocity,
     marker_angle_world,
@@ -138,12 +141,13 @@ def track_video(
     samples = [img for _, img in reader.read_frames(list(indices))]
     if len(samples) < 3:  # seeking failed (damaged index): read the first frames
         samples = [img for _, img in reader.frames(0, BACKGROUND_SAMPLES)]
-    background = median_background(samples)
-    threshold = noise_threshold(samples, background)
     centre = (info.width / 2.0, info.height / 2.0)
     expected = None
     if radius_m is not None and radius_m > 0:
         expected = float(radius_m / calibration.metres_per_pixel(*centre))
+    background, threshold = background_model(
+        samples, roi=roi, expected_radius_px=expected
+    )
     detector = BallDetector(background, threshold, roi=roi, expected_radius_px=expected)
 
     rows = []

@@ -11,6 +11,7 @@ import pytest
 
 from fieldkit.tracking.detection import (
     BallDetector,
+    background_model,
     fit_circle,
     median_background,
     noise_threshold,
@@ -120,3 +121,19 @@ def test_non_circular_moving_object_is_rejected(scene):
     bar_only = _frame(scene, -1.0, -1.0, rng=rng)
     cv2.rectangle(bar_only, (500, 100), (620, 125), (250, 250, 250), -1)
     assert detector.detect(bar_only) is None
+
+
+def test_clean_background_removes_a_slow_body(scene):
+    render, camera, ball, background = scene
+    rng = np.random.default_rng(12)
+    # the ball creeps 6 px per sample: the centre pixel is covered in 7 of 11
+    xs = 0.5 + 0.012 * np.arange(11)
+    frames = [_frame(scene, x, 0.6, rng=rng) for x in xs]
+    first = median_background(frames)
+    truth = np.clip(background + 0.5, 0, 255).astype(np.uint8)
+    u, v = (int(round(c)) for c in camera.to_image(xs[5], 0.6))
+    spoilt = np.abs(first[v, u].astype(int) - truth[v, u].astype(int)).max()
+    assert spoilt > 40  # the median still shows the ball there
+    cleaned, _ = background_model(frames)
+    fixed = np.abs(cleaned[v, u].astype(int) - truth[v, u].astype(int)).max()
+    assert fixed < 12  # noise + JPEG, no ball
