@@ -28,6 +28,8 @@ from fieldkit.tracking.video_impacts import build_impact_table, find_contact_eve
 
 #: Fewest samples a track needs to be analysed.
 MIN_TRACK_SAMPLES = 10
+#: Fewest samples left in a flight trimmed at a soft contact.
+MIN_FLIGHT_SAMPLES = 8
 
 
 @dataclass
@@ -115,10 +117,25 @@ def analyse_track(
         )
 
     seg = find_flights(track.t, track.x, track.z, noise_floor_m=noise_floor(track))
-    flights = [
-        fit_flight(track.t[r], track.x[r], track.z[r], index=i, rows=r)
-        for i, r in enumerate(seg.flights)
-    ]
+    rows_of = list(seg.flights)
+    flights = _fit_all(track, rows_of)
+    events = find_contact_events(track, flights, seg.contacts, seg.frame_interval_s)
+    # samples a soft contact still acted on (before its fitted onset) leave the flights
+    changed = False
+    for ev in events:
+        if not ev.extended:
+            continue
+        before, after = rows_of[ev.before], rows_of[ev.after]
+        keep_b = before[track.t[before] <= ev.t_impact_s]
+        keep_a = after[track.t[after] >= ev.t_restitution_s]
+        if MIN_FLIGHT_SAMPLES <= len(keep_b) < len(before):
+            rows_of[ev.before], changed = keep_b, True
+        if MIN_FLIGHT_SAMPLES <= len(keep_a) < len(after):
+            rows_of[ev.after], changed = keep_a, True
+    if changed:
+        flights = _fit_all(track, rows_of)
+        events = find_contact_events(track, flights, seg.contacts, seg.frame_interval_s)
+
     warnings: list[str] = []
     if not flights:
         warnings.append("no ballistic flight found in the track")
@@ -140,7 +157,6 @@ def analyse_track(
         frame_interval_s=seg.frame_interval_s,
     )
 
-    events = find_contact_events(track, flights, seg.contacts, seg.frame_interval_s)
     table, table_warnings = build_impact_table(
         events,
         flights,
@@ -169,9 +185,18 @@ def analyse_track(
                 gyration_m=gyration_m,
                 omega_i_radps=ev.omega_i_radps,
                 omega_f_radps=ev.omega_f_radps,
+                t_start_s=ev.t_impact_s,
+                t_end_s=ev.t_restitution_s,
             )
         )
     return TrackAnalysis(track, flights, table, contacts, warnings)
+
+
+def _fit_all(track: Track, rows_of: list[np.ndarray]) -> list[FlightFit]:
+    return [
+        fit_flight(track.t[r], track.x[r], track.z[r], index=i, rows=r)
+        for i, r in enumerate(rows_of)
+    ]
 
 
 def noise_floor(track: Track) -> float:

@@ -113,6 +113,76 @@ class NetContact:
         )
 
 
+def contact_onset(
+    track: Track, flight: FlightFit, rows: np.ndarray, *, forward: bool = True
+) -> float:
+    """When a fading or growing contact force starts (or stops) acting [s].
+
+    The per-sample test that ends a flight notices a soft contact only once the
+    deviation from the parabola exceeds the noise, several frames after the force
+    began (a net's force grows from zero). Here the deviation of the samples from
+    the flight's parabola, projected on its final direction, is fitted with the onset
+    law ``s(t) = a max(0, t - t0)^p`` (p = 2: force jumps to a finite value, a damper;
+    p = 3: force grows linearly, a spring), searching ``t0`` on a fine grid; zero-mean
+    noise before the onset, a power law after. With ``forward=False`` the same is
+    done backward in time from the flight after the contact (its start).
+
+    Parameters
+    ----------
+    track
+        The track.
+    flight
+        The flight before (``forward``) or after the contact.
+    rows
+        Track positions of the contact samples.
+
+    Returns
+    -------
+    float
+        The onset time ``t0`` [s] (the flight's boundary when the fit fails).
+    """
+    edge = flight.rows[-10:] if forward else flight.rows[:10]
+    use = np.concatenate([edge, rows]) if forward else np.concatenate([rows, edge])
+    t = track.t[use]
+    px, pz = flight.position(t)
+    dev = np.column_stack([track.x[use] - px, track.z[use] - pz])
+    ok = np.isfinite(dev).all(axis=1)
+    t, dev = t[ok], dev[ok]
+    boundary = flight.t_end_s if forward else flight.t_start_s
+    if len(t) < 8:
+        return boundary
+    order = np.argsort(t) if forward else np.argsort(-t)
+    t, dev = t[order], dev[order]
+    size = np.hypot(dev[:, 0], dev[:, 1])
+    # fit up to where the deviation is 100x its level along the flight (tuned on
+    # spring-damper captures: within a frame of the true start and end)
+    level = max(float(np.median(size[: len(edge)])), 1e-12)
+    stop = (
+        int(np.argmax(size > 100.0 * level)) if (size > 100.0 * level).any() else len(t)
+    )
+    stop = max(stop, len(edge) + 3)
+    t, dev, size = t[:stop], dev[:stop], size[:stop]
+    direction = dev[-3:].mean(axis=0)
+    norm = np.hypot(*direction)
+    if norm == 0:
+        return boundary
+    s = dev @ (direction / norm)
+    tau = (t - t[0]) if forward else (t[0] - t)
+    dt = float(np.median(np.diff(tau)))
+    best = (np.inf, boundary)
+    for tau0 in np.arange(0.0, tau[-2], dt / 10.0):
+        for p in (2.0, 3.0):
+            basis = np.clip(tau - tau0, 0.0, None) ** p
+            norm2 = basis @ basis
+            if norm2 == 0:
+                continue
+            a = (basis @ s) / norm2
+            sse = float(np.sum((s - a * basis) ** 2))
+            if a > 0 and sse < best[0]:
+                best = (sse, float(t[0] + tau0) if forward else float(t[0] - tau0))
+    return best[1]
+
+
 def local_velocity(t: np.ndarray, p: np.ndarray, half_window: int = 4) -> np.ndarray:
     """Derivative of ``p(t)``: local quadratic over ``2 h + 1`` samples (clipped)."""
     n = len(t)
@@ -138,6 +208,8 @@ def analyse_net_contact(
     gyration_m: float | None = None,
     omega_i_radps: float = float("nan"),
     omega_f_radps: float = float("nan"),
+    t_start_s: float | None = None,
+    t_end_s: float | None = None,
 ) -> NetContact:
     """Velocity, impulse and energy through one extended contact.
 
@@ -154,15 +226,19 @@ def analyse_net_contact(
         gyration and the spins are known.
     omega_i_radps, omega_f_radps
         Spin before and after the contact [rad/s].
+    t_start_s, t_end_s
+        Contact start and end [s] (:func:`contact_onset`); default the last sample of
+        the flight before and the first of the flight after.
     """
-    t_start, t_end = before.t_end_s, after.t_start_s
-    edge_before = before.rows[-4:]
-    edge_after = after.rows[:4]
-    use = np.concatenate([edge_before, np.asarray(rows, int), edge_after])
+    t_start = before.t_end_s if t_start_s is None else t_start_s
+    t_end = after.t_start_s if t_end_s is None else t_end_s
+    use = np.unique(
+        np.concatenate([before.rows[-15:], np.asarray(rows, int), after.rows[:15]])
+    )
     t = track.t[use]
     vx = local_velocity(t, track.x[use])
     vz = local_velocity(t, track.z[use])
-    inside = slice(len(edge_before), len(use) - len(edge_after))
+    inside = (t > t_start) & (t < t_end)
     vi = np.array([float(v) for v in before.velocity(t_start)])
     vf = np.array([float(v) for v in after.velocity(t_end)])
     ts = np.concatenate([[t_start], t[inside], [t_end]])
@@ -188,7 +264,9 @@ def analyse_net_contact(
         after=after.index,
         t_start_s=float(t_start),
         t_end_s=float(t_end),
-        n_frames=len(rows) + 1,
+        n_frames=int(round((t_end - t_start) / np.median(np.diff(t))))
+        if len(t) > 1
+        else 0,
         t_s=ts,
         vx_mps=vxs,
         vz_mps=vzs,

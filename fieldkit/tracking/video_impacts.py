@@ -6,8 +6,9 @@ For each contact between two fitted flights (:mod:`fieldkit.tracking.contacts`):
   samples off both parabolas) is treated as instantaneous: the impact instant is where
   the two fixed-g parabolas come closest (both share ``g``, so their separation is
   linear in time and the instant has a closed form), searched near the gap. An
-  extended contact (a net, a rolling phase) starts at the last sample of the flight
-  before and ends at the first sample of the flight after.
+  extended contact (a net, a rolling phase) starts and ends where the deviation from
+  the adjacent parabola sets in (:func:`fieldkit.tracking.net_contact.contact_onset`:
+  an onset power law fitted to the deviations, not the first sample beyond noise).
 * **Velocities.** Impact velocity from the flight before, restitution velocity from the
   flight after, both evaluated at the contact time(s) (fixed-g fits).
 * **Surface angle** ``slope_deg`` (psi, positive descending in the direction of
@@ -45,6 +46,7 @@ from fieldkit.impact_table import ImpactTable
 from fieldkit.physics.constants import G
 from fieldkit.tracking.contacts import EXTENDED_CONTACT_SAMPLES, ContactSpan
 from fieldkit.tracking.flight_fit import FlightFit
+from fieldkit.tracking.net_contact import contact_onset
 from fieldkit.tracking.track import Track
 
 #: Frames beyond the gap searched for the closest approach of the two parabolas (the
@@ -123,7 +125,10 @@ def find_contact_events(
         fa, fb = flights[span.before], flights[span.after]
         extended = len(span.rows) >= EXTENDED_CONTACT_SAMPLES
         if extended:
-            ti, tf = span.t_last_before_s, span.t_first_after_s
+            ti = contact_onset(track, fa, span.rows, forward=True)
+            tf = contact_onset(track, fb, span.rows, forward=False)
+            if not ti < tf:
+                ti, tf = span.t_last_before_s, span.t_first_after_s
         else:
             ti = tf = contact_instant(fa, fb, span, frame_interval_s)
         xa, za = fa.position(ti)

@@ -49,23 +49,26 @@ def test_one_extended_contact_with_absorbed_energy_and_efficiency(capture):
     assert len(analysis.contacts) == 1 and len(analysis.impacts) == 1
     c = analysis.contacts[0]
     absorbed = truth.ke_i_j - truth.ke_f_j
-    assert c.absorbed_j == pytest.approx(absorbed, rel=0.03)
-    assert c.efficiency == pytest.approx(truth.ke_f_j / truth.ke_i_j, abs=0.02)
+    assert c.absorbed_j == pytest.approx(absorbed, rel=0.01)
+    assert c.efficiency == pytest.approx(truth.ke_f_j / truth.ke_i_j, abs=0.01)
     vi = np.hypot(truth.vi_x_mps, truth.vi_z_mps)
     vf = np.hypot(truth.vf_x_mps, truth.vf_z_mps)
     assert c.vi_mps == pytest.approx(vi, rel=0.01)
-    assert c.vf_mps == pytest.approx(vf, rel=0.02)
+    assert c.vf_mps == pytest.approx(vf, rel=0.01)
     assert c.v_min_mps == pytest.approx(truth.v_min_mps, rel=0.03)
 
 
 def test_contact_time_series(capture):
     truth, analysis = capture
     c = analysis.contacts[0]
-    # the contact starts within a few frames of the first net force; its end is
-    # found where the fading net force drops below what the noise can reveal
-    assert c.t_start_s == pytest.approx(truth.t_start_s, abs=4 / 1205)
+    # start and end from the onset fit of the deviation from each parabola: within
+    # a frame or two although the net force fades below the noise at both ends
+    assert c.t_start_s == pytest.approx(truth.t_start_s, abs=1.5 / 1205)
+    assert c.t_end_s == pytest.approx(truth.t_end_s, abs=4 / 1205)
     true_duration = truth.t_end_s - truth.t_start_s
-    assert 0.7 * true_duration < c.duration_s <= true_duration + 2 / 1205
+    assert c.duration_s == pytest.approx(true_duration, rel=0.1)
+    # the flights keep no sample the net still acted on: gravity fits 9.81
+    assert not any("g =" in w for w in analysis.warnings)
     series = c.to_frame()
     assert series["t_from_start_s"].iloc[0] == 0.0
     # Fig. 8.15: share of the impact impulse absorbed, 1 - V(t)/V_i, peaks where
