@@ -10,7 +10,8 @@ body keeps (eq. 8.1)::
 
 For an extended contact between two fitted flights, :func:`analyse_net_contact`
 returns these as time series (speed by local quadratic differentiation of the tracked
-centre; the end points come from the flight fits) and summary numbers.
+centre; the end points come from the flight fits) and summary numbers. Eq. 8.1 itself
+is :func:`fieldkit.physics.fences.energy_efficiency`.
 """
 
 from __future__ import annotations
@@ -21,25 +22,9 @@ import numpy as np
 import pandas as pd
 
 from fieldkit.physics.constants import G
+from fieldkit.physics.fences import energy_efficiency
 from fieldkit.tracking.flight_fit import FlightFit
 from fieldkit.tracking.track import Track
-
-
-def energy_efficiency(energy_in_j, energy_out_j) -> np.ndarray:
-    """Energy efficiency of a protection structure, thesis eq. 8.1 [-].
-
-    ``E_e = E_f / E_i``: restitution energy over impact energy (0 when the body is
-    stopped, 1 when it keeps all its energy). Multiply by 100 for the thesis' per cent.
-
-    Examples
-    --------
-    >>> round(float(energy_efficiency(138.8, 39.2)), 2)  # thesis §8.2.3: 28 per cent
-    0.28
-    """
-    e_in = np.asarray(energy_in_j, float)
-    e_out = np.asarray(energy_out_j, float)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(e_in > 0, e_out / e_in, np.nan)
 
 
 @dataclass

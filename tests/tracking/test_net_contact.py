@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from fieldkit.physics.constants import G
+from fieldkit.physics.fences import energy_efficiency
 from fieldkit.tracking.analysis import analyse_track
-from fieldkit.tracking.net_contact import energy_efficiency
 from fieldkit.tracking.synthetic import net_capture
 
 MASS, R = 0.14, 0.0375
@@ -83,11 +83,12 @@ def test_contact_time_series(capture):
     assert series["net_impulse_ns"].iloc[-1] == pytest.approx(expected, rel=0.05)
 
 
-def test_energy_efficiency_thesis_values():
-    # thesis §8.2.3: 39.2 / 138.8 = 28 per cent; a stopped body: 0
+def test_efficiency_is_eq_8_1_of_the_contact_energies(capture):
+    # eq. 8.1 comes from physics.fences (thesis §8.2.3: 39.2 / 138.8 = 28 per cent)
     assert energy_efficiency(138.8, 39.2) == pytest.approx(0.2824, abs=1e-4)
-    assert energy_efficiency(136.1, 0.0) == 0.0
-    assert np.isnan(energy_efficiency(0.0, 1.0))
+    _, analysis = capture
+    c = analysis.contacts[0]
+    assert c.efficiency == pytest.approx(energy_efficiency(c.energy_i_j, c.energy_f_j))
 
 
 def test_efficiency_without_mass_is_per_unit_mass(capture):
