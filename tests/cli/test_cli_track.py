@@ -267,3 +267,17 @@ def test_other_codecs(cli, render, tmp_path, codec, name):
     assert len(track) == 60
     err = np.hypot(track["x_m"] - poses[:, 0], track["z_m"] - (poses[:, 1] - 0.4))
     assert np.sqrt(np.mean(err**2)) < 0.5e-3
+
+
+def test_roi_restricts_the_search(cli, clip, tmp_path):
+    video, poses = clip
+    out = tmp_path / "t.csv"
+    result = cli(
+        "track", video, "--fps", FPS, *SCALE, "--radius", "0.0375", "--roi",
+        "0,0,120,240", "-o", out,
+    )  # fmt: skip
+    assert result.exit_code == 0, result.stderr
+    track = pd.read_csv(out)
+    inside = (poses[:, 0] / 0.002 + 20) < 120  # truth centre inside the region
+    assert len(track) == inside.sum()
+    assert (track["u_px"] < 120).all()
