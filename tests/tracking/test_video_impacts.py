@@ -11,9 +11,11 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from fieldkit.errors import ArgumentError, InputFileError
-from fieldkit.physics.local_axes import to_local
+from fieldkit.physics.local_axes import to_local, to_section
 from fieldkit.tracking.analysis import analyse_track
 from fieldkit.tracking.synthetic import bouncing_ball
 from fieldkit.tracking.track import Track
@@ -190,3 +192,24 @@ def test_bad_arguments_and_short_tracks():
     short = Track(s.track.frame.iloc[:5].copy(), source="short.csv")
     with pytest.raises(InputFileError, match="short.csv: track has 5 usable samples"):
         analyse_track(short, radius_m=R)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    psi=st.floats(-40.0, 40.0),
+    vit=st.floats(-3.0, 8.0),
+    vin=st.floats(-8.0, -0.5),
+    e_n=st.floats(0.05, 1.2),
+    e_t=st.floats(-0.5, 1.0),
+    omega_i=st.floats(-100.0, 100.0),
+)
+def test_surface_angle_from_spin_recovers_any_rigid_sphere_impact(
+    psi, vit, vin, e_n, e_t, omega_i
+):
+    r, k = 0.0375, np.sqrt(0.4) * 0.0375
+    vft, vfn = e_t * vit, -e_n * vin
+    omega_f = omega_i + r * (vft - vit) / k**2  # friction impulse spins the body
+    vi = to_section(vit, vin, psi)
+    vf = to_section(vft, vfn, psi)
+    got = surface_angle_from_spin(vi, vf, omega_i, omega_f, r, k)
+    assert got == pytest.approx(psi, abs=1e-6)
