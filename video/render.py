@@ -60,6 +60,7 @@ class Camera:
     capture_fps: float = 1205.0
     playback_fps: float = 30.0
     noise_sd: float = 2.5  # grey levels
+    exposure_s: float = 1.0 / 2410.0  # shutter open half the frame interval
     jpeg_quality: int = 90
 
     def to_image(self, x_m, z_m):
@@ -387,42 +388,61 @@ def draw_ball(
     z_m,
     angle_rad,
     supersample: int = 8,
+    motion: tuple[float, float, float] | None = None,
 ) -> None:
-    """Composite the anti-aliased ball (with marker) into ``frame`` (float32 BGR)."""
+    """Composite the anti-aliased ball (with marker) into ``frame`` (uint8 BGR).
+
+    ``motion = (vx_mps, vz_mps, omega_radps)`` adds exposure blur: the ball is
+    averaged over ``camera.exposure_s`` centred on the frame time (5 time samples),
+    so the blurred image is centred on the true position at the frame time.
+    """
     uc, vc = camera.to_image(x_m, z_m)
     r = ball.radius_m / camera.scale_m_per_px
-    u0, u1 = int(math.floor(uc - r - 2)), int(math.ceil(uc + r + 2))
-    v0, v1 = int(math.floor(vc - r - 2)), int(math.ceil(vc + r + 2))
+    steps = [0.0]
+    if motion is not None and camera.exposure_s > 0:
+        steps = list(np.linspace(-0.5, 0.5, 5) * camera.exposure_s)
+        reach = (
+            np.hypot(motion[0], motion[1]) * camera.exposure_s / camera.scale_m_per_px
+        )
+    else:
+        reach = 0.0
+    u0, u1 = int(math.floor(uc - r - 2 - reach)), int(math.ceil(uc + r + 2 + reach))
+    v0, v1 = int(math.floor(vc - r - 2 - reach)), int(math.ceil(vc + r + 2 + reach))
     u0c, u1c = max(u0, 0), min(u1, camera.width - 1)
     v0c, v1c = max(v0, 0), min(v1, camera.height - 1)
     if u0c > u1c or v0c > v1c:
         return
     s = supersample
     offs = (np.arange(s) + 0.5) / s - 0.5
-    us = (np.arange(u0c, u1c + 1)[:, None] + offs[None, :]).ravel()
-    vs = (np.arange(v0c, v1c + 1)[:, None] + offs[None, :]).ravel()
-    du = us[None, :] - uc
-    dv = vs[:, None] - vc
-    inside = du * du + dv * dv <= r * r
-    # marker in world orientation: angle counter-clockwise from +x, z up (v down)
-    mu_ = uc + ball.marker_offset * r * math.cos(angle_rad)
-    mv_ = vc - ball.marker_offset * r * math.sin(angle_rad)
-    if ball.marker == "stripe":  # band through the centre along angle_rad
-        across = -(us[None, :] - uc) * math.sin(angle_rad) - (vs[:, None] - vc) * (
-            math.cos(angle_rad)
-        )
-        mrk = np.abs(across) <= ball.marker_radius * r
-    else:
-        mrk = (us[None, :] - mu_) ** 2 + (vs[:, None] - mv_) ** 2 <= (
-            ball.marker_radius * r
-        ) ** 2
-    mrk &= inside
+    us = (np.arange(u0c, u1c + 1)[:, None] + offs[None, :]).ravel()[None, :]
+    vs = (np.arange(v0c, v1c + 1)[:, None] + offs[None, :]).ravel()[:, None]
     hh, ww = v1c - v0c + 1, u1c - u0c + 1
 
     def block_mean(mask):
         return mask.reshape(hh, s, ww, s).mean(axis=(1, 3)).astype(np.float32)
 
-    cover, mcover = block_mean(inside), block_mean(mrk)
+    cover = np.zeros((hh, ww), np.float32)
+    mcover = np.zeros((hh, ww), np.float32)
+    for dt in steps:
+        if motion is not None and dt != 0.0:
+            ut, vt = camera.to_image(x_m + motion[0] * dt, z_m + motion[1] * dt)
+            at = angle_rad + motion[2] * dt
+        else:
+            ut, vt, at = uc, vc, angle_rad
+        du, dv = us - ut, vs - vt
+        inside = du * du + dv * dv <= r * r
+        # marker in world orientation: angle counter-clockwise from +x, z up (v down)
+        if ball.marker == "stripe":  # band through the centre along the angle
+            across = -du * math.sin(at) - dv * math.cos(at)
+            mrk = np.abs(across) <= ball.marker_radius * r
+        else:
+            mu_ = ball.marker_offset * r * math.cos(at)
+            mv_ = -ball.marker_offset * r * math.sin(at)
+            mrk = (du - mu_) ** 2 + (dv - mv_) ** 2 <= (ball.marker_radius * r) ** 2
+        cover += block_mean(inside)
+        mcover += block_mean(mrk & inside)
+    cover /= len(steps)
+    mcover /= len(steps)
     patch = frame[v0c : v1c + 1, u0c : u1c + 1]
     body = np.array(ball.colour_bgr, np.float32)
     mark = np.array(ball.marker_bgr, np.float32)
@@ -464,8 +484,11 @@ def write_clip(
     *,
     codec: str = "MJPG",
     draw=None,
+    motion: np.ndarray | None = None,
 ) -> Path:
     """Write one video: ``poses[i] = (x_m, z_m, angle_rad)`` per frame (NaN: no ball).
+
+    ``motion[i] = (vx_mps, vz_mps, omega_radps)`` adds exposure blur (see draw_ball).
 
     ``background_bgr`` is uint8; ``draw(frame, i)`` may add scene details (a net)
     before the ball is composited. Sensor noise: windows at random offsets into one
@@ -492,7 +515,8 @@ def write_clip(
         if draw is not None:
             draw(frame, i)
         if np.isfinite(x) and np.isfinite(z):
-            draw_ball(frame, camera, ball, x, z, angle)
+            blur = None if motion is None else tuple(float(m) for m in motion[i])
+            draw_ball(frame, camera, ball, x, z, angle, motion=blur)
         dv, du = (int(k) for k in rng.integers(0, pad, 2))
         window = (slice(dv, dv + camera.height), slice(du, du + camera.width))
         cv2.add(frame, noise_up[window], dst=frame)
@@ -565,8 +589,9 @@ def render(
         def draw(frame, i):
             draw_net(frame, camera, scene, ball, states[i, 0], states[i, 1])
 
+    poses, motion = states[:, [0, 1, 4]], states[:, [2, 3, 5]]
     write_clip(
-        path, camera, ball, bg, states[:, [0, 1, 4]], rng, codec=codec, draw=draw
+        path, camera, ball, bg, poses, rng, codec=codec, draw=draw, motion=motion
     )
     visible = (
         (us + ball.radius_m / camera.scale_m_per_px > 0)

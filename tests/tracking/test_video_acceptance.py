@@ -95,6 +95,14 @@ def test_short_clip_meets_the_acceptance_targets(cli, short_clip, tmp_path):
     _acceptance(cli, short_clip, "bounce_short", tmp_path)
 
 
+def test_short_clip_with_heavy_noise_and_compression(cli, render, tmp_path):
+    # a dim, noisy camera: sensor noise 8 grey levels, MJPG quality 70
+    camera = render.PRESETS["bounce_short"][0]()
+    camera.noise_sd, camera.jpeg_quality = 8.0, 70
+    render.render("bounce_short", tmp_path, camera=camera, seed=7)
+    _acceptance(cli, tmp_path, "bounce_short", tmp_path)
+
+
 @pytest.mark.slow
 def test_full_bounce_clip_meets_the_acceptance_targets(cli, render, tmp_path):
     render.render("bounce", tmp_path)
