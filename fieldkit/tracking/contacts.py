@@ -275,14 +275,13 @@ def find_flights(
 
     local = estimate_noise(t, x, z, window)
     extent = max(np.ptp(x), np.ptp(z), 1e-9)
-    # a 4x longer window also sees errors correlated over a few frames
+    # a 4x longer window also sees errors correlated over a few frames; it may
+    # straddle impacts when flights are short in samples, so it can at most raise
+    # the estimate by half
+    local_sigma = float(np.median(local)) * 1.05
     long = estimate_noise(t, x, z, min(4 * window - 3, n))
-    sigma = max(
-        float(np.median(local)) * 1.05,
-        float(np.median(long)) if len(long) else 0.0,
-        noise_floor_m,
-        1e-9 * extent,
-    )
+    long_sigma = min(float(np.median(long)), 1.5 * local_sigma) if len(long) else 0.0
+    sigma = max(local_sigma, long_sigma, noise_floor_m, 1e-9 * extent)
 
     free = np.ones(n, bool)
     segments: list[tuple[int, int, list[int]]] = []
@@ -302,12 +301,14 @@ def find_flights(
         fits.append(
             fit_flight(t[rows], x[rows], z[rows]) if len(rows) >= min_samples else None
         )
-    g_common = _common_gravity([f for f in fits if f is not None])
+    g_common = _common_gravity(
+        [f for f in fits if f is not None and f.g_mps2 > 3.0 * f.g_se_mps2]
+    )
 
     accepted: list[tuple[int, int, list[int]]] = []
     free = np.ones(n, bool)
     for (lo, hi, outl), fit in zip(segments, fits, strict=True):
-        if fit is None or not _is_flight(fit, g_common):
+        if fit is None or not _is_flight(fit, g_common, sigma):
             continue
         accepted.append((lo, hi, outl))
         free[lo : hi + 1] = False
@@ -367,7 +368,11 @@ def _common_gravity(fits) -> float:
     return float(g[order][np.searchsorted(cum, 0.5 * cum[-1])])
 
 
-def _is_flight(fit, g_common: float) -> bool:
+def _is_flight(fit, g_common: float, sigma: float) -> bool:
+    # a flight falls (g > 0) and fits its parabola to the noise: a run of bounces
+    # merged into one "flight" fails both or the latter
+    if fit.g_mps2 <= 3.0 * fit.g_se_mps2 or fit.rms_free_m > 2.0 * np.sqrt(2.0) * sigma:
+        return False
     if not np.isfinite(g_common):
         return True
     scale = abs(g_common)

@@ -53,6 +53,8 @@ class FlightFit:
         Gravity used for the fixed fit [m/s^2].
     rms_m
         Root-mean-square distance of the samples from the fixed-g parabola [m].
+    rms_free_m
+        Root-mean-square distance of the samples from the free-g parabola [m].
     residual_m
         Distance of each sample from the fixed-g parabola [m].
     """
@@ -72,6 +74,7 @@ class FlightFit:
     g_se_mps2: float
     g_fixed_mps2: float
     rms_m: float
+    rms_free_m: float
     residual_m: np.ndarray = field(repr=False)
 
     @property
@@ -202,6 +205,7 @@ def fit_flight(
         g_se_mps2=g_se,
         g_fixed_mps2=float(g_fixed_mps2),
         rms_m=0.0,
+        rms_free_m=float(np.sqrt((ssx + ssz) / n)),
         residual_m=np.empty(0),
     )
     px, pz = fit.position(t)
