@@ -9,21 +9,24 @@ Method (region growing from the cleanest seeds):
 
 1. **Noise.** A quadratic is fitted to ``x(t)`` and ``z(t)`` in every window of
    ``window`` consecutive samples; the median residual RMS is the position noise
-   ``sigma`` (robust because contacts are a minority of the windows).
-2. **Growth.** Seeds are windows in increasing order of residual. A seed grows one
-   sample at a time, right then left, while the next sample agrees with the current
-   free-g ballistic fit within a chi-square test on its prediction variance
-   (``chi2 <= threshold``). An isolated bad sample (a detection outlier) is skipped
-   when the two following samples agree again; two rejections in a row end the flight.
+   ``sigma`` (robust because contacts are a minority of the windows). A 4x longer
+   window may raise it by up to half (errors correlated over frames), and a floor
+   (``noise_floor_m``, 0.05 px for video) applies.
+2. **Growth.** Seeds are windows in increasing order of residual; each grows sample by
+   sample while the next sample agrees with the current free-g ballistic fit
+   (:func:`fieldkit.tracking.flight_growth.grow_segment`).
 3. **Validation.** Every flight's free-g fit gives ``g`` and its standard error.
    The track's gravity ``g_common`` is their inverse-variance weighted median. A
-   segment is a flight only if its ``g`` is determined (SE < 25 % of ``g_common``) and
+   segment is a flight only if it falls (``g > 3 SE``), fits its parabola to the
+   noise (RMS <= 2x), its ``g`` is determined (SE < 25 % of ``g_common``) and
    consistent with ``g_common`` (within 4 SE + 5 %). This rejects pieces of a net
-   contact or a rolling phase that look ballistic over a few frames. Because the test
-   is against the track's own ``g``, flights are still found when the capture rate is
-   wrong (their common ``g`` is then wrong, which :mod:`flight_fit` warns about).
-4. **Extension.** Accepted flights grow again into samples freed by rejected
-   segments.
+   contact or a rolling phase that look ballistic over a few frames, and runs of
+   bounces merged into one. Because the test is against the track's own ``g``,
+   flights are still found when the capture rate is wrong (their common ``g`` is
+   then wrong, which :mod:`flight_fit` warns about).
+4. **Extension and trimming.** Accepted flights grow again into samples freed by
+   rejected segments; end samples off the fit are trimmed; next to an extended
+   contact, samples are dropped while the contact-side velocity still drifts.
 
 Everything between two consecutive flights is a :class:`ContactSpan`.
 """
@@ -35,13 +38,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from fieldkit.tracking.flight_fit import fit_flight
+from fieldkit.tracking.flight_growth import grow_segment
 
 #: A contact with at least this many samples off both flights is extended (a net, a
 #: rolling phase) rather than an impact.
 EXTENDED_CONTACT_SAMPLES = 5
-
-#: Chi-square (2 d.o.f.) bound for a sample to join a flight (p ~ 4e-6 for pure noise).
-CHI2_JOIN = 25.0
 
 
 @dataclass(frozen=True)
@@ -121,104 +122,6 @@ def estimate_noise(
     return np.sqrt(out / (2 * (window - 3)))
 
 
-class _Grower:
-    """Incremental least squares of x = a + b tau, z = c + d tau + e tau^2.
-
-    Sums of powers of ``tau = (t - t0) / span`` are accumulated; when the samples
-    outgrow twice the current span the sums are rebuilt around the new centre so
-    the 3x3 normal equations stay well conditioned.
-    """
-
-    def __init__(self, t: np.ndarray, x: np.ndarray, z: np.ndarray, members: list[int]):
-        self.t, self.x, self.z = t, x, z
-        self.members = list(members)
-        self._rebuild()
-
-    def _rebuild(self) -> None:
-        tm = self.t[self.members]
-        self.t0 = 0.5 * (tm.min() + tm.max())
-        self.span = max(0.5 * (tm.max() - tm.min()), 1e-12)
-        tau = (tm - self.t0) / self.span
-        p = tau[:, None] ** np.arange(5)[None, :]
-        self.s = p.sum(axis=0)
-        self.sx = (self.x[self.members][:, None] * p[:, :2]).sum(axis=0)
-        self.sz = (self.z[self.members][:, None] * p[:, :3]).sum(axis=0)
-
-    def _tau(self, i: int) -> float:
-        return (self.t[i] - self.t0) / self.span
-
-    def add(self, i: int) -> None:
-        self.members.append(i)
-        tau = self._tau(i)
-        if abs(tau) > 2.0:
-            self._rebuild()
-            return
-        p = tau ** np.arange(5)
-        self.s += p
-        self.sx += self.x[i] * p[:2]
-        self.sz += self.z[i] * p[:3]
-
-    def chi2(self, i: int, sigma: float) -> float:
-        """Prediction chi-square of sample ``i`` against the current fit."""
-        s = self.s
-        mx = np.array([[s[0], s[1]], [s[1], s[2]]])
-        mz = np.array([[s[0], s[1], s[2]], [s[1], s[2], s[3]], [s[2], s[3], s[4]]])
-        try:
-            ix = np.linalg.inv(mx)
-            iz = np.linalg.inv(mz)
-        except np.linalg.LinAlgError:
-            return np.inf
-        tau = self._tau(i)
-        fx = np.array([1.0, tau])
-        fz = np.array([1.0, tau, tau * tau])
-        rx = self.x[i] - fx @ (ix @ self.sx)
-        rz = self.z[i] - fz @ (iz @ self.sz)
-        vx = sigma**2 * (1.0 + fx @ ix @ fx)
-        vz = sigma**2 * (1.0 + fz @ iz @ fz)
-        return float(rx * rx / vx + rz * rz / vz)
-
-
-def _grow(
-    t, x, z, lo: int, hi: int, free: np.ndarray, sigma: float, exclude=()
-) -> tuple[int, int, list[int]]:
-    """Grow the inclusive range ``[lo, hi]`` over samples with ``free`` true.
-
-    Returns the new range and the positions of skipped outliers inside it.
-    """
-    outliers: list[int] = list(exclude)
-    g = _Grower(t, x, z, [i for i in range(lo, hi + 1) if i not in set(exclude)])
-    n = len(t)
-    for step in (1, -1):
-        edge = hi if step == 1 else lo
-        while True:
-            j = edge + step
-            if j < 0 or j >= n or not free[j]:
-                break
-            if g.chi2(j, sigma) <= CHI2_JOIN:
-                g.add(j)
-                edge = j
-                continue
-            # one outlier tolerated if the next two samples agree
-            k1, k2 = j + step, j + 2 * step
-            if (
-                0 <= k2 < n
-                and free[k1]
-                and free[k2]
-                and g.chi2(k1, sigma) <= CHI2_JOIN
-                and g.chi2(k2, sigma) <= CHI2_JOIN
-            ):
-                outliers.append(j)
-                g.add(k1)
-                edge = k1
-                continue
-            break
-        if step == 1:
-            hi = edge
-        else:
-            lo = edge
-    return lo, hi, outliers
-
-
 def find_flights(
     t_s: np.ndarray,
     x_m: np.ndarray,
@@ -291,7 +194,7 @@ def find_flights(
         stop = start + window - 1
         if not free[start : stop + 1].all():
             continue
-        lo, hi, outl = _grow(t, x, z, start, stop, free, sigma)
+        lo, hi, outl = grow_segment(t, x, z, start, stop, free, sigma)
         free[lo : hi + 1] = False
         segments.append((lo, hi, outl))
 
@@ -316,7 +219,7 @@ def find_flights(
     extended = []
     for lo, hi, outl in sorted(accepted):
         free[lo : hi + 1] = True
-        lo2, hi2, outl2 = _grow(t, x, z, lo, hi, free, sigma, exclude=outl)
+        lo2, hi2, outl2 = grow_segment(t, x, z, lo, hi, free, sigma, exclude=outl)
         free[lo2 : hi2 + 1] = False
         extended.append((lo2, hi2, sorted(set(outl) | set(outl2))))
     extended.sort()
