@@ -31,7 +31,7 @@ def track(
         float | None,
         typer.Option(
             "--fps",
-            help="Capture rate [frames/s] (required: high-speed cameras store a "
+            help="Capture rate in frames/s (required: high-speed cameras store a "
             "different playback rate, e.g. 30).",
         ),
     ] = None,
@@ -40,13 +40,13 @@ def track(
         typer.Option(
             "--scale-points",
             metavar="U1,V1,U2,V2",
-            help="Two image points [px] a known distance apart (level camera; the "
+            help="Two image points (pixels) a known distance apart (level camera; the "
             "world origin is the first point).",
         ),
     ] = None,
     scale_length: Annotated[
         float | None,
-        typer.Option("--scale-length", help="Distance between the scale points [m]."),
+        typer.Option("--scale-length", help="Distance between the scale points (m)."),
     ] = None,
     homography: Annotated[
         Path | None,
@@ -61,7 +61,7 @@ def track(
         float | None,
         typer.Option(
             "--surface-angle",
-            help="Dip of the impact surface [deg], positive descending along travel "
+            help="Dip of the impact surface (deg), positive descending along travel "
             "(default: estimated from the contact points).",
         ),
     ] = None,
@@ -72,7 +72,7 @@ def track(
         typer.Option(
             "--roi",
             metavar="U,V,WIDTH,HEIGHT",
-            help="Search only this image region [px].",
+            help="Search only this image region (pixels).",
         ),
     ] = None,
     path_id: Annotated[

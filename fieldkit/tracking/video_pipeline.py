@@ -218,9 +218,15 @@ def track_video(
         & ~detections["found"],
         "frame",
     ].to_numpy()
-    if missing.size:
+    lost, outside = _classify_gaps(missing, found)
+    if lost.size:
         warnings.append(
-            f"{path}: frames {frame_ranges(missing)}: body lost (not detected); "
+            f"{path}: frames {frame_ranges(lost)}: body lost (not detected); "
+            "those frames are left out of the track"
+        )
+    if outside.size:
+        warnings.append(
+            f"{path}: frames {frame_ranges(outside)}: body out of the frame; "
             "those frames are left out of the track"
         )
 
@@ -298,6 +304,28 @@ def track_video(
         "warnings": warnings,
     }
     return Track(frame, source=str(path), fps=float(fps), meta=meta), detections
+
+
+def _classify_gaps(missing: np.ndarray, found: pd.DataFrame):
+    """Split missing frames into runs lost in view and runs beside the frame border.
+
+    A run whose neighbouring detections both touch the frame border is the body
+    leaving and re-entering the picture; any other run is a body lost in view.
+    """
+    if missing.size == 0:
+        return missing, missing
+    frames = found["frame"].to_numpy(int)
+    partial = found["partial"].to_numpy(bool)
+    breaks = np.flatnonzero(np.diff(missing) > 1)
+    starts = np.r_[missing[0], missing[breaks + 1]]
+    ends = np.r_[missing[breaks], missing[-1]]
+    lost, outside = [], []
+    for a, b in zip(starts, ends, strict=True):
+        before = np.searchsorted(frames, a) - 1
+        after = np.searchsorted(frames, b, side="right")
+        edge = partial[before] and partial[min(after, len(frames) - 1)]
+        (outside if edge else lost).extend(range(int(a), int(b) + 1))
+    return np.array(lost, dtype=int), np.array(outside, dtype=int)
 
 
 def _travels_toward_negative_x(x: np.ndarray) -> bool:

@@ -40,6 +40,8 @@ def _clip(
     ball=None,
     leftward=False,
     codec="MJPG",
+    start=(0.05, 0.25),
+    velocity=(2.5, 1.0),
 ):
     """A ball thrown across a 320x240 scene (2 mm/px); ``hide`` frames lack it."""
     camera = render.Camera(width=320, height=240, origin_u_px=20.0, origin_v_px=220.0)
@@ -48,7 +50,11 @@ def _clip(
     bg = np.clip(render.background(camera, rng, scene) + 0.5, 0, 255).astype(np.uint8)
     t = np.arange(frames) / FPS
     poses = np.column_stack(
-        [0.05 + 2.5 * t, 0.25 + 1.0 * t - 0.5 * G * t**2, 0.2 - 40.0 * t]
+        [
+            start[0] + velocity[0] * t,
+            start[1] + velocity[1] * t - 0.5 * G * t**2,
+            0.2 - 40.0 * t,
+        ]
     )
     if leftward:  # thrown toward -x (image left), spinning the other way
         poses[:, 0] = 0.55 - poses[:, 0]
@@ -281,3 +287,23 @@ def test_roi_restricts_the_search(cli, clip, tmp_path):
     inside = (poses[:, 0] / 0.002 + 20) < 120  # truth centre inside the region
     assert len(track) == inside.sum()
     assert (track["u_px"] < 120).all()
+
+
+def test_body_leaving_through_the_top_and_coming_back(cli, render, tmp_path):
+    video, poses = _clip(
+        render,
+        tmp_path / "apex.avi",
+        frames=400,
+        start=(0.05, 0.40),
+        velocity=(1.0, 1.5),
+    )
+    out = tmp_path / "t.csv"
+    result = cli("track", video, "--fps", FPS, *SCALE, "--radius", "0.0375", "-o", out)
+    assert result.exit_code == 0, result.stderr
+    assert "body out of the frame" in result.stderr and "body lost" not in result.stderr
+    track = pd.read_csv(out)
+    hidden = poses[:, 1] - 0.0375 > 0.44  # entirely above the top edge (v < -0.5 px)
+    assert not set(np.flatnonzero(hidden)) & set(track["frame"])
+    truth = poses[track["frame"].to_numpy()]
+    err = np.hypot(track["x_m"] - truth[:, 0], track["z_m"] - (truth[:, 1] - 0.4))
+    assert np.sqrt(np.mean(err**2)) < 0.5e-3
