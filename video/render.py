@@ -61,6 +61,8 @@ class Camera:
     playback_fps: float = 30.0
     noise_sd: float = 2.5  # grey levels
     exposure_s: float = 1.0 / 2410.0  # shutter open half the frame interval
+    flicker: float = 0.0  # relative amplitude of lighting flicker (mains lamps)
+    flicker_hz: float = 100.0
     jpeg_quality: int = 90
 
     def to_image(self, x_m, z_m):
@@ -517,6 +519,10 @@ def write_clip(
         if np.isfinite(x) and np.isfinite(z):
             blur = None if motion is None else tuple(float(m) for m in motion[i])
             draw_ball(frame, camera, ball, x, z, angle, motion=blur)
+        if camera.flicker:
+            t = i / camera.capture_fps
+            gain = 1.0 + camera.flicker * math.sin(2 * math.pi * camera.flicker_hz * t)
+            frame = cv2.convertScaleAbs(frame, alpha=gain)
         dv, du = (int(k) for k in rng.integers(0, pad, 2))
         window = (slice(dv, dv + camera.height), slice(du, du + camera.width))
         cv2.add(frame, noise_up[window], dst=frame)

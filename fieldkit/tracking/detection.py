@@ -12,6 +12,8 @@ Three stages, each cheap enough to run at more than decoding speed:
    contour gets a circle fit to its edge points that are not on the frame border
    (a body entering or leaving the frame is only partly visible) and a shape test:
    fit residual, radius range, fill ratio and the arc of the circle that is visible.
+   The background is scaled by the frame's overall brightness first (lamps on mains
+   power flicker at 100/120 Hz, which a 1000+ frames/s camera sees).
 3. **Sub-pixel centre**: the pixels near the rim are unmixed into a coverage
    ``alpha = (I - B)·(C - B) / |C - B|^2`` between the background ``B`` and the body's
    colour ``C``; the coverage-weighted centroid is the centre of the disc to a few
@@ -157,11 +159,40 @@ def colour_difference(frame: np.ndarray, background: np.ndarray) -> np.ndarray:
     return cv2.max(cv2.max(b, g), r)
 
 
+def brightness_gain(frame: np.ndarray, background: np.ndarray, step: int = 12) -> float:
+    """Overall brightness of ``frame`` relative to ``background`` (lighting flicker).
+
+    Median ratio of the two on a sparse grid of pixels (every ``step``-th row and
+    column, background brighter than 30 grey levels); a small moving body does not
+    move the median.
+
+    Examples
+    --------
+    >>> bg = np.full((48, 48, 3), 100, np.uint8)
+    >>> brightness_gain((bg * 1.1).astype(np.uint8), bg)
+    1.1
+    """
+    grid = (slice(step // 2, None, step), slice(step // 2, None, step))
+    b = background[grid].astype(np.float32)
+    f = frame[grid].astype(np.float32)
+    if b.ndim == 3:
+        b, f = b.mean(axis=2), f.mean(axis=2)
+    ok = b > 30.0
+    if ok.sum() < 10:
+        return 1.0
+    return round(float(np.median(f[ok] / b[ok])), 4)
+
+
+def _scaled(image: np.ndarray, gain: float) -> np.ndarray:
+    return image if abs(gain - 1.0) < 0.004 else cv2.convertScaleAbs(image, alpha=gain)
+
+
 def noise_threshold(frames: list[np.ndarray], background: np.ndarray) -> float:
     """Difference threshold from the robust noise level of frames vs the background."""
     sigmas = []
     for frame in frames[: min(len(frames), 7)]:
-        d = colour_difference(frame, background).astype(np.float32)
+        gain = brightness_gain(frame, background)
+        d = colour_difference(frame, _scaled(background, gain)).astype(np.float32)
         sigmas.append(
             1.4826 * float(np.median(np.abs(d - np.median(d))))
             + 0.5 * float(np.median(d))
@@ -227,12 +258,15 @@ class BallDetector:
         self.roi = (max(u0, 0), max(v0, 0), min(u0 + rw, w), min(v0 + rh, h))
         self.expected_radius_px = expected_radius_px
         self._radii: list[float] = []
+        self._gain = 1.0  # brightness of the current frame relative to the background
 
     # ---------------------------------------------------------------- candidates
     def _candidates(self, frame: np.ndarray, window: tuple[int, int, int, int]):
         u0, v0, u1, v1 = window
         w, h = self.size
-        diff = colour_difference(frame[v0:v1, u0:u1], self.background[v0:v1, u0:u1])
+        diff = colour_difference(
+            frame[v0:v1, u0:u1], _scaled(self.background[v0:v1, u0:u1], self._gain)
+        )
         _, mask = cv2.threshold(diff, self.threshold, 255, cv2.THRESH_BINARY)
         mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, _OPEN_KERNEL)
         contours = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)[-2]
@@ -321,7 +355,7 @@ class BallDetector:
         if u1 - u0 < 4 or v1 - v0 < 4:
             return None
         patch = frame[v0:v1, u0:u1].astype(np.float32)
-        bg = self.background_f[v0:v1, u0:u1]
+        bg = self.background_f[v0:v1, u0:u1] * self._gain
         shape = patch.shape[:2]
         uu = np.broadcast_to(np.arange(u0, u1, dtype=np.float64)[None, :], shape)
         vv = np.broadcast_to(np.arange(v0, v1, dtype=np.float64)[:, None], shape)
@@ -392,6 +426,7 @@ class BallDetector:
     ) -> Detection | None:
         """Find the ball; ``prediction`` = (u, v, search radius) narrows the search."""
         w, h = self.size
+        self._gain = brightness_gain(frame, self.background)
         candidates = []
         if prediction is not None:
             pu, pv, reach = prediction

@@ -12,6 +12,7 @@ import pytest
 from fieldkit.tracking.detection import (
     BallDetector,
     background_model,
+    brightness_gain,
     fit_circle,
     median_background,
     noise_threshold,
@@ -137,3 +138,23 @@ def test_clean_background_removes_a_slow_body(scene):
     cleaned, _ = background_model(frames)
     fixed = np.abs(cleaned[v, u].astype(int) - truth[v, u].astype(int)).max()
     assert fixed < 12  # noise + JPEG, no ball
+
+
+def test_lighting_flicker_is_compensated(scene):
+    render, camera, ball, _ = scene
+    rng = np.random.default_rng(13)
+    detector = _detector(scene, rng)
+    for gain in (0.8, 1.15):
+        img = cv2.convertScaleAbs(_frame(scene, 0.7, 0.6, rng=rng), alpha=gain)
+        assert brightness_gain(img, detector.background) == pytest.approx(
+            gain, abs=0.01
+        )
+        det = detector.detect(img)
+        u, v = camera.to_image(0.7, 0.6)
+        assert det is not None and np.hypot(det.u_px - u, det.v_px - v) < 0.1
+    # without compensation a 20 % darker frame differs from the background everywhere
+    dark = cv2.convertScaleAbs(detector.background, alpha=0.8)
+    assert (
+        np.median(np.abs(dark.astype(int) - detector.background))
+        > detector.threshold / 2
+    )

@@ -95,10 +95,11 @@ def test_short_clip_meets_the_acceptance_targets(cli, short_clip, tmp_path):
     _acceptance(cli, short_clip, "bounce_short", tmp_path)
 
 
-def test_short_clip_with_heavy_noise_and_compression(cli, render, tmp_path):
-    # a dim, noisy camera: sensor noise 8 grey levels, MJPG quality 70
+def test_short_clip_with_noise_compression_and_flicker(cli, render, tmp_path):
+    # a dim, noisy camera (sensor noise 8 grey levels, MJPG quality 70) under lamps
+    # flickering +-15 % at 100 Hz
     camera = render.PRESETS["bounce_short"][0]()
-    camera.noise_sd, camera.jpeg_quality = 8.0, 70
+    camera.noise_sd, camera.jpeg_quality, camera.flicker = 8.0, 70, 0.15
     render.render("bounce_short", tmp_path, camera=camera, seed=7)
     _acceptance(cli, tmp_path, "bounce_short", tmp_path)
 
