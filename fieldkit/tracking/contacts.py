@@ -229,6 +229,7 @@ def find_flights(
         rows = np.setdiff1d(np.arange(lo, hi + 1), outl)
         rows = _trim_ends(t, x, z, rows, sigma)
         if np.isfinite(g_common):
+            rows = _trim_kinked_ends(t, x, z, rows, sigma, g_common)
             rows = _trim_biased_ends(t, x, z, rows, sigma, g_common)
         if len(rows) >= min_samples:
             flights.append(rows)
@@ -295,6 +296,43 @@ def _trim_ends(t, x, z, rows: np.ndarray, sigma: float) -> np.ndarray:
             rows = rows[:-1]
         else:
             break
+    return rows
+
+
+def _trim_kinked_ends(
+    t, x, z, rows: np.ndarray, sigma: float, g: float, kmax: int = 3
+) -> np.ndarray:
+    """Drop the last (first) k <= 3 samples when the flight without them misses one.
+
+    A small impact seen at a low frame rate bends the fit enough that the one or two
+    samples after it pass one at a time; predicted from the rest of the flight (g
+    fixed at the track's own value) the furthest of them stands out.
+    """
+    limit = 3.5 * sigma * np.sqrt(2.0)
+    for _ in range(2 * kmax):
+        cut = None
+        for at_start in (False, True):
+            for k in range(1, kmax + 1):
+                if len(rows) - k < 3 * kmax + 3:
+                    break
+                keep = rows[k:] if at_start else rows[:-k]
+                out = rows[:k] if at_start else rows[-k:]
+                tau = t[keep] - t[keep].mean()
+                design = np.column_stack([np.ones_like(tau), tau])
+                zc = z[keep] + 0.5 * g * tau**2
+                cx = np.linalg.lstsq(design, x[keep], rcond=None)[0]
+                cz = np.linalg.lstsq(design, zc, rcond=None)[0]
+                tau_out = t[out] - t[keep].mean()
+                px = cx[0] + cx[1] * tau_out
+                pz = cz[0] + cz[1] * tau_out - 0.5 * g * tau_out**2
+                if np.hypot(x[out] - px, z[out] - pz).max() > limit:
+                    cut = (at_start, k)
+                    break
+            if cut:
+                break
+        if cut is None:
+            return rows
+        rows = rows[cut[1] :] if cut[0] else rows[: -cut[1]]
     return rows
 
 
