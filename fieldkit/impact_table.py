@@ -97,8 +97,9 @@ CONTRACT_COLUMNS: tuple[Column, ...] = (
 #: Documented extension columns that fieldkit producers may add (kept on read/write).
 EXTENSION_COLUMNS: tuple[Column, ...] = (
     Column("omega_source", "str", False, "measured | estimated (v/r, eq. 3.17) | none"),
-    Column("slope_source", "str", False, "chord | surveyed | given | video"),
+    Column("slope_source", "str", False, "chord | surveyed | given | video | assumed"),
     Column("flight_dke_j", "float", False, "KE gained in the flight arriving here [J]"),
+    Column("contact_duration_s", "float", False, "time in contact at this impact [s]"),
     Column(
         "dke_theory_j",
         "float",
