@@ -179,7 +179,8 @@ class ImpactTable:
         if dup.any():
             i = int(np.flatnonzero(dup.to_numpy())[0])
             raise InputFileError(
-                f"duplicated point {out['point'].iloc[i]!s} in path {out['path_id'].iloc[i]!s}",
+                f"duplicated point {out['point'].iloc[i]!s} "
+                f"in path {out['path_id'].iloc[i]!s}",
                 source=self.source,
                 where=f"row {i + 1}",
             )
@@ -187,7 +188,8 @@ class ImpactTable:
         bad_src = src[~src.isin(sorted(THETA0_SOURCES))]
         if len(bad_src):
             raise InputFileError(
-                f"theta0_source {bad_src.iloc[0]!r} is not one of {sorted(THETA0_SOURCES)}",
+                f"theta0_source {bad_src.iloc[0]!r} is not one of "
+                f"{sorted(THETA0_SOURCES)}",
                 source=self.source,
                 where=f"row {bad_src.index[0] + 1}",
             )
