@@ -77,6 +77,8 @@ def median_background(frames: list[np.ndarray]) -> np.ndarray:
     12
     """
     stack = np.stack(frames, axis=0)
+    if len(frames) % 2:  # odd count: the middle order statistic, no float copy
+        return np.partition(stack, len(frames) // 2, axis=0)[len(frames) // 2]
     return np.median(stack, axis=0).astype(np.uint8)
 
 
@@ -99,13 +101,12 @@ def clean_background(
     ]
     if not discs:
         return out
-    stack = np.stack(frames, axis=0).astype(np.float32)
     for _, uc, vc, reach in discs:
         u0, u1 = max(int(uc - 2 * reach), 0), min(int(uc + 2 * reach) + 1, w)
         v0, v1 = max(int(vc - 2 * reach), 0), min(int(vc + 2 * reach) + 1, h)
         if u1 <= u0 or v1 <= v0:
             continue
-        patch = stack[:, v0:v1, u0:u1].copy()
+        patch = np.stack([f[v0:v1, u0:u1] for f in frames]).astype(np.float32)
         uu = np.arange(u0, u1)[None, :]
         vv = np.arange(v0, v1)[:, None]
         for j, uj, vj, rj in discs:
@@ -136,18 +137,26 @@ def background_model(
     """
     first = median_background(frames)
     background, threshold = first, noise_threshold(frames, first)
-    found = -1
+    detections: list = [None] * len(frames)
     for _ in range(max_rounds):
         detector = BallDetector(
             background, threshold, roi=roi, expected_radius_px=expected_radius_px
         )
-        detections = [detector.detect(f) for f in frames]
-        count = sum(d is not None for d in detections)
-        if count <= found:
+        new = 0
+        for i, frame in enumerate(frames):
+            if detections[i] is None:  # found ones stay found
+                detections[i] = detector.detect(frame)
+                new += detections[i] is not None
+        if new == 0:
             break
-        found = count
         background = clean_background(frames, first, detections)
     return background, threshold
+
+
+def flickers(frames: list[np.ndarray], background: np.ndarray) -> bool:
+    """Whether the overall brightness of the frames varies by more than 0.5 %."""
+    gains = [brightness_gain(f, background) for f in frames]
+    return bool(gains) and (max(gains) - min(gains)) > 0.005
 
 
 def colour_difference(frame: np.ndarray, background: np.ndarray) -> np.ndarray:
@@ -159,7 +168,7 @@ def colour_difference(frame: np.ndarray, background: np.ndarray) -> np.ndarray:
     return cv2.max(cv2.max(b, g), r)
 
 
-def brightness_gain(frame: np.ndarray, background: np.ndarray, step: int = 12) -> float:
+def brightness_gain(frame: np.ndarray, background: np.ndarray, step: int = 20) -> float:
     """Overall brightness of ``frame`` relative to ``background`` (lighting flicker).
 
     Median ratio of the two on a sparse grid of pixels (every ``step``-th row and
@@ -168,7 +177,7 @@ def brightness_gain(frame: np.ndarray, background: np.ndarray, step: int = 12) -
 
     Examples
     --------
-    >>> bg = np.full((48, 48, 3), 100, np.uint8)
+    >>> bg = np.full((200, 200, 3), 100, np.uint8)
     >>> brightness_gain((bg * 1.1).astype(np.uint8), bg)
     1.1
     """
@@ -192,7 +201,8 @@ def noise_threshold(frames: list[np.ndarray], background: np.ndarray) -> float:
     sigmas = []
     for frame in frames[: min(len(frames), 7)]:
         gain = brightness_gain(frame, background)
-        d = colour_difference(frame, _scaled(background, gain)).astype(np.float32)
+        d = colour_difference(frame, _scaled(background, gain))[::2, ::2]
+        d = d.astype(np.float32)
         sigmas.append(
             1.4826 * float(np.median(np.abs(d - np.median(d))))
             + 0.5 * float(np.median(d))
@@ -235,6 +245,9 @@ class BallDetector:
     expected_radius_px
         Body radius in pixels when known (``--radius`` and the calibration); otherwise
         learnt from the first confident detections.
+    compensate_flicker
+        Scale the background by each frame's brightness (:func:`brightness_gain`);
+        :func:`flickers` tells whether a clip needs it.
     """
 
     def __init__(
@@ -245,8 +258,10 @@ class BallDetector:
         roi: tuple[int, int, int, int] | None = None,
         expected_radius_px: float | None = None,
         settings: DetectorSettings | None = None,
+        compensate_flicker: bool = True,
     ) -> None:
         self.background = background
+        self.compensate_flicker = compensate_flicker
         self.background_f = background.astype(np.float32)
         self.threshold = float(threshold)
         self.settings = settings or DetectorSettings()
@@ -305,8 +320,8 @@ class BallDetector:
             if rms > s.max_fit_residual * r_rim:
                 continue
             angles = np.arctan2(v[inner] - vc, u[inner] - uc)
-            bins = np.unique(((angles + np.pi) / (2 * np.pi) * 36).astype(int) % 36)
-            visible = len(bins) / 36.0
+            bins = ((angles + np.pi) / (2 * np.pi) * 36).astype(int) % 36
+            visible = np.count_nonzero(np.bincount(bins, minlength=36)) / 36.0
             if visible < s.min_visible_fraction:
                 continue
             if not partial and not 0.7 <= area / (np.pi * r * r) <= 1.3:
@@ -426,7 +441,8 @@ class BallDetector:
     ) -> Detection | None:
         """Find the ball; ``prediction`` = (u, v, search radius) narrows the search."""
         w, h = self.size
-        self._gain = brightness_gain(frame, self.background)
+        if self.compensate_flicker:
+            self._gain = brightness_gain(frame, self.background)
         candidates = []
         if prediction is not None:
             pu, pv, reach = prediction

@@ -18,6 +18,7 @@ from fieldkit.tracking.calibration import Calibration
 from fieldkit.tracking.detection import (
     BallDetector,
     background_model,
+    flickers,
 )
 from fieldkit.tracking.spin import (
     angular_velocity,
@@ -148,7 +149,13 @@ def track_video(
     background, threshold = background_model(
         samples, roi=roi, expected_radius_px=expected
     )
-    detector = BallDetector(background, threshold, roi=roi, expected_radius_px=expected)
+    detector = BallDetector(
+        background,
+        threshold,
+        roi=roi,
+        expected_radius_px=expected,
+        compensate_flicker=flickers(samples, background),
+    )
 
     rows = []
     last: list[tuple[int, float, float, float]] = []
