@@ -307,3 +307,15 @@ def test_body_leaving_through_the_top_and_coming_back(cli, render, tmp_path):
     truth = poses[track["frame"].to_numpy()]
     err = np.hypot(track["x_m"] - truth[:, 0], track["z_m"] - (truth[:, 1] - 0.4))
     assert np.sqrt(np.mean(err**2)) < 0.5e-3
+
+
+def test_no_marker_gives_nan_spin_and_a_warning(cli, render, tmp_path):
+    plain = render.Ball(marker_bgr=render.Ball().colour_bgr)  # marker invisible
+    video, _ = _clip(render, tmp_path / "plain.avi", frames=60, ball=plain)
+    out = tmp_path / "t.csv"
+    result = cli("track", video, "--fps", FPS, *SCALE, "--radius", "0.0375", "-o", out)
+    assert result.exit_code == 0, result.stderr
+    assert "no marker could be followed" in result.stderr
+    track = pd.read_csv(out)
+    assert len(track) == 60
+    assert track["omega_radps"].isna().all() and track["angle_rad"].isna().all()
