@@ -249,7 +249,8 @@ def track_video(
     )
     frames = found["frame"].to_numpy(int)
     t = frames / float(fps)
-    mirrored = _travels_toward_negative_x(x)
+    radius_m_median = float(np.nanmedian(found["radius_px"].to_numpy(float) * scale))
+    mirrored = _travels_toward_negative_x(x, min_shift_m=0.5 * radius_m_median)
     if mirrored:
         x = -x
         angle = np.pi - angle
@@ -335,10 +336,23 @@ def _classify_gaps(missing: np.ndarray, found: pd.DataFrame):
     return np.array(lost, dtype=int), np.array(outside, dtype=int)
 
 
-def _travels_toward_negative_x(x: np.ndarray) -> bool:
-    """Direction of travel from the first tenth of the track (at least 5 samples)."""
+def _travels_toward_negative_x(x: np.ndarray, min_shift_m: float = 0.0) -> bool:
+    """Whether the body moves toward -x over the first tenth of the track.
+
+    At least 5 samples; the shift must exceed ``min_shift_m`` (half a radius), so a
+    vertical drop is never mirrored by noise.
+
+    Examples
+    --------
+    >>> _travels_toward_negative_x(np.linspace(1.0, 0.0, 50), 0.01)
+    True
+    >>> jitter = np.array([0.0, -0.001, 0.0005, -0.002, -0.001])  # a vertical drop
+    >>> _travels_toward_negative_x(jitter, 0.01)
+    False
+    """
     if x.size < 2:
         return False
     n = max(5, x.size // 10)
     head = x[:n]
-    return bool(head[-1] - head[0] < 0)
+    shift = head[-1] - head[0]
+    return bool(shift < 0 and abs(shift) > min_shift_m)

@@ -319,3 +319,20 @@ def test_no_marker_gives_nan_spin_and_a_warning(cli, render, tmp_path):
     track = pd.read_csv(out)
     assert len(track) == 60
     assert track["omega_radps"].isna().all() and track["angle_rad"].isna().all()
+
+
+def test_vertical_drop_is_not_mirrored(cli, render, tmp_path):
+    video, poses = _clip(
+        render,
+        tmp_path / "drop.avi",
+        frames=80,
+        start=(0.25, 0.40),
+        velocity=(0.0, -2.0),
+    )
+    out = tmp_path / "t.csv"
+    result = cli("track", video, "--fps", FPS, *SCALE, "--radius", "0.0375", "-o", out)
+    assert result.exit_code == 0, result.stderr
+    assert "mirrored" not in result.stderr
+    track = pd.read_csv(out)
+    np.testing.assert_allclose(track["x_m"], 0.25, atol=0.5e-3)
+    np.testing.assert_allclose(track["z_m"], poses[:, 1] - 0.4, atol=0.5e-3)
