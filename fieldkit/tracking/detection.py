@@ -136,7 +136,9 @@ def background_model(
     uncovers more of it).
     """
     first = median_background(frames)
-    background, threshold = first, noise_threshold(frames, first)
+    threshold = noise_threshold(frames, first)
+    first = repair_resting_body(frames, first, threshold, roi=roi)
+    background = first
     detections: list = [None] * len(frames)
     for _ in range(max_rounds):
         detector = BallDetector(
@@ -151,6 +153,80 @@ def background_model(
             break
         background = clean_background(frames, first, detections)
     return background, threshold
+
+
+def _ring_colour(image: np.ndarray, uc: float, vc: float, r: float) -> np.ndarray:
+    """Mean colour of the ring 0.8-0.92 r (outside a marker, inside the rim)."""
+    h, w = image.shape[:2]
+    u0, u1 = max(int(uc - r), 0), min(int(uc + r) + 2, w)
+    v0, v1 = max(int(vc - r), 0), min(int(vc + r) + 2, h)
+    uu = np.arange(u0, u1)[None, :] - uc
+    vv = np.arange(v0, v1)[:, None] - vc
+    d2 = uu * uu + vv * vv
+    ring = (d2 > (0.8 * r) ** 2) & (d2 < (0.92 * r) ** 2)
+    patch = image[v0:v1, u0:u1].astype(np.float32)
+    return patch[ring].mean(axis=0) if ring.any() else np.full(3, np.nan)
+
+
+def repair_resting_body(
+    frames: list[np.ndarray],
+    background: np.ndarray,
+    threshold: float,
+    *,
+    roi: tuple[int, int, int, int] | None = None,
+) -> np.ndarray:
+    """Remove a body that rests for most of the clip from the median background.
+
+    Such a body is part of the median, so the frames where it is elsewhere show its
+    "ghost": a ball-shaped difference at the same place in several samples. A static
+    candidate is a ghost when the background model there has the colour of the moving
+    body (seen in the other candidates) while the frames show something else; the
+    background there is then taken from the samples that show the ghost (they show the
+    scene without the body). A genuinely resting body seen in a minority of samples
+    keeps the median, which is already clean.
+    """
+    detector = BallDetector(background, threshold, roi=roi, compensate_flicker=False)
+    h, w = background.shape[:2]
+    found = []  # (sample, uc, vc, r)
+    for i, frame in enumerate(frames):
+        window = (0, 0, w, h)
+        for uc, vc, r, _, partial, _ in detector._candidates(frame, window):
+            if not partial:
+                found.append((i, uc, vc, r))
+    clusters: list[list[tuple]] = []
+    for item in found:
+        for cluster in clusters:
+            if np.hypot(item[1] - cluster[0][1], item[2] - cluster[0][2]) < 1.5:
+                cluster.append(item)
+                break
+        else:
+            clusters.append([item])
+    moving = [c[0] for c in clusters if len(c) == 1]
+    static = [c for c in clusters if len({s for s, *_ in c}) >= 2]
+    if not moving or not static:
+        return background
+    body = np.median(
+        [_ring_colour(frames[i], u, v, r) for i, u, v, r in moving], axis=0
+    )
+    out = background.copy()
+    for cluster in static:
+        _, uc, vc, r = cluster[0]
+        in_model = _ring_colour(background, uc, vc, r)
+        in_frames = np.mean(
+            [_ring_colour(frames[i], uc, vc, r) for i, *_ in cluster], 0
+        )
+        if np.linalg.norm(in_model - body) >= np.linalg.norm(in_frames - body):
+            continue  # the frames hold the body: a body resting in a few samples
+        reach = 1.3 * r + 3.0
+        u0, u1 = max(int(uc - reach), 0), min(int(uc + reach) + 2, w)
+        v0, v1 = max(int(vc - reach), 0), min(int(vc + reach) + 2, h)
+        patches = np.stack([frames[i][v0:v1, u0:u1] for i, *_ in cluster])
+        uu = np.arange(u0, u1)[None, :] - uc
+        vv = np.arange(v0, v1)[:, None] - vc
+        disc = uu * uu + vv * vv <= reach * reach
+        region = out[v0:v1, u0:u1]
+        region[disc] = np.median(patches, axis=0).astype(np.uint8)[disc]
+    return out
 
 
 def flickers(frames: list[np.ndarray], background: np.ndarray) -> bool:

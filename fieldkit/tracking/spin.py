@@ -203,7 +203,7 @@ def angular_velocity(
     sd = np.full(n, np.nan)
     if n < 3:
         return omega, sd
-    window = max(3, int(window) | 1)
+    window = max(3, min(int(window), n if n % 2 else n - 1) | 1)
     half = window // 2
     ok = np.isfinite(a) & np.isfinite(t)
     kernel = np.ones(window)

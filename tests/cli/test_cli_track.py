@@ -336,3 +336,23 @@ def test_vertical_drop_is_not_mirrored(cli, render, tmp_path):
     track = pd.read_csv(out)
     np.testing.assert_allclose(track["x_m"], 0.25, atol=0.5e-3)
     np.testing.assert_allclose(track["z_m"], poses[:, 1] - 0.4, atol=0.5e-3)
+
+
+def test_body_resting_for_most_of_the_clip(cli, render, tmp_path):
+    # 60 frames of motion, then 90 at rest: the plain median holds the resting ball,
+    # and its "ghost" would be tracked in the early frames if not repaired
+    camera = render.Camera(width=320, height=240, origin_u_px=20.0, origin_v_px=220.0)
+    rng = np.random.default_rng(4)
+    scene = render.BounceScene(plate_point_m=(0.0, -1.0))
+    bg = np.clip(render.background(camera, rng, scene) + 0.5, 0, 255).astype(np.uint8)
+    t = np.arange(150) / FPS
+    moving = np.minimum(t, 0.05)
+    poses = np.column_stack([0.05 + 5.0 * moving, np.full(t.size, 0.2), -40 * moving])
+    video = render.write_clip(
+        tmp_path / "rest.avi", camera, render.Ball(), bg, poses, rng
+    )
+    out = tmp_path / "t.csv"
+    result = cli("track", video, "--fps", FPS, *SCALE, "--radius", "0.0375", "-o", out)
+    track = pd.read_csv(out)
+    assert len(track) == 150, result.stderr
+    np.testing.assert_allclose(track["x_m"], poses[:, 0], atol=0.5e-3)

@@ -132,3 +132,11 @@ def test_angular_velocity_exact_for_any_uniform_spin(omega0, angle0):
     t = np.arange(50) / 1205.0
     omega, _ = angular_velocity(t, angle0 + omega0 * t)
     np.testing.assert_allclose(omega[8:-8], omega0, atol=1e-7 * max(1.0, abs(omega0)))
+
+
+@pytest.mark.parametrize("n", [3, 4, 13, 14])
+def test_angular_velocity_of_tracks_shorter_than_the_window(n):
+    t = np.arange(n) / 1205.0
+    omega, sd = angular_velocity(t, 1.0 + 25.0 * t, window=15)
+    assert omega.shape == sd.shape == (n,)
+    np.testing.assert_allclose(omega[1:-1], 25.0, rtol=1e-9)
