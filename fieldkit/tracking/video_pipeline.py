@@ -14,12 +14,9 @@ import numpy as np
 import pandas as pd
 
 from fieldkit.errors import ArgumentError, InputFileError
+from fieldkit.tracking.background import background_model, flickers
 from fieldkit.tracking.calibration import Calibration
-from fieldkit.tracking.detection import (
-    BallDetector,
-    background_model,
-    flickers,
-)
+from fieldkit.tracking.detection import BallDetector
 from fieldkit.tracking.spin import (
     angular_velocity,
     marker_angle_world,

@@ -9,14 +9,13 @@ import cv2
 import numpy as np
 import pytest
 
-from fieldkit.tracking.detection import (
-    BallDetector,
+from fieldkit.tracking.background import (
     background_model,
-    brightness_gain,
-    fit_circle,
     median_background,
     noise_threshold,
 )
+from fieldkit.tracking.detection import BallDetector, fit_circle
+from fieldkit.tracking.image_difference import brightness_gain
 
 
 @pytest.fixture(scope="module")
