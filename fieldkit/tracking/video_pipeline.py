@@ -109,6 +109,8 @@ def track_video(
         Body radius [m] when known: sharpens the shape test.
     progress
         Called as ``progress(frames_done, frames_total)``.
+    reader
+        An already opened :class:`VideoReader` of ``path`` (saves reopening it).
 
     Returns
     -------
@@ -116,8 +118,9 @@ def track_video(
         The :class:`~fieldkit.tracking.track.Track` (one row per frame with a body;
         extra columns ``omega_sd_radps, u_px, v_px, radius_px, radius_m, partial,
         visible_fraction``; ``meta["warnings"]`` lists one-line warnings) and a
-        per-frame
-        table (every decoded frame; ``found`` False where no body was seen).
+        per-frame table (every decoded frame; ``found`` False where no body was
+        seen; pixel centre, radius, marker offset ``marker_du_px, marker_dv_px``
+        and ``marker_axial``).
 
     Raises
     ------
