@@ -356,3 +356,18 @@ def test_body_resting_for_most_of_the_clip(cli, render, tmp_path):
     track = pd.read_csv(out)
     assert len(track) == 150, result.stderr
     np.testing.assert_allclose(track["x_m"], poses[:, 0], atol=0.5e-3)
+
+
+def test_rerun_recording_and_figures(cli, clip, tmp_path):
+    video, _ = clip
+    rrd, figures = tmp_path / "rec.rrd", tmp_path / "figs"
+    result = cli(
+        "track", video, "--fps", FPS, *SCALE, "--radius", "0.0375", "--rrd", rrd,
+        "--figures", figures,
+    )  # fmt: skip
+    assert result.exit_code == 0, result.stderr
+    assert rrd.stat().st_size > 10_000  # frames are in it
+    pngs = sorted(p.name for p in figures.glob("*.png"))
+    assert "track.png" in pngs and len(pngs) >= 2
+    for name in pngs:
+        assert f"wrote {figures / name}" in result.stdout
