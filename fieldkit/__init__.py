@@ -2,8 +2,8 @@
 
 The data flow (ARCHITECTURE §1): ``io`` readers -> ``reduce`` (survey) or
 ``tracking`` (video) -> :class:`~fieldkit.impact_table.ImpactTable` -> figures
-(``viz``), reports and, later, ``model`` / ``fit`` / ``diagnose`` / ``export``. ``physics`` holds the thesis
-equations as pure functions.
+(``viz``), reports and, later, ``model`` / ``fit`` / ``diagnose`` / ``export``.
+``physics`` holds the thesis equations as pure functions.
 """
 
 from fieldkit.errors import FieldkitError

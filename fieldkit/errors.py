@@ -1,8 +1,9 @@
 """The one error type that bad input raises, and how it prints.
 
-Every reader, physics guard and command raises :class:`FieldkitError` (or a subclass)
-for problems with the *user's input*. The command line turns it into a single line on
-stderr and a non-zero exit code; anything else escaping is a bug and keeps its traceback.
+Every reader, physics guard and command raises :class:`FieldkitError` (or a
+subclass) for problems with the *user's input*. The command line turns it into a
+single line on stderr and a non-zero exit code; anything else escaping is a bug and
+keeps its traceback.
 """
 
 from __future__ import annotations
@@ -50,7 +51,7 @@ class InputFileError(FieldkitError):
 
 
 class PhysicsError(FieldkitError):
-    """Inputs that no physical solution satisfies (e.g. no ballistic path reaches a point)."""
+    """Inputs that no physical solution satisfies (e.g. an unreachable point)."""
 
 
 class ArgumentError(FieldkitError):

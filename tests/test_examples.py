@@ -1,4 +1,4 @@
-"""Every script in examples/ runs, and says what the thesis says (examples are tests)."""
+"""Every script in examples/ runs and prints the thesis numbers (examples are tests)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,6 @@ import subprocess
 import sys
 
 import pytest
-
 from conftest import REPO
 
 EXAMPLES = sorted((REPO / "examples").glob("*.py"))

@@ -97,3 +97,15 @@ def test_bad_values_name_the_row(tmp_path):
     with pytest.raises(InputFileError, match="unknown table format"):
         _table().write(tmp_path / "t.txt")
     assert not (tmp_path / "t.txt").exists()
+
+
+def test_outputs_get_normal_permissions(tmp_path):
+    import os
+
+    mask = os.umask(0o022)
+    try:
+        path = _table().write(tmp_path / "t.csv")
+    finally:
+        os.umask(mask)
+    assert path.stat().st_mode & 0o777 == 0o644
+    assert [p.name for p in tmp_path.iterdir()] == ["t.csv"]  # no temporary left

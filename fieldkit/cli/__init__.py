@@ -12,7 +12,7 @@ from fieldkit.cli import fence, impact, reduce, track, view
 
 app = typer.Typer(
     name="fieldkit",
-    help="Rockfall engineering workstation: field and video measurements -> impact physics.",
+    help="Rockfall engineering: field and video measurements -> impact physics.",
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,

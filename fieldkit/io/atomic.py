@@ -1,7 +1,9 @@
 """Atomic output files that never overwrite an input.
 
-A command writes each output to a temporary file in the destination folder and renames it
-into place only when the whole file is written, so a failure leaves no partial output.
+A command writes each output to a temporary file in the destination folder and renames
+it into place only when the whole file is written, so a failure leaves no partial
+output. The file gets the usual permissions (``0o666`` less the umask), not the
+private mode of a temporary file.
 """
 
 from __future__ import annotations
@@ -47,10 +49,17 @@ def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     tmp_path = Path(tmp)
     try:
         yield tmp_path
+        os.chmod(tmp_path, 0o666 & ~_umask())
         os.replace(tmp_path, target)
     finally:
         if tmp_path.exists():
             tmp_path.unlink()
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
 
 
 def write_atomic(path: str | os.PathLike[str], write: Callable[[Path], object]) -> Path:

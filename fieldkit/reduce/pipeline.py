@@ -29,10 +29,10 @@ import pandas as pd
 
 from fieldkit.errors import InputFileError
 from fieldkit.impact_table import ImpactTable
-from fieldkit.reduce.impact_theory import DEFAULT_FRICTION, add_theory_columns
 from fieldkit.physics.energy import kinetic_energy
 from fieldkit.reduce.body import BodyProperties
 from fieldkit.reduce.flights import SolvedFlight, TreeStrike, solve_flights
+from fieldkit.reduce.impact_theory import DEFAULT_FRICTION, add_theory_columns
 
 
 @dataclass(frozen=True)

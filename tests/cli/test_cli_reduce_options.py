@@ -1,4 +1,4 @@
-"""`fieldkit reduce` reader options: --epsg, --lenient-checksum, measured theta0, theory line."""
+"""`fieldkit reduce` options: --epsg, --lenient-checksum, measured theta0, theory."""
 
 from __future__ import annotations
 
