@@ -13,7 +13,7 @@ from fieldkit.cli.common import GyrationOpt, MassOpt, RadiusOpt, one_line_errors
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.impact_table import ImpactTable
 from fieldkit.io.atomic import refuse_input_overwrite
-from fieldkit.io.delimited_text import detect_delimiter, read_lines, split_row
+from fieldkit.io.csv_table import detect_delimiter, read_text, split_row
 from fieldkit.tracking.track import Track
 
 
@@ -158,9 +158,10 @@ def detect_format(path: Path) -> str:
     """``impacts``, ``track``, ``tracker`` or ``kinovea`` from a file's first lines."""
     if path.suffix.lower() in (".parquet", ".xlsx"):
         return "impacts"
-    lines = [ln for ln in read_lines(path)[:3] if ln.strip()]
+    lines = [ln for ln in read_text(path, kind="input").splitlines()[:3] if ln.strip()]
     first = lines[0].strip()
-    cells = [c.strip().strip('"') for c in split_row(first, detect_delimiter(first))]
+    delimiter = detect_delimiter(first, default=" ")
+    cells = [c.strip().strip('"') for c in split_row(first, delimiter)]
     if first.lower().startswith("#multi"):
         return "tracker"
     if {"path_id", "vi_x_mps"} <= set(cells):
@@ -175,7 +176,8 @@ def detect_format(path: Path) -> str:
         return "kinovea"
     if len(lines) > 1:
         second = lines[1]
-        names = {c.strip() for c in split_row(second, detect_delimiter(second))}
+        delimiter = detect_delimiter(second, default=" ")
+        names = {c.strip() for c in split_row(second, delimiter)}
         if {"t", "x", "y"} <= names:
             return "tracker"
     raise InputFileError(
@@ -228,7 +230,7 @@ def _read_track(path, fmt, unit, metres_per_pixel, y_down, fps, file_fps) -> Tra
             )
         frame[col] = values
     if fps is not None or file_fps is not None:
-        from fieldkit.io.delimited_text import time_factor
+        from fieldkit.io.tracking_export import time_factor
 
         frame["t_s"] = frame["t_s"] * time_factor(file_fps, fps, path)
     return Track(frame, source=str(path), fps=fps)

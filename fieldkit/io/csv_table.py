@@ -1,12 +1,21 @@
-"""Plain-text tables (CSV, semicolon or tab separated) with file row numbers kept.
+"""Delimited text tables (comma, semicolon, tab or space separated), rows numbered.
 
-Every CSV reader in :mod:`fieldkit.io` goes through :func:`read_csv_table`, so they all
-agree on what "row 7" means, how column names are normalised and aliased, how numbers
-are parsed and what a bad file says.
+Every delimited-text reader in :mod:`fieldkit.io` goes through this module: the
+field-data importers (GPX/CSV points, fieldbook, stations, trees) through
+:func:`read_csv_table`, the tracking-program readers (OSP Tracker, Kinovea) through
+:func:`read_text`, :func:`detect_delimiter`, :func:`split_row` and
+:func:`parse_number`. So they all agree on how a file is decoded, which separator it
+uses, how a decimal comma is read, what unit a column name carries, what "row 7"
+means and what a bad file says.
 
-Row numbers are spreadsheet row numbers: the header is row 1, the first data row is
-row 2 (equal to the line number in a text editor unless a quoted cell spans lines).
-Blank lines and lines starting with ``#`` are skipped but still counted.
+Row numbers are file line numbers: the header of a plain table is row 1, its first
+data row is row 2 (equal to the line number in a text editor unless a quoted cell
+spans lines). Blank lines are skipped but still counted; :func:`read_csv_table`
+also skips lines starting with ``#``.
+
+Numbers may be written in the user's locale: ``1.25`` or ``1,25`` (and ``1.2E-3`` or
+``1,2E-3``, ``1.234,5``). With a tab, semicolon or space separator a comma can only be
+a decimal mark; with a comma separator it cannot be.
 """
 
 from __future__ import annotations
@@ -23,6 +32,26 @@ from fieldkit.errors import ArgumentError, InputFileError
 
 #: Length units a column name may carry, e.g. ``x_m``, ``x_ft`` or ``Altitude (ft)``.
 LENGTH_UNITS: dict[str, float] = {"m": 1.0, "ft": 0.3048, "mm": 1e-3, "cm": 1e-2}
+
+#: Spelled-out unit names and the short name they stand for.
+_UNIT_SPELLINGS: dict[str, str] = {
+    "meter": "m",
+    "meters": "m",
+    "metre": "m",
+    "metres": "m",
+    "feet": "ft",
+    "foot": "ft",
+    "pixel": "px",
+    "pixels": "px",
+}
+
+#: Separators in order of preference when a header line uses two equally often.
+_SEPARATORS = ("\t", ";", ",")
+
+#: ``1.234,5`` (dots grouping thousands, a decimal comma).
+_GROUPED_DECIMAL_COMMA = re.compile(
+    r"^[+-]?\d{1,3}(?:\.\d{3})+(?:,\d*)?(?:[eE][+-]?\d+)?$"
+)
 
 _UNIT_IN_NAME = re.compile(r"^(?P<base>.*?)(?:_(?P<suffix>m|ft|mm|cm|deg))?$")
 
@@ -53,11 +82,70 @@ def normalise_name(raw: str) -> tuple[str, str | None]:
     if unit is None and match and match.group("suffix") and match.group("base"):
         unit = match.group("suffix")
         text = match.group("base")
-    if unit in ("meter", "meters", "metre", "metres"):
-        unit = "m"
-    if unit in ("feet", "foot"):
-        unit = "ft"
-    return text, unit
+    return text, unit_name(unit)
+
+
+def unit_name(text: str | None) -> str | None:
+    """The short name of a unit written in a header (``metres`` -> ``m``).
+
+    Examples
+    --------
+    >>> unit_name("Metres"), unit_name(" pixels "), unit_name("°"), unit_name("")
+    ('m', 'px', 'deg', None)
+    """
+    if not text:
+        return None
+    unit = text.strip().lower().replace("°", "deg")
+    return _UNIT_SPELLINGS.get(unit, unit)
+
+
+def detect_delimiter(header: str, default: str = ",") -> str:
+    """The separator the header line uses most: tab, semicolon or comma.
+
+    Ties go to tab, then semicolon (a comma may also be text or a decimal mark).
+    ``default`` when the line has none of them (``" "``: split on white space).
+
+    Examples
+    --------
+    >>> detect_delimiter("t\\tx\\ty"), detect_delimiter("x;y,z")
+    ('\\t', ';')
+    >>> detect_delimiter("t x y", default=" ")
+    ' '
+    """
+    best = max(_SEPARATORS, key=header.count)
+    return best if header.count(best) else default
+
+
+def split_row(line: str, delimiter: str) -> list[str]:
+    """Cells of one line, honouring double quotes (RFC 4180); ``" "``: white space."""
+    if delimiter == " ":
+        return line.split()
+    return next(csv.reader(io.StringIO(line), delimiter=delimiter), [])
+
+
+def parse_number(cell: str, delimiter: str) -> float:
+    """A number in either locale; empty cells are NaN. Raises ValueError otherwise.
+
+    A comma is a decimal mark unless the separator is a comma; dots then may only
+    group thousands (``1.234,5``).
+
+    Examples
+    --------
+    >>> parse_number("1,25E-3", "\\t"), parse_number("", ";"), parse_number("-0.5", ",")
+    (0.00125, nan, -0.5)
+    >>> parse_number("1.234,5", ";")
+    1234.5
+    """
+    text = cell.strip().strip('"').replace("\u2212", "-")
+    if not text:
+        return math.nan
+    if delimiter != "," and "," in text:
+        if "." in text:
+            if not _GROUPED_DECIMAL_COMMA.match(text):
+                raise ValueError(f"could not convert string to float: {cell!r}")
+            text = text.replace(".", "")
+        text = text.replace(",", ".")
+    return float(text)
 
 
 @dataclass(frozen=True)
@@ -115,11 +203,8 @@ class CsvTable:
                     where=place,
                 )
             return math.nan
-        candidate = text
-        if self.delimiter != "," and "," in text and "." not in text:
-            candidate = text.replace(",", ".")  # decimal comma (European locale)
         try:
-            value = float(candidate)
+            value = parse_number(text, self.delimiter)
         except ValueError:
             raise InputFileError(
                 f"column '{column.header.strip()}': '{text}' is not a number",
@@ -167,25 +252,34 @@ def decode_text(data: bytes, source: str, kind: str = "CSV") -> str:
         return text
 
 
+def read_text(path: str | PathLike[str], kind: str = "CSV") -> str:
+    """The text of a readable, non-binary, non-blank file; one-line errors otherwise."""
+    file = check_readable(path)
+    text = decode_text(file.read_bytes(), str(path), kind)
+    if not text.strip():
+        raise InputFileError("file is empty", source=str(path))
+    return text
+
+
+def numbered_lines(text: str) -> list[tuple[int, str]]:
+    """The non-blank lines of ``text``, each with its line number (from 1)."""
+    return [(n, line) for n, line in enumerate(text.splitlines(), 1) if line.strip()]
+
+
 def read_csv_table(path: str | PathLike[str]) -> CsvTable:
     """Read a delimited text table with its header.
 
     The delimiter (``,`` ``;`` or tab) is taken from the header line. Raises
     :class:`InputFileError` for a missing, empty, binary or header-only file.
     """
-    file = check_readable(path)
     source = str(path)
-    text = decode_text(file.read_bytes(), source)
-    if not text.strip():
-        raise InputFileError("file is empty", source=source)
+    text = read_text(path)
     header_line = next(
         (ln for ln in text.splitlines() if ln.strip() and not ln.startswith("#")), None
     )
     if header_line is None:
         raise InputFileError("file has no header line", source=source)
-    delimiter = max((",", ";", "\t"), key=header_line.count)
-    if header_line.count(delimiter) == 0:
-        delimiter = ","
+    delimiter = detect_delimiter(header_line)
     reader = csv.reader(io.StringIO(text, newline=""), delimiter=delimiter)
     header: list[str] | None = None
     rows: list[tuple[int, tuple[str, ...]]] = []

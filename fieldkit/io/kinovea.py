@@ -28,13 +28,18 @@ import re
 import numpy as np
 
 from fieldkit.errors import ArgumentError, InputFileError
-from fieldkit.io.delimited_text import (
+from fieldkit.io.csv_table import (
+    detect_delimiter,
+    numbered_lines,
+    read_text,
+    split_row,
+    unit_name,
+)
+from fieldkit.io.tracking_export import (
     LengthScale,
     build_track,
-    detect_delimiter,
-    parse_number,
-    read_lines,
-    split_row,
+    check_increasing_times,
+    read_number_columns,
     time_factor,
 )
 from fieldkit.tracking.track import Track
@@ -91,20 +96,22 @@ def read_kinovea(
     ([0.0, 0.03333], [1.5, 1.6])
     """
     src = str(path)
-    lines = [ln for ln in read_lines(path) if ln.strip()]
-    delim = detect_delimiter(lines[0])
-    header = [h.strip() for h in split_row(lines[0], delim)]
+    lines = numbered_lines(read_text(path))
+    delim = detect_delimiter(lines[0][1], default=" ")
+    header = [h.strip() for h in split_row(lines[0][1], delim)]
     tm = _TIME.match(header[0]) if header else None
     if tm is None:
         raise InputFileError(
             f"first column {header[0] if header else ''!r} is not the time",
             source=src,
-            where="row 1",
+            where=f"row {lines[0][0]}",
         )
     pairs = _coordinate_pairs(header)
     if not pairs:
         raise InputFileError(
-            "no X and Y coordinate columns in the header", source=src, where="row 1"
+            "no X and Y coordinate columns in the header",
+            source=src,
+            where=f"row {lines[0][0]}",
         )
     if point is None:
         name = next(iter(pairs))
@@ -117,42 +124,20 @@ def read_kinovea(
             )
         name = found[0]
     (x_col, x_unit), (y_col, _) = pairs[name]["x"], pairs[name]["y"]
-    length_unit = _unit_name(x_unit) or unit
+    length_unit = unit_name(x_unit) or unit
     if length_unit is None:
         raise ArgumentError(
             "the export does not name its length unit: give it (--unit m|cm|mm|px)",
             source=src,
         )
-    rows = []
-    for k, line in enumerate(lines[1:], start=2):
-        cells = split_row(line, delim)
-        try:
-            rows.append(
-                [
-                    parse_number(cells[c], delim) if c < len(cells) else np.nan
-                    for c in (0, x_col, y_col)
-                ]
-            )
-        except ValueError:
-            raise InputFileError(
-                f"{line.strip()[:40]!r} holds a value that is not a number",
-                source=src,
-                where=f"row {k}",
-            ) from None
-    if not rows:
-        raise InputFileError("no data rows after the header", source=src)
-    data = np.array(rows, float)
+    row_numbers, data = read_number_columns(
+        lines[1:], delim, header, (0, x_col, y_col), src
+    )
     t = data[:, 0] * _seconds_per_time_unit(
         time_unit, tm.group("unit"), data[:, 0], src
     )
+    check_increasing_times(t, row_numbers, src)
     ok = np.isfinite(t)
-    if ok.sum() > 1 and np.any(np.diff(t[ok]) <= 0):
-        j = int(np.flatnonzero(np.diff(t[ok]) <= 0)[0])
-        raise InputFileError(
-            "times are not increasing",
-            source=src,
-            where=f"row {2 + int(np.flatnonzero(ok)[j + 1])}",
-        )
     tracked = ok & np.isfinite(data[:, 1]) & np.isfinite(data[:, 2])
     return build_track(
         np.where(tracked, t, np.nan),
@@ -182,13 +167,6 @@ def _coordinate_pairs(
         name = m.group("name").strip() or "point"
         pairs.setdefault(name, {})[m.group("axis").lower()] = (j, m.group("unit"))
     return {n: p for n, p in pairs.items() if "x" in p and "y" in p}
-
-
-def _unit_name(text: str | None) -> str | None:
-    if not text:
-        return None
-    t = text.strip().lower()
-    return {"pixels": "px", "pixel": "px", "metres": "m", "meters": "m"}.get(t, t)
 
 
 def _seconds_per_time_unit(time_unit: str, header_unit: str | None, t, src) -> float:

@@ -27,16 +27,13 @@ from __future__ import annotations
 
 import os
 
-import numpy as np
-
 from fieldkit.errors import InputFileError
-from fieldkit.io.delimited_text import (
+from fieldkit.io.csv_table import detect_delimiter, numbered_lines, read_text, split_row
+from fieldkit.io.tracking_export import (
     LengthScale,
     build_track,
-    detect_delimiter,
-    parse_number,
-    read_lines,
-    split_row,
+    check_increasing_times,
+    read_number_columns,
     time_factor,
 )
 from fieldkit.tracking.track import Track
@@ -77,63 +74,36 @@ def read_osp_tracker(
     >>> tr.meta["track_name"], tr.x.tolist(), tr.z.tolist()
     ('ball', [1.5, 1.6], [2.0, 1.95])
     """
-    lines = [ln for ln in read_lines(path) if ln.strip()]
     src = str(path)
+    numbered = numbered_lines(read_text(path, kind="Tracker data"))
+    lines = [line for _, line in numbered]
     i = 0
     names_line = None
     if lines[0].strip().lower().startswith("#multi"):
-        names_line, i = lines[1], 2
+        names_line, i = lines[1] if len(lines) > 1 else "", 2
         name = None
     elif _is_header(lines[0]):
         name = ""
     else:
         name, i = lines[0].strip(), 1
     if i >= len(lines) or not _is_header(lines[i]):
+        row = numbered[i][0] if i < len(lines) else numbered[-1][0] + 1
         raise InputFileError(
             "no column header with 't' found (expected the track name, then 't  x  y')",
             source=src,
-            where=f"row {i + 1}",
+            where=f"row {row}",
         )
     header_line = lines[i]
-    delim = detect_delimiter(header_line)
+    delim = detect_delimiter(header_line, default=" ")
     header = [h.strip() for h in split_row(header_line, delim)]
     t_col = header.index("t")
     x_col, y_col = _xy_columns(header, names_line, delim, track_name, src)
     if names_line is not None:
         name = _track_names(names_line, delim).get(x_col, "")
-    rows = []
-    for k, line in enumerate(lines[i + 1 :], start=i + 2):
-        cells = split_row(line, delim)
-        if delim == "," and len(cells) > len(header):
-            raise InputFileError(
-                f"{len(cells)} cells for {len(header)} columns: decimal commas with a "
-                "comma separator are ambiguous; export with tab or semicolon",
-                source=src,
-                where=f"row {k}",
-            )
-        try:
-            rows.append(
-                [
-                    parse_number(cells[c], delim) if c < len(cells) else np.nan
-                    for c in (t_col, x_col, y_col)
-                ]
-            )
-        except ValueError:
-            bad = next(c for c in cells if not _is_number(c, delim))
-            raise InputFileError(
-                f"{bad.strip()!r} is not a number", source=src, where=f"row {k}"
-            ) from None
-    if not rows:
-        raise InputFileError("no data rows after the header", source=src)
-    data = np.array(rows, float)
-    ok = np.isfinite(data[:, 0])
-    if ok.sum() > 1 and np.any(np.diff(data[ok, 0]) <= 0):
-        j = int(np.flatnonzero(np.diff(data[ok, 0]) <= 0)[0])
-        raise InputFileError(
-            "times are not increasing",
-            source=src,
-            where=f"row {i + 2 + int(np.flatnonzero(ok)[j + 1])}",
-        )
+    row_numbers, data = read_number_columns(
+        numbered[i + 1 :], delim, header, (t_col, x_col, y_col), src
+    )
+    check_increasing_times(data[:, 0], row_numbers, src)
     return build_track(
         data[:, 0],
         data[:, 1],
@@ -152,16 +122,9 @@ def read_osp_tracker(
 
 
 def _is_header(line: str) -> bool:
-    cells = [c.strip().strip('"') for c in split_row(line, detect_delimiter(line))]
+    delim = detect_delimiter(line, default=" ")
+    cells = [c.strip().strip('"') for c in split_row(line, delim)]
     return "t" in cells and "x" in cells and "y" in cells
-
-
-def _is_number(cell: str, delim: str) -> bool:
-    try:
-        parse_number(cell, delim)
-    except ValueError:
-        return False
-    return True
 
 
 def _track_names(names_line: str, delim: str) -> dict[int, str]:

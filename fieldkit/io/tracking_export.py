@@ -1,84 +1,80 @@
-"""Delimited text as tracking programs write it: any separator, locale decimals, units.
+"""Coordinates exported by tracking programs -> Track: columns, units, time base.
 
-Shared by the OSP Tracker and Kinovea readers. Programs write numbers in the user's
-locale: ``1.25`` or ``1,25`` (and ``1.2E-3`` or ``1,2E-3``). With a tab or semicolon
-separator a comma can only be a decimal mark; with a comma separator it cannot be.
-Coordinates arrive in metres, centimetres, millimetres or pixels; pixels need a scale.
+Shared by the OSP Tracker and Kinovea readers; the text itself (decoding, separator,
+locale decimals, row numbers) is read by :mod:`fieldkit.io.csv_table`. Coordinates
+arrive in metres, centimetres, millimetres, inches, feet or pixels; pixels need a
+scale. Times may have been computed at a playback rate instead of the capture rate.
 """
 
 from __future__ import annotations
 
-import csv
-import io
-import os
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from fieldkit.errors import ArgumentError, InputFileError
+from fieldkit.io.csv_table import LENGTH_UNITS, parse_number, split_row
 from fieldkit.tracking.track import Track
 
 #: Metres per unit for the length units tracking programs export.
-METRES_PER_UNIT: dict[str, float] = {
-    "m": 1.0,
-    "cm": 0.01,
-    "mm": 0.001,
-    "in": 0.0254,
-    "ft": 0.3048,
-}
+METRES_PER_UNIT: dict[str, float] = {**LENGTH_UNITS, "in": 0.0254}
 #: The unit name for pixels (needs ``metres_per_pixel``).
 PIXELS = "px"
 
 
-def read_lines(path: str | os.PathLike[str]) -> list[str]:
-    """The file's lines (UTF-8, else Latin-1), BOM removed; errors name the file."""
-    p = Path(path)
-    if not p.is_file():
-        raise InputFileError("file not found", source=p)
-    raw = p.read_bytes()
-    if not raw.strip():
-        raise InputFileError("file is empty", source=p)
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError:
-        text = raw.decode("latin-1")
-    return text.splitlines()
+def read_number_columns(
+    rows: list[tuple[int, str]],
+    delimiter: str,
+    header: list[str],
+    columns: tuple[int, ...],
+    source: str,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Row numbers and the numbers in ``columns`` of the numbered data ``rows``.
 
-
-def detect_delimiter(header: str) -> str:
-    """Tab, semicolon or comma, whichever the header line uses (else whitespace)."""
-    for delim in ("\t", ";", ","):
-        if delim in header:
-            return delim
-    return " "
-
-
-def split_row(line: str, delimiter: str) -> list[str]:
-    """Cells of one line, honouring double quotes (RFC 4180)."""
-    if delimiter == " ":
-        return line.split()
-    return next(csv.reader(io.StringIO(line), delimiter=delimiter))
-
-
-def parse_number(cell: str, delimiter: str) -> float:
-    """A number in either locale; empty cells are NaN. Raises ValueError otherwise.
-
-    Examples
-    --------
-    >>> parse_number("1,25E-3", "\\t"), parse_number("", ";"), parse_number("-0.5", ",")
-    (0.00125, nan, -0.5)
+    Cells missing at the end of a row are NaN. Raises :class:`InputFileError` naming
+    the row for a cell that is not a number, for more cells than ``header`` columns
+    in a comma-separated file (decimal commas), and for no rows at all.
     """
-    text = cell.strip().strip('"').replace("\u2212", "-")
-    if not text:
-        return float("nan")
-    if delimiter != "," and "," in text:
-        if "." in text:  # thousands separators: 1.234,5
-            text = text.replace(".", "")
-        text = text.replace(",", ".")
-    value = float(text)
-    return value
+    row_numbers, data = [], []
+    for row_number, line in rows:
+        cells = split_row(line, delimiter)
+        if delimiter == "," and len(cells) > len(header):
+            raise InputFileError(
+                f"{len(cells)} cells for {len(header)} columns: decimal commas with a "
+                "comma separator are ambiguous; export with tab or semicolon",
+                source=source,
+                where=f"row {row_number}",
+            )
+        values = []
+        for c in columns:
+            cell = cells[c] if c < len(cells) else ""
+            try:
+                values.append(parse_number(cell, delimiter))
+            except ValueError:
+                raise InputFileError(
+                    f"column {header[c]!r}: {cell.strip()!r} is not a number",
+                    source=source,
+                    where=f"row {row_number}",
+                ) from None
+        row_numbers.append(row_number)
+        data.append(values)
+    if not data:
+        raise InputFileError("no data rows after the header", source=source)
+    return np.array(row_numbers, int), np.array(data, float)
+
+
+def check_increasing_times(t: np.ndarray, row_numbers: np.ndarray, source: str):
+    """Raise naming the first row whose time is not after the previous time."""
+    ok = np.isfinite(t)
+    steps = np.diff(t[ok])
+    if np.any(steps <= 0):
+        j = int(np.flatnonzero(steps <= 0)[0])
+        raise InputFileError(
+            "times are not increasing",
+            source=source,
+            where=f"row {row_numbers[ok][j + 1]}",
+        )
 
 
 @dataclass(frozen=True)
