@@ -175,6 +175,28 @@ class CsvTable:
                     return column
         return None
 
+    def header_text(self) -> str:
+        """The header cells as written, comma separated (for error messages)."""
+        return ", ".join(column.header.strip() for column in self.columns)
+
+    def require(
+        self, aliases: dict[str, tuple[str, ...]], needs: str
+    ) -> dict[str, Column]:
+        """The column for each key of ``aliases``; raise naming the keys not found.
+
+        ``needs`` begins the message, e.g. ``"stations CSV needs columns station,
+        lat"``; the keys not found and the header follow it.
+        """
+        found = {key: self.find(names) for key, names in aliases.items()}
+        missing = [key for key, column in found.items() if column is None]
+        if missing:
+            raise InputFileError(
+                f"{needs}; missing {', '.join(missing)} (have: {self.header_text()})",
+                source=self.source,
+                where="row 1",
+            )
+        return found  # type: ignore[return-value]
+
     def cell(self, row: tuple[str, ...], column: Column) -> str:
         """The stripped text of ``column`` in ``row`` ('' if the row is short)."""
         return row[column.index].strip() if column.index < len(row) else ""

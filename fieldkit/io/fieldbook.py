@@ -109,22 +109,17 @@ def read_fieldbook(
         )
     table = read_csv_table(path)
     source = table.source
-    columns = {
-        "point": table.find(NAME_ALIASES),
-        "station": table.find(STATION_COLUMN_ALIASES),
-        "instrument_height_m": table.find(INSTRUMENT_HEIGHT_ALIASES),
-        "target_height_m": table.find(TARGET_HEIGHT_ALIASES),
-        "sentence": table.find(SENTENCE_ALIASES),
-    }
-    missing = [key for key, column in columns.items() if column is None]
-    if missing:
-        have = ", ".join(c.header.strip() for c in table.columns)
-        raise InputFileError(
-            f"field book needs columns point, station, instrument_height_m, "
-            f"target_height_m, sentence; missing {', '.join(missing)} (have: {have})",
-            source=source,
-            where="row 1",
-        )
+    columns = table.require(
+        {
+            "point": NAME_ALIASES,
+            "station": STATION_COLUMN_ALIASES,
+            "instrument_height_m": INSTRUMENT_HEIGHT_ALIASES,
+            "target_height_m": TARGET_HEIGHT_ALIASES,
+            "sentence": SENTENCE_ALIASES,
+        },
+        "field book needs columns point, station, instrument_height_m, "
+        "target_height_m, sentence",
+    )
     stations = read_stations(stations_path, units=units)
     ih_factor = length_factor(table, columns["instrument_height_m"], units)
     th_factor = length_factor(table, columns["target_height_m"], units)

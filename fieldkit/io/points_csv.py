@@ -151,18 +151,7 @@ def read_points_csv(
         lon = _require_numbers(table, lon_column)
         _check_range(table, lat_column, lat, -90.0, 90.0)
         _check_range(table, lon_column, lon, -180.0, 180.0)
-        elev, reference = _elevations(table, units)
-        return point_set_from_geographic(
-            names,
-            lat,
-            lon,
-            elev,
-            source=source,
-            height_reference=reference,
-            epsg=epsg,
-            notes=notes,
-            extra=extra,
-        )
+        return _geographic_points(table, units, names, lat, lon, epsg, notes, extra)
     if easting_column is not None and northing_column is not None:
         if epsg is None:
             raise InputFileError(
@@ -190,18 +179,7 @@ def read_points_csv(
                 f"easting/northing cannot be converted from {geodesy.crs_label(crs)}",
                 source=source,
             )
-        elev, reference = _elevations(table, units)
-        return point_set_from_geographic(
-            names,
-            lat,
-            lon,
-            elev,
-            source=source,
-            height_reference=reference,
-            epsg=crs,
-            notes=notes,
-            extra=extra,
-        )
+        return _geographic_points(table, units, names, lat, lon, crs, notes, extra)
     if x_column is not None:
         z_column = table.find(ELEVATION_ALIASES)
         if z_column is None:
@@ -224,12 +202,27 @@ def read_points_csv(
             notes=notes,
             extra=extra,
         )
-    found = ", ".join(c.header.strip() for c in table.columns)
     raise InputFileError(
-        f"no coordinate columns found (have: {found}); need lat, lon, elev or "
-        "easting, northing, elevation (+ --epsg) or x, z",
+        f"no coordinate columns found (have: {table.header_text()}); need lat, lon, "
+        "elev or easting, northing, elevation (+ --epsg) or x, z",
         source=source,
         where="row 1",
+    )
+
+
+def _geographic_points(table: CsvTable, units, names, lat, lon, epsg, notes, extra):
+    """Points at ``lat``/``lon`` with the table's elevations."""
+    elev, reference = _elevations(table, units)
+    return point_set_from_geographic(
+        names,
+        lat,
+        lon,
+        elev,
+        source=table.source,
+        height_reference=reference,
+        epsg=epsg,
+        notes=notes,
+        extra=extra,
     )
 
 

@@ -64,21 +64,15 @@ def read_stations(path: str | PathLike[str], *, units: str = "m") -> Stations:
         )
         return Stations(frame, source, GPX_HEIGHT_REFERENCE)
     table = read_csv_table(path)
-    wanted = {
-        "station": table.find(STATION_ALIASES),
-        "lat": table.find(LAT_ALIASES),
-        "lon": table.find(LON_ALIASES),
-        "elev": table.find(ELEVATION_ALIASES),
-    }
-    missing = [key for key, column in wanted.items() if column is None]
-    if missing:
-        have = ", ".join(c.header.strip() for c in table.columns)
-        raise InputFileError(
-            f"stations CSV needs columns station, lat, lon, elev_m; missing "
-            f"{', '.join(missing)} (have: {have})",
-            source=source,
-            where="row 1",
-        )
+    wanted = table.require(
+        {
+            "station": STATION_ALIASES,
+            "lat": LAT_ALIASES,
+            "lon": LON_ALIASES,
+            "elev": ELEVATION_ALIASES,
+        },
+        "stations CSV needs columns station, lat, lon, elev_m",
+    )
     names, lats, lons, elevs, wheres = [], [], [], [], []
     elev_factor = length_factor(table, wanted["elev"], units)
     for number, row in table.rows:

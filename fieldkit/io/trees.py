@@ -159,7 +159,7 @@ def read_trees(
     species_column = table.find(SPECIES_ALIASES)
     tree_column = table.find(TREE_ALIASES)
     dbh_column, dbh_factor = _dbh_column(table)
-    have = ", ".join(c.header.strip() for c in table.columns)
+    have = table.header_text()
     if height_column is None:
         raise InputFileError(
             f"tree strikes need a strike_height_m column (have: {have})",
