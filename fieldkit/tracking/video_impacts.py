@@ -11,21 +11,11 @@ For each contact between two fitted flights (:mod:`fieldkit.tracking.contacts`):
   an onset power law fitted to the deviations, not the first sample beyond noise).
 * **Velocities.** Impact velocity from the flight before, restitution velocity from the
   flight after, both evaluated at the contact time(s) (fixed-g fits).
-* **Surface angle** ``slope_deg`` (psi, positive descending in the direction of
-  travel, ARCHITECTURE §2): the given ``surface_angle_deg`` if any; otherwise
-
-  - two or more impacts: the least-squares line through the centres at the impact
-    instants (the centres lie one radius off a plane surface, so the line is parallel
-    to it);
-  - a single impact: from the angular-momentum balance of a rigid body about the
-    contact point. The friction impulse that changes the tangential velocity also
-    changes the spin: ``dv_T = k^2 d_omega / r``. With the measured velocity change
-    and spin change this fixes the direction of T (the root with an outward normal
-    impulse). It needs spin before and after (a marker), the radius and the radius of
-    gyration (a solid sphere, ``k = sqrt(2/5) r``, when not given);
-  - a single impact without spin: 0° (horizontal) is assumed, with a warning;
-  - an extended contact: the chord from the centre at contact start to the centre at
-    contact end (the body follows the surface while in contact).
+* **Surface angle** ``slope_deg`` (psi, ARCHITECTURE §2), always on the side facing
+  the incoming body so that ``vin < 0``: given, or estimated from the contact points,
+  the spin balance or the contact's chord; left NaN (e_n, e_t NaN, with a warning)
+  when the data cannot identify it (a net without spin). Details and measured
+  accuracy in :mod:`fieldkit.tracking.contact_surface`.
 * **Spin** before and after: slope of a straight line through the unwrapped marker
   angle over the whole adjacent flight (spin is constant in free flight), else the
   median of the track's ``omega_radps`` there, else NaN.
@@ -44,6 +34,7 @@ import pandas as pd
 
 from fieldkit.impact_table import ImpactTable
 from fieldkit.physics.constants import G
+from fieldkit.tracking.contact_surface import surface_angles
 from fieldkit.tracking.contacts import EXTENDED_CONTACT_SAMPLES, ContactSpan
 from fieldkit.tracking.flight_fit import FlightFit
 from fieldkit.tracking.net_contact import contact_onset
@@ -72,6 +63,7 @@ class ContactEvent:
     omega_i_radps: float
     omega_f_radps: float
     rows: np.ndarray
+    sag_rms_m: float = float("nan")
 
     @property
     def duration_s(self) -> float:
@@ -140,6 +132,9 @@ def find_contact_events(
             z_i = z_f = 0.5 * float(za + zb)
         vi = tuple(float(v) for v in fa.velocity(ti))
         vf = tuple(float(v) for v in fb.velocity(tf))
+        sag = float("nan")
+        if extended:
+            sag = chord_sag(track, span.rows, (x_i, z_i), (x_f, z_f), (ti, tf))
         events.append(
             ContactEvent(
                 span.before,
@@ -156,71 +151,42 @@ def find_contact_events(
                 spins[span.before],
                 spins[span.after],
                 span.rows,
+                sag,
             )
         )
     return events
+
+
+def chord_sag(
+    track: Track,
+    rows: np.ndarray,
+    start: tuple[float, float],
+    end: tuple[float, float],
+    times: tuple[float, float],
+) -> float:
+    """RMS distance [m] of the centres in contact from the chord start -> end.
+
+    A body rolling or sliding on a rigid plane keeps its centre on the chord (within
+    the noise); in a net it sags into the net by centimetres. NaN without samples.
+    """
+    rows = np.asarray(rows, int)
+    t = track.t[rows]
+    inside = (t > times[0]) & (t < times[1])
+    dx, dz = end[0] - start[0], end[1] - start[1]
+    length = np.hypot(dx, dz)
+    if not inside.any() or length == 0:
+        return float("nan")
+    px = track.x[rows][inside] - start[0]
+    pz = track.z[rows][inside] - start[1]
+    off = (px * dz - pz * dx) / length
+    off = off[np.isfinite(off)]
+    return float(np.sqrt(np.mean(off**2))) if len(off) else float("nan")
 
 
 def travel_direction(flights: list[FlightFit]) -> float:
     """+1 when the body travels toward +x overall, -1 toward -x."""
     total = sum(f.vx_mps * f.n_samples for f in flights)
     return -1.0 if total < 0 else 1.0
-
-
-def surface_angle_from_points(x_m: np.ndarray, z_m: np.ndarray) -> tuple[float, float]:
-    """Dip psi [deg] of the least-squares line through contact centres, and its SE.
-
-    Examples
-    --------
-    >>> x = np.array([0.0, 1.0, 2.0])
-    >>> round(surface_angle_from_points(x, -np.tan(np.radians(10.0)) * x)[0], 6)
-    10.0
-    """
-    x = np.asarray(x_m, float)
-    z = np.asarray(z_m, float)
-    coef, cov = (
-        np.polyfit(x, z, 1, cov=True) if len(x) > 3 else (np.polyfit(x, z, 1), None)
-    )
-    slope = coef[0]
-    psi = -np.degrees(np.arctan(slope))
-    se = float("nan")
-    if cov is not None:
-        se = float(np.degrees(np.sqrt(max(cov[0, 0], 0.0)) / (1.0 + slope**2)))
-    return float(psi), se
-
-
-def surface_angle_from_spin(
-    vi: tuple[float, float],
-    vf: tuple[float, float],
-    omega_i: float,
-    omega_f: float,
-    radius_m: float,
-    gyration_m: float,
-) -> float:
-    """Dip psi [deg] of the surface at one impact from the angular-momentum balance.
-
-    About the contact point the friction impulse ``P_T`` changes both the tangential
-    velocity and the spin of a rigid body: ``m dv_T = P_T`` and
-    ``m k^2 d_omega = r P_T``
-    (thesis ch. 4; sign convention of ARCHITECTURE §2), so ``dv . T = k^2 d_omega / r``
-    with ``T = (cos psi, -sin psi)``. Of the two roots the one whose normal impulse
-    ``dv . N`` is outward (positive) is returned.
-
-    Examples
-    --------
-    >>> psi = surface_angle_from_spin((1.0, -3.0), (1.0, 2.0), 0.0, 0.0, 0.04, 0.025)
-    >>> round(psi, 6)
-    0.0
-    """
-    dvx, dvz = vf[0] - vi[0], vf[1] - vi[1]
-    big = np.hypot(dvx, dvz)
-    c = gyration_m**2 * (omega_f - omega_i) / radius_m
-    if big <= 0 or not np.isfinite(c):
-        return float("nan")
-    phi = np.arctan2(dvz, dvx)
-    psi = np.arccos(np.clip(c / big, -1.0, 1.0)) - phi
-    psi = (psi + np.pi / 2) % np.pi - np.pi / 2  # into [-90, 90)
-    return float(np.degrees(psi))
 
 
 def build_impact_table(
@@ -264,56 +230,16 @@ def build_impact_table(
                 t_s=ev.t_impact_s,
                 contact_duration_s=ev.duration_s,
                 extended=ev.extended,
+                sag_rms_m=ev.sag_rms_m,
             )
         )
     f = pd.DataFrame(rows)
-    slope = np.full(len(f), np.nan)
-    source = np.full(len(f), "video", dtype=object)
-    if surface_angle_deg is not None:
-        slope[:] = surface_angle_deg
-        source[:] = "given"
-    else:
-        short = ~f["extended"].to_numpy(bool)
-        if short.sum() >= 2:
-            psi, se = surface_angle_from_points(
-                f.loc[short, "x_m"], f.loc[short, "z_m"]
-            )
-            slope[short] = psi
-            note = f" +/- {se:.2f}" if np.isfinite(se) else ""
-            warnings.append(
-                f"surface angle estimated from {int(short.sum())} contact points: "
-                f"{psi:.2f}{note} deg (give --surface-angle to override)"
-            )
-        elif short.sum() == 1:
-            i = int(np.flatnonzero(short)[0])
-            r = f.iloc[i]
-            psi = surface_angle_from_spin(
-                (r.vi_x_mps, r.vi_z_mps),
-                (r.vf_x_mps, r.vf_z_mps),
-                r.omega_i_radps,
-                r.omega_f_radps,
-                radius_m,
-                k,
-            )
-            if np.isfinite(psi):
-                slope[i] = psi
-                warnings.append(
-                    f"surface angle {psi:.2f} deg estimated from the single impact's "
-                    "velocity and spin change (angular-momentum balance, "
-                    f"k = {k:.4g} m); give --surface-angle if the surface is known"
-                )
-            else:
-                slope[i] = 0.0
-                source[i] = "assumed"
-                warnings.append(
-                    "no surface angle from a single impact without spin: "
-                    "0 deg assumed; give --surface-angle"
-                )
-        for i in np.flatnonzero(~short):
-            r = f.iloc[i]
-            slope[i] = -np.degrees(np.arctan2(r.z_end_m - r.z_m, r.x_end_m - r.x_m))
+    slope, source, slope_warnings = surface_angles(
+        f, radius_m=radius_m, gyration_m=k, surface_angle_deg=surface_angle_deg
+    )
+    warnings.extend(slope_warnings)
     f["slope_deg"] = slope
-    f["slope_source"] = source
+    f["slope_source"] = pd.array(source, dtype="string")
     f.insert(0, "path_id", path_id)
     f.insert(1, "point", [str(i + 1) for i in range(len(f))])
     f["radius_m"] = radius_m
@@ -322,7 +248,7 @@ def build_impact_table(
     has_spin = np.isfinite(f["omega_i_radps"]) & np.isfinite(f["omega_f_radps"])
     f["omega_source"] = np.where(has_spin, "measured", "none")
     _flight_geometry(f)
-    f = f.drop(columns=["x_end_m", "z_end_m", "extended"])
+    f = f.drop(columns=["x_end_m", "z_end_m", "extended", "sag_rms_m"])
     table = ImpactTable(f, source=path_id).derive()
     table.frame["theta0_deg"] = table.frame["theta_f_deg"]
     table.frame["theta0_source"] = pd.array(["video"] * len(f), dtype="string")

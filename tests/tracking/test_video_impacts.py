@@ -19,7 +19,7 @@ from fieldkit.physics.local_axes import to_local, to_section
 from fieldkit.tracking.analysis import analyse_track
 from fieldkit.tracking.synthetic import bouncing_ball
 from fieldkit.tracking.track import Track
-from fieldkit.tracking.video_impacts import (
+from fieldkit.tracking.contact_surface import (
     surface_angle_from_points,
     surface_angle_from_spin,
 )
