@@ -8,9 +8,12 @@ fails a check, so missing data propagates as NaN.
 
 from __future__ import annotations
 
-import numpy as np
+from collections.abc import Callable
 
-from fieldkit.errors import ArgumentError, PhysicsError
+import numpy as np
+from numpy.typing import ArrayLike
+
+from fieldkit.errors import ArgumentError, FieldkitError, PhysicsError
 
 
 def where_first(mask: np.ndarray) -> str | None:
@@ -27,6 +30,24 @@ def first_values(mask: np.ndarray, *arrays: np.ndarray) -> list[float]:
     return [float(np.broadcast_to(a, mask.shape)[index]) for a in arrays]
 
 
+def raise_at_first(
+    bad: ArrayLike,
+    message: Callable[..., str],
+    *values: ArrayLike,
+    error: type[FieldkitError] = ArgumentError,
+    source: str | None = None,
+) -> None:
+    """Raise ``error`` at the first True of ``bad``, if any, naming that element.
+
+    ``message`` is called with the values of ``values`` at that element.
+    """
+    bad = np.asarray(bad)
+    if bad.any():
+        raise error(
+            message(*first_values(bad, *values)), source=source, where=where_first(bad)
+        )
+
+
 def as_output(value: np.ndarray) -> np.ndarray:
     """Return 0-d arrays as numpy scalars, arrays unchanged."""
     return value[()] if np.ndim(value) == 0 else value
@@ -40,56 +61,51 @@ def check_gravity(g: float) -> None:
 
 def check_nonnegative(value: np.ndarray, name: str, unit: str) -> None:
     """ArgumentError naming ``name`` if any element is negative."""
-    bad = np.asarray(value < 0)
-    if bad.any():
-        (v,) = first_values(bad, value)
-        raise ArgumentError(
-            f"{name} must not be negative, got {v:g} {unit}",
-            source=name,
-            where=where_first(bad),
-        )
+    raise_at_first(
+        value < 0,
+        lambda v: f"{name} must not be negative, got {v:g} {unit}",
+        value,
+        source=name,
+    )
 
 
 def check_positive(value: np.ndarray, name: str, unit: str) -> None:
     """ArgumentError naming ``name`` if any element is zero or negative."""
-    bad = np.asarray(value <= 0)
-    if bad.any():
-        (v,) = first_values(bad, value)
-        raise ArgumentError(
-            f"{name} must be positive, got {v:g} {unit}",
-            source=name,
-            where=where_first(bad),
-        )
+    raise_at_first(
+        value <= 0,
+        lambda v: f"{name} must be positive, got {v:g} {unit}",
+        value,
+        source=name,
+    )
 
 
 def check_forward_angle(alpha_deg: np.ndarray) -> None:
     """ArgumentError unless -90° < alpha < 90° (travel toward +x)."""
-    bad = np.asarray(np.abs(alpha_deg) >= 90)
-    if bad.any():
-        (a,) = first_values(bad, alpha_deg)
-        raise ArgumentError(
+    raise_at_first(
+        np.abs(alpha_deg) >= 90,
+        lambda a: (
             "launch angle must be between -90° and 90° (travel toward +x), "
-            f"got {a:.1f}°",
-            source="alpha_deg",
-            where=where_first(bad),
-        )
+            f"got {a:.1f}°"
+        ),
+        alpha_deg,
+        source="alpha_deg",
+    )
 
 
 def check_into_slope(theta0_deg: np.ndarray, psi_deg: np.ndarray) -> None:
     """ArgumentError for |psi| >= 90°; PhysicsError for a launch into the slope."""
-    steep = np.asarray(np.abs(psi_deg) >= 90)
-    if steep.any():
-        (p,) = first_values(steep, psi_deg)
-        raise ArgumentError(
-            f"slope dip must be between -90° and 90°, got {p:.1f}°",
-            source="slope_deg",
-            where=where_first(steep),
-        )
-    into = np.asarray(theta0_deg <= 0)
-    if into.any():
-        (t,) = first_values(into, theta0_deg)
-        raise PhysicsError(
-            f"a rock launched at {t:.1f}° to the slope goes into the ground: the "
-            "restitution angle theta0 must be above 0°",
-            where=where_first(into),
-        )
+    raise_at_first(
+        np.abs(psi_deg) >= 90,
+        lambda p: f"slope dip must be between -90° and 90°, got {p:.1f}°",
+        psi_deg,
+        source="slope_deg",
+    )
+    raise_at_first(
+        theta0_deg <= 0,
+        lambda t: (
+            f"a rock launched at {t:.1f}° to the slope goes into the ground: "
+            "the restitution angle theta0 must be above 0°"
+        ),
+        theta0_deg,
+        error=PhysicsError,
+    )

@@ -263,10 +263,7 @@ def sliding_friction_energy(
     >>> round(float(e) / 1e3, 1)
     -30.8
     """
-    mass = _positive(mass_kg, "mass_kg")
-    slip = np.asarray(slip_mps, float)
-    p_f = _not_negative(final_impulse_ns, "final_impulse_ns")
-    mu = _not_negative(friction, "friction")
+    mass, slip, p_f, mu = _friction_args(mass_kg, slip_mps, final_impulse_ns, friction)
     b1, b2 = np.asarray(beta1, float), np.asarray(beta2, float)
     return _out(-mu * p_f / 2.0 * (2.0 * slip - (b2 + mu * b1) * p_f / mass))
 
@@ -300,10 +297,8 @@ def friction_energy(
     >>> round(float(friction_energy(100.0, 7.0, 1e4, 0.7, 3.5)))
     -700
     """
-    mass = _positive(mass_kg, "mass_kg")
-    slip = np.abs(np.asarray(slip_mps, float))
-    p_f = _not_negative(final_impulse_ns, "final_impulse_ns")
-    mu = _not_negative(friction, "friction")
+    mass, slip, p_f, mu = _friction_args(mass_kg, slip_mps, final_impulse_ns, friction)
+    slip = np.abs(slip)
     slope = np.asarray(beta2, float) + mu * np.asarray(beta1, float)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         p_stop = np.where(slope > 0, mass * slip / slope, np.inf)
@@ -399,6 +394,19 @@ def oblique_impact_energies(
 
 # ------------------------------------------------------------------ argument checks
 _out = as_output
+
+
+def _friction_args(
+    mass_kg: ArrayLike,
+    slip_mps: ArrayLike,
+    final_impulse_ns: ArrayLike,
+    friction: ArrayLike,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Checked mass, slip velocity, final normal impulse and friction (eq. 6.9)."""
+    mass = _positive(mass_kg, "mass_kg")
+    slip = np.asarray(slip_mps, float)
+    p_f = _not_negative(final_impulse_ns, "final_impulse_ns")
+    return mass, slip, p_f, _not_negative(friction, "friction")
 
 
 def _check_not_negative(value: np.ndarray, name: str) -> None:

@@ -26,8 +26,7 @@ from fieldkit.physics._validate import (
     check_gravity,
     check_nonnegative,
     check_positive,
-    first_values,
-    where_first,
+    raise_at_first,
 )
 from fieldkit.physics.constants import G
 
@@ -97,14 +96,12 @@ def design_friction(category: str) -> float:
 
 
 def _check_slope(psi_deg: np.ndarray) -> None:
-    bad = np.asarray((psi_deg <= 0) | (psi_deg > 90))
-    if bad.any():
-        (p,) = first_values(bad, psi_deg)
-        raise ArgumentError(
-            f"slope angle must be above 0° and at most 90°, got {p:.1f}°",
-            source="slope_deg",
-            where=where_first(bad),
-        )
+    raise_at_first(
+        (psi_deg <= 0) | (psi_deg > 90),
+        lambda p: f"slope angle must be above 0° and at most 90°, got {p:.1f}°",
+        psi_deg,
+        source="slope_deg",
+    )
 
 
 def velocity_ratio_from_friction(
@@ -139,14 +136,16 @@ def velocity_ratio_from_friction(
     psi = np.asarray(slope_deg, float)
     _check_slope(psi)
     tan_psi = np.tan(np.radians(psi))
-    held = np.asarray(mu > tan_psi * (1.0 + 1e-12))  # tolerate rounding of tan(psi)
-    if held.any():
-        m, p = first_values(held, mu, psi)
-        raise PhysicsError(
+    raise_at_first(
+        mu > tan_psi * (1.0 + 1e-12),  # tolerate rounding of tan(psi)
+        lambda m, p: (
             f"effective friction mu' = {m:.2f} exceeds tan({p:.1f}°) = "
-            f"{np.tan(np.radians(p)):.2f}: a block on this slope does not accelerate",
-            where=where_first(held),
-        )
+            f"{np.tan(np.radians(p)):.2f}: a block on this slope does not accelerate"
+        ),
+        mu,
+        psi,
+        error=PhysicsError,
+    )
     return as_output(np.sqrt(np.maximum(1.0 - mu / tan_psi, 0.0)))
 
 
@@ -265,14 +264,15 @@ def friction_from_velocity_ratio(eta: ArrayLike, slope_deg: ArrayLike) -> np.nda
     """
     eta = np.asarray(eta, float)
     check_nonnegative(eta, "eta", "")
-    fast = np.asarray(eta > 1)
-    if fast.any():
-        (e,) = first_values(fast, eta)
-        raise PhysicsError(
-            f"velocity ratio eta = {e:.2f} exceeds 1: the rock would be faster than in "
-            "free fall from that height, which no friction coefficient explains",
-            where=where_first(fast),
-        )
+    raise_at_first(
+        eta > 1,
+        lambda e: (
+            f"velocity ratio eta = {e:.2f} exceeds 1: the rock would be faster "
+            "than in free fall from that height, which no friction coefficient explains"
+        ),
+        eta,
+        error=PhysicsError,
+    )
     psi = np.asarray(slope_deg, float)
     _check_slope(psi)
     return as_output(np.tan(np.radians(psi)) * (1.0 - eta**2))
@@ -315,12 +315,15 @@ def back_analyse_friction(
     0.39
     """
     eta = velocity_ratio(velocity_mps, height_m, g=g)
-    fast = np.asarray(eta > 1)
-    if fast.any():
-        v, h = first_values(fast, np.asarray(velocity_mps, float), height_m)
-        raise PhysicsError(
-            f"{v:.1f} m/s exceeds the free-fall velocity {np.sqrt(2 * g * h):.1f} m/s "
-            f"from {h:.1f} m: no friction coefficient explains it",
-            where=where_first(fast),
-        )
+    raise_at_first(
+        eta > 1,
+        lambda v, h: (
+            f"{v:.1f} m/s exceeds the free-fall velocity "
+            f"{np.sqrt(2 * g * h):.1f} m/s from {h:.1f} m: no friction coefficient "
+            "explains it"
+        ),
+        np.asarray(velocity_mps, float),
+        height_m,
+        error=PhysicsError,
+    )
     return friction_from_velocity_ratio(eta, slope_deg)

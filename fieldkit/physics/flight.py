@@ -29,6 +29,7 @@ from fieldkit.physics._validate import (
     check_nonnegative,
     check_positive,
     first_values,
+    raise_at_first,
     where_first,
 )
 from fieldkit.physics.constants import G
@@ -232,14 +233,15 @@ def launch_speed(
     alpha_d = np.asarray(alpha_deg, float)
     check_forward_angle(alpha_d)
     alpha = np.radians(alpha_d)
-    behind = np.asarray(dx <= 0)
-    if behind.any():
-        (x,) = first_values(behind, dx)
-        raise PhysicsError(
-            f"no ballistic path reaches a point {x:.1f} m along the section: the "
-            "arrival must lie beyond the launch (dx > 0)",
-            where=where_first(behind),
-        )
+    raise_at_first(
+        dx <= 0,
+        lambda x: (
+            f"no ballistic path reaches a point {x:.1f} m along the section: "
+            "the arrival must lie beyond the launch (dx > 0)"
+        ),
+        dx,
+        error=PhysicsError,
+    )
     drop = dx * np.tan(alpha) - dz  # height of the launch line above the target
     unreachable = np.asarray(drop <= 0)
     if unreachable.any():

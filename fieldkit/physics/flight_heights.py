@@ -25,6 +25,22 @@ from fieldkit.physics.constants import G
 __all__ = ["max_normal_height", "max_vertical_height", "vertical_height_above_slope"]
 
 
+def _launch_parabola(
+    v0_mps: ArrayLike, alpha_deg: ArrayLike, g: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Checked launch angle [deg] and the parabola coefficients of eq. 3.9.
+
+    Returns ``alpha_deg``, ``a = -g / (2 V0^2 cos^2 alpha)`` and ``b = tan(alpha)``.
+    """
+    check_gravity(g)
+    v0 = np.asarray(v0_mps, float)
+    check_positive(v0, "v0_mps", "m/s")
+    alpha_d = np.asarray(alpha_deg, float)
+    check_forward_angle(alpha_d)
+    alpha = np.radians(alpha_d)
+    return alpha_d, -g / (2.0 * (v0 * np.cos(alpha)) ** 2), np.tan(alpha)
+
+
 def vertical_height_above_slope(
     x_m: ArrayLike,
     v0_mps: ArrayLike,
@@ -58,16 +74,10 @@ def vertical_height_above_slope(
     >>> round(float(vertical_height_above_slope(5.0, 10.0, 0.0, 45.0, g=10.0)), 9)
     3.75
     """
-    check_gravity(g)
-    v0 = np.asarray(v0_mps, float)
-    check_positive(v0, "v0_mps", "m/s")
-    alpha_d = np.asarray(alpha_deg, float)
-    check_forward_angle(alpha_d)
-    alpha = np.radians(alpha_d)
+    _, a, b = _launch_parabola(v0_mps, alpha_deg, g)
     x = np.asarray(x_m, float)
-    a = -g / (2.0 * (v0 * np.cos(alpha)) ** 2)
     kappa = -np.tan(np.radians(np.asarray(slope_deg, float)))
-    return as_output(a * x**2 + (np.tan(alpha) - kappa) * x)
+    return as_output(a * x**2 + (b - kappa) * x)
 
 
 def max_vertical_height(
@@ -108,16 +118,10 @@ def max_vertical_height(
     >>> round(float(x), 2), round(float(h), 2)
     (13.86, 3.29)
     """
-    check_gravity(g)
-    v0 = np.asarray(v0_mps, float)
-    check_positive(v0, "v0_mps", "m/s")
-    alpha_d = np.asarray(alpha_deg, float)
-    check_forward_angle(alpha_d)
+    alpha_d, a, b = _launch_parabola(v0_mps, alpha_deg, g)
     psi_d = np.asarray(slope_deg, float)
     check_into_slope(alpha_d + psi_d, psi_d)
-    alpha = np.radians(alpha_d)
-    a = -g / (2.0 * (v0 * np.cos(alpha)) ** 2)
-    rise = np.tan(alpha) + np.tan(np.radians(psi_d))  # b - kappa
+    rise = b + np.tan(np.radians(psi_d))  # b - kappa
     return as_output(-rise / (2.0 * a)), as_output(-(rise**2) / (4.0 * a))
 
 

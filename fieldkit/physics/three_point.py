@@ -25,7 +25,12 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from fieldkit.errors import PhysicsError
-from fieldkit.physics._validate import check_gravity, first_values, where_first
+from fieldkit.physics._validate import (
+    check_gravity,
+    first_values,
+    raise_at_first,
+    where_first,
+)
 from fieldkit.physics.constants import G
 from fieldkit.physics.flight import Flight, _flight
 
@@ -111,22 +116,28 @@ def solve_three_point(
     x1, z1, x2, z2, xt, zt = np.broadcast_arrays(
         *(np.asarray(a, float) for a in (x1_m, z1_m, x2_m, z2_m, xt_m, zt_m))
     )
-    backwards = np.asarray(x2 <= x1)
-    if backwards.any():
-        a, b = first_values(backwards, x1, x2)
-        raise PhysicsError(
-            f"the arrival impact (x = {b:.2f} m) is not beyond the launch impact "
-            f"(x = {a:.2f} m): impacts must be ordered along the direction of travel",
-            where=where_first(backwards),
-        )
-    outside = np.asarray((xt <= x1) | (xt >= x2))
-    if outside.any():
-        t, a, b = first_values(outside, xt, x1, x2)
-        raise PhysicsError(
+    raise_at_first(
+        x2 <= x1,
+        lambda a, b: (
+            f"the arrival impact (x = {b:.2f} m) is not beyond the launch "
+            f"impact (x = {a:.2f} m): impacts must be ordered along the direction of "
+            "travel"
+        ),
+        x1,
+        x2,
+        error=PhysicsError,
+    )
+    raise_at_first(
+        (xt <= x1) | (xt >= x2),
+        lambda t, a, b: (
             f"the tree strike (x = {t:.2f} m) is not between the launch "
-            f"(x = {a:.2f} m) and the arrival (x = {b:.2f} m) impacts",
-            where=where_first(outside),
-        )
+            f"(x = {a:.2f} m) and the arrival (x = {b:.2f} m) impacts"
+        ),
+        xt,
+        x1,
+        x2,
+        error=PhysicsError,
+    )
     ut = xt - x1
     u2 = x2 - x1
     slope_tree = (zt - z1) / ut
