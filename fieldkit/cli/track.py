@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 import sys
 from pathlib import Path
@@ -242,16 +243,18 @@ def _run_tracking(video, reader, fps, calibration, roi, radius, *, show: bool):
     """track_video with a rich progress bar on stderr for long videos."""
     from fieldkit.tracking.video_pipeline import track_video
 
+    run = functools.partial(
+        track_video,
+        video,
+        fps=fps,
+        calibration=calibration,
+        roi=roi,
+        radius_m=radius,
+        reader=reader,
+    )
     total = reader.info.frame_count
     if not show or total < PROGRESS_MIN_FRAMES:
-        return track_video(
-            video,
-            fps=fps,
-            calibration=calibration,
-            roi=roi,
-            radius_m=radius,
-            reader=reader,
-        )
+        return run()
     from rich.console import Console
     from rich.progress import (
         BarColumn,
@@ -262,14 +265,7 @@ def _run_tracking(video, reader, fps, calibration, roi, radius, *, show: bool):
 
     console = Console(file=sys.stderr)
     if not console.is_terminal:  # no bar in logs and pipes
-        return track_video(
-            video,
-            fps=fps,
-            calibration=calibration,
-            roi=roi,
-            radius_m=radius,
-            reader=reader,
-        )
+        return run()
     with Progress(
         "[progress.description]{task.description}",
         BarColumn(),
@@ -279,15 +275,7 @@ def _run_tracking(video, reader, fps, calibration, roi, radius, *, show: bool):
         transient=True,
     ) as bar:
         task = bar.add_task("tracking", total=total)
-        return track_video(
-            video,
-            fps=fps,
-            calibration=calibration,
-            roi=roi,
-            radius_m=radius,
-            reader=reader,
-            progress=lambda done, n: bar.update(task, completed=done, total=n),
-        )
+        return run(progress=lambda done, n: bar.update(task, completed=done, total=n))
 
 
 def _summary(video, track_data, detections, analysis, calibration_text) -> None:
