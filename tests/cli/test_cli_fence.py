@@ -22,6 +22,8 @@ EXAMPLE_8B = [
     "--spin-out",
     "-11.6",
 ]
+ROCK = ["--mass", "520", "--speed-in", "22"]
+SPHERE_8A = [*ROCK, "--gyration", "0.35", "--radius", "0.43"]  # worked example 8A
 
 
 def _number(pattern: str, text: str) -> float:
@@ -115,7 +117,7 @@ def test_figure_and_json(cli, tmp_path):
 
 
 def test_time_force_only(cli):
-    result = cli("fence", "--mass", "520", "--speed-in", "22", "--impulse", "20000")
+    result = cli("fence", *ROCK, "--impulse", "20000")
     assert result.exit_code == 0, result.stderr
     assert "no rebound given" in result.stdout
     assert "20,000 N s (--impulse" in result.stdout
@@ -127,92 +129,17 @@ def test_time_force_only(cli):
         (["--mass", "-520", "--speed-in", "22"], "--mass: must be positive"),
         (["--speed-in", "22"], "--mass"),
         (["--mass", "520"], "--speed-in"),
-        (["--mass", "520", "--speed-in", "22", "--gyration", "-0.3"], "--gyration"),
+        ([*ROCK, "--gyration", "-0.3"], "--gyration"),
+        ([*ROCK, "--gyration", "0.3", "--inertia", "40"], "--inertia"),
+        ([*SPHERE_8A, "--angle-in", "120"], "--angle-in"),
+        (SPHERE_8A, "--angle-in"),
+        ([*SPHERE_8A, "--angle-in", "50", "--e-n", "-0.2"], "--e-n"),
+        ([*ROCK, "--speed-out", "-3", "--gyration", "0.3"], "--speed-out"),
+        ([*ROCK, "--speed-out", "10"], "--gyration"),
+        ([*ROCK, "--stiff", "3e4"], "--stiff"),
+        ([*ROCK, "--rigid", "-1e6,1"], "--rigid"),
         (
-            [
-                "--mass",
-                "520",
-                "--speed-in",
-                "22",
-                "--gyration",
-                "0.3",
-                "--inertia",
-                "40",
-            ],
-            "--inertia",
-        ),
-        (
-            [
-                "--mass",
-                "520",
-                "--speed-in",
-                "22",
-                "--gyration",
-                "0.35",
-                "--radius",
-                "0.43",
-                "--angle-in",
-                "120",
-            ],
-            "--angle-in",
-        ),
-        (
-            [
-                "--mass",
-                "520",
-                "--speed-in",
-                "22",
-                "--gyration",
-                "0.35",
-                "--radius",
-                "0.43",
-            ],
-            "--angle-in",
-        ),
-        (
-            [
-                "--mass",
-                "520",
-                "--speed-in",
-                "22",
-                "--gyration",
-                "0.35",
-                "--radius",
-                "0.43",
-                "--angle-in",
-                "50",
-                "--e-n",
-                "-0.2",
-            ],
-            "--e-n",
-        ),
-        (
-            [
-                "--mass",
-                "520",
-                "--speed-in",
-                "22",
-                "--speed-out",
-                "-3",
-                "--gyration",
-                "0.3",
-            ],
-            "--speed-out",
-        ),
-        (["--mass", "520", "--speed-in", "22", "--speed-out", "10"], "--gyration"),
-        (["--mass", "520", "--speed-in", "22", "--stiff", "3e4"], "--stiff"),
-        (["--mass", "520", "--speed-in", "22", "--rigid", "-1e6,1"], "--rigid"),
-        (
-            [
-                "--mass",
-                "520",
-                "--speed-in",
-                "22",
-                "--gyration",
-                "0.3",
-                "--spin-out",
-                "4",
-            ],
+            [*ROCK, "--gyration", "0.3", "--spin-out", "4"],
             "--spin-out: a measured rebound needs --speed-out",
         ),
     ],
@@ -227,9 +154,7 @@ def test_bad_input_one_line_error(cli, args, message):
 
 def test_bad_input_writes_no_figure(cli, tmp_path):
     png = tmp_path / "fence.png"
-    result = cli(
-        "fence", "--mass", "520", "--speed-in", "22", "--stiff", "x,y", "--figure", png
-    )
+    result = cli("fence", *ROCK, "--stiff", "x,y", "--figure", png)
     assert result.exit_code != 0
     assert not png.exists()
     assert list(tmp_path.iterdir()) == []
