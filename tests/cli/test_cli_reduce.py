@@ -6,8 +6,6 @@ the thesis reproduction itself is in tests/reduce/test_tornado_table_2_4.py.
 
 from __future__ import annotations
 
-import hashlib
-
 import numpy as np
 import pandas as pd
 import pytest
@@ -25,19 +23,6 @@ def survey(tmp_path):
     trees = tmp_path / "trees.csv"
     trees.write_text("after_impact,horizontal_distance_m,strike_height_m\nP1,5.0,1.2\n")
     return impacts, trees
-
-
-def digest(path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
-
-
-def fails(result, *words: str) -> None:
-    """Exit code != 0 and a single 'error:' line naming every word."""
-    assert result.exit_code != 0
-    lines = [line for line in result.stderr.splitlines() if line.strip()]
-    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
-    for word in words:
-        assert word in lines[0], (word, lines[0])
 
 
 def test_help_has_a_runnable_example(cli):
@@ -161,7 +146,7 @@ def test_units_ft_converts_at_the_edge(cli, tmp_path):
 
 
 # ------------------------------------------------------------------ bad input
-def test_tree_strike_no_parabola_can_reach(cli, survey, tmp_path):
+def test_tree_strike_no_parabola_can_reach(cli, survey, tmp_path, digest, fails):
     """A strike below the chord between the impacts: no downward parabola."""
     impacts, _ = survey
     trees = tmp_path / "low_tree.csv"
@@ -188,7 +173,7 @@ def test_tree_strike_no_parabola_can_reach(cli, survey, tmp_path):
     assert (digest(trees), digest(impacts)) == before
 
 
-def test_uphill_flight_no_ballistic_path_makes(cli, tmp_path):
+def test_uphill_flight_no_ballistic_path_makes(cli, tmp_path, fails):
     impacts = tmp_path / "uphill.csv"
     impacts.write_text("point,x_m,z_m\nP0,0,100\nP1,10,94\nP2,20,97\n")
     out = tmp_path / "t.csv"
@@ -250,7 +235,7 @@ def test_uphill_flight_no_ballistic_path_makes(cli, tmp_path):
         (("--impacts", "{impacts}"), ("impacts.csv", "point P1", "--theta0")),
     ],
 )
-def test_bad_arguments(cli, survey, tmp_path, args, words):
+def test_bad_arguments(cli, survey, tmp_path, args, words, fails):
     impacts, _ = survey
     out = tmp_path / "t.csv"
     args = [a.format(impacts=impacts) for a in args]
@@ -259,7 +244,7 @@ def test_bad_arguments(cli, survey, tmp_path, args, words):
     assert not out.exists()
 
 
-def test_output_never_overwrites_an_input(cli, survey):
+def test_output_never_overwrites_an_input(cli, survey, digest, fails):
     impacts, trees = survey
     before = digest(impacts)
     result = cli("reduce", "--impacts", impacts, "--theta0", "30", "-o", impacts)
@@ -267,14 +252,14 @@ def test_output_never_overwrites_an_input(cli, survey):
     assert digest(impacts) == before
 
 
-def test_unknown_output_format_writes_nothing(cli, survey, tmp_path):
+def test_unknown_output_format_writes_nothing(cli, survey, tmp_path, fails):
     impacts, _ = survey
     out = tmp_path / "t.txt"
     fails(cli("reduce", "--impacts", impacts, "--theta0", "30", "-o", out), "t.txt")
     assert not out.exists()
 
 
-def test_empty_and_binary_inputs(cli, tmp_path):
+def test_empty_and_binary_inputs(cli, tmp_path, fails):
     empty = tmp_path / "empty.gpx"
     empty.write_text("")
     out = tmp_path / "t.csv"
@@ -285,7 +270,7 @@ def test_empty_and_binary_inputs(cli, tmp_path):
     assert not out.exists()
 
 
-def test_two_tree_strikes_on_one_flight(cli, survey, tmp_path):
+def test_two_tree_strikes_on_one_flight(cli, survey, tmp_path, fails):
     impacts, _ = survey
     trees = tmp_path / "two.csv"
     trees.write_text(
@@ -299,7 +284,7 @@ def test_two_tree_strikes_on_one_flight(cli, survey, tmp_path):
     assert not out.exists()
 
 
-def test_tree_after_unknown_impact(cli, survey, tmp_path):
+def test_tree_after_unknown_impact(cli, survey, tmp_path, fails):
     impacts, _ = survey
     trees = tmp_path / "unknown.csv"
     trees.write_text("after_impact,horizontal_distance_m,strike_height_m\nQ9,4.0,1.0\n")
@@ -311,7 +296,7 @@ def test_tree_after_unknown_impact(cli, survey, tmp_path):
     assert not out.exists()
 
 
-def test_duplicated_point(cli, tmp_path):
+def test_duplicated_point(cli, tmp_path, fails):
     impacts = tmp_path / "dup.csv"
     impacts.write_text("point,x_m,z_m\nP0,0,100\nP1,10,94\nP1,20,88\n")
     out = tmp_path / "t.csv"
@@ -323,7 +308,7 @@ def test_duplicated_point(cli, tmp_path):
     assert not out.exists()
 
 
-def test_reader_errors_reach_the_command_line_as_one_line(cli, repo, tmp_path):
+def test_reader_errors_reach_the_command_line_as_one_line(cli, repo, tmp_path, fails):
     """Issue 2 bad inputs handled by the readers: each stops `reduce` with one line."""
     out = tmp_path / "t.csv"
     no_ele = tmp_path / "no_ele.gpx"

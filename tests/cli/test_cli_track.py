@@ -7,7 +7,6 @@ tests/tracking/test_video_acceptance.py.
 
 from __future__ import annotations
 
-import hashlib
 import importlib.util
 import sys
 
@@ -72,19 +71,6 @@ def clip(render, tmp_path_factory):
     return _clip(render, tmp_path_factory.mktemp("clip") / "throw.avi")
 
 
-def digest(path) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
-
-
-def fails(result, *words: str) -> None:
-    """Exit code != 0 and a single 'error:' line naming every word."""
-    assert result.exit_code != 0
-    lines = [line for line in result.stderr.splitlines() if line.strip()]
-    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
-    for word in words:
-        assert word in lines[0], (word, lines[0])
-
-
 def test_help_has_an_example(cli):
     result = cli("track", "--help")
     assert result.exit_code == 0
@@ -93,7 +79,7 @@ def test_help_has_an_example(cli):
     )
 
 
-def test_track_writes_track_and_warns_about_playback_rate(cli, clip, tmp_path):
+def test_track_writes_track_and_warns_about_playback_rate(cli, clip, tmp_path, digest):
     video, poses = clip
     out, table = tmp_path / "track.csv", tmp_path / "impacts.csv"
     before = digest(video)
@@ -163,13 +149,13 @@ def test_homography_file_gives_the_same_track(cli, clip, tmp_path):
         (("--fps", "1205", *SCALE, "--radius", "-1"), ("--radius",)),
     ],
 )
-def test_bad_arguments_one_line_and_no_output(cli, clip, tmp_path, args, words):
+def test_bad_arguments_one_line_and_no_output(cli, clip, tmp_path, args, words, fails):
     out = tmp_path / "t.csv"
     fails(cli("track", clip[0], *args, "-o", out), *words)
     assert not out.exists()
 
 
-def test_unreadable_missing_and_empty_videos(cli, render, tmp_path):
+def test_unreadable_missing_and_empty_videos(cli, render, tmp_path, fails):
     import cv2
 
     junk = tmp_path / "junk.avi"
@@ -188,7 +174,7 @@ def test_unreadable_missing_and_empty_videos(cli, render, tmp_path):
         assert not out.exists()
 
 
-def test_no_body_found(cli, render, tmp_path):
+def test_no_body_found(cli, render, tmp_path, fails):
     video, _ = _clip(
         render, tmp_path / "empty_scene.avi", frames=40, ball_visible=False
     )
@@ -227,7 +213,7 @@ def test_truncated_video_warns_and_tracks_what_is_there(cli, render, tmp_path):
     assert 40 < len(pd.read_csv(out)) < 110
 
 
-def test_refuses_to_overwrite_the_video(cli, clip):
+def test_refuses_to_overwrite_the_video(cli, clip, digest, fails):
     video = clip[0]
     before = digest(video)
     fails(cli("track", video, "--fps", "1205", *SCALE, "-o", video), "overwrite")
