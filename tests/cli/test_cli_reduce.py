@@ -16,6 +16,12 @@ POINTS = "point,x_m,z_m\nP0,0,100\nP1,10,94\nP2,20,88\nP3,30,82\nP4,40,76\n"
 BODY = ("--mass", "1000", "--radius", "0.5", "--gyration", "0.3")
 
 
+def reduce_with_trees(cli, impacts, trees, *options):
+    """``fieldkit reduce`` of impacts with tree strikes, theta0 = 30° and BODY."""
+    inputs = ("--impacts", impacts, "--trees", trees, "--theta0", "30")
+    return cli("reduce", *inputs, *BODY, *options)
+
+
 @pytest.fixture()
 def survey(tmp_path):
     impacts = tmp_path / "impacts.csv"
@@ -52,18 +58,7 @@ def test_help_has_a_runnable_example(cli):
 def test_every_output_format(cli, survey, tmp_path, suffix):
     impacts, trees = survey
     out = tmp_path / f"table{suffix}"
-    result = cli(
-        "reduce",
-        "--impacts",
-        impacts,
-        "--trees",
-        trees,
-        "--theta0",
-        "30",
-        *BODY,
-        "-o",
-        out,
-    )
+    result = reduce_with_trees(cli, impacts, trees, "-o", out)
     assert result.exit_code == 0, result.stderr
     table = ImpactTable.read(out).frame
     assert table["point"].tolist() == ["P0", "P1", "P2", "P3", "P4"]
@@ -78,19 +73,8 @@ def test_every_output_format(cli, survey, tmp_path, suffix):
 def test_figures_are_written(cli, survey, tmp_path):
     impacts, trees = survey
     figures = tmp_path / "figs"
-    result = cli(
-        "reduce",
-        "--impacts",
-        impacts,
-        "--trees",
-        trees,
-        "--theta0",
-        "30",
-        *BODY,
-        "--figures",
-        figures,
-        "-o",
-        tmp_path / "t.csv",
+    result = reduce_with_trees(
+        cli, impacts, trees, "--figures", figures, "-o", tmp_path / "t.csv"
     )
     assert result.exit_code == 0, result.stderr
     names = sorted(p.name for p in figures.iterdir())
@@ -156,18 +140,7 @@ def test_tree_strike_no_parabola_can_reach(cli, survey, tmp_path, digest, fails)
     )  # strike at 81 m, chord there at 85 m
     before = digest(trees), digest(impacts)
     out = tmp_path / "t.csv"
-    result = cli(
-        "reduce",
-        "--impacts",
-        impacts,
-        "--trees",
-        trees,
-        "--theta0",
-        "30",
-        *BODY,
-        "-o",
-        out,
-    )
+    result = reduce_with_trees(cli, impacts, trees, "-o", out)
     fails(result, "low_tree.csv", "row 2", "P2", "no parabola")
     assert not out.exists()
     assert (digest(trees), digest(impacts)) == before
