@@ -11,12 +11,15 @@ stops), and the simulation itself is checked against energy conservation
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from fieldkit.physics.constants import G
 from fieldkit.physics.fences import energy_efficiency
+from fieldkit.physics.local_axes import to_local
 from fieldkit.tracking.analysis import analyse_track
 from fieldkit.tracking.synthetic import net_capture
+from fieldkit.tracking.track import Track
 
 MASS, R = 0.14, 0.0375
 
@@ -98,3 +101,97 @@ def test_efficiency_without_mass_is_per_unit_mass(capture):
     c = again.contacts[0]
     assert np.isnan(c.absorbed_j) and np.isnan(c.net_impulse_ns).all()
     assert c.efficiency == pytest.approx(analysis.contacts[0].efficiency)
+
+
+# --- the local frame of a net contact (ARCHITECTURE §2: N faces the body, vin < 0) ---
+
+
+def with_marker(track: Track, omega_radps: float, seed: int) -> Track:
+    """The track with a marker angle: the synthetic net is frictionless (its force is
+    along the normal, through the centre), so the true spin is constant throughout."""
+    rng = np.random.default_rng(seed)
+    t = track.frame["t_s"]
+    angle = 0.3 + omega_radps * t + rng.normal(0.0, 0.02, len(t))
+    frame = track.frame.assign(angle_rad=angle, omega_radps=np.nan)
+    return Track(frame, source=track.source, fps=track.fps, meta=dict(track.meta))
+
+
+def truth_normal_components(truth, normal_deg: float) -> dict[str, float]:
+    """vin, vit, vfn, vft of the simulated contact on the net's own axes."""
+    psi = 90.0 - normal_deg  # N = (cos a, sin a) = (sin psi, cos psi)
+    vit, vin = to_local(truth.vi_x_mps, truth.vi_z_mps, psi)
+    vft, vfn = to_local(truth.vf_x_mps, truth.vf_z_mps, psi)
+    return dict(psi=psi, vin=vin, vit=vit, vfn=vfn, vft=vft)
+
+
+# overhang: the net leans over the incoming ball (like video/net), psi beyond -90 deg
+OVERHANG = dict(net_normal_deg=200.0, start_velocity_mps=(5.0, -1.0), duration_s=0.25)
+CASES = {
+    "overhang": OVERHANG,
+    "rebound": dict(net_normal_deg=150.0, start_velocity_mps=(12.0, -2.0)),
+    "redirect": dict(net_normal_deg=120.0, start_velocity_mps=(14.0, -3.0)),
+}
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_net_normal_faces_the_body_and_e_n_matches_the_truth(name):
+    kw = CASES[name]
+    sim = net_capture(noise_m=3e-4, rng=np.random.default_rng(11), radius_m=R, **kw)
+    truth = sim.truth.iloc[0]
+    ref = truth_normal_components(truth, kw["net_normal_deg"])
+    assert ref["vin"] < 0 < ref["vfn"]  # the simulation's own axes obey §2
+    a = analyse_track(with_marker(sim.track, -25.0, 3), radius_m=R, mass_kg=MASS)
+    row = a.impacts.frame.iloc[0]
+    assert len(a.impacts) == 1 and len(a.contacts) == 1
+    # surface from the velocity and spin change over the contact (no spin change:
+    # the net impulse is along N once gravity is removed)
+    assert row.slope_deg == pytest.approx(ref["psi"], abs=0.2)
+    assert row.vin_mps < 0 < row.vfn_mps
+    assert row.vin_mps == pytest.approx(ref["vin"], rel=0.03)
+    assert row.vfn_mps == pytest.approx(ref["vfn"], rel=0.03)
+    assert row.e_n == pytest.approx(-ref["vfn"] / ref["vin"], abs=0.05)
+    assert row.e_t == pytest.approx(ref["vft"] / ref["vit"], abs=0.05)
+    assert any("angular-momentum balance" in w for w in a.warnings)
+
+
+def test_overhang_psi_is_beyond_90_deg_with_t_up_the_net():
+    sim = net_capture(
+        noise_m=3e-4, rng=np.random.default_rng(6), radius_m=R, **OVERHANG
+    )
+    a = analyse_track(with_marker(sim.track, 0.0, 4), radius_m=R)
+    row = a.impacts.frame.iloc[0]
+    # N = (sin psi, cos psi) points down and back toward the ball; T, its right-handed
+    # partner, points up the net while the ball slides down it: vit < 0
+    assert -180.0 < row.slope_deg < -90.0
+    assert row.vit_mps < 0 and row.theta_i_deg > 90.0
+    assert row.e_t > 0  # vft / vit: both against T
+
+
+def test_net_without_spin_leaves_e_n_nan_and_says_why():
+    sim = net_capture(
+        noise_m=3e-4, rng=np.random.default_rng(7), radius_m=R, **OVERHANG
+    )
+    a = analyse_track(sim.track, radius_m=R, mass_kg=MASS)  # no marker angle
+    row = a.impacts.frame.iloc[0]
+    for col in ("slope_deg", "vin_mps", "vfn_mps", "e_n", "e_t"):
+        assert np.isnan(row[col]), col
+    assert pd.isna(row.slope_source)
+    assert any("cannot be identified without spin" in w for w in a.warnings)
+    # speeds, energies and the contact phase do not need the surface
+    assert row.vi_mps > 0 and np.isfinite(row.ke_i_j)
+    assert np.isfinite(a.contacts[0].efficiency)
+
+
+def test_given_net_angle_is_turned_to_face_the_body():
+    kw = OVERHANG
+    sim = net_capture(noise_m=3e-4, rng=np.random.default_rng(8), radius_m=R, **kw)
+    truth = sim.truth.iloc[0]
+    ref = truth_normal_components(truth, kw["net_normal_deg"])
+    line_dip = ref["psi"] + 180.0  # 70 deg: the same line, normal into the net
+    a = analyse_track(sim.track, radius_m=R, surface_angle_deg=line_dip)
+    row = a.impacts.frame.iloc[0]
+    assert row.slope_deg == pytest.approx(ref["psi"])
+    assert row.slope_source == "given"
+    assert any("from below" in w for w in a.warnings)
+    assert row.vin_mps < 0 < row.vfn_mps
+    assert row.e_n == pytest.approx(-ref["vfn"] / ref["vin"], abs=0.05)
