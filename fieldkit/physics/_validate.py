@@ -48,9 +48,10 @@ def raise_at_first(
         )
 
 
-def as_output(value: np.ndarray) -> np.ndarray:
+def as_output(value: ArrayLike) -> np.ndarray:
     """Return 0-d arrays as numpy scalars, arrays unchanged."""
-    return value[()] if np.ndim(value) == 0 else value
+    value = np.asarray(value)
+    return value[()] if value.ndim == 0 else value
 
 
 def check_gravity(g: float) -> None:
@@ -77,6 +78,20 @@ def check_positive(value: np.ndarray, name: str, unit: str) -> None:
         value,
         source=name,
     )
+
+
+def nonnegative_array(value: ArrayLike, name: str, unit: str = "") -> np.ndarray:
+    """``value`` as a float array; ArgumentError naming ``name`` if any is negative."""
+    array = np.asarray(value, float)
+    check_nonnegative(array, name, unit)
+    return array
+
+
+def positive_array(value: ArrayLike, name: str, unit: str = "") -> np.ndarray:
+    """``value`` as a float array; ArgumentError naming ``name`` unless all are > 0."""
+    array = np.asarray(value, float)
+    check_positive(array, name, unit)
+    return array
 
 
 def check_forward_angle(alpha_deg: np.ndarray) -> None:

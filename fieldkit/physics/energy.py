@@ -20,8 +20,8 @@ from numpy.typing import ArrayLike
 from fieldkit.errors import ArgumentError
 from fieldkit.physics._validate import (
     as_output,
-    check_nonnegative,
-    check_positive,
+    nonnegative_array,
+    positive_array,
     where_first,
 )
 from fieldkit.physics.constants import G
@@ -85,7 +85,7 @@ def rotational_energy_change(
     -18.24
     """
     inertia = np.asarray(inertia_kgm2, float)
-    _check_not_negative(inertia, "inertia_kgm2")
+    nonnegative_array(inertia, "inertia_kgm2")
     w_i = np.asarray(omega_i_radps, float)
     w_f = np.asarray(omega_f_radps, float)
     return _out(-0.5 * inertia * (w_i**2 - w_f**2))
@@ -108,8 +108,8 @@ def total_kinetic_energy(
     """
     mass = np.asarray(mass_kg, float)
     inertia = np.asarray(inertia_kgm2, float)
-    _check_not_negative(mass, "mass_kg")
-    _check_not_negative(inertia, "inertia_kgm2")
+    nonnegative_array(mass, "mass_kg")
+    nonnegative_array(inertia, "inertia_kgm2")
     speed = np.asarray(speed_mps, float)
     omega = np.asarray(omega_radps, float)
     return _out(0.5 * mass * speed**2 + 0.5 * inertia * omega**2)
@@ -136,7 +136,7 @@ def total_energy_change(
     -97.49
     """
     mass = np.asarray(mass_kg, float)
-    _check_not_negative(mass, "mass_kg")
+    nonnegative_array(mass, "mass_kg")
     translational = 0.5 * mass * (
         np.asarray(speed_f_mps, float) ** 2 - np.asarray(speed_i_mps, float) ** 2
     )
@@ -371,7 +371,7 @@ def oblique_impact_energies(
     """
     mass, vin, _ = _normal_args(mass_kg, vin_mps, 1.0)
     e_n = _restitution_arg(e_n)
-    mu = _not_negative(friction, "friction")
+    mu = nonnegative_array(friction, "friction")
     b1, b2, b3 = (np.asarray(b, float) for b in (beta1, beta2, beta3))
     beta = b3 + mu * b2
     if np.any(beta <= 0):
@@ -403,32 +403,16 @@ def _friction_args(
     friction: ArrayLike,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Checked mass, slip velocity, final normal impulse and friction (eq. 6.9)."""
-    mass = _positive(mass_kg, "mass_kg")
+    mass = positive_array(mass_kg, "mass_kg")
     slip = np.asarray(slip_mps, float)
-    p_f = _not_negative(final_impulse_ns, "final_impulse_ns")
-    return mass, slip, p_f, _not_negative(friction, "friction")
-
-
-def _check_not_negative(value: np.ndarray, name: str) -> None:
-    check_nonnegative(np.asarray(value, float), name, "")
-
-
-def _not_negative(value: ArrayLike, name: str) -> np.ndarray:
-    arr = np.asarray(value, float)
-    check_nonnegative(arr, name, "")
-    return arr
-
-
-def _positive(value: ArrayLike, name: str) -> np.ndarray:
-    arr = np.asarray(value, float)
-    check_positive(arr, name, "")
-    return arr
+    p_f = nonnegative_array(final_impulse_ns, "final_impulse_ns")
+    return mass, slip, p_f, nonnegative_array(friction, "friction")
 
 
 def _normal_args(
     mass_kg: ArrayLike, vin_mps: ArrayLike, beta: ArrayLike
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    mass = _positive(mass_kg, "mass_kg")
+    mass = positive_array(mass_kg, "mass_kg")
     vin = np.asarray(vin_mps, float)
     bad = np.asarray(vin > 0)
     if bad.any():
@@ -437,8 +421,8 @@ def _normal_args(
             source="vin_mps",
             where=where_first(bad),
         )
-    return mass, vin, _positive(beta, "beta")
+    return mass, vin, positive_array(beta, "beta")
 
 
 def _restitution_arg(e_n: ArrayLike) -> np.ndarray:
-    return _not_negative(e_n, "e_n")
+    return nonnegative_array(e_n, "e_n")

@@ -33,6 +33,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from fieldkit.errors import ArgumentError
+from fieldkit.physics._validate import as_output
 from fieldkit.physics.energy import total_kinetic_energy
 from fieldkit.physics.impact_mechanics import rough_body_impact
 from fieldkit.physics.restitution import angle_dependent_restitution
@@ -106,7 +107,7 @@ def energy_efficiency(
         raise ArgumentError(
             "restitution energy must not be negative", source="restitution_energy_j"
         )
-    return _out(e_f / e_i)
+    return as_output(e_f / e_i)
 
 
 def fence_energy_split(
@@ -166,15 +167,15 @@ def fence_energy_split(
         efficiency = np.where(e_i > 0, e_f / e_i, np.nan)
     absorbed = e_i - e_f
     return FenceEnergySplit(
-        _out(ke_i),
-        _out(e_i - ke_i),
-        _out(e_i),
-        _out(ke_f),
-        _out(e_f - ke_f),
-        _out(e_f),
-        _out(absorbed),
-        _out(1.0 - efficiency),
-        _out(efficiency),
+        as_output(ke_i),
+        as_output(e_i - ke_i),
+        as_output(e_i),
+        as_output(ke_f),
+        as_output(e_f - ke_f),
+        as_output(e_f),
+        as_output(absorbed),
+        as_output(1.0 - efficiency),
+        as_output(efficiency),
     )
 
 
@@ -245,18 +246,13 @@ def fence_redirection(
         friction=friction,
     )
     return FenceRedirection(
-        _out(v_it),
-        _out(v_in),
-        _out(result.v_ft_mps),
-        _out(result.v_fn_mps),
-        _out(result.omega_f_radps),
-        _out(result.v_f_mps),
-        _out(result.theta_f_deg),
-        _out(np.asarray(e_n, float)),
-        _out(result.slip_stops),
+        as_output(v_it),
+        as_output(v_in),
+        as_output(result.v_ft_mps),
+        as_output(result.v_fn_mps),
+        as_output(result.omega_f_radps),
+        as_output(result.v_f_mps),
+        as_output(result.theta_f_deg),
+        as_output(np.asarray(e_n, float)),
+        as_output(result.slip_stops),
     )
-
-
-def _out(value: ArrayLike) -> np.ndarray:
-    value = np.asarray(value)
-    return value[()] if value.ndim == 0 else value

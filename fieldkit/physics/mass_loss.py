@@ -20,6 +20,12 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from fieldkit.errors import ArgumentError
+from fieldkit.physics._validate import (
+    as_output,
+    nonnegative_array,
+    positive_array,
+    where_first,
+)
 
 __all__ = [
     "IMPACT_EXPONENT",
@@ -61,9 +67,9 @@ def volume_ratio_with_distance(
     >>> round(0.22 * float(volume_ratio_with_distance(57.0, 0.02)), 3)
     0.103
     """
-    x = _not_negative(x_m, "x_m")
-    lam = _not_negative(reduction_per_m, "reduction_per_m")
-    return _out(1.0 / (1.0 + x * lam))
+    x = nonnegative_array(x_m, "x_m")
+    lam = nonnegative_array(reduction_per_m, "reduction_per_m")
+    return as_output(1.0 / (1.0 + x * lam))
 
 
 def reduction_coefficient(x_m: ArrayLike, volume_ratio: ArrayLike) -> np.ndarray:
@@ -76,14 +82,16 @@ def reduction_coefficient(x_m: ArrayLike, volume_ratio: ArrayLike) -> np.ndarray
     >>> round(float(reduction_coefficient(610.0, 1.42 / 30.0)), 3)
     0.033
     """
-    x = _positive(x_m, "x_m")
+    x = positive_array(x_m, "x_m")
     ratio = np.asarray(volume_ratio, float)
     bad = np.asarray((ratio <= 0) | (ratio > 1))
     if bad.any():
         raise ArgumentError(
-            "volume_ratio must be in (0, 1]", source="volume_ratio", where=_where(bad)
+            "volume_ratio must be in (0, 1]",
+            source="volume_ratio",
+            where=where_first(bad),
         )
-    return _out((1.0 / ratio - 1.0) / x)
+    return as_output((1.0 / ratio - 1.0) / x)
 
 
 def volume_ratio_with_impacts(
@@ -109,12 +117,13 @@ def volume_ratio_with_impacts(
         raise ArgumentError(
             "impact_number must be >= 1 (eq. 6.16 starts at the first impact)",
             source="impact_number",
-            where=_where(bad),
+            where=where_first(bad),
         )
     if exponent < 0:
-        raise ArgumentError(f"exponent must not be negative, got {exponent:g}",
-                            source="exponent")
-    return _out(n ** (-float(exponent)))
+        raise ArgumentError(
+            f"exponent must not be negative, got {exponent:g}", source="exponent"
+        )
+    return as_output(n ** (-float(exponent)))
 
 
 def initial_volume_from_impacts(
@@ -132,33 +141,5 @@ def initial_volume_from_impacts(
     >>> round(float(initial_volume_from_impacts(1.42, 46)), 1)
     30.4
     """
-    final = _not_negative(final_volume_m3, "final_volume_m3")
-    return _out(final / volume_ratio_with_impacts(impact_number, exponent))
-
-
-def _where(bad: np.ndarray) -> str | None:
-    if bad.ndim == 0:
-        return None
-    return f"element {int(np.flatnonzero(bad.ravel())[0])}"
-
-
-def _not_negative(value: ArrayLike, name: str) -> np.ndarray:
-    arr = np.asarray(value, float)
-    bad = np.asarray(arr < 0)
-    if bad.any():
-        message = f"{name} must not be negative"
-        raise ArgumentError(message, source=name, where=_where(bad))
-    return arr
-
-
-def _positive(value: ArrayLike, name: str) -> np.ndarray:
-    arr = np.asarray(value, float)
-    bad = np.asarray(arr <= 0)
-    if bad.any():
-        raise ArgumentError(f"{name} must be positive", source=name, where=_where(bad))
-    return arr
-
-
-def _out(value: np.ndarray) -> np.ndarray:
-    value = np.asarray(value)
-    return value[()] if value.ndim == 0 else value
+    final = nonnegative_array(final_volume_m3, "final_volume_m3")
+    return as_output(final / volume_ratio_with_impacts(impact_number, exponent))

@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from fieldkit.errors import ArgumentError
+from fieldkit.physics._validate import as_output, nonnegative_array
 
 __all__ = [
     "THESIS_STRUCTURES",
@@ -90,8 +91,8 @@ def force_at(law: StructureLaw, t_s: ArrayLike) -> np.ndarray:
     >>> float(force_at(THESIS_STRUCTURES["flexible"], 0.5))
     10000.0
     """
-    t = _not_negative(t_s, "t_s")
-    return _out(law.coefficient * t**law.exponent)
+    t = nonnegative_array(t_s, "t_s")
+    return as_output(law.coefficient * t**law.exponent)
 
 
 def impulse_absorbed(law: StructureLaw, t_s: ArrayLike) -> np.ndarray:
@@ -104,9 +105,9 @@ def impulse_absorbed(law: StructureLaw, t_s: ArrayLike) -> np.ndarray:
     >>> round(float(impulse_absorbed(THESIS_STRUCTURES["rigid"], 0.1)), 6)
     5000.0
     """
-    t = _not_negative(t_s, "t_s")
+    t = nonnegative_array(t_s, "t_s")
     x = law.exponent
-    return _out(law.coefficient * t ** (x + 1.0) / (x + 1.0))
+    return as_output(law.coefficient * t ** (x + 1.0) / (x + 1.0))
 
 
 def contact_time(law: StructureLaw, impulse_ns: ArrayLike) -> np.ndarray:
@@ -121,9 +122,9 @@ def contact_time(law: StructureLaw, impulse_ns: ArrayLike) -> np.ndarray:
     >>> round(float(contact_time(THESIS_STRUCTURES["rigid"], 520 * 22.0)), 2)
     0.15
     """
-    p = _not_negative(impulse_ns, "impulse_ns")
+    p = nonnegative_array(impulse_ns, "impulse_ns")
     x = law.exponent
-    return _out(((x + 1.0) * p / law.coefficient) ** (1.0 / (x + 1.0)))
+    return as_output(((x + 1.0) * p / law.coefficient) ** (1.0 / (x + 1.0)))
 
 
 def peak_force(law: StructureLaw, impulse_ns: ArrayLike) -> np.ndarray:
@@ -137,18 +138,4 @@ def peak_force(law: StructureLaw, impulse_ns: ArrayLike) -> np.ndarray:
     >>> round(float(peak_force(THESIS_STRUCTURES["stiff"], 11440.0)) / 1e3, 1)
     24.9
     """
-    return _out(np.asarray(force_at(law, contact_time(law, impulse_ns))))
-
-
-def _not_negative(value: ArrayLike, name: str) -> np.ndarray:
-    arr = np.asarray(value, float)
-    bad = np.asarray(arr < 0)
-    if bad.any():
-        where = None if bad.ndim == 0 else f"element {int(np.flatnonzero(bad)[0])}"
-        raise ArgumentError(f"{name} must not be negative", source=name, where=where)
-    return arr
-
-
-def _out(value: np.ndarray) -> np.ndarray:
-    value = np.asarray(value)
-    return value[()] if value.ndim == 0 else value
+    return as_output(np.asarray(force_at(law, contact_time(law, impulse_ns))))

@@ -26,6 +26,7 @@ from numpy.typing import ArrayLike
 
 from fieldkit.errors import PhysicsError
 from fieldkit.physics._validate import (
+    as_output,
     check_gravity,
     first_values,
     raise_at_first,
@@ -60,7 +61,7 @@ def tree_height_above_chord(
     )
     chord_z = z1 + (z2 - z1) * (xt - x1) / (x2 - x1)
     out = zt - chord_z
-    return out[()] if out.ndim == 0 else out
+    return as_output(out)
 
 
 def solve_three_point(
