@@ -15,7 +15,8 @@ Two ways to calibrate a video:
 
   (a bare list of such objects, or of ``[u_px, v_px, x_m, z_m]`` rows, also works)
 
-  CSV with a header ``u_px,v_px,x_m,z_m`` (one point per row; ``#`` comments allowed).
+  CSV with a header ``u_px,v_px,x_m,z_m`` (one point per row; ``#`` comments allowed;
+  read like every fieldkit CSV: ``,`` ``;`` or tab, decimal commas, ``x_ft`` etc.).
 
 Pixel centres sit at integer (u, v), as in OpenCV. Both calibrations become one 3x3
 matrix ``H`` mapping ``(u, v, 1)`` to ``(x, z, 1)``, so world z is up whatever the
@@ -32,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from fieldkit.errors import ArgumentError, InputFileError
+from fieldkit.io.csv_table import length_factor, read_csv_table
 
 
 @dataclass(frozen=True)
@@ -287,28 +289,19 @@ def read_homography_file(
                     where=f"point {i + 1}",
                 ) from None
     else:
-        lines = [
-            ln
-            for ln in text.splitlines()
-            if ln.strip() and not ln.lstrip().startswith("#")
-        ]
-        if not lines:
-            raise InputFileError("file is empty", source=path)
-        header = [h.strip().lower() for h in lines[0].split(",")]
-        wanted = ("u_px", "v_px", "x_m", "z_m")
-        if not all(w in header for w in wanted):
-            raise InputFileError(
-                f"CSV header must name {', '.join(wanted)}", source=path, where="row 1"
+        table = read_csv_table(path)
+        columns = table.require(
+            {"u_px": ("u_px",), "v_px": ("v_px",), "x_m": ("x",), "z_m": ("z",)},
+            "homography CSV needs columns u_px, v_px, x_m, z_m",
+        )
+        factors = {
+            key: length_factor(table, column, "m") if key in ("x_m", "z_m") else 1.0
+            for key, column in columns.items()
+        }
+        for number, row in table.rows:
+            rows.append(
+                [table.number(number, row, c) * factors[k] for k, c in columns.items()]
             )
-        cols = [header.index(w) for w in wanted]
-        for i, line in enumerate(lines[1:], start=2):
-            cells = line.split(",")
-            try:
-                rows.append([float(cells[c]) for c in cols])
-            except (IndexError, ValueError):
-                raise InputFileError(
-                    "needs numbers u_px, v_px, x_m, z_m", source=path, where=f"row {i}"
-                ) from None
     points = np.array(rows, dtype=float).reshape(-1, 4)
     cal = homography_from_points(
         points[:, :2], points[:, 2:], image_size=image_size, source=str(path)
