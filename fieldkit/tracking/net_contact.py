@@ -38,8 +38,16 @@ class NetContact:
     before, after
         Flights before and after the contact.
     t_start_s, t_end_s, duration_s
-        Contact start (last sample of the flight before), end (first sample of the
-        flight after) and duration [s]; ``n_frames`` samples apart.
+        Contact start and end [s] where the net force sets in and fades out
+        (:func:`contact_onset`; by default the last sample of the flight before and
+        the first of the flight after), and the duration; ``n_frames`` frames apart.
+        This is the contact of the *force*: a damped net stops pushing while the body
+        is still inside its undeformed plane (the force ``k d + c d'`` reaches zero
+        with ``d > 0``), and from then on the track is ballistic, so a contact defined
+        by penetration cannot be seen in it. On the rendered ``video/net`` clip the
+        force acts for frames 292.97-355.60 and the ball leaves the net's plane at
+        frame 361.9; the end found is 0.4 frame after the force's end, the start 1.3
+        frames after its onset.
     t_s, speed_mps, vx_mps, vz_mps
         Time series through the contact [s], [m/s] (first and last value from the flight
         fits).
@@ -54,7 +62,9 @@ class NetContact:
         Total (translational + rotational) energy before and after, and their
         difference [J]; NaN without mass.
     efficiency
-        Eq. 8.1, ``E_f / E_i`` [-] (per unit mass when no mass is given).
+        Eq. 8.1, ``E_f / E_i`` [-] (per unit mass when no mass is given), over the
+        force contact (``video/net``: 71.34 % against 71.44 % at the true ends of the
+        force, 72.95 % at the end of penetration, after 5 ballistic frames).
     """
 
     index: int
