@@ -148,6 +148,36 @@ def parse_number(cell: str, delimiter: str) -> float:
     return float(text)
 
 
+def finite_number(
+    text: str,
+    label: str,
+    *,
+    delimiter: str = ",",
+    source: str | PathLike[str],
+    where: str | None,
+) -> float:
+    """``text`` as a finite number (:func:`parse_number`), else a one-line error.
+
+    The error reads ``<label> '<text>' is not a number`` (or ``a finite number``).
+
+    Examples
+    --------
+    >>> finite_number("1,5", "<ele>", delimiter=";", source="a.csv", where="row 2")
+    1.5
+    """
+    try:
+        value = parse_number(text, delimiter)
+    except ValueError:
+        raise InputFileError(
+            f"{label} '{text}' is not a number", source=source, where=where
+        ) from None
+    if not math.isfinite(value):
+        raise InputFileError(
+            f"{label} '{text}' is not a finite number", source=source, where=where
+        )
+    return value
+
+
 @dataclass(frozen=True)
 class Column:
     """A header cell after normalisation: position, original text, base name, unit."""
@@ -225,21 +255,13 @@ class CsvTable:
                     where=place,
                 )
             return math.nan
-        try:
-            value = parse_number(text, self.delimiter)
-        except ValueError:
-            raise InputFileError(
-                f"column '{column.header.strip()}': '{text}' is not a number",
-                source=self.source,
-                where=place,
-            ) from None
-        if not math.isfinite(value):
-            raise InputFileError(
-                f"column '{column.header.strip()}': '{text}' is not a finite number",
-                source=self.source,
-                where=place,
-            )
-        return value
+        return finite_number(
+            text,
+            f"column '{column.header.strip()}':",
+            delimiter=self.delimiter,
+            source=self.source,
+            where=place,
+        )
 
 
 def check_readable(path: str | PathLike[str]) -> Path:

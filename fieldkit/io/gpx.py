@@ -32,7 +32,7 @@ import pandas as pd
 
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.io.atomic import write_text_atomic
-from fieldkit.io.csv_table import check_readable
+from fieldkit.io.csv_table import check_readable, finite_number
 
 GPX_11_NAMESPACE = "http://www.topografix.com/GPX/1/1"
 _KINDS = {"waypoints": "wpt", "route": "rtept", "track": "trkpt"}
@@ -155,18 +155,7 @@ def read_gpx_waypoints(
         ele_text = _child_text(element, "ele")
         elev = math.nan
         if ele_text:
-            try:
-                elev = float(ele_text)
-            except ValueError:
-                raise InputFileError(
-                    f"<ele> '{ele_text}' is not a number", source=path, where=where
-                ) from None
-            if not math.isfinite(elev):
-                raise InputFileError(
-                    f"<ele> '{ele_text}' is not a finite number",
-                    source=path,
-                    where=where,
-                )
+            elev = finite_number(ele_text, "<ele>", source=path, where=where)
         time_text = _child_text(element, "time") or None
         type_text = _child_text(element, "type") or None
         records.append((name, lat, lon, elev, time_text, where, type_text))
