@@ -36,8 +36,9 @@ Where psi comes from (:func:`surface_angles`):
     net (the body leaves while still pressing into it by ``c |d'| / k``; -107.6 deg
     on ``video/net``, 4 to 14 deg off on synthetic captures) and the direction of the
     net impulse leans by the friction (13 deg on ``video/net``); on ``video/net``
-    they give e_n = 0.743 and 0.356 against the true 0.664. psi, and so ``vin``, ``vfn``, e_n, e_t and the angles, are left
-    NaN with a warning (give ``--surface-angle`` or film a marker for the spin).
+    they give e_n = 0.743 and 0.356 against the true 0.664. psi, and so ``vin``,
+    ``vfn``, e_n, e_t and the angles, are left NaN with a warning (give
+    ``--surface-angle`` or film a marker for the spin).
 
 A surface estimated from the data that the body does not leave (``vfn <= 0``) is
 likewise left NaN with a warning.
