@@ -14,6 +14,7 @@ from fieldkit.impact_table import ImpactTable
 
 POINTS = "point,x_m,z_m\nP0,0,100\nP1,10,94\nP2,20,88\nP3,30,82\nP4,40,76\n"
 BODY = ("--mass", "1000", "--radius", "0.5", "--gyration", "0.3")
+BOULDER = ("--shape", "ellipsoid", "--dimensions", "1.6,1.3,1.3")
 
 
 def reduce_with_trees(cli, impacts, trees, *options):
@@ -94,21 +95,8 @@ def test_figures_are_written(cli, survey, tmp_path):
 def test_shape_option_gives_the_table_4_1_body(cli, survey, tmp_path):
     impacts, _ = survey
     out = tmp_path / "t.csv"
-    result = cli(
-        "reduce",
-        "--impacts",
-        impacts,
-        "--theta0",
-        "30",
-        "--shape",
-        "ellipsoid",
-        "--dimensions",
-        "1.6,1.3,1.3",
-        "--unit-weight",
-        "26",
-        "-o",
-        out,
-    )
+    options = (*BOULDER, "--unit-weight", "26", "-o", out)
+    result = cli("reduce", "--impacts", impacts, "--theta0", "30", *options)
     assert result.exit_code == 0, result.stderr
     t = pd.read_csv(out)
     assert t["mass_kg"].iloc[0] == pytest.approx(3752, abs=1)  # Table 4-1: ~3750 kg
@@ -165,18 +153,7 @@ def test_uphill_flight_no_ballistic_path_makes(cli, tmp_path, fails):
         (("--impacts", "{impacts}", "--theta0", "30", "--units", "yd"), ("--units",)),
         (("--impacts", "{impacts}", "--theta0", "30", "--mass", "-1"), ("--mass",)),
         (
-            (
-                "--impacts",
-                "{impacts}",
-                "--theta0",
-                "30",
-                "--shape",
-                "ellipsoid",
-                "--dimensions",
-                "1.6,1.3,1.3",
-                "--mass",
-                "10",
-            ),
+            ("--impacts", "{impacts}", "--theta0", "30", *BOULDER, "--mass", "10"),
             ("--mass",),
         ),
         (
