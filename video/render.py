@@ -265,14 +265,14 @@ def net_motion(scene: NetScene, ball: Ball, times: np.ndarray, substeps: int = 4
     for i in range(len(times)):
         states[i] = state
         in_contact[i] = _net_derivative(state, scene, ball)[1]
-        for _ in range(substeps):
+        for step in range(substeps):
             k1, c1 = _net_derivative(state, scene, ball)
             k2, _ = _net_derivative(state + 0.5 * dt * k1, scene, ball)
             k3, _ = _net_derivative(state + 0.5 * dt * k2, scene, ball)
             k4, _ = _net_derivative(state + dt * k3, scene, ball)
             new = state + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
             c_new = _net_derivative(new, scene, ball)[1]
-            t_here = times[i] + (_ + 1) * dt
+            t_here = times[i] + (step + 1) * dt
             if c_new and not c1 and t_on is None:
                 t_on, s_on = t_here, new.copy()
             if c1 and not c_new and t_on is not None and t_off is None:
