@@ -270,8 +270,11 @@ def impact(
     ] = None,
     vt: Annotated[
         float | None,
-        typer.Option("--vt", help="Impact velocity along the ground v_iT (m/s), "
-                     "down-slope positive (instead of --speed/--angle)."),
+        typer.Option(
+            "--vt",
+            help="Impact velocity along the ground v_iT (m/s), "
+            "down-slope positive (instead of --speed/--angle).",
+        ),
     ] = None,  # fmt: skip
     vn: Annotated[
         float | None,
@@ -279,22 +282,31 @@ def impact(
     ] = None,
     spin: Annotated[
         float,
-        typer.Option("--spin", help="Spin at impact omega_i (rad/s); negative = "
-                     "clockwise, the usual spin going down-slope (thesis Fig. 4.6)."),
+        typer.Option(
+            "--spin",
+            help="Spin at impact omega_i (rad/s); negative = "
+            "clockwise, the usual spin going down-slope (thesis Fig. 4.6).",
+        ),
     ] = 0.0,  # fmt: skip
     mass: MassOpt = None,
     radius: RadiusOpt = None,
     gyration: GyrationOpt = None,
     shape: Annotated[
         str | None,
-        typer.Option("--shape", help=f"Body shape from thesis Table 4-1: "
-                     f"{', '.join(SHAPES)} (gives k, volume, mass, contact radius)."),
+        typer.Option(
+            "--shape",
+            help=f"Body shape from thesis Table 4-1: "
+            f"{', '.join(SHAPES)} (gives k, volume, mass, contact radius).",
+        ),
     ] = None,  # fmt: skip
     dimensions: Annotated[
         str | None,
-        typer.Option("--dimensions", help="Shape dimensions (m), comma-separated: "
-                     "cube L; sphere r (radius); cylinder L,r; ellipsoid 2a,2b,2c "
-                     "(axis lengths, rotating about c)."),
+        typer.Option(
+            "--dimensions",
+            help="Shape dimensions (m), comma-separated: "
+            "cube L; sphere r (radius); cylinder L,r; ellipsoid 2a,2b,2c "
+            "(axis lengths, rotating about c).",
+        ),
     ] = None,  # fmt: skip
     unit_weight: Annotated[
         float,
@@ -302,9 +314,12 @@ def impact(
     ] = UNIT_WEIGHT_KN_M3,
     offset: Annotated[
         float,
-        typer.Option("--offset", help="Eccentric impact: tangential offset r_T of the "
-                     "centre of mass from the contact point (m) (App. C.11); 0 = "
-                     "collinear (sphere)."),
+        typer.Option(
+            "--offset",
+            help="Eccentric impact: tangential offset r_T of the "
+            "centre of mass from the contact point (m) (App. C.11); 0 = "
+            "collinear (sphere).",
+        ),
     ] = 0.0,  # fmt: skip
     en: Annotated[
         float | None,
@@ -312,9 +327,12 @@ def impact(
     ] = None,
     law: Annotated[
         str | None,
-        typer.Option("--law", help="Restitution law: constant (--en), angle "
-                     "(e_N = a theta_i^-b, eq. 5.4) or velocity (--en scaled by "
-                     "1/(1+(v_iN/K)^2), eq. 7.1)."),
+        typer.Option(
+            "--law",
+            help="Restitution law: constant (--en), angle "
+            "(e_N = a theta_i^-b, eq. 5.4) or velocity (--en scaled by "
+            "1/(1+(v_iN/K)^2), eq. 7.1).",
+        ),
     ] = None,  # fmt: skip
     a: Annotated[float, typer.Option("--a", help="eq. 5.4 factor a.")] = ANGLE_LAW_A,
     b: Annotated[float, typer.Option("--b", help="eq. 5.4 exponent b.")] = ANGLE_LAW_B,
@@ -324,14 +342,16 @@ def impact(
     ] = VELOCITY_SCALE_MPS,
     friction: Annotated[
         float,
-        typer.Option("--friction", help="Friction coefficient mu at the contact; "
-                     "default inf = slip always stops before separation (eqs. "
-                     "4.20-4.22); 0 = smooth."),
+        typer.Option(
+            "--friction",
+            help="Friction coefficient mu at the contact; "
+            "default inf = slip always stops before separation (eqs. "
+            "4.20-4.22); 0 = smooth.",
+        ),
     ] = math.inf,  # fmt: skip
     figure: Annotated[
         Path | None,
-        typer.Option("--figure", help="Write the pN-v diagram (Figs. 4.4/4.5) "
-                     "as PNG."),
+        typer.Option("--figure", help="Write the pN-v diagram (Figs. 4.4/4.5) as PNG."),
     ] = None,  # fmt: skip
     json_out: Annotated[
         Path | None, typer.Option("--json", help="Write inputs and results as JSON.")

@@ -209,9 +209,7 @@ def reduce(
     if impacts is not None:
         from fieldkit.io.points import read_impacts
 
-        points = read_impacts(
-            impacts, units=units, epsg=epsg, gpx_points=gpx_points
-        )
+        points = read_impacts(impacts, units=units, epsg=epsg, gpx_points=gpx_points)
         name = impacts.stem
     else:
         from fieldkit.io.fieldbook import read_fieldbook

@@ -42,6 +42,7 @@ def as_argument_array(name: str, value: ArrayLike) -> np.ndarray:
     reject(np.isnan(array), name, "a number", array)
     return array
 
+
 def inertial_coefficients(
     gyration_m: ArrayLike, r_t_m: ArrayLike, r_n_m: ArrayLike
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -74,6 +75,7 @@ def inertial_coefficients(
     r_t = np.asarray(r_t_m, float)
     r_n = np.asarray(r_n_m, float)
     return 1.0 + r_n**2 / k2, r_n * r_t / k2, 1.0 + r_t**2 / k2
+
 
 @dataclass(frozen=True)
 class ContactPhases:

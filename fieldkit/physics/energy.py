@@ -137,8 +137,10 @@ def total_energy_change(
     """
     mass = np.asarray(mass_kg, float)
     nonnegative_array(mass, "mass_kg")
-    translational = 0.5 * mass * (
-        np.asarray(speed_f_mps, float) ** 2 - np.asarray(speed_i_mps, float) ** 2
+    translational = (
+        0.5
+        * mass
+        * (np.asarray(speed_f_mps, float) ** 2 - np.asarray(speed_i_mps, float) ** 2)
     )
     rotation = rotational_energy_change(inertia_kgm2, omega_i_radps, omega_f_radps)
     return _out(translational + rotation)

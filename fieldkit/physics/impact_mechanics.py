@@ -49,6 +49,7 @@ __all__ = [
     "slip_velocity",
 ]
 
+
 def slip_velocity(
     v_t_mps: ArrayLike, omega_radps: ArrayLike, radius_m: ArrayLike
 ) -> np.ndarray:
@@ -66,6 +67,7 @@ def slip_velocity(
     return np.asarray(v_t_mps, float) + np.asarray(radius_m, float) * np.asarray(
         omega_radps, float
     )
+
 
 def compression_impulse(
     v_in_mps: ArrayLike,
@@ -216,6 +218,7 @@ def minimum_friction_to_stop_slip(
     v_s = np.abs(slip_velocity(v_it_mps, omega_i_radps, r))
     q_f = -(1.0 + np.asarray(e_n, float)) * np.asarray(v_in_mps, float)
     return v_s / (q_f * (1.0 + r**2 / k**2))
+
 
 @dataclass(frozen=True)
 class ImpactResult:

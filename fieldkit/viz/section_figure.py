@@ -96,9 +96,20 @@ def plot_section(table: ImpactTable, trees: object | None = None) -> Figure:
     ok = np.isfinite(vfx) & np.isfinite(vfz)
     if ok.any():
         top = float(np.nanmax(np.hypot(vfx[ok], vfz[ok])))
-        ax.quiver(x[ok], z[ok], vfx[ok], vfz[ok], angles="xy", scale_units="xy",
-                  scale=top / (0.05 * np.ptp(x)), width=0.0022, color=FLIGHT_COLOUR,
-                  alpha=0.8, zorder=6, label="restitution velocity $v_f$ (∝ speed)")
+        ax.quiver(
+            x[ok],
+            z[ok],
+            vfx[ok],
+            vfz[ok],
+            angles="xy",
+            scale_units="xy",
+            scale=top / (0.05 * np.ptp(x)),
+            width=0.0022,
+            color=FLIGHT_COLOUR,
+            alpha=0.8,
+            zorder=6,
+            label="restitution velocity $v_f$ (∝ speed)",
+        )
     step = max(1, len(f) // 15)
     for i, row in enumerate(f.itertuples(index=False)):
         if i % step == 0 or i == len(f) - 1:

@@ -268,18 +268,36 @@ def test_reader_errors_reach_the_command_line_as_one_line(cli, repo, tmp_path, f
         '<wpt lat="49.0" lon="-114.0"><ele>1500</ele><name>A</name></wpt>'
         '<wpt lat="49.0001" lon="-114.0"><name>B</name></wpt></gpx>'
     )
-    fails(cli("reduce", "--impacts", no_ele, "--theta0", "30", "-o", out),
-          "no_ele.gpx", "B")
+    fails(
+        cli("reduce", "--impacts", no_ele, "--theta0", "30", "-o", out),
+        "no_ele.gpx",
+        "B",
+    )
     text = tmp_path / "text.csv"
     text.write_text("point,x_m,z_m\nP0,0,100\nP1,ten,94\n")
-    fails(cli("reduce", "--impacts", text, "--theta0", "30", "-o", out),
-          "text.csv", "row 3")
+    fails(
+        cli("reduce", "--impacts", text, "--theta0", "30", "-o", out),
+        "text.csv",
+        "row 3",
+    )
     folder = repo / "surveys" / "tornado_mountain"
     book = tmp_path / "book.csv"
     lines = (folder / "boulder_a_fieldbook.csv").read_text().splitlines()
-    lines[3] = lines[3][:-3] + "00\""  # corrupt the checksum of point C (row 4)
+    lines[3] = lines[3][:-3] + '00"'  # corrupt the checksum of point C (row 4)
     book.write_text("\n".join(lines) + "\n")
-    fails(cli("reduce", "--fieldbook", book, "--stations",
-              folder / "boulder_a_stations.gpx", "--theta0", "30", "-o", out),
-          "book.csv", "row 4")
+    fails(
+        cli(
+            "reduce",
+            "--fieldbook",
+            book,
+            "--stations",
+            folder / "boulder_a_stations.gpx",
+            "--theta0",
+            "30",
+            "-o",
+            out,
+        ),
+        "book.csv",
+        "row 4",
+    )
     assert not out.exists()

@@ -17,8 +17,12 @@ def test_easting_northing_needs_and_uses_epsg(cli, tmp_path):
     d = np.array([0.0, 30.0, 60.0])
     csv = tmp_path / "en.csv"
     pd.DataFrame(
-        {"name": ["A", "B", "C"], "easting": e0 + d * np.sin(az),
-         "northing": n0 + d * np.cos(az), "elevation": [1000.0, 985.0, 972.0]}
+        {
+            "name": ["A", "B", "C"],
+            "easting": e0 + d * np.sin(az),
+            "northing": n0 + d * np.cos(az),
+            "elevation": [1000.0, 985.0, 972.0],
+        }
     ).to_csv(csv, index=False)
     out = tmp_path / "t.csv"
     r = cli("reduce", "--impacts", csv, "--theta0", 30, "-o", out)
@@ -71,9 +75,21 @@ def test_measured_theta0_in_section_csv_is_used(cli, tmp_path):
 
 def test_summary_reports_theory_fraction(cli, repo, tmp_path):
     r = cli(
-        "reduce", "--impacts", repo / TORNADO / "boulder_a_impacts.gpx",
-        "--theta0", 32.6, "--mass", 3750, "--radius", 0.725, "--gyration", 0.46,
-        "--friction", 0.4, "-o", tmp_path / "t.parquet",
+        "reduce",
+        "--impacts",
+        repo / TORNADO / "boulder_a_impacts.gpx",
+        "--theta0",
+        32.6,
+        "--mass",
+        3750,
+        "--radius",
+        0.725,
+        "--gyration",
+        0.46,
+        "--friction",
+        0.4,
+        "-o",
+        tmp_path / "t.parquet",
     )
     assert r.exit_code == 0, r.stderr
     assert "impact mechanics explains a median" in r.stdout
@@ -82,7 +98,16 @@ def test_summary_reports_theory_fraction(cli, repo, tmp_path):
     assert ok.sum() > 30
     ratio = t.loc[ok, "dke_theory_j"] / t.loc[ok, "dke_j"]
     assert np.allclose(ratio, t.loc[ok, "theory_loss_fraction"])
-    r = cli("reduce", "--impacts", repo / TORNADO / "boulder_a_impacts.gpx",
-            "--theta0", 32.6, "--friction", -1, "-o", tmp_path / "u.csv")
+    r = cli(
+        "reduce",
+        "--impacts",
+        repo / TORNADO / "boulder_a_impacts.gpx",
+        "--theta0",
+        32.6,
+        "--friction",
+        -1,
+        "-o",
+        tmp_path / "u.csv",
+    )
     assert r.exit_code != 0 and "friction" in r.stderr
     assert not (tmp_path / "u.csv").exists()

@@ -25,9 +25,15 @@ def reduced():
         source="p.csv",
     )
     trees = SimpleNamespace(
-        frame=pd.DataFrame({"after_impact": ["b"], "horizontal_distance_m": [6.0],
-                            "strike_height_m": [1.5], "ground_z_m": [np.nan],
-                            "row": [2]}),
+        frame=pd.DataFrame(
+            {
+                "after_impact": ["b"],
+                "horizontal_distance_m": [6.0],
+                "strike_height_m": [1.5],
+                "ground_z_m": [np.nan],
+                "row": [2],
+            }
+        ),
         source="t.csv",
     )
     body = resolve_body(mass_kg=500.0, radius_m=0.36, gyration_m=0.295)
@@ -36,7 +42,7 @@ def reduced():
 
 def test_tree_strike_lies_on_the_drawn_flight(reduced):
     table, trees = reduced
-    (xt, ground, strike), = _trees_xy(table, trees)
+    ((xt, ground, strike),) = _trees_xy(table, trees)
     assert xt == pytest.approx(16.0)
     assert ground == pytest.approx(52.0 - 8.0 * 6.0 / 12.0)  # on the chord b -> c
     xs, zs, source = flight_paths(table, n_samples=4001)[1]
@@ -60,9 +66,16 @@ def test_energy_profile_conserves_energy_in_flight(reduced):
 
 
 def test_energy_partition_without_mass_says_so():
-    points = SimpleNamespace(frame=pd.DataFrame(
-        {"point": ["a", "b", "c"], "x_m": [0.0, 10.0, 20.0], "z_m": [20.0, 14.0, 8.0]}),
-        source="p.csv")
+    points = SimpleNamespace(
+        frame=pd.DataFrame(
+            {
+                "point": ["a", "b", "c"],
+                "x_m": [0.0, 10.0, 20.0],
+                "z_m": [20.0, 14.0, 8.0],
+            }
+        ),
+        source="p.csv",
+    )
     table = reduce_survey(points, None, ReduceOptions("p", 30.0))
     fig = plot_energy_partition(table)
     texts = [t.get_text() for ax in fig.axes for t in ax.texts]
@@ -70,8 +83,9 @@ def test_energy_partition_without_mass_says_so():
 
 
 def test_en_theta_draws_the_requested_law():
-    fig = plot_en_theta([20.0, 40.0], [1.0, 0.5], material=["rock", "talus"],
-                        law=(10.0, 0.8))
+    fig = plot_en_theta(
+        [20.0, 40.0], [1.0, 0.5], material=["rock", "talus"], law=(10.0, 0.8)
+    )
     line = [ln for ln in fig.axes[0].lines if len(ln.get_xdata()) > 10][0]
     t, e = line.get_xdata(), line.get_ydata()
     np.testing.assert_allclose(e, 10.0 * t**-0.8)
