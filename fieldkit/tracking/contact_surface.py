@@ -87,7 +87,9 @@ def wrap_angle_deg(angle_deg: float) -> float:
     >>> wrap_angle_deg(-105.0), wrap_angle_deg(255.0), wrap_angle_deg(-180.0)
     (-105.0, -105.0, 180.0)
     """
-    return float(180.0 - (180.0 - angle_deg) % 360.0)
+    wrapped = 180.0 - (180.0 - angle_deg) % 360.0
+    # (-tiny) % 360 rounds to exactly 360.0, which would give -180
+    return float(wrapped + 360.0 if wrapped <= -180.0 else wrapped)
 
 
 def facing_body(psi_deg: float, vi: tuple[float, float]) -> float:

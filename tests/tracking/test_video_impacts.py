@@ -264,6 +264,9 @@ def test_facing_body_turns_the_normal_toward_the_incoming_body(psi, vx, vz):
 def test_wrap_angle_and_facing_body_examples():
     assert wrap_angle_deg(-180.0) == 180.0 and wrap_angle_deg(540.0) == 180.0
     assert wrap_angle_deg(-105.0) == -105.0 and wrap_angle_deg(255.0) == -105.0
+    # a hair above 180 must not round to -180 (found by hypothesis)
+    assert wrap_angle_deg(180.0 + 4e-14) == pytest.approx(180.0)
+    assert facing_body(3.983025535649092e-14, (0.0, 1.0)) == pytest.approx(180.0)
     # an overhang leaning over a body coming from the left, given as its line's dip
     assert facing_body(75.0, (4.0, -2.7)) == pytest.approx(-105.0)
     assert facing_body(15.0, (2.0, -3.0)) == 15.0  # an ordinary slope: unchanged
