@@ -10,6 +10,7 @@ from typing import Annotated, ParamSpec, TypeVar
 import typer
 
 from fieldkit.errors import FieldkitError
+from fieldkit.physics.bodies import SHAPES
 
 P = ParamSpec("P")
 R = TypeVar("R")
@@ -47,4 +48,20 @@ RadiusOpt = Annotated[
 GyrationOpt = Annotated[
     float | None,
     typer.Option("--gyration", help="Radius of gyration k (m); I = m k^2."),
+]
+ShapeOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--shape",
+        help=f"Body shape from thesis Table 4-1: {', '.join(SHAPES)} (gives k, volume, "
+        "mass and contact radius; instead of --mass/--gyration).",
+    ),
+]
+DimensionsOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--dimensions",
+        help="Shape dimensions (m), comma-separated: cube L; sphere r (radius); "
+        "cylinder L,r; ellipsoid 2a,2b,2c (full axis lengths, rotating about c).",
+    ),
 ]

@@ -11,7 +11,15 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from fieldkit.cli.common import GyrationOpt, MassOpt, RadiusOpt, one_line_errors, warn
+from fieldkit.cli.common import (
+    DimensionsOpt,
+    GyrationOpt,
+    MassOpt,
+    RadiusOpt,
+    ShapeOpt,
+    one_line_errors,
+    warn,
+)
 from fieldkit.errors import ArgumentError
 from fieldkit.io.atomic import write_text_atomic
 from fieldkit.physics.bodies import SHAPES, UNIT_WEIGHT_KN_M3, Body, shape_body
@@ -291,23 +299,8 @@ def impact(
     mass: MassOpt = None,
     radius: RadiusOpt = None,
     gyration: GyrationOpt = None,
-    shape: Annotated[
-        str | None,
-        typer.Option(
-            "--shape",
-            help=f"Body shape from thesis Table 4-1: "
-            f"{', '.join(SHAPES)} (gives k, volume, mass, contact radius).",
-        ),
-    ] = None,  # fmt: skip
-    dimensions: Annotated[
-        str | None,
-        typer.Option(
-            "--dimensions",
-            help="Shape dimensions (m), comma-separated: "
-            "cube L; sphere r (radius); cylinder L,r; ellipsoid 2a,2b,2c "
-            "(axis lengths, rotating about c).",
-        ),
-    ] = None,  # fmt: skip
+    shape: ShapeOpt = None,
+    dimensions: DimensionsOpt = None,
     unit_weight: Annotated[
         float,
         typer.Option("--unit-weight", help="Rock unit weight (kN/m^3) for --shape."),

@@ -8,7 +8,14 @@ from typing import Annotated
 
 import typer
 
-from fieldkit.cli.common import GyrationOpt, MassOpt, RadiusOpt, one_line_errors
+from fieldkit.cli.common import (
+    DimensionsOpt,
+    GyrationOpt,
+    MassOpt,
+    RadiusOpt,
+    ShapeOpt,
+    one_line_errors,
+)
 from fieldkit.errors import ArgumentError
 from fieldkit.impact_table import FORMATS
 from fieldkit.io.atomic import refuse_input_overwrite
@@ -63,22 +70,8 @@ def reduce(
     mass: MassOpt = None,
     radius: RadiusOpt = None,
     gyration: GyrationOpt = None,
-    shape: Annotated[
-        str | None,
-        typer.Option(
-            "--shape",
-            help="Body from thesis Table 4-1 instead of --mass/--gyration: "
-            "cube, sphere, cylinder or ellipsoid.",
-        ),
-    ] = None,
-    dimensions: Annotated[
-        str | None,
-        typer.Option(
-            "--dimensions",
-            help="Shape dimensions in metres, comma separated: cube L; sphere r "
-            "(radius); cylinder L,r; ellipsoid 2a,2b,2c (full axis lengths).",
-        ),
-    ] = None,
+    shape: ShapeOpt = None,
+    dimensions: DimensionsOpt = None,
     unit_weight: Annotated[
         float | None,
         typer.Option(
