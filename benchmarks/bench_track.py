@@ -20,9 +20,9 @@ from pathlib import Path
 
 import cv2
 
-from fieldkit.tracking.analysis import analyse_track
-from fieldkit.tracking.calibration import read_homography_file
-from fieldkit.tracking.video_pipeline import track_video
+from fieldkit.tracking.flights.pipeline import analyse_track
+from fieldkit.tracking.video.calibration import read_homography_file
+from fieldkit.tracking.video.pipeline import track_video
 
 REPO = Path(__file__).resolve().parents[1]
 

@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 from fieldkit.errors import InputFileError
-from fieldkit.io.atomic import write_atomic
+from fieldkit.outputs import write_atomic
 from fieldkit.physics.energy import energy_head, kinetic_energy, rotational_energy
 from fieldkit.physics.local_axes import angle_to_ground_deg, to_local
 

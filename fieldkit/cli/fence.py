@@ -137,7 +137,7 @@ def fence(
         fieldkit fence --mass 520 --gyration 0.35 --radius 0.43 --speed-in 22
         --angle-in 50 --spin-in 18
     """
-    from fieldkit.io.atomic import write_text_atomic
+    from fieldkit.outputs import write_text_atomic
     from fieldkit.physics.fences import fence_energy_split, fence_redirection
     from fieldkit.physics.structure_forces import StructureLaw, contact_time, peak_force
 

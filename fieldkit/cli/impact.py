@@ -21,7 +21,7 @@ from fieldkit.cli.common import (
     warn,
 )
 from fieldkit.errors import ArgumentError
-from fieldkit.io.atomic import write_text_atomic
+from fieldkit.outputs import write_text_atomic
 from fieldkit.physics.bodies import SHAPES, UNIT_WEIGHT_KN_M3, Body, shape_body
 from fieldkit.physics.impact_mechanics import (
     ImpactResult,

@@ -18,7 +18,7 @@ from fieldkit.cli.common import (
 )
 from fieldkit.errors import ArgumentError
 from fieldkit.impact_table import FORMATS
-from fieldkit.io.atomic import refuse_input_overwrite
+from fieldkit.outputs import refuse_input_overwrite
 
 FIGURE_NAMES = (
     "section.png",

@@ -13,7 +13,7 @@ import typer
 from fieldkit.cli.common import GyrationOpt, MassOpt, RadiusOpt, one_line_errors, warn
 from fieldkit.errors import ArgumentError
 from fieldkit.impact_table import FORMATS
-from fieldkit.io.atomic import atomic_path, refuse_input_overwrite, write_atomic
+from fieldkit.outputs import atomic_path, refuse_input_overwrite, write_atomic
 
 #: show a progress bar for videos longer than this many frames
 PROGRESS_MIN_FRAMES = 300
@@ -118,14 +118,14 @@ def track(
         --scale-length 1.2 --radius 0.0375 --mass 0.14 --surface-angle 15
         -o out/bounce_track.csv --impacts out/bounce_impacts.csv --figures out/bounce
     """
-    from fieldkit.tracking.analysis import analyse_track
-    from fieldkit.tracking.calibration import (
+    from fieldkit.tracking.flights.pipeline import analyse_track
+    from fieldkit.tracking.video.calibration import (
         parse_scale_points,
         read_homography_file,
         two_point_scale,
     )
-    from fieldkit.tracking.video_pipeline import parse_roi
-    from fieldkit.tracking.video_reader import VideoReader, fps_mismatch_message
+    from fieldkit.tracking.video.pipeline import parse_roi
+    from fieldkit.tracking.video.reader import VideoReader, fps_mismatch_message
 
     if fps is None:
         raise ArgumentError(
@@ -241,7 +241,7 @@ def track(
 
 def _run_tracking(video, reader, fps, calibration, roi, radius, *, show: bool):
     """track_video with a rich progress bar on stderr for long videos."""
-    from fieldkit.tracking.video_pipeline import track_video
+    from fieldkit.tracking.video.pipeline import track_video
 
     run = functools.partial(
         track_video,

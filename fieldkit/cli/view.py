@@ -12,9 +12,9 @@ import typer
 from fieldkit.cli.common import GyrationOpt, MassOpt, RadiusOpt, one_line_errors, warn
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.impact_table import ImpactTable
-from fieldkit.io.atomic import refuse_input_overwrite
+from fieldkit.outputs import refuse_input_overwrite
 from fieldkit.io.csv_table import detect_delimiter, read_text, split_row
-from fieldkit.tracking.track import Track
+from fieldkit.track import Track
 
 
 class InputFormat(StrEnum):
@@ -131,7 +131,7 @@ def view(
         raise ArgumentError(
             "a track needs the body radius to analyse its impacts", source="--radius"
         )
-    from fieldkit.tracking.analysis import analyse_track
+    from fieldkit.tracking.flights.pipeline import analyse_track
 
     analysis = analyse_track(
         track,

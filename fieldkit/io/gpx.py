@@ -31,7 +31,7 @@ from xml.sax.saxutils import escape, quoteattr
 import pandas as pd
 
 from fieldkit.errors import ArgumentError, InputFileError
-from fieldkit.io.atomic import write_text_atomic
+from fieldkit.outputs import write_text_atomic
 from fieldkit.io.csv_table import check_readable, finite_number
 
 GPX_11_NAMESPACE = "http://www.topografix.com/GPX/1/1"

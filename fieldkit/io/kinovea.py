@@ -42,7 +42,7 @@ from fieldkit.io.tracking_export import (
     read_number_columns,
     time_factor,
 )
-from fieldkit.tracking.track import Track
+from fieldkit.track import Track
 
 _COORD = re.compile(
     r"^(?P<name>.*?)[\s/_\-:]*\b(?P<axis>[XxYy])\b\s*(?:\((?P<unit>[^)]*)\))?\s*$"

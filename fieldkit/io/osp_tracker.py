@@ -36,7 +36,7 @@ from fieldkit.io.tracking_export import (
     read_number_columns,
     time_factor,
 )
-from fieldkit.tracking.track import Track
+from fieldkit.track import Track
 
 
 def read_osp_tracker(

@@ -15,7 +15,7 @@ import pandas as pd
 
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.io.csv_table import LENGTH_UNITS, parse_number, split_row
-from fieldkit.tracking.track import Track
+from fieldkit.track import Track
 
 #: Metres per unit for the length units tracking programs export.
 METRES_PER_UNIT: dict[str, float] = {**LENGTH_UNITS, "in": 0.0254}

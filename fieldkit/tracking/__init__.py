@@ -1,1 +1,2 @@
-"""High-speed video and track exports -> Track -> flights and impacts (ImpactTable)."""
+"""Tracking in two stages: ``video`` (pixels -> Track) and ``flights`` (Track ->
+ImpactTable)."""

@@ -12,7 +12,7 @@ matplotlib.use("Agg")  # headless everywhere; set before pyplot is imported
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
-from fieldkit.io.atomic import write_atomic  # noqa: E402
+from fieldkit.outputs import write_atomic  # noqa: E402
 
 DPI = 150
 

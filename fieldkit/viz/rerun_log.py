@@ -35,9 +35,9 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from fieldkit.impact_table import ImpactTable
-from fieldkit.io.atomic import atomic_path
-from fieldkit.tracking.analysis import TrackAnalysis
-from fieldkit.tracking.net_contact import local_velocity
+from fieldkit.outputs import atomic_path
+from fieldkit.tracking.flights.pipeline import TrackAnalysis
+from fieldkit.tracking.flights.net_contacts import local_velocity
 from fieldkit.viz.image_projection import project, world_to_image
 
 #: At most this many video frames go into a recording.
@@ -77,7 +77,7 @@ def write_recording(
     path
         Output ``.rrd`` file (written atomically).
     analysis
-        From :func:`fieldkit.tracking.analysis.analyse_track`.
+        From :func:`fieldkit.tracking.flights.pipeline.analyse_track`.
     frames
         ``(frame_index, BGR image)`` pairs; at most :data:`MAX_FRAMES` evenly spaced
         frames are kept (every n-th over the track's frame range; the iterable is

@@ -20,8 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from fieldkit.tracking.analysis import TrackAnalysis
-from fieldkit.tracking.net_contact import local_velocity
+from fieldkit.tracking.flights.pipeline import TrackAnalysis
+from fieldkit.tracking.flights.net_contacts import local_velocity
 from fieldkit.viz.figure_files import new_figure, save_png
 from fieldkit.viz.image_projection import project, world_to_image
 
@@ -40,7 +40,7 @@ def write_track_figures(
     directory
         Output folder (created if needed).
     analysis
-        From :func:`fieldkit.tracking.analysis.analyse_track`.
+        From :func:`fieldkit.tracking.flights.pipeline.analyse_track`.
     background_frame
         A BGR video frame to draw the track over (needs ``u_px``/``v_px`` columns in
         the track).

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from rerun.chunk import RrdReader
 
-from fieldkit.tracking.synthetic import bouncing_ball
+from fieldkit.tracking.flights.synthetic_tracks import bouncing_ball
 
 DATA = Path(__file__).parents[1] / "io" / "data"
 
@@ -58,8 +58,8 @@ def test_track_csv_to_recording_and_figures(cli, track_csv, tmp_path):
 def test_impact_table_from_a_track_then_viewed(cli, track_csv, tmp_path):
     import pandas as pd
 
-    from fieldkit.tracking.analysis import analyse_track
-    from fieldkit.tracking.track import Track
+    from fieldkit.tracking.flights.pipeline import analyse_track
+    from fieldkit.track import Track
 
     a = analyse_track(Track(pd.read_csv(track_csv)), radius_m=0.0375)
     table = tmp_path / "impacts.csv"

@@ -9,7 +9,7 @@ import pytest
 
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.io.osp_tracker import read_osp_tracker
-from fieldkit.tracking.flight_fit import fit_flight
+from fieldkit.tracking.flights.ballistic_fit import fit_flight
 
 DATA = Path(__file__).parent / "data"
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from fieldkit.errors import ArgumentError, InputFileError
-from fieldkit.tracking.calibration import (
+from fieldkit.tracking.video.calibration import (
     homography_from_points,
     parse_scale_points,
     read_homography_file,

@@ -9,13 +9,13 @@ import cv2
 import numpy as np
 import pytest
 
-from fieldkit.tracking.background import (
+from fieldkit.tracking.video.background import (
     background_model,
     median_background,
     noise_threshold,
 )
-from fieldkit.tracking.detection import BallDetector, fit_circle
-from fieldkit.tracking.image_difference import brightness_gain
+from fieldkit.tracking.video.detection import BallDetector, fit_circle
+from fieldkit.tracking.video.image_difference import brightness_gain
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from fieldkit.physics.constants import G
-from fieldkit.tracking.flight_fit import fit_flight
+from fieldkit.tracking.flights.ballistic_fit import fit_flight
 
 
 def parabola(t, x0, z0, vx, vz, g=G):

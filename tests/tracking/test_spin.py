@@ -7,8 +7,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fieldkit.tracking.calibration import homography_from_points, two_point_scale
-from fieldkit.tracking.spin import (
+from fieldkit.tracking.video.calibration import homography_from_points, two_point_scale
+from fieldkit.tracking.video.spin import (
     angular_velocity,
     marker_angle_world,
     marker_offset_px,

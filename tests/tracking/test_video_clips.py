@@ -11,7 +11,7 @@ import pandas as pd
 import pytest
 
 from fieldkit.physics.local_axes import to_local
-from fieldkit.tracking.video_reader import VideoReader, fps_mismatch_message
+from fieldkit.tracking.video.reader import VideoReader, fps_mismatch_message
 
 
 @pytest.fixture(scope="module")

@@ -17,8 +17,8 @@ from hypothesis import strategies as st
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.physics.constants import G
 from fieldkit.physics.local_axes import to_local, to_section
-from fieldkit.tracking.analysis import analyse_track
-from fieldkit.tracking.contact_surface import (
+from fieldkit.tracking.flights.pipeline import analyse_track
+from fieldkit.tracking.flights.contact_surface import (
     RIGID_SAG_FRACTION,
     extended_contact_angle,
     facing_body,
@@ -26,8 +26,8 @@ from fieldkit.tracking.contact_surface import (
     surface_angle_from_spin,
     wrap_angle_deg,
 )
-from fieldkit.tracking.synthetic import bouncing_ball
-from fieldkit.tracking.track import Track
+from fieldkit.tracking.flights.synthetic_tracks import bouncing_ball
+from fieldkit.track import Track
 
 FPS = 1205.0
 R = 0.0375
@@ -343,8 +343,8 @@ def test_rendered_overhanging_net_clip_against_its_truth(repo, tmp_path):
     import json
     import sys
 
-    from fieldkit.tracking.calibration import read_homography_file
-    from fieldkit.tracking.video_pipeline import track_video
+    from fieldkit.tracking.video.calibration import read_homography_file
+    from fieldkit.tracking.video.pipeline import track_video
 
     name = "fieldkit_video_render_for_impacts"
     spec = importlib.util.spec_from_file_location(name, repo / "video" / "render.py")

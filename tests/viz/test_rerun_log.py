@@ -7,8 +7,8 @@ import pandas as pd
 import pytest
 from rerun.chunk import RrdReader
 
-from fieldkit.tracking.analysis import analyse_track
-from fieldkit.tracking.synthetic import bouncing_ball, net_capture
+from fieldkit.tracking.flights.pipeline import analyse_track
+from fieldkit.tracking.flights.synthetic_tracks import bouncing_ball, net_capture
 from fieldkit.viz.rerun_log import (
     MAX_FRAME_SIDE_PX,
     MAX_FRAMES,

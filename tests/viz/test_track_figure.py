@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.image import imread
 
-from fieldkit.tracking.analysis import analyse_track
-from fieldkit.tracking.synthetic import bouncing_ball, net_capture
+from fieldkit.tracking.flights.pipeline import analyse_track
+from fieldkit.tracking.flights.synthetic_tracks import bouncing_ball, net_capture
 from fieldkit.viz.track_figure import write_track_figures
 
 

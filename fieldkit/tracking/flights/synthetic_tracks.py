@@ -1,7 +1,7 @@
 """Synthetic tracks with known truth: a ball bouncing on a tilted plane, a net capture.
 
 Used by the tests (recover the truth within stated tolerances) and by examples. Both
-generators return the sampled :class:`~fieldkit.tracking.track.Track` together with the
+generators return the sampled :class:`~fieldkit.track.Track` together with the
 exact truth, so analysis can be checked against numbers it never saw.
 
 * :func:`bouncing_ball` — exact parabolas between instantaneous impacts on the plane
@@ -25,7 +25,7 @@ import pandas as pd
 
 from fieldkit.physics.constants import G
 from fieldkit.physics.local_axes import to_local, to_section
-from fieldkit.tracking.track import Track
+from fieldkit.track import Track
 
 
 @dataclass

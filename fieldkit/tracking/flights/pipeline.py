@@ -3,13 +3,13 @@
 :func:`analyse_track` runs the whole chain on any :class:`Track` (from video, OSP
 Tracker or Kinovea):
 
-1. :func:`fieldkit.tracking.contacts.find_flights` splits the track into ballistic
+1. :func:`fieldkit.tracking.flights.segmentation.find_flights` splits the track into ballistic
    flights (contacts found from the data);
-2. :func:`fieldkit.tracking.flight_fit.fit_flight` fits each flight with g free (its g
+2. :func:`fieldkit.tracking.flights.ballistic_fit.fit_flight` fits each flight with g free (its g
    and standard error are checked against 9.81) and with g fixed;
-3. :mod:`fieldkit.tracking.video_impacts` evaluates the fits at each contact and builds
+3. :mod:`fieldkit.tracking.flights.contact_impacts` evaluates the fits at each contact and builds
    the ImpactTable (surface angle given or estimated);
-4. :mod:`fieldkit.tracking.net_contact` describes every extended contact (net).
+4. :mod:`fieldkit.tracking.flights.net_contacts` describes every extended contact (net).
 """
 
 from __future__ import annotations
@@ -20,11 +20,11 @@ import numpy as np
 
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.impact_table import ImpactTable
-from fieldkit.tracking.contacts import find_flights
-from fieldkit.tracking.flight_fit import FlightFit, fit_flight
-from fieldkit.tracking.net_contact import NetContact, analyse_net_contact
-from fieldkit.tracking.track import Track
-from fieldkit.tracking.video_impacts import build_impact_table, find_contact_events
+from fieldkit.tracking.flights.segmentation import find_flights
+from fieldkit.tracking.flights.ballistic_fit import FlightFit, fit_flight
+from fieldkit.tracking.flights.net_contacts import NetContact, analyse_net_contact
+from fieldkit.track import Track
+from fieldkit.tracking.flights.contact_impacts import build_impact_table, find_contact_events
 
 #: Fewest samples a track needs to be analysed.
 MIN_TRACK_SAMPLES = 10
@@ -78,7 +78,7 @@ def analyse_track(
         Body radius [m] (contact geometry, spin-based surface angle).
     surface_angle_deg
         Dip of the impact surface psi [deg], positive descending toward travel; when
-        None it is estimated (see :mod:`fieldkit.tracking.video_impacts`).
+        None it is estimated (see :mod:`fieldkit.tracking.flights.contact_impacts`).
     mass_kg, gyration_m
         Body mass [kg] and radius of gyration [m] for energies (optional).
     path_id
@@ -90,7 +90,7 @@ def analyse_track(
 
     Examples
     --------
-    >>> from fieldkit.tracking.synthetic import bouncing_ball
+    >>> from fieldkit.tracking.flights.synthetic_tracks import bouncing_ball
     >>> truth = bouncing_ball(duration_s=0.5, e_n=0.6, e_t=0.8)
     >>> a = analyse_track(truth.track, radius_m=0.0375, surface_angle_deg=10.0)
     >>> len(a.flights), round(float(a.impacts.frame["e_n"].iloc[0]), 3)

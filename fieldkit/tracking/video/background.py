@@ -14,8 +14,8 @@ import warnings
 
 import numpy as np
 
-from fieldkit.tracking.detection import BallDetector
-from fieldkit.tracking.image_difference import (
+from fieldkit.tracking.video.detection import BallDetector
+from fieldkit.tracking.video.image_difference import (
     brightness_gain,
     colour_difference,
     scaled,

@@ -14,7 +14,7 @@ Method (region growing from the cleanest seeds):
    (``noise_floor_m``, 0.05 px for video) applies.
 2. **Growth.** Seeds are windows in increasing order of residual; each grows sample by
    sample while the next sample agrees with the current free-g ballistic fit
-   (:func:`fieldkit.tracking.flight_growth.grow_segment`).
+   (:func:`fieldkit.tracking.flights.segment_growth.grow_segment`).
 3. **Validation.** Every flight's free-g fit gives ``g`` and its standard error.
    The track's gravity ``g_common`` is their inverse-variance weighted median. A
    segment is a flight only if it falls (``g > 3 SE``), fits its parabola to the
@@ -37,9 +37,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fieldkit.tracking.flight_fit import fit_flight
-from fieldkit.tracking.flight_growth import grow_segment
-from fieldkit.tracking.flight_trimming import (
+from fieldkit.tracking.flights.ballistic_fit import fit_flight
+from fieldkit.tracking.flights.segment_growth import grow_segment
+from fieldkit.tracking.flights.end_trimming import (
     stable_end,
     trim_biased_ends,
     trim_ends,

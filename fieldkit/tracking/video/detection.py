@@ -2,7 +2,7 @@
 
 Three stages, each cheap enough to run at more than decoding speed:
 
-1. **Background model** (:mod:`fieldkit.tracking.background`): the per-pixel median
+1. **Background model** (:mod:`fieldkit.tracking.video.background`): the per-pixel median
    of frames sampled across the clip, repaired where a slow or resting body spoils
    it. A moving body vanishes from it; a static textured scene (plate, net anchors,
    scale bars) stays.
@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from fieldkit.tracking.image_difference import (
+from fieldkit.tracking.video.image_difference import (
     brightness_gain,
     colour_difference,
     scaled,

@@ -14,17 +14,17 @@ import numpy as np
 import pandas as pd
 
 from fieldkit.errors import ArgumentError, InputFileError
-from fieldkit.tracking.background import background_model, flickers
-from fieldkit.tracking.calibration import Calibration
-from fieldkit.tracking.detection import BallDetector
-from fieldkit.tracking.spin import (
+from fieldkit.tracking.video.background import background_model, flickers
+from fieldkit.tracking.video.calibration import Calibration
+from fieldkit.tracking.video.detection import BallDetector
+from fieldkit.tracking.video.spin import (
     angular_velocity,
     marker_angle_world,
     measure_marker,
     unwrap_angle,
 )
-from fieldkit.tracking.track import Track
-from fieldkit.tracking.video_reader import VideoReader
+from fieldkit.track import Track
+from fieldkit.tracking.video.reader import VideoReader
 
 #: frames sampled across the clip for the median background
 BACKGROUND_SAMPLES = 11
@@ -102,7 +102,7 @@ def track_video(
     fps
         Capture rate [frames/s] (the time base; the container's rate is ignored).
     calibration
-        Pixels -> world metres (:mod:`fieldkit.tracking.calibration`).
+        Pixels -> world metres (:mod:`fieldkit.tracking.video.calibration`).
     roi
         ``(u, v, width, height)`` [px] search region.
     radius_m
@@ -115,7 +115,7 @@ def track_video(
     Returns
     -------
     track, detections
-        The :class:`~fieldkit.tracking.track.Track` (one row per frame with a body;
+        The :class:`~fieldkit.track.Track` (one row per frame with a body;
         extra columns ``omega_sd_radps, u_px, v_px, radius_px, radius_m, partial,
         visible_fraction``; ``meta["warnings"]`` lists one-line warnings) and a
         per-frame table (every decoded frame; ``found`` False where no body was

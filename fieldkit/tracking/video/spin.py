@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fieldkit.tracking.calibration import Calibration
+from fieldkit.tracking.video.calibration import Calibration
 
 #: the marker must cover at least this share of the inner disc to be trusted
 MIN_MARKER_SHARE = 0.015

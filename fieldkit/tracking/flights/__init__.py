@@ -1,0 +1,2 @@
+"""Track -> ImpactTable: flight segmentation, ballistic fits, end trimming, contacts,
+impacts and net contacts."""

@@ -1,0 +1,2 @@
+"""Video -> Track: pixels to world positions and spin (reader, background, detection,
+calibration, marker spin)."""
