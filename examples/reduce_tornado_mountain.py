@@ -19,11 +19,12 @@ import sys
 import tempfile
 from pathlib import Path
 
-from fieldkit.io.points import read_impacts
+from fieldkit.io.impacts import read_impacts
 from fieldkit.io.trees import read_trees
 from fieldkit.reduce.body import resolve_body
 from fieldkit.reduce.pipeline import ReduceOptions, reduce_survey
 from fieldkit.reduce.summary import format_summary, summarize
+from fieldkit.survey import Survey
 from fieldkit.viz.section_figure import write_section_figure
 
 SURVEY = Path(__file__).resolve().parents[1] / "surveys" / "tornado_mountain"
@@ -37,7 +38,7 @@ def main(out_dir: Path) -> None:
 
     body = resolve_body(mass_kg=3750, radius_m=0.725, gyration_m=0.46)
     options = ReduceOptions(path_id="boulder_a", theta0_deg=32.6, body=body)
-    table = reduce_survey(points, trees, options)
+    table = reduce_survey(Survey(points, trees), options)
     print(format_summary(summarize(table)))
 
     row = table.frame.set_index("point").loc["26"]
@@ -49,7 +50,7 @@ def main(out_dir: Path) -> None:
     )
     out_dir.mkdir(parents=True, exist_ok=True)
     table.write(out_dir / "boulder_a.csv")
-    write_section_figure(table, out_dir / "section.png", trees=trees)
+    write_section_figure(table, out_dir / "section.png", survey=Survey(points, trees))
     print(f"wrote {out_dir / 'boulder_a.csv'} and {out_dir / 'section.png'}")
 
 

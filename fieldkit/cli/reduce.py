@@ -158,6 +158,7 @@ def reduce(
     from fieldkit.reduce.body import parse_dimensions, resolve_body
     from fieldkit.reduce.pipeline import ReduceOptions, reduce_survey
     from fieldkit.reduce.summary import format_summary, summarize
+    from fieldkit.survey import Survey
 
     if (impacts is None) == (fieldbook is None):
         raise ArgumentError(
@@ -200,7 +201,7 @@ def reduce(
         unit_weight_kn_m3=unit_weight,
     )
     if impacts is not None:
-        from fieldkit.io.points import read_impacts
+        from fieldkit.io.impacts import read_impacts
 
         points = read_impacts(impacts, units=units, epsg=epsg, gpx_points=gpx_points)
         name = impacts.stem
@@ -224,7 +225,8 @@ def reduce(
     options = ReduceOptions(
         path_id=path_id or name, theta0_deg=theta0, body=body, friction=friction
     )
-    table = reduce_survey(points, tree_set, options)
+    survey = Survey(points, tree_set)
+    table = reduce_survey(survey, options)
 
     if out is not None:
         table.write(out)
@@ -233,7 +235,7 @@ def reduce(
         from fieldkit.viz.restitution_figure import write_restitution_figures
         from fieldkit.viz.section_figure import write_section_figure
 
-        write_section_figure(table, figures / FIGURE_NAMES[0], trees=tree_set)
+        write_section_figure(table, figures / FIGURE_NAMES[0], survey=survey)
         write_restitution_figures(
             table, figures / FIGURE_NAMES[1], figures / FIGURE_NAMES[2]
         )

@@ -12,8 +12,8 @@ import typer
 from fieldkit.cli.common import GyrationOpt, MassOpt, RadiusOpt, one_line_errors, warn
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.impact_table import ImpactTable
-from fieldkit.outputs import refuse_input_overwrite
 from fieldkit.io.csv_table import detect_delimiter, read_text, split_row
+from fieldkit.outputs import refuse_input_overwrite
 from fieldkit.track import Track
 
 

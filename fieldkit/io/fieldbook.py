@@ -31,10 +31,11 @@ import numpy as np
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.io import geodesy
 from fieldkit.io.csv_table import Column, CsvTable, length_factor, read_csv_table
-from fieldkit.io.points import PointSet, check_unique_points, point_set_from_geographic
+from fieldkit.io.point_sets import check_unique_points, point_set_from_geographic
 from fieldkit.io.points_csv import MATERIAL_ALIASES, NAME_ALIASES, SLOPE_ALIASES
 from fieldkit.io.stations import read_stations
 from fieldkit.io.trupulse import parse_trupulse
+from fieldkit.survey import PointSet
 
 STATION_COLUMN_ALIASES = ("station", "station_id", "stn", "from", "setup")
 INSTRUMENT_HEIGHT_ALIASES = (

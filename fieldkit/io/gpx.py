@@ -18,7 +18,7 @@ Names
 Heights
     ``<ele>`` is kept as given (usually metres above sea level from the receiver's geoid
     model; GPX does not say) and never converted. A missing ``<ele>`` gives NaN here;
-    :func:`fieldkit.io.points.read_impacts` refuses it and names the waypoint.
+    :func:`fieldkit.io.impacts.read_impacts` refuses it and names the waypoint.
 """
 
 from __future__ import annotations
@@ -31,8 +31,12 @@ from xml.sax.saxutils import escape, quoteattr
 import pandas as pd
 
 from fieldkit.errors import ArgumentError, InputFileError
-from fieldkit.outputs import write_text_atomic
 from fieldkit.io.csv_table import check_readable, finite_number
+from fieldkit.outputs import write_text_atomic
+
+GPX_HEIGHT_REFERENCE = (
+    "GPX <ele> as given (usually above sea level); no geoid conversion"
+)
 
 GPX_11_NAMESPACE = "http://www.topografix.com/GPX/1/1"
 _KINDS = {"waypoints": "wpt", "route": "rtept", "track": "trkpt"}

@@ -30,12 +30,12 @@ import pandas as pd
 from fieldkit.errors import InputFileError
 from fieldkit.io import geodesy
 from fieldkit.io.csv_table import Column, CsvTable, length_factor, read_csv_table
-from fieldkit.io.points import (
-    PointSet,
+from fieldkit.io.point_sets import (
     check_unique_points,
     point_set_from_geographic,
     point_set_from_section,
 )
+from fieldkit.survey import PointSet
 
 NAME_ALIASES = (
     "point",

@@ -8,7 +8,6 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from os import PathLike
 
 import numpy as np
@@ -16,25 +15,12 @@ import pandas as pd
 
 from fieldkit.errors import InputFileError
 from fieldkit.io.csv_table import check_readable, length_factor, read_csv_table
-from fieldkit.io.points import GPX_HEIGHT_REFERENCE, check_unique_points
+from fieldkit.io.gpx import GPX_HEIGHT_REFERENCE, read_gpx_waypoints
+from fieldkit.io.point_sets import check_unique_points
 from fieldkit.io.points_csv import ELEVATION_ALIASES, LAT_ALIASES, LON_ALIASES
+from fieldkit.survey import Stations
 
 STATION_ALIASES = ("station", "station_id", "stn", "name", "id", "point", "point_id")
-
-
-@dataclass(frozen=True)
-class Stations:
-    """Station positions: frame with ``station`` (str), ``lat_deg``, ``lon_deg``,
-    ``elev_m`` (NaN when a GPX waypoint has no ``<ele>``), indexed by nothing."""
-
-    frame: pd.DataFrame
-    source: str
-    height_reference: str
-
-    def lookup(self, station: str) -> pd.Series | None:
-        """The row of ``station``, or None."""
-        match = self.frame[self.frame["station"] == station]
-        return None if match.empty else match.iloc[0]
 
 
 def read_stations(path: str | PathLike[str], *, units: str = "m") -> Stations:
@@ -47,8 +33,6 @@ def read_stations(path: str | PathLike[str], *, units: str = "m") -> Stations:
         head = handle.read(512).lstrip(b"\xef\xbb\xbf \t\r\n")
     source = str(path)
     if head.startswith(b"<") or file.suffix.lower() == ".gpx":
-        from fieldkit.io.gpx import read_gpx_waypoints
-
         table = read_gpx_waypoints(path)
         names = [str(n) for n in table["point"]]
         check_unique_points(

@@ -28,7 +28,6 @@ unit in their column names; ``dbh`` is read from ``dbh_mm``, ``dbh_cm`` or ``dbh
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 from os import PathLike
 
 import numpy as np
@@ -37,8 +36,8 @@ import pandas as pd
 from fieldkit.errors import InputFileError
 from fieldkit.io import geodesy
 from fieldkit.io.csv_table import Column, CsvTable, length_factor, read_csv_table
-from fieldkit.io.points import PointSet
 from fieldkit.io.points_csv import LAT_ALIASES, LON_ALIASES
+from fieldkit.survey import TREE_COLUMNS, PointSet, TreeStrikes
 
 AFTER_IMPACT_ALIASES = ("after_impact", "after", "from_impact", "impact", "after_point")
 DISTANCE_ALIASES = (
@@ -54,45 +53,6 @@ SPECIES_ALIASES = ("species", "tree_species")
 TREE_ALIASES = ("tree", "tree_id", "name", "id")
 SECTION_X_ALIASES = ("x", "x_section", "chainage")
 DBH_UNITS = {"mm": 1.0, "cm": 10.0, "in": 25.4}
-
-TREE_COLUMNS = (
-    "after_impact",
-    "horizontal_distance_m",
-    "strike_height_m",
-    "ground_z_m",
-    "species",
-    "dbh_mm",
-    "tree",
-    "row",
-    "offset_m",
-)
-
-
-@dataclass(frozen=True)
-class TreeStrikes:
-    """Tree strikes in a fall path.
-
-    Attributes
-    ----------
-    frame
-        ``after_impact`` (str), ``horizontal_distance_m`` (plan distance from that
-        impact toward the next [m]), ``strike_height_m`` (scar above the ground at the
-        tree [m]), ``ground_z_m`` (NaN unless given), ``species`` (str or NA),
-        ``dbh_mm`` (NaN unless given), ``tree`` (id from the file or "row N"),
-        ``row`` (row number in the file, for messages), ``offset_m`` (plan distance
-        of a lat/lon tree from the flight line, NaN otherwise).
-    source
-        The file.
-    notes
-        Decisions worth telling the user.
-    """
-
-    frame: pd.DataFrame
-    source: str
-    notes: tuple[str, ...] = field(default_factory=tuple)
-
-    def __len__(self) -> int:
-        return len(self.frame)
 
 
 def _dbh_column(table: CsvTable) -> tuple[Column | None, float]:
@@ -121,7 +81,7 @@ def read_trees(
     path
         Tree CSV (layouts in the module docstring).
     impacts
-        The impacts of the same path (from :func:`fieldkit.io.points.read_impacts`).
+        The impacts of the same path (from :func:`fieldkit.io.impacts.read_impacts`).
     units
         ``"m"`` or ``"ft"`` for lengths without units in their column names.
 
@@ -135,7 +95,7 @@ def read_trees(
     Examples
     --------
     >>> import tempfile, pathlib
-    >>> from fieldkit.io.points import point_set_from_section
+    >>> from fieldkit.io.point_sets import point_set_from_section
     >>> impacts = point_set_from_section(["A", "B"], [0.0, 12.0], [100.0, 90.0],
     ...                                  source="impacts.csv")
     >>> f = pathlib.Path(tempfile.mkdtemp()) / "trees.csv"

@@ -34,31 +34,7 @@ import numpy as np
 from fieldkit.errors import ArgumentError, FieldkitError, PhysicsError
 from fieldkit.physics.flight import Flight, flight_between
 from fieldkit.physics.three_point import solve_three_point
-
-
-@dataclass(frozen=True)
-class TreeStrike:
-    """A tree struck during the flight that leaves impact ``after_impact``.
-
-    Attributes
-    ----------
-    after_impact
-        Name of the launch impact.
-    distance_m
-        Horizontal distance of the tree from that impact [m].
-    height_m
-        Height of the strike (the boulder's centre, lumped mass) above the ground [m].
-    ground_z_m
-        Ground elevation at the tree [m] (section datum).
-    where
-        Location in the tree file for messages, e.g. ``"row 4"``.
-    """
-
-    after_impact: str
-    distance_m: float
-    height_m: float
-    ground_z_m: float
-    where: str
+from fieldkit.survey import TreeStrike
 
 
 @dataclass(frozen=True)
@@ -217,7 +193,7 @@ def _tree_flight(
 ) -> Flight:
     x1, z1, x2, z2 = (float(v) for v in (x_m[j], z_m[j], x_m[j + 1], z_m[j + 1]))
     xt = x1 + tree.distance_m
-    zt = tree.ground_z_m + tree.height_m
+    zt = tree.z_m
     try:
         return solve_three_point(x1, z1, x2, z2, xt, zt)
     except FieldkitError as exc:

@@ -4,7 +4,7 @@
 
 1. :func:`section_slopes` -- the ground dip psi at each point: the chord from the
    previous point (thesis "slope angle above impact point"), or the surveyed slope;
-2. :func:`tree_strikes_by_launch` -- tree strikes keyed by the flight they fix;
+2. :meth:`Survey.trees_by_launch` -- tree strikes keyed by the flight they fix;
 3. :func:`fieldkit.reduce.flights.solve_flights` -- each flight's parabola (tree
    three-point solve, given angle, or assumed ``--theta0``);
 4. :func:`impact_rows` -- primary ImpactTable columns: velocities at the end of each
@@ -31,8 +31,9 @@ from fieldkit.errors import InputFileError
 from fieldkit.impact_table import ImpactTable
 from fieldkit.physics.energy import kinetic_energy
 from fieldkit.reduce.body import BodyProperties
-from fieldkit.reduce.flights import SolvedFlight, TreeStrike, solve_flights
+from fieldkit.reduce.flights import SolvedFlight, solve_flights
 from fieldkit.reduce.impact_theory import DEFAULT_FRICTION, add_theory_columns
+from fieldkit.survey import Survey
 
 
 @dataclass(frozen=True)
@@ -88,64 +89,6 @@ def section_slopes(
             psi[i] = surveyed[i]
             source[i] = "surveyed"
     return psi, source
-
-
-def tree_strikes_by_launch(
-    trees: object | None, points: list[str], x_m: np.ndarray, z_m: np.ndarray
-) -> dict[str, TreeStrike]:
-    """Tree strikes keyed by the launch impact of the flight they fix.
-
-    ``trees`` is a :class:`fieldkit.io.trees.TreeStrikes` (``frame`` with
-    ``after_impact, horizontal_distance_m, strike_height_m, ground_z_m`` and, when the
-    reader keeps it, the file ``row``). Where ``ground_z_m`` is not given, the ground
-    at the tree is interpolated on the straight line between the two impacts. Two
-    strikes on one flight over-determine the parabola and raise
-    :class:`InputFileError` naming both rows.
-    """
-    if trees is None:
-        return {}
-    frame: pd.DataFrame = trees.frame  # type: ignore[attr-defined]
-    source = getattr(trees, "source", None)
-    index = {name: i for i, name in enumerate(points)}
-    out: dict[str, TreeStrike] = {}
-    for i, row in enumerate(frame.itertuples(index=False)):
-        number = getattr(row, "row", None)
-        where = f"row {int(number) if number is not None else i + 2}"
-        key = str(row.after_impact)
-        j = index.get(key)
-        if j is None or j == len(points) - 1:
-            what = "is not a point of" if j is None else "is the last point of"
-            raise InputFileError(
-                f"tree strike after impact {key}, which {what} the path "
-                "(no flight leaves it)",
-                source=source,
-                where=where,
-            )
-        distance = float(row.horizontal_distance_m)
-        ground = float(row.ground_z_m)
-        if not math.isfinite(ground):
-            dx = x_m[j + 1] - x_m[j]
-            ground = (
-                float(z_m[j] + (z_m[j + 1] - z_m[j]) * distance / dx)
-                if dx > 0
-                else math.nan
-            )
-        if key in out:
-            raise InputFileError(
-                f"a second tree strike on the flight after point {key} "
-                f"(first at {out[key].where}): one strike fixes the parabola; "
-                "keep the better measured one",
-                source=source,
-                where=where,
-            )
-        out[key] = TreeStrike(
-            after_impact=key,
-            distance_m=distance,
-            height_m=float(row.strike_height_m),
-            ground_z_m=ground,
-            where=where,
-        )
-    return out
 
 
 def impact_rows(
@@ -240,23 +183,17 @@ def add_flight_energy(table: ImpactTable) -> ImpactTable:
     return ImpactTable(f, source=table.source)
 
 
-def reduce_survey(
-    points: object,
-    trees: object | None = None,
-    options: ReduceOptions | None = None,
-) -> ImpactTable:
+def reduce_survey(survey: Survey, options: ReduceOptions | None = None) -> ImpactTable:
     """Reduce a surveyed path to an :class:`ImpactTable` (thesis §7.1).
 
     Parameters
     ----------
-    points
-        A :class:`fieldkit.io.points.PointSet` (``frame`` with ``point, x_m, z_m`` and
-        optional ``material``, ``slope_deg`` (surveyed psi) and ``theta0_deg``
-        (measured restitution angle); ``source`` the file name).
-    trees
-        A :class:`fieldkit.io.trees.TreeStrikes`, or None.
+    survey
+        The path's points (``frame`` with ``point, x_m, z_m`` and optional
+        ``material``, ``slope_deg`` (surveyed psi) and ``theta0_deg`` (measured
+        restitution angle)) and its tree strikes, if a tree file was given.
     options
-        Path id, assumed ``theta0_deg`` and body.
+        Path id, assumed ``theta0_deg``, body and friction.
 
     Returns
     -------
@@ -270,8 +207,8 @@ def reduce_survey(
         One line naming the file and point or row (see
         :func:`fieldkit.reduce.flights.solve_flights`).
     """
-    frame: pd.DataFrame = points.frame.reset_index(drop=True)  # type: ignore[attr-defined]
-    source = getattr(points, "source", None)
+    frame = survey.points.frame.reset_index(drop=True)
+    source = survey.source
     options = options or ReduceOptions(path_id="path")
     if len(frame) < 2:
         raise InputFileError(
@@ -286,7 +223,7 @@ def reduce_survey(
 
     slope, slope_source = section_slopes(x, z, surveyed)
     names = frame["point"].astype(str).tolist()
-    by_launch = tree_strikes_by_launch(trees, names, x, z)
+    by_launch = survey.trees_by_launch()
     flights = solve_flights(
         names,
         x,
@@ -296,10 +233,15 @@ def reduce_survey(
         given_theta0_deg=given,
         trees=by_launch,
         points_source=source,
-        trees_source=getattr(trees, "source", None),
+        trees_source=None if survey.trees is None else survey.trees.source,
     )
     rows = impact_rows(
-        frame, slope, slope_source, flights, options, trees_given=trees is not None
+        frame,
+        slope,
+        slope_source,
+        flights,
+        options,
+        trees_given=survey.trees is not None,
     )
     table = ImpactTable(rows, source=source).derive()
     table = add_flight_energy(table)

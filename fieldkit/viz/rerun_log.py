@@ -36,8 +36,8 @@ import rerun.blueprint as rrb
 
 from fieldkit.impact_table import ImpactTable
 from fieldkit.outputs import atomic_path
-from fieldkit.tracking.flights.pipeline import TrackAnalysis
 from fieldkit.tracking.flights.net_contacts import local_velocity
+from fieldkit.tracking.flights.pipeline import TrackAnalysis
 from fieldkit.viz.image_projection import project, world_to_image
 
 #: At most this many video frames go into a recording.

@@ -18,6 +18,7 @@ from matplotlib.figure import Figure
 
 from fieldkit.impact_table import ImpactTable
 from fieldkit.physics.constants import G
+from fieldkit.survey import Survey
 from fieldkit.viz.figure_files import save_png
 
 TREE_COLOUR = "#2e7d32"
@@ -57,25 +58,21 @@ def detail_row(table: ImpactTable) -> int | None:
 
 
 def _trees_xy(
-    table: ImpactTable, trees: object | None
+    table: ImpactTable, survey: Survey | None
 ) -> list[tuple[float, float, float]]:
     """(x, ground z, strike z) of each tree strike (ground interpolated if missing)."""
-    if trees is None:
+    if survey is None:
         return []
-    from fieldkit.reduce.pipeline import tree_strikes_by_launch
-
     f = table.frame
-    names = f["point"].astype(str).tolist()
-    x, z = f["x_m"].to_numpy(float), f["z_m"].to_numpy(float)
-    index = {name: i for i, name in enumerate(names)}
-    out = []
-    for key, tree in tree_strikes_by_launch(trees, names, x, z).items():
-        xt = float(x[index[key]]) + tree.distance_m
-        out.append((xt, tree.ground_z_m, tree.ground_z_m + tree.height_m))
-    return out
+    x = f["x_m"].to_numpy(float)
+    index = {name: i for i, name in enumerate(f["point"].astype(str))}
+    return [
+        (float(x[index[key]]) + tree.distance_m, tree.ground_z_m, tree.z_m)
+        for key, tree in survey.trees_by_launch().items()
+    ]
 
 
-def plot_section(table: ImpactTable, trees: object | None = None) -> Figure:
+def plot_section(table: ImpactTable, survey: Survey | None = None) -> Figure:
     """Draw the section figure and return it (see the module docstring)."""
     f = table.frame
     fig = Figure(figsize=(13.0, 6.2), layout="constrained")
@@ -121,7 +118,7 @@ def plot_section(table: ImpactTable, trees: object | None = None) -> Figure:
                 fontsize=7,
                 color=IMPACT_COLOUR,
             )
-    tree_xy = _trees_xy(table, trees)
+    tree_xy = _trees_xy(table, survey)
     if tree_xy:
         span = np.ptp(z) * 0.035
         for xt, zg, zs in tree_xy:
@@ -236,7 +233,7 @@ def _draw_detail(ax: Axes, row, f, i: int) -> None:
 
 
 def write_section_figure(
-    table: ImpactTable, path: str | os.PathLike[str], trees: object | None = None
+    table: ImpactTable, path: str | os.PathLike[str], survey: Survey | None = None
 ) -> Path:
     """Draw :func:`plot_section` and save it as a PNG (atomically)."""
-    return save_png(plot_section(table, trees=trees), path)
+    return save_png(plot_section(table, survey=survey), path)

@@ -20,8 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from fieldkit.tracking.flights.pipeline import TrackAnalysis
 from fieldkit.tracking.flights.net_contacts import local_velocity
+from fieldkit.tracking.flights.pipeline import TrackAnalysis
 from fieldkit.viz.figure_files import new_figure, save_png
 from fieldkit.viz.image_projection import project, world_to_image
 

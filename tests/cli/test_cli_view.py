@@ -58,8 +58,8 @@ def test_track_csv_to_recording_and_figures(cli, track_csv, tmp_path):
 def test_impact_table_from_a_track_then_viewed(cli, track_csv, tmp_path):
     import pandas as pd
 
-    from fieldkit.tracking.flights.pipeline import analyse_track
     from fieldkit.track import Track
+    from fieldkit.tracking.flights.pipeline import analyse_track
 
     a = analyse_track(Track(pd.read_csv(track_csv)), radius_m=0.0375)
     table = tmp_path / "impacts.csv"

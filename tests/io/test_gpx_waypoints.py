@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from fieldkit.errors import InputFileError
 from fieldkit.io import geodesy
 from fieldkit.io.gpx import read_gpx_waypoints, write_gpx_waypoints
-from fieldkit.io.points import read_impacts
+from fieldkit.io.impacts import read_impacts
 
 GPXPY = "gpx_gpxpy/test_files"
 

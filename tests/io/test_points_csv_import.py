@@ -8,7 +8,7 @@ import pytest
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.io import geodesy
 from fieldkit.io.gpx import write_gpx_waypoints
-from fieldkit.io.points import read_impacts
+from fieldkit.io.impacts import read_impacts
 from fieldkit.io.points_csv import read_points_csv
 
 FOOT = 0.3048

@@ -9,7 +9,8 @@ import pytest
 from fieldkit.errors import InputFileError
 from fieldkit.io import geodesy
 from fieldkit.io.gpx import write_gpx_waypoints
-from fieldkit.io.points import point_set_from_section, read_impacts
+from fieldkit.io.impacts import read_impacts
+from fieldkit.io.point_sets import point_set_from_section
 from fieldkit.io.trees import read_trees
 
 FOOT = 0.3048

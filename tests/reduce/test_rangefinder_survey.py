@@ -14,7 +14,7 @@ import pytest
 
 from fieldkit.io.fieldbook import read_fieldbook
 from fieldkit.io.geodesy import geodesic_inverse
-from fieldkit.io.points import read_impacts
+from fieldkit.io.impacts import read_impacts
 
 DECLINATION = 14.2
 

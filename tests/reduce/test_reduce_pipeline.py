@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
@@ -17,13 +16,14 @@ from fieldkit.reduce.body import parse_dimensions, resolve_body
 from fieldkit.reduce.flights import least_speed_launch_angle_deg
 from fieldkit.reduce.pipeline import ReduceOptions, reduce_survey, section_slopes
 from fieldkit.reduce.summary import format_summary, summarize
+from fieldkit.survey import PointSet, Survey, TreeStrikes
 
 G = 9.81
 
 
 def points(names, x, z, **extra):
     frame = pd.DataFrame({"point": names, "x_m": x, "z_m": z, **extra})
-    return SimpleNamespace(frame=frame, source="synthetic.csv")
+    return PointSet(frame, source="synthetic.csv")
 
 
 def trees(rows):
@@ -37,7 +37,7 @@ def trees(rows):
         ],
     )
     frame["row"] = np.arange(2, len(frame) + 2)
-    return SimpleNamespace(frame=frame, source="trees.csv")
+    return TreeStrikes(frame, source="trees.csv")
 
 
 def test_section_slopes_chord_and_surveyed():
@@ -100,8 +100,7 @@ def test_tree_strikes_recover_known_velocities(path):
         ground = z[j] + (z[j + 1] - z[j]) * f - 0.25  # ground given, below the chord
         rows.append([names[j], d, zs - ground, ground])
     table = reduce_survey(
-        points(names, x, z),
-        trees(rows),
+        Survey(points(names, x, z), trees(rows)),
         ReduceOptions("syn", None, resolve_body(mass_kg=100.0)),
     )
     f = table.frame
@@ -124,8 +123,7 @@ def test_tree_strikes_recover_known_velocities(path):
 def test_assumed_theta0_on_the_chord():
     x, z = np.array([0.0, 10.0, 20.0, 30.0]), np.array([30.0, 24.0, 18.0, 12.0])
     table = reduce_survey(
-        points(["a", "b", "c", "d"], x, z),
-        None,
+        Survey(points(["a", "b", "c", "d"], x, z), None),
         ReduceOptions("p", 32.6, resolve_body()),
     )
     f = table.frame
@@ -145,7 +143,7 @@ def test_assumed_theta0_on_the_chord():
 def test_given_theta0_wins_over_assumed():
     x, z = np.array([0.0, 10.0, 20.0]), np.array([20.0, 14.0, 8.0])
     pts = points(["a", "b", "c"], x, z, theta0_deg=[np.nan, 20.0, np.nan])
-    f = reduce_survey(pts, None, ReduceOptions("p", 40.0)).frame
+    f = reduce_survey(Survey(pts, None), ReduceOptions("p", 40.0)).frame
     assert f["theta0_source"].tolist()[:2] == ["assumed", "given"]
     assert f["theta0_deg"].iloc[1] == pytest.approx(20.0)
 
@@ -154,15 +152,17 @@ def test_errors_name_the_file_and_point_or_row():
     x, z = np.array([0.0, 10.0, 20.0]), np.array([20.0, 14.0, 8.0])
     pts = points(["a", "b", "c"], x, z)
     with pytest.raises(ArgumentError, match=r"synthetic.csv: point b: .*--theta0"):
-        reduce_survey(pts, None, ReduceOptions("p", None))
+        reduce_survey(Survey(pts, None), ReduceOptions("p", None))
     below = trees([["a", 5.0, 0.5, 14.0]])  # strike at 14.5 m, chord at 17 m
     with pytest.raises(PhysicsError, match=r"trees.csv: row 2: .*no parabola"):
-        reduce_survey(pts, below, ReduceOptions("p", 30.0))
+        reduce_survey(Survey(pts, below), ReduceOptions("p", 30.0))
     last = trees([["c", 1.0, 1.0, 8.0]])
     with pytest.raises(InputFileError, match=r"trees.csv: row 2: .*last point"):
-        reduce_survey(pts, last, ReduceOptions("p", 30.0))
+        reduce_survey(Survey(pts, last), ReduceOptions("p", 30.0))
     with pytest.raises(InputFileError, match="at least two points"):
-        reduce_survey(points(["a"], [0.0], [1.0]), None, ReduceOptions("p", 30.0))
+        reduce_survey(
+            Survey(points(["a"], [0.0], [1.0]), None), ReduceOptions("p", 30.0)
+        )
 
 
 def test_body_options():
@@ -189,7 +189,7 @@ def test_summary_statistics_by_material():
     z = np.array([40.0, 34.0, 28.0, 22.0, 16.0])
     pts = points(list("abcde"), x, z, material=["rock", "rock", "talus", "talus", "x"])
     table = reduce_survey(
-        pts, None, ReduceOptions("p", 30.0, resolve_body(mass_kg=10.0))
+        Survey(pts, None), ReduceOptions("p", 30.0, resolve_body(mass_kg=10.0))
     )
     s = summarize(table)
     f = table.frame

@@ -17,9 +17,10 @@ from dataclasses import replace
 import pandas as pd
 import pytest
 
-from fieldkit.io.points import read_impacts
+from fieldkit.io.impacts import read_impacts
 from fieldkit.reduce.body import resolve_body
 from fieldkit.reduce.pipeline import ReduceOptions, reduce_survey
+from fieldkit.survey import Survey
 
 
 def reduce_section(path, mass_kg):
@@ -28,7 +29,7 @@ def reduce_section(path, mass_kg):
     frame = points.frame.copy()
     frame["theta0_deg"] = given
     options = ReduceOptions(path_id=path.stem, body=resolve_body(mass_kg=mass_kg))
-    table = reduce_survey(replace(points, frame=frame), None, options)
+    table = reduce_survey(Survey(replace(points, frame=frame), None), options)
     return table.frame.set_index("point")
 
 

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from types import SimpleNamespace
-
 import numpy as np
 import pandas as pd
 import pytest
@@ -11,6 +9,7 @@ import pytest
 from fieldkit.physics.constants import G
 from fieldkit.reduce.body import resolve_body
 from fieldkit.reduce.pipeline import ReduceOptions, reduce_survey
+from fieldkit.survey import PointSet, Survey, TreeStrikes
 from fieldkit.viz.energy_figure import energy_profile, plot_energy_partition
 from fieldkit.viz.restitution_figure import plot_en_theta, plot_et_impacts
 from fieldkit.viz.section_figure import _trees_xy, detail_row, flight_paths
@@ -20,11 +19,11 @@ from fieldkit.viz.section_figure import _trees_xy, detail_row, flight_paths
 def reduced():
     x = np.array([0.0, 10.0, 22.0, 31.0, 45.0])
     z = np.array([60.0, 52.0, 44.0, 39.0, 30.0])
-    points = SimpleNamespace(
+    points = PointSet(
         frame=pd.DataFrame({"point": list("abcde"), "x_m": x, "z_m": z}),
         source="p.csv",
     )
-    trees = SimpleNamespace(
+    trees = TreeStrikes(
         frame=pd.DataFrame(
             {
                 "after_impact": ["b"],
@@ -37,12 +36,13 @@ def reduced():
         source="t.csv",
     )
     body = resolve_body(mass_kg=500.0, radius_m=0.36, gyration_m=0.295)
-    return reduce_survey(points, trees, ReduceOptions("p", 30.0, body)), trees
+    survey = Survey(points, trees)
+    return reduce_survey(survey, ReduceOptions("p", 30.0, body)), survey
 
 
 def test_tree_strike_lies_on_the_drawn_flight(reduced):
-    table, trees = reduced
-    ((xt, ground, strike),) = _trees_xy(table, trees)
+    table, survey = reduced
+    ((xt, ground, strike),) = _trees_xy(table, survey)
     assert xt == pytest.approx(16.0)
     assert ground == pytest.approx(52.0 - 8.0 * 6.0 / 12.0)  # on the chord b -> c
     xs, zs, source = flight_paths(table, n_samples=4001)[1]
@@ -66,7 +66,7 @@ def test_energy_profile_conserves_energy_in_flight(reduced):
 
 
 def test_energy_partition_without_mass_says_so():
-    points = SimpleNamespace(
+    points = PointSet(
         frame=pd.DataFrame(
             {
                 "point": ["a", "b", "c"],
@@ -76,7 +76,7 @@ def test_energy_partition_without_mass_says_so():
         ),
         source="p.csv",
     )
-    table = reduce_survey(points, None, ReduceOptions("p", 30.0))
+    table = reduce_survey(Survey(points, None), ReduceOptions("p", 30.0))
     fig = plot_energy_partition(table)
     texts = [t.get_text() for ax in fig.axes for t in ax.texts]
     assert any("no mass" in t for t in texts)
