@@ -13,7 +13,7 @@ import typer
 from fieldkit.cli.common import GyrationOpt, MassOpt, RadiusOpt, one_line_errors, warn
 from fieldkit.errors import ArgumentError
 from fieldkit.impact_table import FORMATS
-from fieldkit.outputs import atomic_path, refuse_input_overwrite, write_atomic
+from fieldkit.outputs import atomic_path, refuse_input_overwrite
 
 #: show a progress bar for videos longer than this many frames
 PROGRESS_MIN_FRAMES = 300
@@ -213,10 +213,7 @@ def track(
         warn(message)
 
     if out is not None:
-        frame = analysis.track.frame
-        write_atomic(
-            out, lambda tmp: frame.to_csv(tmp, index=False, float_format="%.9g")
-        )
+        analysis.track.write(out)
     if impacts is not None:
         analysis.impacts.write(impacts)
     if rrd is not None:

@@ -6,15 +6,13 @@ from enum import StrEnum
 from pathlib import Path
 from typing import Annotated
 
-import pandas as pd
 import typer
 
 from fieldkit.cli.common import GyrationOpt, MassOpt, RadiusOpt, one_line_errors, warn
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.impact_table import ImpactTable
-from fieldkit.io.csv_table import detect_delimiter, read_text, split_row
+from fieldkit.io.track_files import detect_format, read_track
 from fieldkit.outputs import refuse_input_overwrite
-from fieldkit.track import Track
 
 
 class InputFormat(StrEnum):
@@ -126,7 +124,15 @@ def view(
         rerun_log.write_impact_recording(out, table.derive())
         typer.echo(f"wrote {out}: {len(table)} impacts, {len(table.paths())} path(s)")
         return
-    track = _read_track(input_file, fmt, unit, metres_per_pixel, y_down, fps, file_fps)
+    track = read_track(
+        input_file,
+        fmt,
+        unit=unit,
+        metres_per_pixel=metres_per_pixel,
+        y_down=y_down,
+        fps=fps,
+        file_fps=file_fps,
+    )
     if radius is None:
         raise ArgumentError(
             "a track needs the body radius to analyse its impacts", source="--radius"
@@ -152,85 +158,3 @@ def view(
         f"wrote {out}: {len(analysis.track)} samples, {len(analysis.flights)} flights, "
         f"{len(analysis.impacts)} impacts, {len(analysis.contacts)} net contacts"
     )
-
-
-def detect_format(path: Path) -> str:
-    """``impacts``, ``track``, ``tracker`` or ``kinovea`` from a file's first lines."""
-    if path.suffix.lower() in (".parquet", ".xlsx"):
-        return "impacts"
-    lines = [ln for ln in read_text(path, kind="input").splitlines()[:3] if ln.strip()]
-    first = lines[0].strip()
-    delimiter = detect_delimiter(first, default=" ")
-    cells = [c.strip().strip('"') for c in split_row(first, delimiter)]
-    if first.lower().startswith("#multi"):
-        return "tracker"
-    if {"path_id", "vi_x_mps"} <= set(cells):
-        return "impacts"
-    if {"t_s", "x_m", "z_m"} <= set(cells):
-        return "track"
-    if (
-        cells
-        and cells[0].lower().startswith("time")
-        and any("x" in c.lower() for c in cells[1:])
-    ):
-        return "kinovea"
-    if len(lines) > 1:
-        second = lines[1]
-        delimiter = detect_delimiter(second, default=" ")
-        names = {c.strip() for c in split_row(second, delimiter)}
-        if {"t", "x", "y"} <= names:
-            return "tracker"
-    raise InputFileError(
-        "cannot tell what this file is (ImpactTable, track CSV, Tracker or Kinovea "
-        "export); give --format",
-        source=path,
-        where="row 1",
-    )
-
-
-def _read_track(path, fmt, unit, metres_per_pixel, y_down, fps, file_fps) -> Track:
-    if fmt == "tracker":
-        from fieldkit.io.osp_tracker import read_osp_tracker
-
-        return read_osp_tracker(
-            path,
-            unit=unit or "m",
-            metres_per_pixel=metres_per_pixel,
-            fps=fps,
-            file_fps=file_fps,
-        )
-    if fmt == "kinovea":
-        from fieldkit.io.kinovea import read_kinovea
-
-        return read_kinovea(
-            path,
-            unit=unit,
-            metres_per_pixel=metres_per_pixel,
-            y_down=y_down,
-            fps=fps,
-            file_fps=file_fps,
-        )
-    try:
-        frame = pd.read_csv(path)
-    except (ValueError, OSError, pd.errors.ParserError) as exc:
-        raise InputFileError(f"cannot read CSV: {exc}", source=path) from None
-    for col in ("t_s", "x_m", "z_m"):
-        if col not in frame:
-            raise InputFileError(
-                f"track lacks column {col}", source=path, where="row 1"
-            )
-        values = pd.to_numeric(frame[col], errors="coerce")
-        bad = frame[col].notna() & values.isna()
-        if bad.any():
-            row = int(bad.to_numpy().nonzero()[0][0]) + 2
-            raise InputFileError(
-                f"column {col}: {frame[col][bad].iloc[0]!r} is not a number",
-                source=path,
-                where=f"row {row}",
-            )
-        frame[col] = values
-    if fps is not None or file_fps is not None:
-        from fieldkit.io.tracking_export import time_factor
-
-        frame["t_s"] = frame["t_s"] * time_factor(file_fps, fps, path)
-    return Track(frame, source=str(path), fps=fps)
