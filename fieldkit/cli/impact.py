@@ -32,8 +32,10 @@ from fieldkit.physics.impulse_history import impulse_history
 from fieldkit.physics.restitution import (
     ANGLE_LAW_A,
     ANGLE_LAW_B,
-    RESTITUTION_LAWS,
     VELOCITY_SCALE_MPS,
+    angle_dependent_restitution,
+    constant_restitution,
+    velocity_scaled_restitution,
 )
 
 #: Library argument names -> the command-line options the user typed.
@@ -150,6 +152,10 @@ def _body(
     return Body(1.0 if mass is None else mass, radius, gyration), mass is not None
 
 
+#: --law choices: constant e_N (--en), eq. 5.4 (angle), eq. 7.1 (velocity).
+_LAWS = ("constant", "angle", "velocity")
+
+
 def _restitution(
     law: str | None,
     en: float | None,
@@ -166,21 +172,19 @@ def _restitution(
         raise ArgumentError(
             "give --en E (constant e_N) or a restitution law, e.g. --law angle"
         )
-    if law not in RESTITUTION_LAWS:
-        raise ArgumentError(
-            f"--law must be one of {', '.join(RESTITUTION_LAWS)} (got {law!r})"
-        )
+    if law not in _LAWS:
+        raise ArgumentError(f"--law must be one of {', '.join(_LAWS)} (got {law!r})")
     if law == "angle":
         if en is not None:
             raise ArgumentError("--en is not used with --law angle (it gives e_N)")
-        e = float(RESTITUTION_LAWS["angle"](a, b)(theta_i_deg, v_in))
+        e = float(angle_dependent_restitution(theta_i_deg, a, b))
         return e, f"eq. 5.4, {a:g} x {theta_i_deg:.1f}^-{b:g}"
     if en is None:
         raise ArgumentError(f"--law {law} needs --en")
     if law == "velocity":
-        e = float(RESTITUTION_LAWS["velocity"](en, scale)(theta_i_deg, v_in))
+        e = float(velocity_scaled_restitution(v_in, en, scale))
         return e, f"eq. 7.1, {en:g} / (1 + ({v_in:.2f}/{scale:g})^2)"
-    e = float(RESTITUTION_LAWS["constant"](en)(theta_i_deg, v_in))
+    e = float(constant_restitution(en))
     return e, "constant"
 
 

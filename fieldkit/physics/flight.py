@@ -16,11 +16,12 @@ are re-exported here.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from fieldkit.errors import PhysicsError
+from fieldkit.errors import ArgumentError, PhysicsError
 from fieldkit.physics._validate import (
     as_output,
     check_forward_angle,
@@ -41,8 +42,10 @@ from fieldkit.physics.flight_heights import (
 
 __all__ = [
     "Flight",
+    "FlightSamples",
     "ballistic_reachable",
     "flight_between",
+    "flight_samples",
     "launch_angle",
     "launch_speed",
     "max_normal_height",
@@ -141,6 +144,85 @@ def trajectory_velocity(
     vx = v0 * np.cos(alpha) * np.ones_like(t)
     vz = v0 * np.sin(alpha) - g * t
     return as_output(vx), as_output(vz)
+
+
+class FlightSamples(NamedTuple):
+    """A flight sampled in time (:func:`flight_samples`); section-frame values."""
+
+    t_s: np.ndarray
+    x_m: np.ndarray
+    z_m: np.ndarray
+    vx_mps: np.ndarray
+    vz_mps: np.ndarray
+
+    @property
+    def speed_mps(self) -> np.ndarray:
+        """Speed at each sample [m/s]."""
+        return np.hypot(self.vx_mps, self.vz_mps)
+
+
+def flight_samples(
+    x0_m: ArrayLike,
+    z0_m: ArrayLike,
+    vx_mps: ArrayLike,
+    vz_mps: ArrayLike,
+    duration_s: ArrayLike,
+    n_samples: int = 51,
+    g: float = G,
+) -> FlightSamples:
+    """Positions and velocities along a flight from its launch state (eqs. 3.1-3.3).
+
+    ``n_samples`` instants equally spaced from launch (``t = 0``) to ``duration_s``:
+    ``x = x0 + vx t``, ``z = z0 + vz t - g t^2 / 2``, velocity ``(vx, vz - g t)``.
+    Unlike :func:`trajectory_position` the launch is given by its section-frame
+    position and velocity components (an ImpactTable's ``x_m``, ``z_m``,
+    ``vf_x_mps``, ``vf_z_mps`` and ``flight_time_s``), and positions are absolute.
+
+    Parameters
+    ----------
+    x0_m, z0_m
+        Launch point [m].
+    vx_mps, vz_mps
+        Launch velocity [m/s] (``vz > 0`` rising).
+    duration_s
+        Flight time [s], >= 0 (NaN gives NaN samples).
+    n_samples
+        Number of instants, >= 2.
+    g
+        Gravitational acceleration [m/s^2].
+
+    Returns
+    -------
+    FlightSamples
+        ``t_s``, ``x_m``, ``z_m``, ``vx_mps``, ``vz_mps`` (and ``speed_mps``); the
+        arguments broadcast together, the samples run along a new last axis.
+
+    Examples
+    --------
+    >>> s = flight_samples(0.0, 10.0, 3.0, 4.0, 1.0, n_samples=3, g=10.0)
+    >>> s.x_m.tolist(), s.z_m.tolist(), s.vz_mps.tolist()
+    ([0.0, 1.5, 3.0], [10.0, 10.75, 9.0], [4.0, -1.0, -6.0])
+    >>> s.speed_mps.tolist()
+    [5.0, 3.1622776601683795, 6.708203932499369]
+    """
+    check_gravity(g)
+    if int(n_samples) < 2:
+        raise ArgumentError(
+            f"n_samples must be at least 2, got {n_samples}", source="n_samples"
+        )
+    duration = np.asarray(duration_s, float)
+    check_nonnegative(duration, "duration_s", "s")
+    t = np.linspace(0.0, duration, int(n_samples), axis=-1)
+    x0, z0, vx, vz = (
+        np.asarray(a, float)[..., np.newaxis] for a in (x0_m, z0_m, vx_mps, vz_mps)
+    )
+    return FlightSamples(
+        t_s=t,
+        x_m=x0 + vx * t,
+        z_m=z0 + vz * t - 0.5 * g * t**2,
+        vx_mps=vx * np.ones_like(t),
+        vz_mps=vz - g * t,
+    )
 
 
 def launch_angle(theta0_deg: ArrayLike, slope_deg: ArrayLike) -> np.ndarray:

@@ -1,22 +1,19 @@
 """Normal coefficient of restitution laws (thesis eqs. 4.6, 5.4, 7.1).
 
-Three laws, each a small pure function plus a frozen dataclass with the same
-call signature ``law(theta_i_deg, v_in_mps) -> e_n`` so a forward model can hold any of
-them:
+Three pure functions, each returning ``e_N``:
 
-* :class:`ConstantRestitution` - a fixed ``e_N`` per material (RocFall/CRSP base model);
-* :class:`AngleDependentRestitution` - ``e_N = a theta_i^(-b)`` (eq. 5.4, thesis best
+* :func:`constant_restitution` - a fixed ``e_N`` per material (RocFall/CRSP base
+  model, eq. 4.6);
+* :func:`angle_dependent_restitution` - ``e_N = a theta_i^(-b)`` (eq. 5.4, thesis best
   fit a = 19.5, b = 1.03 with theta_i in degrees);
-* :class:`VelocityScaledRestitution` - ``v_fN = e_N |v_iN| / (1 + (v_iN/K)^2)``
+* :func:`velocity_scaled_restitution` - ``v_fN = e_N |v_iN| / (1 + (v_iN/K)^2)``
   (eq. 7.1, RocFall/CRSP; K = 9.144 m/s = 30 ft/s, the thesis's "9.14 m/s").
 
-``e_N > 1`` is legal (shallow impacts, thesis §5.2.1); laws never cap it.
-:data:`RESTITUTION_LAWS` maps names to the classes.
+The last two carry the effect names of ARCHITECTURE §5. ``e_N > 1`` is legal (shallow
+impacts, thesis §5.2.1); laws never cap it.
 """
 
 from __future__ import annotations
-
-from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -46,6 +43,22 @@ def _require(name: str, bad: np.ndarray, requirement: str, value: np.ndarray) ->
         raise ArgumentError(f"{name} must be {requirement} (got {first.flat[0]:g})")
 
 
+def constant_restitution(e_n: ArrayLike) -> np.ndarray:
+    """A constant normal coefficient of restitution ``e_N`` (eq. 4.6), ``>= 0``.
+
+    The base model of RocFall and CRSP: one ``e_N`` per slope material, whatever the
+    impact angle and speed.
+
+    Examples
+    --------
+    >>> float(constant_restitution(0.35))
+    0.35
+    """
+    e = np.asarray(e_n, float)
+    _require("e_n", ~(e >= 0), ">= 0", e)
+    return e[()]
+
+
 def angle_dependent_restitution(
     theta_i_deg: ArrayLike, a: float = ANGLE_LAW_A, b: float = ANGLE_LAW_B
 ) -> np.ndarray:
@@ -65,10 +78,10 @@ def angle_dependent_restitution(
     >>> [round(float(e), 2) for e in angle_dependent_restitution([25.0, 50.0])]
     [0.71, 0.35]
     """
-    theta = _finite("theta_i_deg", theta_i_deg)
-    _require("theta_i_deg", ~((theta > 0) & (theta <= 90)), "in (0, 90] deg", theta)
     _require("a", ~(np.asarray(a, float) > 0), "> 0", np.asarray(a, float))
     _require("b", ~(np.asarray(b, float) >= 0), ">= 0", np.asarray(b, float))
+    theta = _finite("theta_i_deg", theta_i_deg)
+    _require("theta_i_deg", ~((theta > 0) & (theta <= 90)), "in (0, 90] deg", theta)
     return a * theta ** (-b)
 
 
@@ -92,83 +105,3 @@ def velocity_scaled_restitution(
     scale = np.asarray(velocity_scale_mps, float)
     _require("velocity_scale_mps", ~(scale > 0), "> 0", scale)
     return e0 / (1.0 + (v_in / scale) ** 2)
-
-
-@dataclass(frozen=True)
-class ConstantRestitution:
-    """A constant normal coefficient of restitution ``e_N`` (eq. 4.6).
-
-    Examples
-    --------
-    >>> float(ConstantRestitution(0.35)(40.0, -8.0))
-    0.35
-    """
-
-    e_n: float
-
-    name = "constant"
-
-    def __post_init__(self) -> None:
-        _require("e_n", ~(np.asarray(self.e_n, float) >= 0), ">= 0", self.e_n)
-
-    def __call__(self, theta_i_deg: ArrayLike, v_in_mps: ArrayLike) -> np.ndarray:
-        shape = np.broadcast_shapes(np.shape(theta_i_deg), np.shape(v_in_mps))
-        return np.full(shape, float(self.e_n))[()]
-
-
-@dataclass(frozen=True)
-class AngleDependentRestitution:
-    """``e_N = a theta_i^(-b)`` (eq. 5.4); the impact speed is not used.
-
-    Examples
-    --------
-    >>> round(float(AngleDependentRestitution()(25.0, -9.3)), 3)
-    0.708
-    """
-
-    a: float = ANGLE_LAW_A
-    b: float = ANGLE_LAW_B
-
-    name = "angle_dependent_restitution"
-
-    def __post_init__(self) -> None:
-        _require("a", ~(np.asarray(self.a, float) > 0), "> 0", self.a)
-        _require("b", ~(np.asarray(self.b, float) >= 0), ">= 0", self.b)
-
-    def __call__(self, theta_i_deg: ArrayLike, v_in_mps: ArrayLike) -> np.ndarray:
-        e = angle_dependent_restitution(theta_i_deg, self.a, self.b)
-        return np.broadcast_to(e, np.broadcast_shapes(e.shape, np.shape(v_in_mps)))[()]
-
-
-@dataclass(frozen=True)
-class VelocityScaledRestitution:
-    """``e_N / (1 + (v_iN/K)^2)`` (eq. 7.1); the impact angle is not used.
-
-    Examples
-    --------
-    >>> round(float(VelocityScaledRestitution(0.8)(30.0, -9.144)), 3)
-    0.4
-    """
-
-    e_n: float
-    velocity_scale_mps: float = VELOCITY_SCALE_MPS
-
-    name = "velocity_scaled_restitution"
-
-    def __post_init__(self) -> None:
-        _require("e_n", ~(np.asarray(self.e_n, float) >= 0), ">= 0", self.e_n)
-        scale = self.velocity_scale_mps
-        _require("velocity_scale_mps", ~(np.asarray(scale, float) > 0), "> 0", scale)
-
-    def __call__(self, theta_i_deg: ArrayLike, v_in_mps: ArrayLike) -> np.ndarray:
-        e = velocity_scaled_restitution(v_in_mps, self.e_n, self.velocity_scale_mps)
-        shape = np.broadcast_shapes(e.shape, np.shape(theta_i_deg))
-        return np.broadcast_to(e, shape)[()]
-
-
-#: Restitution laws by name (CLI ``--law`` and model files).
-RESTITUTION_LAWS = {
-    "constant": ConstantRestitution,
-    "angle": AngleDependentRestitution,
-    "velocity": VelocityScaledRestitution,
-}

@@ -20,6 +20,7 @@ from matplotlib.figure import Figure
 from fieldkit.impact_table import ImpactTable
 from fieldkit.physics.constants import G
 from fieldkit.physics.energy import energy_head, kinetic_energy
+from fieldkit.physics.flight import flight_samples
 from fieldkit.viz.figure_files import save_png
 
 
@@ -42,10 +43,12 @@ def energy_profile(table: ImpactTable, n_samples: int = 30) -> dict[str, np.ndar
             res.append(row.re_i_j)
         if not np.isfinite(row.flight_time_s):
             continue
-        t = np.linspace(0.0, row.flight_time_s, n_samples)
-        xs.extend(row.x_m + row.vf_x_mps * t)
-        zs.extend(row.z_m + row.vf_z_mps * t - 0.5 * G * t**2)
-        speeds.extend(np.hypot(row.vf_x_mps, row.vf_z_mps - G * t))
+        s = flight_samples(
+            row.x_m, row.z_m, row.vf_x_mps, row.vf_z_mps, row.flight_time_s, n_samples
+        )
+        xs.extend(s.x_m)
+        zs.extend(s.z_m)
+        speeds.extend(s.speed_mps)
         res.extend(np.full(n_samples, row.re_f_j))
     x, z, v = np.asarray(xs), np.asarray(zs), np.asarray(speeds)
     return {
@@ -129,7 +132,7 @@ def plot_energy_head(table: ImpactTable) -> Figure:
         label=r"energy head $E = z + v^2/2g$ (eq. 6.14)",
     )
     ax.plot(p["x_m"], p["z_m"], color="#1f4e9c", lw=0.7, ls="--", label="flight paths")
-    head_i = energy_head(z, f["vi_mps"].to_numpy(float))
+    head_i = f["energy_head_i_m"].to_numpy(float)
     ax.plot(x, head_i, "v", color="#c62828", ms=3.5, label="before impact")
     ax.set_xlabel("x, horizontal distance along the path [m]")
     ax.set_ylabel("elevation / energy head [m]")

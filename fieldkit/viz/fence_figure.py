@@ -102,6 +102,7 @@ def _draw_time_force(
 def _draw_energy(ax: Axes, split: FenceEnergySplit) -> None:
     ke = np.array([float(split.kinetic_in_j), float(split.kinetic_out_j)]) / 1e3
     re = np.array([float(split.rotational_in_j), float(split.rotational_out_j)]) / 1e3
+    totals = np.array([float(split.total_in_j), float(split.total_out_j)]) / 1e3
     x = np.array([0.0, 1.0])
     ax.bar(x, ke, 0.6, color="#fdae6b", label="kinetic 1/2 m v^2")
     ax.bar(x, re, 0.6, bottom=ke, color="#a1d99b", label="rotational 1/2 I w^2")
@@ -110,17 +111,17 @@ def _draw_energy(ax: Axes, split: FenceEnergySplit) -> None:
         [1.0],
         [absorbed],
         0.6,
-        bottom=[ke[1] + re[1]],
+        bottom=[totals[1]],
         color="#e0e0e0",
         hatch="///",
         edgecolor="#9e9e9e",
         label="absorbed by the fence",
     )
-    for xi, total in zip(x, ke + re, strict=True):
+    for xi, total in zip(x, totals, strict=True):
         ax.text(xi, total, f"{total:.1f} kJ", ha="center", va="bottom", fontsize=8)
     ax.text(
         1.0,
-        ke[1] + re[1] + absorbed / 2,
+        totals[1] + absorbed / 2,
         f"{absorbed:.1f} kJ\n({float(split.absorbed_fraction):.0%})",
         ha="center",
         va="center",

@@ -36,7 +36,7 @@ import rerun.blueprint as rrb
 
 from fieldkit.impact_table import ImpactTable
 from fieldkit.outputs import atomic_path
-from fieldkit.tracking.flights.net_contacts import local_velocity
+from fieldkit.physics.local_axes import to_section
 from fieldkit.tracking.flights.pipeline import TrackAnalysis
 from fieldkit.viz.image_projection import project, world_to_image
 
@@ -241,12 +241,7 @@ def _log_series(rec: rr.RecordingStream, analysis: TrackAnalysis) -> None:
     f = analysis.track.frame
     frames = f["frame"].to_numpy(int)
     t = f["t_s"].to_numpy(float)
-    ok = np.isfinite(t) & np.isfinite(f["x_m"]) & np.isfinite(f["z_m"])
-    measured = np.full(len(f), np.nan)
-    if ok.sum() >= 5:
-        vx = local_velocity(t[ok], f.loc[ok, "x_m"].to_numpy(float))
-        vz = local_velocity(t[ok], f.loc[ok, "z_m"].to_numpy(float))
-        measured[ok] = np.hypot(vx, vz)
+    measured = np.hypot(*analysis.measured_velocity)
     fitted = np.full(len(f), np.nan)
     for fl in analysis.flights:
         vx, vz = fl.velocity(t[fl.rows])
@@ -375,8 +370,8 @@ def _log_section(rec: rr.RecordingStream, f: pd.DataFrame, path_id: str) -> None
         f"{base}/path", rr.LineStrips3D([_xyz(x, z)], colors=_TRACK_COLOUR), static=True
     )
     length = 0.05 * _scale(x, z)
-    psi = np.radians(f["slope_deg"].to_numpy(float))
-    tick = np.column_stack([np.cos(psi), -np.sin(psi)]) * length
+    t_x, t_z = to_section(1.0, 0.0, f["slope_deg"].to_numpy(float))  # local T axis
+    tick = np.column_stack([t_x, t_z]) * length
     strips = [
         _xyz([xi - tx, xi + tx], [zi - tz, zi + tz])
         for xi, zi, (tx, tz) in zip(x, z, tick, strict=True)

@@ -18,10 +18,12 @@ from matplotlib.figure import Figure
 from numpy.typing import ArrayLike
 
 from fieldkit.impact_table import ImpactTable
+from fieldkit.physics.restitution import (
+    ANGLE_LAW_A,
+    ANGLE_LAW_B,
+    angle_dependent_restitution,
+)
 from fieldkit.viz.figure_files import save_png
-
-#: Eq. 5.4 (thesis Fig. 5.7): e_N = a * theta_i**(-b), theta_i in degrees.
-THESIS_EN_LAW = (19.5, 1.03)
 
 MARKERS = {
     "rock": "s",
@@ -54,7 +56,7 @@ def plot_en_theta(
     e_n: ArrayLike,
     *,
     material: Sequence[str] | None = None,
-    law: tuple[float, float] | None = THESIS_EN_LAW,
+    law: tuple[float, float] | None = (ANGLE_LAW_A, ANGLE_LAW_B),
     law_label: str | None = None,
     title: str | None = None,
 ) -> Figure:
@@ -69,8 +71,10 @@ def plot_en_theta(
     material
         Slope material per point (one marker per material), or None.
     law
-        ``(a, b)`` of the power law to draw, default the thesis eq. 5.4
-        ``(19.5, 1.03)``; None draws no curve.
+        ``(a, b)`` of the power law to draw (drawn by
+        :func:`fieldkit.physics.restitution.angle_dependent_restitution`), default
+        the thesis fit of eq. 5.4 ``(ANGLE_LAW_A, ANGLE_LAW_B)`` = ``(19.5, 1.03)``;
+        None draws no curve.
     law_label, title
         Legend text for the curve and figure title (defaults describe eq. 5.4).
 
@@ -100,7 +104,7 @@ def plot_en_theta(
         t = np.linspace(3.0, 90.0, 300)
         ax.plot(
             t,
-            a * t ** (-b),
+            angle_dependent_restitution(t, a, b),
             color="black",
             lw=1.2,
             label=law_label or f"eq. 5.4: $e_N$ = {a:g}·$\\theta_i^{{-{b:g}}}$",
@@ -171,7 +175,7 @@ def write_restitution_figures(
     en_path: str | os.PathLike[str],
     et_path: str | os.PathLike[str],
     *,
-    law: tuple[float, float] | None = THESIS_EN_LAW,
+    law: tuple[float, float] | None = (ANGLE_LAW_A, ANGLE_LAW_B),
 ) -> tuple[Path, Path]:
     """Write the Fig. 5.7 and Fig. 5.8 PNGs of an ImpactTable's impacts."""
     f = table.frame

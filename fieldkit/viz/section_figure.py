@@ -17,7 +17,8 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from fieldkit.impact_table import ImpactTable
-from fieldkit.physics.constants import G
+from fieldkit.physics.flight import flight_samples
+from fieldkit.physics.local_axes import to_section
 from fieldkit.survey import Survey
 from fieldkit.viz.figure_files import save_png
 
@@ -27,16 +28,20 @@ IMPACT_COLOUR = "#b22222"
 
 
 def flight_paths(table: ImpactTable, n_samples: int = 40) -> list[tuple]:
-    """``(x, z, source)`` samples of each flight's parabola (eqs. 3.1, 3.2)."""
+    """``(x, z, source)`` samples of each flight's parabola (eqs. 3.1, 3.2).
+
+    Sampled by :func:`fieldkit.physics.flight.flight_samples` from the table's launch
+    state (``x_m``, ``z_m``, ``vf_x_mps``, ``vf_z_mps``) and ``flight_time_s``.
+    """
     f = table.frame
     out = []
     for row in f.itertuples(index=False):
         if not np.isfinite(row.flight_time_s):
             continue
-        t = np.linspace(0.0, row.flight_time_s, n_samples)
-        x = row.x_m + row.vf_x_mps * t
-        z = row.z_m + row.vf_z_mps * t - 0.5 * G * t**2
-        out.append((x, z, str(row.theta0_source)))
+        s = flight_samples(
+            row.x_m, row.z_m, row.vf_x_mps, row.vf_z_mps, row.flight_time_s, n_samples
+        )
+        out.append((s.x_m, s.z_m, str(row.theta0_source)))
     return out
 
 
@@ -92,7 +97,7 @@ def plot_section(table: ImpactTable, survey: Survey | None = None) -> Figure:
     vfx, vfz = f["vf_x_mps"].to_numpy(float), f["vf_z_mps"].to_numpy(float)
     ok = np.isfinite(vfx) & np.isfinite(vfz)
     if ok.any():
-        top = float(np.nanmax(np.hypot(vfx[ok], vfz[ok])))
+        top = float(np.nanmax(f["vf_mps"].to_numpy(float)[ok]))
         ax.quiver(
             x[ok],
             z[ok],
@@ -149,13 +154,12 @@ def plot_section(table: ImpactTable, survey: Survey | None = None) -> Figure:
 
 def _draw_detail(ax: Axes, row, f, i: int) -> None:
     """Inset: impact ``row`` with v_i, v_f and their N/T components."""
-    psi = np.radians(float(row.slope_deg))
-    tangent = np.array([np.cos(psi), -np.sin(psi)])
-    normal = np.array([np.sin(psi), np.cos(psi)])
+    tangent = np.array(to_section(1.0, 0.0, row.slope_deg))  # local T and N axes
+    normal = np.array(to_section(0.0, 1.0, row.slope_deg))
     p = np.array([row.x_m, row.z_m])
     vi = np.array([row.vi_x_mps, row.vi_z_mps])
     vf = np.array([row.vf_x_mps, row.vf_z_mps])
-    scale = 1.0 / max(np.hypot(*vi), np.hypot(*vf))  # longest vector = 1 unit
+    scale = 1.0 / max(row.vi_mps, row.vf_mps)  # longest vector = 1 unit
     ground = np.array([p - 1.4 * tangent, p + 1.4 * tangent])
     ax.fill(
         [*ground[:, 0], ground[1, 0], ground[0, 0]],

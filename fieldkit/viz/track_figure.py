@@ -20,7 +20,6 @@ from pathlib import Path
 
 import numpy as np
 
-from fieldkit.tracking.flights.net_contacts import local_velocity
 from fieldkit.tracking.flights.pipeline import TrackAnalysis
 from fieldkit.viz.figure_files import new_figure, save_png
 from fieldkit.viz.image_projection import project, world_to_image
@@ -133,14 +132,13 @@ def _speed_spin_figure(path: Path, a: TrackAnalysis) -> Path:
 
     f = a.track.frame
     t = f["t_s"].to_numpy(float)
-    ok = np.isfinite(t) & np.isfinite(f["x_m"]) & np.isfinite(f["z_m"])
+    measured = np.hypot(*a.measured_velocity)
+    ok = np.isfinite(measured)
     fig, (ax1, ax2) = plt.subplots(
         2, 1, figsize=(8, 6), sharex=True, layout="constrained"
     )
-    if ok.sum() >= 5:
-        vx = local_velocity(t[ok], f.loc[ok, "x_m"].to_numpy(float))
-        vz = local_velocity(t[ok], f.loc[ok, "z_m"].to_numpy(float))
-        ax1.plot(t[ok], np.hypot(vx, vz), ".", ms=2, color="0.5", label="measured")
+    if ok.any():
+        ax1.plot(t[ok], measured[ok], ".", ms=2, color="0.5", label="measured")
     for fl in a.flights:
         tt = np.linspace(fl.t_start_s, fl.t_end_s, 50)
         ax1.plot(

@@ -22,6 +22,7 @@ from fieldkit.physics.flight import (
     Flight,
     ballistic_reachable,
     flight_between,
+    flight_samples,
     launch_angle,
     launch_speed,
     max_normal_height,
@@ -71,6 +72,26 @@ def test_position_and_velocity_are_consistent_by_differentiation():
     vx, vz = trajectory_velocity(17.0, 28.0, t)
     np.testing.assert_allclose((x2 - x1) / (2 * step), vx, rtol=1e-8)
     np.testing.assert_allclose((z2 - z1) / (2 * step), vz, atol=1e-7)
+
+
+def test_flight_samples_are_eqs_3_1_to_3_3_from_the_launch_point():
+    # launch at (5, 40) with V0 = 17 m/s at 28 deg: the same path as
+    # trajectory_position/velocity, shifted to the launch point
+    v0, alpha = 17.0, 28.0
+    vx0, vz0 = v0 * math.cos(math.radians(alpha)), v0 * math.sin(math.radians(alpha))
+    s = flight_samples(5.0, 40.0, vx0, vz0, 2.5, n_samples=11)
+    np.testing.assert_allclose(s.t_s, np.linspace(0.0, 2.5, 11), rtol=1e-15)
+    x, z = trajectory_position(v0, alpha, s.t_s)
+    vx, vz = trajectory_velocity(v0, alpha, s.t_s)
+    np.testing.assert_allclose(s.x_m, 5.0 + x, rtol=1e-12)
+    np.testing.assert_allclose(s.z_m, 40.0 + z, rtol=1e-12)
+    np.testing.assert_allclose(s.vx_mps, vx, rtol=1e-12)
+    np.testing.assert_allclose(s.vz_mps, vz, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(s.speed_mps, np.hypot(vx, vz), rtol=1e-12)
+    # arrays broadcast, samples along a new last axis; NaN duration gives NaN
+    b = flight_samples([0.0, 1.0], 0.0, 2.0, [0.0, 3.0], [1.0, np.nan], n_samples=4)
+    assert b.x_m.shape == (2, 4) and b.x_m[0, -1] == pytest.approx(2.0)
+    assert np.isnan(b.z_m[1]).all()
 
 
 def test_eq_3_6_launch_and_restitution_angles():
@@ -344,6 +365,8 @@ def test_ballistic_reachable_agrees_with_launch_speed():
         (lambda: next_impact_on_slope(10.0, 20.0, 90.0), "slope dip must be between"),
         (lambda: next_impact_on_slope(10.0, 135.0, 40.0), "between -90° and 90°"),
         (lambda: vertical_height_above_slope(1.0, 0.0, 5.0, 30.0), "must be positive"),
+        (lambda: flight_samples(0.0, 0.0, 1.0, 1.0, -0.5), "duration_s must not be"),
+        (lambda: flight_samples(0.0, 0.0, 1.0, 1.0, 1.0, 1), "n_samples must be"),
     ],
 )
 def test_impossible_parameters_raise_argument_error(call, message):

@@ -9,12 +9,9 @@ from fieldkit.errors import ArgumentError
 from fieldkit.physics.restitution import (
     ANGLE_LAW_A,
     ANGLE_LAW_B,
-    RESTITUTION_LAWS,
     VELOCITY_SCALE_MPS,
-    AngleDependentRestitution,
-    ConstantRestitution,
-    VelocityScaledRestitution,
     angle_dependent_restitution,
+    constant_restitution,
     velocity_scaled_restitution,
 )
 
@@ -52,19 +49,16 @@ def test_equation_7_1_scaling_factor():
     assert v_fn == pytest.approx(0.5 * 12.0 / (1 + (12.0 / 20.0) ** 2))
 
 
-def test_law_objects_share_a_call_signature():
+def test_law_functions():
     theta = np.array([20.0, 40.0])
     v_in = np.array([-3.0, -12.0])
-    assert ConstantRestitution(0.4)(theta, v_in) == pytest.approx([0.4, 0.4])
-    assert AngleDependentRestitution()(theta, v_in) == pytest.approx(
-        angle_dependent_restitution(theta)
+    assert constant_restitution(0.4) == pytest.approx(0.4)
+    assert angle_dependent_restitution(theta) == pytest.approx(
+        ANGLE_LAW_A * theta ** (-ANGLE_LAW_B)
     )
-    assert VelocityScaledRestitution(0.8, 10.0)(theta, v_in) == pytest.approx(
+    assert velocity_scaled_restitution(v_in, 0.8, 10.0) == pytest.approx(
         0.8 / (1 + (v_in / 10.0) ** 2)
     )
-    assert set(RESTITUTION_LAWS) == {"constant", "angle", "velocity"}
-    assert AngleDependentRestitution.name == "angle_dependent_restitution"
-    assert VelocityScaledRestitution.name == "velocity_scaled_restitution"
 
 
 @pytest.mark.parametrize(
@@ -74,11 +68,11 @@ def test_law_objects_share_a_call_signature():
         (lambda: angle_dependent_restitution(95.0), r"theta_i_deg .* \(got 95\)"),
         (lambda: angle_dependent_restitution(-5.0), r"theta_i_deg"),
         (lambda: angle_dependent_restitution(np.nan), r"theta_i_deg must be finite"),
-        (lambda: AngleDependentRestitution(a=-1.0), r"a must be > 0"),
-        (lambda: AngleDependentRestitution(b=-0.5), r"b must be >= 0"),
-        (lambda: ConstantRestitution(-0.1), r"e_n must be >= 0 \(got -0.1\)"),
+        (lambda: angle_dependent_restitution(25.0, a=-1.0), r"a must be > 0"),
+        (lambda: angle_dependent_restitution(25.0, b=-0.5), r"b must be >= 0"),
+        (lambda: constant_restitution(-0.1), r"e_n must be >= 0 \(got -0.1\)"),
         (
-            lambda: VelocityScaledRestitution(0.5, 0.0),
+            lambda: velocity_scaled_restitution(-3.0, 0.5, 0.0),
             r"velocity_scale_mps must be > 0",
         ),
         (lambda: velocity_scaled_restitution(-3.0, -0.5), r"e_n must be >= 0"),

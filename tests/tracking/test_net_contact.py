@@ -195,3 +195,19 @@ def test_given_net_angle_is_turned_to_face_the_body():
     assert any("from below" in w for w in a.warnings)
     assert row.vin_mps < 0 < row.vfn_mps
     assert row.e_n == pytest.approx(-ref["vfn"] / ref["vin"], abs=0.05)
+
+
+def test_measured_velocity_is_the_local_derivative_of_the_track():
+    # a noiseless parabola: the local quadratic fit is exact; a missing sample is NaN
+    t = np.arange(40) / 200.0
+    frame = pd.DataFrame(
+        {"frame": np.arange(40), "t_s": t, "x_m": 2.0 * t, "z_m": 1.0 + 3.0 * t}
+    )
+    frame["z_m"] -= 0.5 * G * t**2
+    frame.loc[7, "x_m"] = np.nan
+    analysis = analyse_track(Track(frame), radius_m=R)
+    vx, vz = analysis.measured_velocity
+    ok = np.arange(40) != 7
+    np.testing.assert_allclose(vx[ok], 2.0, atol=1e-9)
+    np.testing.assert_allclose(vz[ok], 3.0 - G * t[ok], atol=1e-9)
+    assert np.isnan(vx[7]) and np.isnan(vz[7])

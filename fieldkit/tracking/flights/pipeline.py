@@ -15,6 +15,7 @@ Tracker or Kinovea):
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -26,13 +27,19 @@ from fieldkit.tracking.flights.contact_impacts import (
     build_impact_table,
     find_contact_events,
 )
-from fieldkit.tracking.flights.net_contacts import NetContact, analyse_net_contact
+from fieldkit.tracking.flights.net_contacts import (
+    NetContact,
+    analyse_net_contact,
+    local_velocity,
+)
 from fieldkit.tracking.flights.segmentation import find_flights
 
 #: Fewest samples a track needs to be analysed.
 MIN_TRACK_SAMPLES = 10
 #: Fewest samples left in a flight trimmed at a soft contact.
 MIN_FLIGHT_SAMPLES = 8
+#: Fewest usable samples for the measured velocities of a track.
+MIN_VELOCITY_SAMPLES = 5
 
 
 @dataclass
@@ -53,6 +60,8 @@ class TrackAnalysis:
         The extended contacts (nets, rolling phases) with their time series.
     warnings
         One-line warnings for the user (gravity off, surface angle assumed, ...).
+    measured_velocity
+        Velocity of every track sample by local differentiation (not from the fits).
     """
 
     track: Track
@@ -60,6 +69,26 @@ class TrackAnalysis:
     impacts: ImpactTable
     contacts: list[NetContact]
     warnings: list[str]
+
+    @cached_property
+    def measured_velocity(self) -> tuple[np.ndarray, np.ndarray]:
+        """Velocity ``(vx, vz)`` [m/s] of every track sample, from the samples alone.
+
+        Local quadratic differentiation of the tracked centre
+        (:func:`fieldkit.tracking.flights.net_contacts.local_velocity`, as in the net
+        contacts) over the samples with finite ``t_s``, ``x_m`` and ``z_m``; NaN for
+        the others, and everywhere when fewer than :data:`MIN_VELOCITY_SAMPLES` are
+        usable. Aligned with the rows of ``track``; computed on first use.
+        """
+        f = self.track.frame
+        t = f["t_s"].to_numpy(float)
+        x, z = f["x_m"].to_numpy(float), f["z_m"].to_numpy(float)
+        ok = np.isfinite(t) & np.isfinite(x) & np.isfinite(z)
+        vx, vz = np.full(len(f), np.nan), np.full(len(f), np.nan)
+        if ok.sum() >= MIN_VELOCITY_SAMPLES:
+            vx[ok] = local_velocity(t[ok], x[ok])
+            vz[ok] = local_velocity(t[ok], z[ok])
+        return vx, vz
 
 
 def analyse_track(
