@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fieldkit.tracking.flights.segmentation import estimate_noise, find_flights
 from fieldkit.tracking.flights.ballistic_fit import fit_flight
+from fieldkit.tracking.flights.segmentation import estimate_noise, find_flights
 from fieldkit.tracking.flights.synthetic_tracks import bouncing_ball
 
 FPS = 1205.0

@@ -17,9 +17,9 @@ import pytest
 from fieldkit.physics.constants import G
 from fieldkit.physics.fences import energy_efficiency
 from fieldkit.physics.local_axes import to_local
+from fieldkit.track import Track
 from fieldkit.tracking.flights.pipeline import analyse_track
 from fieldkit.tracking.flights.synthetic_tracks import net_capture
-from fieldkit.track import Track
 
 MASS, R = 0.14, 0.0375
 

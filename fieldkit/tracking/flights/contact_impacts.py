@@ -1,14 +1,16 @@
 """Impacts from fitted flights: velocities at the contact, surface angle, spin, table.
 
-For each contact between two fitted flights (:mod:`fieldkit.tracking.flights.segmentation`):
+For each contact between two fitted flights
+(:mod:`fieldkit.tracking.flights.segmentation`):
 
 * **Contact time.** A short contact (fewer than ``EXTENDED_CONTACT_SAMPLES`` measured
   samples off both parabolas) is treated as instantaneous: the impact instant is where
   the two fixed-g parabolas come closest (both share ``g``, so their separation is
   linear in time and the instant has a closed form), searched near the gap. An
   extended contact (a net, a rolling phase) starts and ends where the deviation from
-  the adjacent parabola sets in (:func:`fieldkit.tracking.flights.net_contacts.contact_onset`:
-  an onset power law fitted to the deviations, not the first sample beyond noise).
+  the adjacent parabola sets in
+  (:func:`fieldkit.tracking.flights.net_contacts.contact_onset`: an onset power law
+  fitted to the deviations, not the first sample beyond noise).
 * **Velocities.** Impact velocity from the flight before, restitution velocity from the
   flight after, both evaluated at the contact time(s) (fixed-g fits).
 * **Surface angle** ``slope_deg`` (psi, ARCHITECTURE §2), always on the side facing
@@ -34,11 +36,11 @@ import pandas as pd
 
 from fieldkit.impact_table import ImpactTable
 from fieldkit.physics.constants import G
-from fieldkit.tracking.flights.contact_surface import surface_angles
-from fieldkit.tracking.flights.segmentation import EXTENDED_CONTACT_SAMPLES, ContactSpan
-from fieldkit.tracking.flights.ballistic_fit import FlightFit
-from fieldkit.tracking.flights.net_contacts import contact_onset
 from fieldkit.track import Track
+from fieldkit.tracking.flights.ballistic_fit import FlightFit
+from fieldkit.tracking.flights.contact_surface import surface_angles
+from fieldkit.tracking.flights.net_contacts import contact_onset
+from fieldkit.tracking.flights.segmentation import EXTENDED_CONTACT_SAMPLES, ContactSpan
 
 #: Frames beyond the gap searched for the closest approach of the two parabolas (the
 #: samples next to a soft impact fit either parabola within the noise).

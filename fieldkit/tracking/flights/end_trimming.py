@@ -1,7 +1,8 @@
 """Trimming the ends of a flight: samples that belong to the contact, not the flight.
 
-Region growing (:mod:`fieldkit.tracking.flights.segment_growth`) accepts a sample when it is
-consistent with the flight so far; near a contact a few samples pass that should not:
+Region growing (:mod:`fieldkit.tracking.flights.segment_growth`) accepts a sample when
+it is consistent with the flight so far; near a contact a few samples pass that should
+not:
 one or two just after a small impact (low frame rates), or the tail of a soft contact
 whose force has faded below the noise (a net letting go). Each function here takes a
 flight's sample positions and returns them without such end samples. The parabolas are

@@ -23,8 +23,8 @@ import pandas as pd
 
 from fieldkit.physics.constants import G
 from fieldkit.physics.fences import energy_efficiency
-from fieldkit.tracking.flights.ballistic_fit import FlightFit
 from fieldkit.track import Track
+from fieldkit.tracking.flights.ballistic_fit import FlightFit
 
 
 @dataclass

@@ -3,12 +3,12 @@
 :func:`analyse_track` runs the whole chain on any :class:`Track` (from video, OSP
 Tracker or Kinovea):
 
-1. :func:`fieldkit.tracking.flights.segmentation.find_flights` splits the track into ballistic
-   flights (contacts found from the data);
-2. :func:`fieldkit.tracking.flights.ballistic_fit.fit_flight` fits each flight with g free (its g
-   and standard error are checked against 9.81) and with g fixed;
-3. :mod:`fieldkit.tracking.flights.contact_impacts` evaluates the fits at each contact and builds
-   the ImpactTable (surface angle given or estimated);
+1. :func:`fieldkit.tracking.flights.segmentation.find_flights` splits the track into
+   ballistic flights (contacts found from the data);
+2. :func:`fieldkit.tracking.flights.ballistic_fit.fit_flight` fits each flight with g
+   free (its g and standard error are checked against 9.81) and with g fixed;
+3. :mod:`fieldkit.tracking.flights.contact_impacts` evaluates the fits at each contact
+   and builds the ImpactTable (surface angle given or estimated);
 4. :mod:`fieldkit.tracking.flights.net_contacts` describes every extended contact (net).
 """
 
@@ -20,11 +20,14 @@ import numpy as np
 
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.impact_table import ImpactTable
-from fieldkit.tracking.flights.segmentation import find_flights
-from fieldkit.tracking.flights.ballistic_fit import FlightFit, fit_flight
-from fieldkit.tracking.flights.net_contacts import NetContact, analyse_net_contact
 from fieldkit.track import Track
-from fieldkit.tracking.flights.contact_impacts import build_impact_table, find_contact_events
+from fieldkit.tracking.flights.ballistic_fit import FlightFit, fit_flight
+from fieldkit.tracking.flights.contact_impacts import (
+    build_impact_table,
+    find_contact_events,
+)
+from fieldkit.tracking.flights.net_contacts import NetContact, analyse_net_contact
+from fieldkit.tracking.flights.segmentation import find_flights
 
 #: Fewest samples a track needs to be analysed.
 MIN_TRACK_SAMPLES = 10

@@ -38,13 +38,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from fieldkit.tracking.flights.ballistic_fit import fit_flight
-from fieldkit.tracking.flights.segment_growth import grow_segment
 from fieldkit.tracking.flights.end_trimming import (
     stable_end,
     trim_biased_ends,
     trim_ends,
     trim_kinked_ends,
 )
+from fieldkit.tracking.flights.segment_growth import grow_segment
 
 #: A contact with at least this many samples off both flights is extended (a net, a
 #: rolling phase) rather than an impact.

@@ -2,10 +2,10 @@
 
 Three stages, each cheap enough to run at more than decoding speed:
 
-1. **Background model** (:mod:`fieldkit.tracking.video.background`): the per-pixel median
-   of frames sampled across the clip, repaired where a slow or resting body spoils
-   it. A moving body vanishes from it; a static textured scene (plate, net anchors,
-   scale bars) stays.
+1. **Background model** (:mod:`fieldkit.tracking.video.background`): the per-pixel
+   median of frames sampled across the clip, repaired where a slow or resting body
+   spoils it. A moving body vanishes from it; a static textured scene (plate, net
+   anchors, scale bars) stays.
 2. **Candidates**: colour difference to the background (largest channel difference,
    so a coloured ball on a grey scene of the same brightness still stands out), a
    threshold set from the measured noise, a morphological opening (removes sensor

@@ -14,17 +14,17 @@ import numpy as np
 import pandas as pd
 
 from fieldkit.errors import ArgumentError, InputFileError
+from fieldkit.track import Track
 from fieldkit.tracking.video.background import background_model, flickers
 from fieldkit.tracking.video.calibration import Calibration
 from fieldkit.tracking.video.detection import BallDetector
+from fieldkit.tracking.video.reader import VideoReader
 from fieldkit.tracking.video.spin import (
     angular_velocity,
     marker_angle_world,
     measure_marker,
     unwrap_angle,
 )
-from fieldkit.track import Track
-from fieldkit.tracking.video.reader import VideoReader
 
 #: frames sampled across the clip for the median background
 BACKGROUND_SAMPLES = 11
