@@ -1,9 +1,12 @@
-"""Input checks shared by the flight, three-point and fall-velocity physics.
+"""Input checks shared by the physics modules: the one way physics validates input.
 
-Private to :mod:`fieldkit.physics`. Each check raises a one-line
-:class:`~fieldkit.errors.ArgumentError` or :class:`~fieldkit.errors.PhysicsError`; for
-array inputs ``where`` names the first offending element (``"element 3"``). NaN never
-fails a check, so missing data propagates as NaN.
+Private to :mod:`fieldkit.physics`. Every check raises a one-line
+:class:`~fieldkit.errors.ArgumentError` (or :class:`~fieldkit.errors.PhysicsError`)
+through :func:`raise_at_first`: ``source`` names the argument, ``where`` the first
+offending element of an array (``"element 3"``), and the message reads
+``"<name> must <requirement> (got <value>)"``. The range checks let NaN pass, so
+missing data propagates as NaN; :func:`number_array` is for arguments that must be
+numbers.
 """
 
 from __future__ import annotations
@@ -54,30 +57,63 @@ def as_output(value: ArrayLike) -> np.ndarray:
     return value[()] if value.ndim == 0 else value
 
 
+def reject(
+    bad: ArrayLike,
+    name: str,
+    requirement: str,
+    value: ArrayLike,
+    *,
+    unit: str = "",
+    error: type[FieldkitError] = ArgumentError,
+) -> None:
+    """Raise ``"<name> must <requirement> (got <value> <unit>)"`` at the first bad one.
+
+    Examples
+    --------
+    >>> reject(np.array([1.0, -2.0]) < 0, "e_n", "be >= 0", [1.0, -2.0])
+    Traceback (most recent call last):
+    ...
+    fieldkit.errors.ArgumentError: e_n: element 1: e_n must be >= 0 (got -2)
+    """
+    suffix = f" {unit}" if unit else ""
+    raise_at_first(
+        bad,
+        lambda v: f"{name} must {requirement} (got {v:g}{suffix})",
+        value,
+        error=error,
+        source=name,
+    )
+
+
+def number_array(value: ArrayLike, name: str) -> np.ndarray:
+    """``value`` as a float array; ArgumentError naming ``name`` unless all are numbers
+    (NaN included)."""
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ArgumentError(
+            f"{name} must be a number (got {value!r})", source=name
+        ) from None
+    reject(np.isnan(array), name, "be a number", array)
+    return array
+
+
 def check_gravity(g: float) -> None:
-    """ArgumentError unless ``g > 0``."""
-    if not np.all(np.asarray(g, float) > 0):
-        raise ArgumentError(f"gravity g must be positive, got {g}", source="g")
+    """ArgumentError unless ``g > 0`` (NaN fails)."""
+    g = np.asarray(g, float)
+    raise_at_first(
+        ~(g > 0), lambda v: f"gravity g must be positive (got {v:g})", g, source="g"
+    )
 
 
 def check_nonnegative(value: np.ndarray, name: str, unit: str) -> None:
     """ArgumentError naming ``name`` if any element is negative."""
-    raise_at_first(
-        value < 0,
-        lambda v: f"{name} must not be negative, got {v:g} {unit}",
-        value,
-        source=name,
-    )
+    reject(value < 0, name, "not be negative", value, unit=unit)
 
 
 def check_positive(value: np.ndarray, name: str, unit: str) -> None:
     """ArgumentError naming ``name`` if any element is zero or negative."""
-    raise_at_first(
-        value <= 0,
-        lambda v: f"{name} must be positive, got {v:g} {unit}",
-        value,
-        source=name,
-    )
+    reject(value <= 0, name, "be positive", value, unit=unit)
 
 
 def nonnegative_array(value: ArrayLike, name: str, unit: str = "") -> np.ndarray:
@@ -99,8 +135,8 @@ def check_forward_angle(alpha_deg: np.ndarray) -> None:
     raise_at_first(
         np.abs(alpha_deg) >= 90,
         lambda a: (
-            "launch angle must be between -90° and 90° (travel toward +x), "
-            f"got {a:.1f}°"
+            "launch angle must be between -90° and 90° (travel toward +x) "
+            f"(got {a:.1f}°)"
         ),
         alpha_deg,
         source="alpha_deg",
@@ -111,7 +147,7 @@ def check_into_slope(theta0_deg: np.ndarray, psi_deg: np.ndarray) -> None:
     """ArgumentError for |psi| >= 90°; PhysicsError for a launch into the slope."""
     raise_at_first(
         np.abs(psi_deg) >= 90,
-        lambda p: f"slope dip must be between -90° and 90°, got {p:.1f}°",
+        lambda p: f"slope dip must be between -90° and 90° (got {p:.1f}°)",
         psi_deg,
         source="slope_deg",
     )

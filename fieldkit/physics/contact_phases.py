@@ -20,27 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from fieldkit.errors import ArgumentError
-
-
-def reject(bad: np.ndarray, name: str, requirement: str, value: ArrayLike) -> None:
-    """Raise ArgumentError ``"<name> must be <requirement> (got <first bad value>)"``
-    if any element of ``bad`` is true."""
-    bad = np.atleast_1d(bad)
-    if np.any(bad):
-        values = np.atleast_1d(np.asarray(value, float))
-        shape = np.broadcast_shapes(bad.shape, values.shape)
-        first = np.broadcast_to(values, shape)[np.broadcast_to(bad, shape)]
-        raise ArgumentError(f"{name} must be {requirement} (got {first.flat[0]:g})")
-
-
-def as_argument_array(name: str, value: ArrayLike) -> np.ndarray:
-    try:
-        array = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ArgumentError(f"{name} must be a number (got {value!r})") from None
-    reject(np.isnan(array), name, "a number", array)
-    return array
+from fieldkit.physics._validate import number_array, reject
 
 
 def inertial_coefficients(
@@ -194,29 +174,29 @@ def contact_phases(
     Arguments as :func:`fieldkit.physics.impact_mechanics.rough_body_impact`.
     Raises :class:`ArgumentError` naming the argument for out-of-range input.
     """
-    v_it = as_argument_array("v_it_mps", v_it_mps)
-    v_in = as_argument_array("v_in_mps", v_in_mps)
-    omega_i = as_argument_array("omega_i_radps", omega_i_radps)
-    r_n = as_argument_array("radius_m", radius_m)
-    k = as_argument_array("gyration_m", gyration_m)
-    e = as_argument_array("e_n", e_n)
-    mu = as_argument_array("friction", friction)
-    r_t = as_argument_array("offset_m", offset_m)
-    reject(~np.isfinite(v_it), "v_it_mps", "finite", v_it)
-    reject(~np.isfinite(v_in), "v_in_mps", "finite", v_in)
-    reject(~np.isfinite(omega_i), "omega_i_radps", "finite", omega_i)
-    reject(~(r_n > 0) | ~np.isfinite(r_n), "radius_m", "> 0", r_n)
-    reject(~(k > 0) | ~np.isfinite(k), "gyration_m", "> 0", k)
-    reject(~(e >= 0) | ~np.isfinite(e), "e_n", ">= 0", e)
-    reject(~(mu >= 0), "friction", ">= 0 (inf = slip always stops)", mu)
-    reject(~np.isfinite(r_t), "offset_m", "finite", r_t)
+    v_it = number_array(v_it_mps, "v_it_mps")
+    v_in = number_array(v_in_mps, "v_in_mps")
+    omega_i = number_array(omega_i_radps, "omega_i_radps")
+    r_n = number_array(radius_m, "radius_m")
+    k = number_array(gyration_m, "gyration_m")
+    e = number_array(e_n, "e_n")
+    mu = number_array(friction, "friction")
+    r_t = number_array(offset_m, "offset_m")
+    reject(~np.isfinite(v_it), "v_it_mps", "be finite", v_it)
+    reject(~np.isfinite(v_in), "v_in_mps", "be finite", v_in)
+    reject(~np.isfinite(omega_i), "omega_i_radps", "be finite", omega_i)
+    reject(~(r_n > 0) | ~np.isfinite(r_n), "radius_m", "be > 0", r_n)
+    reject(~(k > 0) | ~np.isfinite(k), "gyration_m", "be > 0", k)
+    reject(~(e >= 0) | ~np.isfinite(e), "e_n", "be >= 0", e)
+    reject(~(mu >= 0), "friction", "be >= 0 (inf = slip always stops)", mu)
+    reject(~np.isfinite(r_t), "offset_m", "be finite", r_t)
     reject(
         np.isinf(mu) & (r_t != 0),
         "friction",
-        "finite for an eccentric impact (offset_m != 0)",
+        "be finite for an eccentric impact (offset_m != 0)",
         mu,
     )
-    reject(~(v_in < 0), "v_in_mps", "< 0 (moving into the ground)", v_in)
+    reject(~(v_in < 0), "v_in_mps", "be < 0 (moving into the ground)", v_in)
 
     v_it, v_in, omega_i, r_n, k, e, mu, r_t = np.broadcast_arrays(
         v_it, v_in, omega_i, r_n, k, e, mu, r_t
@@ -228,7 +208,7 @@ def contact_phases(
     reject(
         ~(normal_i < 0),
         "v_in_mps",
-        "such that the contact point moves into the ground (v_in - omega_i r_T < 0)",
+        "be such that the contact point moves into the ground (v_in - omega_i r_T < 0)",
         v_in,
     )
     s = np.sign(slip_i)

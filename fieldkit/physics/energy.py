@@ -17,12 +17,12 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-from fieldkit.errors import ArgumentError
 from fieldkit.physics._validate import (
     as_output,
     nonnegative_array,
     positive_array,
-    where_first,
+    raise_at_first,
+    reject,
 )
 from fieldkit.physics.constants import G
 from fieldkit.physics.impact_mechanics import compression_impulse, final_impulse
@@ -88,7 +88,7 @@ def rotational_energy_change(
     nonnegative_array(inertia, "inertia_kgm2")
     w_i = np.asarray(omega_i_radps, float)
     w_f = np.asarray(omega_f_radps, float)
-    return _out(-0.5 * inertia * (w_i**2 - w_f**2))
+    return as_output(-0.5 * inertia * (w_i**2 - w_f**2))
 
 
 def total_kinetic_energy(
@@ -112,7 +112,7 @@ def total_kinetic_energy(
     nonnegative_array(inertia, "inertia_kgm2")
     speed = np.asarray(speed_mps, float)
     omega = np.asarray(omega_radps, float)
-    return _out(0.5 * mass * speed**2 + 0.5 * inertia * omega**2)
+    return as_output(0.5 * mass * speed**2 + 0.5 * inertia * omega**2)
 
 
 def total_energy_change(
@@ -143,7 +143,7 @@ def total_energy_change(
         * (np.asarray(speed_f_mps, float) ** 2 - np.asarray(speed_i_mps, float) ** 2)
     )
     rotation = rotational_energy_change(inertia_kgm2, omega_i_radps, omega_f_radps)
-    return _out(translational + rotation)
+    return as_output(translational + rotation)
 
 
 def compression_energy(
@@ -177,7 +177,7 @@ def compression_energy(
     -49.05
     """
     mass, vin, beta = _normal_args(mass_kg, vin_mps, beta)
-    return _out(-mass * vin**2 / (2.0 * beta))
+    return as_output(-mass * vin**2 / (2.0 * beta))
 
 
 def restitution_energy(
@@ -202,7 +202,7 @@ def restitution_energy(
     """
     mass, vin, beta = _normal_args(mass_kg, vin_mps, beta)
     e_n = _restitution_arg(e_n)
-    return _out(e_n**2 * mass * vin**2 / (2.0 * beta))
+    return as_output(e_n**2 * mass * vin**2 / (2.0 * beta))
 
 
 def normal_energy_change(
@@ -223,7 +223,7 @@ def normal_energy_change(
     """
     mass, vin, beta = _normal_args(mass_kg, vin_mps, beta)
     e_n = _restitution_arg(e_n)
-    return _out(-0.5 * mass * vin**2 * (1.0 - e_n**2) / beta)
+    return as_output(-0.5 * mass * vin**2 * (1.0 - e_n**2) / beta)
 
 
 def sliding_friction_energy(
@@ -267,7 +267,7 @@ def sliding_friction_energy(
     """
     mass, slip, p_f, mu = _friction_args(mass_kg, slip_mps, final_impulse_ns, friction)
     b1, b2 = np.asarray(beta1, float), np.asarray(beta2, float)
-    return _out(-mu * p_f / 2.0 * (2.0 * slip - (b2 + mu * b1) * p_f / mass))
+    return as_output(-mu * p_f / 2.0 * (2.0 * slip - (b2 + mu * b1) * p_f / mass))
 
 
 def friction_energy(
@@ -305,7 +305,7 @@ def friction_energy(
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         p_stop = np.where(slope > 0, mass * slip / slope, np.inf)
     p_end = np.minimum(p_f, p_stop)
-    return _out(-mu * (slip * p_end - slope * p_end**2 / (2.0 * mass)))
+    return as_output(-mu * (slip * p_end - slope * p_end**2 / (2.0 * mass)))
 
 
 class ImpactEnergies(NamedTuple):
@@ -376,8 +376,12 @@ def oblique_impact_energies(
     mu = nonnegative_array(friction, "friction")
     b1, b2, b3 = (np.asarray(b, float) for b in (beta1, beta2, beta3))
     beta = b3 + mu * b2
-    if np.any(beta <= 0):
-        raise ArgumentError("beta3 + friction * beta2 must be positive", source="beta3")
+    raise_at_first(
+        beta <= 0,
+        lambda b: f"beta3 + friction * beta2 must be positive (got {b:g})",
+        beta,
+        source="beta3",
+    )
     p_c = compression_impulse(vin, mass, b2, b3, mu)  # eqs. 6.6, C.16
     p_f = final_impulse(p_c, e_n)  # eqs. C.17, C.18
     compression = -mass * vin**2 / (2.0 * beta)
@@ -385,17 +389,16 @@ def oblique_impact_energies(
     tangential = friction_energy if slip_stops else sliding_friction_energy
     work = tangential(mass, slip_mps, p_f, mu, b1, b2)
     return ImpactEnergies(
-        _out(compression),
-        _out(restitution),
-        _out(np.asarray(work)),
-        _out(compression + restitution + work),
-        _out(p_c),
-        _out(p_f),
+        as_output(compression),
+        as_output(restitution),
+        as_output(np.asarray(work)),
+        as_output(compression + restitution + work),
+        as_output(p_c),
+        as_output(p_f),
     )
 
 
 # ------------------------------------------------------------------ argument checks
-_out = as_output
 
 
 def _friction_args(
@@ -416,13 +419,7 @@ def _normal_args(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     mass = positive_array(mass_kg, "mass_kg")
     vin = np.asarray(vin_mps, float)
-    bad = np.asarray(vin > 0)
-    if bad.any():
-        raise ArgumentError(
-            "normal impact velocity v_iN must be <= 0 (toward the ground)",
-            source="vin_mps",
-            where=where_first(bad),
-        )
+    reject(vin > 0, "vin_mps", "be <= 0 (toward the ground)", vin, unit="m/s")
     return mass, vin, positive_array(beta, "beta")
 
 

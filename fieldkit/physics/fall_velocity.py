@@ -98,7 +98,7 @@ def design_friction(category: str) -> float:
 def _check_slope(psi_deg: np.ndarray) -> None:
     raise_at_first(
         (psi_deg <= 0) | (psi_deg > 90),
-        lambda p: f"slope angle must be above 0° and at most 90°, got {p:.1f}°",
+        lambda p: f"slope angle must be above 0° and at most 90° (got {p:.1f}°)",
         psi_deg,
         source="slope_deg",
     )

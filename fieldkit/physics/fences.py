@@ -32,8 +32,12 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-from fieldkit.errors import ArgumentError
-from fieldkit.physics._validate import as_output
+from fieldkit.physics._validate import (
+    as_output,
+    nonnegative_array,
+    positive_array,
+    reject,
+)
 from fieldkit.physics.energy import total_kinetic_energy
 from fieldkit.physics.impact_mechanics import rough_body_impact
 from fieldkit.physics.restitution import angle_dependent_restitution
@@ -97,16 +101,8 @@ def energy_efficiency(
     >>> round(float(energy_efficiency(138.8, 39.2)), 2)
     0.28
     """
-    e_i = np.asarray(impact_energy_j, float)
-    e_f = np.asarray(restitution_energy_j, float)
-    bad = np.asarray(e_i <= 0)
-    if bad.any():
-        raise ArgumentError("impact energy must be positive", source="impact_energy_j")
-    bad = np.asarray(e_f < 0)
-    if bad.any():
-        raise ArgumentError(
-            "restitution energy must not be negative", source="restitution_energy_j"
-        )
+    e_i = positive_array(impact_energy_j, "impact_energy_j", "J")
+    e_f = nonnegative_array(restitution_energy_j, "restitution_energy_j", "J")
     return as_output(e_f / e_i)
 
 
@@ -144,25 +140,15 @@ def fence_energy_split(
     >>> round(float(s.absorbed_j) / 1e3, 2), round(float(s.absorbed_fraction), 2)
     (97.49, 0.72)
     """
-    mass = np.asarray(mass_kg, float)
-    if np.any(mass <= 0):
-        raise ArgumentError("mass must be positive", source="mass_kg")
-    gyration = np.asarray(gyration_m, float)
-    if np.any(gyration < 0):
-        raise ArgumentError(
-            "radius of gyration must not be negative", source="gyration_m"
-        )
-    speeds = (("speed_in_mps", speed_in_mps), ("speed_out_mps", speed_out_mps))
-    for name, value in speeds:
-        if np.any(np.asarray(value, float) < 0):
-            raise ArgumentError("speed must not be negative", source=name)
+    mass = positive_array(mass_kg, "mass_kg", "kg")
+    gyration = nonnegative_array(gyration_m, "gyration_m", "m")
+    speed_in = nonnegative_array(speed_in_mps, "speed_in_mps", "m/s")
+    speed_out = nonnegative_array(speed_out_mps, "speed_out_mps", "m/s")
     inertia = mass * gyration**2
-    ke_i = 0.5 * mass * np.asarray(speed_in_mps, float) ** 2
-    ke_f = 0.5 * mass * np.asarray(speed_out_mps, float) ** 2
-    e_i = np.asarray(total_kinetic_energy(mass, speed_in_mps, inertia, omega_in_radps))
-    e_f = np.asarray(
-        total_kinetic_energy(mass, speed_out_mps, inertia, omega_out_radps)
-    )
+    ke_i = 0.5 * mass * speed_in**2
+    ke_f = 0.5 * mass * speed_out**2
+    e_i = np.asarray(total_kinetic_energy(mass, speed_in, inertia, omega_in_radps))
+    e_f = np.asarray(total_kinetic_energy(mass, speed_out, inertia, omega_out_radps))
     with np.errstate(divide="ignore", invalid="ignore"):
         efficiency = np.where(e_i > 0, e_f / e_i, np.nan)
     absorbed = e_i - e_f
@@ -223,14 +209,9 @@ def fence_redirection(
     >>> [round(float(x), 1) for x in (r.v_fn_mps, r.v_ft_mps, r.omega_f_radps)]
     [5.9, 5.4, -12.6]
     """
-    speed = np.asarray(speed_mps, float)
+    speed = positive_array(speed_mps, "speed_mps", "m/s")
     angle = np.asarray(angle_deg, float)
-    if np.any(speed <= 0):
-        raise ArgumentError("impact speed must be positive", source="speed_mps")
-    if np.any((angle <= 0) | (angle > 90)):
-        raise ArgumentError(
-            "impact angle to the net must be in (0, 90] degrees", source="angle_deg"
-        )
+    reject((angle <= 0) | (angle > 90), "angle_deg", "be in (0, 90]", angle, unit="deg")
     theta = np.radians(angle)
     v_it = speed * np.cos(theta)
     v_in = -speed * np.sin(theta)

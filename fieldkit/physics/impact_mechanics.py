@@ -29,12 +29,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from fieldkit.physics.contact_phases import (
-    as_argument_array,
-    contact_phases,
-    inertial_coefficients,
-    reject,
-)
+from fieldkit.physics._validate import number_array, reject
+from fieldkit.physics.contact_phases import contact_phases, inertial_coefficients
 
 __all__ = [
     "ImpactResult",
@@ -346,8 +342,8 @@ def rough_body_impact(
         mass = np.ones_like(ph.q_f)
         energy_scale = np.full_like(ph.q_f, np.nan)
     else:
-        mass = as_argument_array("mass_kg", mass_kg)
-        reject(~(mass > 0) | ~np.isfinite(mass), "mass_kg", "> 0", mass)
+        mass = number_array(mass_kg, "mass_kg")
+        reject(~(mass > 0) | ~np.isfinite(mass), "mass_kg", "be > 0", mass)
         mass = np.broadcast_to(mass, ph.q_f.shape)
         energy_scale = mass
     v_ft, v_fn, omega_f = ph.body_velocities(ph.q_f)

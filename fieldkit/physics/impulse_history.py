@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fieldkit.errors import ArgumentError
+from fieldkit.physics._validate import reject
 from fieldkit.physics.contact_phases import contact_phases
 
 
@@ -79,8 +80,7 @@ def impulse_history(
     >>> float(h.v_n_mps[0]), round(float(h.v_n_mps[-1]), 3), float(h.v_slip_mps[-1])
     (-9.3, 6.603, 0.0)
     """
-    if points < 2:
-        raise ArgumentError(f"points must be >= 2 (got {points})")
+    reject(np.asarray(points) < 2, "points", "be >= 2", points)
     scalars = (v_it_mps, v_in_mps, omega_i_radps, radius_m, gyration_m, e_n, friction)
     if any(np.ndim(x) for x in (*scalars, offset_m)):
         raise ArgumentError("impulse_history takes one impact (scalar arguments)")
@@ -95,8 +95,7 @@ def impulse_history(
         offset_m=offset_m,
     )
     mass = 1.0 if mass_kg is None else float(mass_kg)
-    if not mass > 0:
-        raise ArgumentError(f"mass_kg must be > 0 (got {mass:g})")
+    reject(~(np.asarray(mass) > 0), "mass_kg", "be > 0", mass)
     q_f = float(ph.q_f)
     q_s = float(ph.q_slip_stop)
     marks = [float(ph.q_c)] + ([q_s] if np.isfinite(q_s) else [])

@@ -19,12 +19,12 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from fieldkit.errors import ArgumentError
 from fieldkit.physics._validate import (
     as_output,
+    check_nonnegative,
     nonnegative_array,
     positive_array,
-    where_first,
+    reject,
 )
 
 __all__ = [
@@ -84,13 +84,7 @@ def reduction_coefficient(x_m: ArrayLike, volume_ratio: ArrayLike) -> np.ndarray
     """
     x = positive_array(x_m, "x_m")
     ratio = np.asarray(volume_ratio, float)
-    bad = np.asarray((ratio <= 0) | (ratio > 1))
-    if bad.any():
-        raise ArgumentError(
-            "volume_ratio must be in (0, 1]",
-            source="volume_ratio",
-            where=where_first(bad),
-        )
+    reject((ratio <= 0) | (ratio > 1), "volume_ratio", "be in (0, 1]", ratio)
     return as_output((1.0 / ratio - 1.0) / x)
 
 
@@ -112,17 +106,8 @@ def volume_ratio_with_impacts(
     0.0468
     """
     n = np.asarray(impact_number, float)
-    bad = np.asarray(n < 1)
-    if bad.any():
-        raise ArgumentError(
-            "impact_number must be >= 1 (eq. 6.16 starts at the first impact)",
-            source="impact_number",
-            where=where_first(bad),
-        )
-    if exponent < 0:
-        raise ArgumentError(
-            f"exponent must not be negative, got {exponent:g}", source="exponent"
-        )
+    reject(n < 1, "impact_number", "be >= 1 (eq. 6.16 starts at the first impact)", n)
+    check_nonnegative(np.asarray(exponent, float), "exponent", "")
     return as_output(n ** (-float(exponent)))
 
 

@@ -26,8 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from fieldkit.errors import ArgumentError
-from fieldkit.physics._validate import as_output, nonnegative_array
+from fieldkit.physics._validate import as_output, nonnegative_array, raise_at_first
 
 __all__ = [
     "THESIS_STRUCTURES",
@@ -61,17 +60,17 @@ class StructureLaw:
     equation: str = ""
 
     def __post_init__(self) -> None:
-        if not np.isfinite(self.coefficient) or self.coefficient <= 0:
-            raise ArgumentError(
-                f"{self.name} structure coefficient must be positive, "
-                f"got {self.coefficient:g}",
-                source="coefficient",
-            )
-        if not np.isfinite(self.exponent) or self.exponent <= 0:
-            raise ArgumentError(
-                f"{self.name} structure exponent must be positive, "
-                f"got {self.exponent:g}",
-                source="exponent",
+        for name, value in (
+            ("coefficient", self.coefficient),
+            ("exponent", self.exponent),
+        ):
+            raise_at_first(
+                ~(np.isfinite(value) & (value > 0)),
+                lambda v, name=name: (
+                    f"{self.name} structure {name} must be positive (got {v:g})"
+                ),
+                value,
+                source=name,
             )
 
 

@@ -21,7 +21,6 @@ restitution velocity: those stay NaN.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -246,19 +245,3 @@ def reduce_survey(survey: Survey, options: ReduceOptions | None = None) -> Impac
     table = ImpactTable(rows, source=source).derive()
     table = add_flight_energy(table)
     return add_theory_columns(table, friction=options.friction)
-
-
-def flights_of(table: ImpactTable) -> Mapping[str, np.ndarray]:
-    """Per-flight arrays (launch position and velocity, duration) for drawing paths.
-
-    Returns ``x0_m, z0_m, vx_mps, vz_mps, time_s`` for every row that starts a flight.
-    """
-    f = table.frame
-    ok = np.isfinite(f["flight_time_s"].to_numpy(float))
-    return {
-        "x0_m": f["x_m"].to_numpy(float)[ok],
-        "z0_m": f["z_m"].to_numpy(float)[ok],
-        "vx_mps": f["vf_x_mps"].to_numpy(float)[ok],
-        "vz_mps": f["vf_z_mps"].to_numpy(float)[ok],
-        "time_s": f["flight_time_s"].to_numpy(float)[ok],
-    }

@@ -1,4 +1,4 @@
-"""Ballistic fit of one flight of a track: free gravity first, then fixed gravity.
+"""Least-squares ballistic parabolas, and the fit of one flight of a track.
 
 Between contacts the centre of mass of a body moves on a parabola (thesis eq. 3.1-3.5,
 drag neglected)::
@@ -6,13 +6,23 @@ drag neglected)::
     x(t) = x0 + vx * tau
     z(t) = z0 + vz * tau - g * tau**2 / 2,        tau = t - t_ref
 
-:func:`fit_flight` fits this model twice by linear least squares:
+This module holds the one implementation of its linear least-squares fit, used by
+every stage of :mod:`fieldkit.tracking.flights`:
+
+* :func:`fit_fixed_g` -- ``g`` given: ``x`` and ``z + g tau^2 / 2`` are straight lines
+  in ``tau``;
+* :func:`fit_free_g` -- ``g`` fitted too (a third column ``-tau^2 / 2`` for ``z``).
+
+:func:`fit_flight` fits one flight both ways:
 
 1. with ``g`` **free**: the fitted ``g`` and its standard error check the time base
    and the length scale of the video. A wrong capture rate scales the apparent gravity
    by ``(fps_used / fps_true)**2``; a wrong scale scales it linearly.
 2. with ``g`` **fixed** at 9.81 m/s^2: the velocities reported for impacts come from
    this fit (one parameter fewer, smaller errors).
+
+Region growing (:mod:`fieldkit.tracking.flights.segment_growth`) solves the free-g
+model through incrementally updated normal equations instead; see its docstring.
 """
 
 from __future__ import annotations
@@ -28,6 +38,139 @@ from fieldkit.physics.constants import G
 GRAVITY_WARNING_FRACTION = 0.05
 
 
+@dataclass(frozen=True)
+class Parabola:
+    """A ballistic parabola fitted by least squares (:func:`fit_fixed_g`,
+    :func:`fit_free_g`).
+
+    Attributes
+    ----------
+    t_ref_s
+        Reference time of the parameters [s].
+    x0_m, z0_m, vx_mps, vz_mps
+        Position [m] and velocity [m/s] at ``t_ref_s``.
+    g_mps2
+        Gravity [m/s^2]: the given value (fixed fit) or the fitted one (free fit).
+    residual_x_m, residual_z_m
+        Residuals of the samples in x and z [m] (for the fixed fit, those of the
+        straight line fitted to ``z + g tau^2 / 2``: the same values).
+    design
+        The design matrix of the ``z`` fit, columns ``1, tau`` (fixed) or
+        ``1, tau, -tau^2 / 2`` (free); the ``x`` fit uses its first two columns.
+    """
+
+    t_ref_s: float
+    x0_m: float
+    z0_m: float
+    vx_mps: float
+    vz_mps: float
+    g_mps2: float
+    residual_x_m: np.ndarray = field(repr=False)
+    residual_z_m: np.ndarray = field(repr=False)
+    design: np.ndarray = field(repr=False)
+
+    @property
+    def residual_m(self) -> np.ndarray:
+        """Distance of each sample from the parabola [m]."""
+        return np.hypot(self.residual_x_m, self.residual_z_m)
+
+    @property
+    def sse_m2(self) -> float:
+        """Sum of the squared residuals of x and z [m^2]."""
+        rx, rz = self.residual_x_m, self.residual_z_m
+        return float(rx @ rx) + float(rz @ rz)
+
+    def unit_covariance(self) -> np.ndarray:
+        """``(A'A)^-1`` of the z design: covariance of ``(z0, vz[, g])`` per unit
+        noise variance (multiply by ``sigma^2``); ``[1, 1]`` also serves ``vx``."""
+        return np.linalg.inv(self.design.T @ self.design)
+
+    def position(self, t_s: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """Centre position ``(x, z)`` [m] on the parabola at time(s) ``t_s``."""
+        tau = np.asarray(t_s, float) - self.t_ref_s
+        x = self.x0_m + self.vx_mps * tau
+        z = self.z0_m + self.vz_mps * tau - 0.5 * self.g_mps2 * tau**2
+        return x, z
+
+
+def fit_fixed_g(
+    t_s: ArrayLike,
+    x_m: ArrayLike,
+    z_m: ArrayLike,
+    g_mps2: float = G,
+    *,
+    t_ref_s: float | None = None,
+) -> Parabola:
+    """Least-squares parabola with gravity fixed at ``g_mps2``.
+
+    Parameters
+    ----------
+    t_s, x_m, z_m
+        Sample times [s] and centre positions [m] (at least 2 samples).
+    g_mps2
+        Gravity [m/s^2].
+    t_ref_s
+        Reference time of the fitted position and velocity (default: mean of
+        ``t_s``, where they are least correlated).
+
+    Returns
+    -------
+    Parabola
+
+    Examples
+    --------
+    >>> t = np.linspace(0.0, 0.2, 20)
+    >>> p = fit_fixed_g(t, 1.0 + 3.0 * t, 2.0 + t - 0.5 * 9.81 * t**2, t_ref_s=0.0)
+    >>> [round(v, 9) for v in (p.x0_m, p.z0_m, p.vx_mps, p.vz_mps)]
+    [1.0, 2.0, 3.0, 1.0]
+    """
+    t, x, z = (np.asarray(a, float) for a in (t_s, x_m, z_m))
+    t_ref = float(t.mean()) if t_ref_s is None else float(t_ref_s)
+    tau = t - t_ref
+    design = np.column_stack([np.ones_like(tau), tau])
+    cx, rx = _lstsq(design, x)
+    cz, rz = _lstsq(design, z + 0.5 * g_mps2 * tau**2)
+    return _parabola(t_ref, cx, cz, float(g_mps2), rx, rz, design)
+
+
+def fit_free_g(
+    t_s: ArrayLike,
+    x_m: ArrayLike,
+    z_m: ArrayLike,
+    *,
+    t_ref_s: float | None = None,
+) -> Parabola:
+    """Least-squares parabola with gravity fitted (x linear, z quadratic in time).
+
+    Parameters
+    ----------
+    t_s, x_m, z_m
+        Sample times [s] and centre positions [m] (at least 3 samples).
+    t_ref_s
+        Reference time of the fitted position and velocity (default: mean of
+        ``t_s``).
+
+    Returns
+    -------
+    Parabola
+        ``g_mps2`` is the fitted gravity.
+
+    Examples
+    --------
+    >>> t = np.linspace(0.0, 0.2, 20)
+    >>> round(fit_free_g(t, 3.0 * t, 2.0 + t - 0.5 * 9.5 * t**2).g_mps2, 9)
+    9.5
+    """
+    t, x, z = (np.asarray(a, float) for a in (t_s, x_m, z_m))
+    t_ref = float(t.mean()) if t_ref_s is None else float(t_ref_s)
+    tau = t - t_ref
+    one = np.ones_like(tau)
+    cx, rx = _lstsq(np.column_stack([one, tau]), x)
+    design = np.column_stack([one, tau, -0.5 * tau**2])
+    cz, rz = _lstsq(design, z)
+    return _parabola(t_ref, cx, cz, float(cz[2]), rx, rz, design)
+
+
 @dataclass
 class FlightFit:
     """A fitted ballistic flight.
@@ -41,6 +184,8 @@ class FlightFit:
         Flight number along the track (0, 1, ...).
     rows
         Positions (``iloc``) in the track frame of the samples used in the fit.
+    t_start_s, t_end_s
+        Times of the first and last sample [s].
     t_ref_s
         Reference time of the parameters [s].
     x0_m, z0_m, vx_mps, vz_mps
@@ -167,45 +312,30 @@ def fit_flight(
     n = len(t)
     if n < 4:
         raise ValueError("a flight fit needs at least 4 samples")
-    t_ref = float(t.mean())
-    tau = t - t_ref
-    one = np.ones_like(tau)
-
-    # x = x0 + vx tau (same design in both fits)
-    ax = np.column_stack([one, tau])
-    cx, ssx = _lstsq(ax, x)
-    # free g: z = z0 + vz tau - g tau^2 / 2
-    az = np.column_stack([one, tau, -0.5 * tau**2])
-    cz, ssz = _lstsq(az, z)
-    dof_free = max(2 * n - 5, 1)
-    sigma2_free = (ssx + ssz) / dof_free
-    cov_z = sigma2_free * np.linalg.inv(az.T @ az)
-    g_free, g_se = float(cz[2]), float(np.sqrt(max(cov_z[2, 2], 0.0)))
-
-    # fixed g: z + g tau^2 / 2 = z0 + vz tau
-    cz_fixed, ssz_fixed = _lstsq(ax, z + 0.5 * g_fixed_mps2 * tau**2)
-    dof_fixed = max(2 * n - 4, 1)
-    sigma2 = (ssx + ssz_fixed) / dof_fixed
-    cov_lin = sigma2 * np.linalg.inv(ax.T @ ax)
-    v_se = float(np.sqrt(max(cov_lin[1, 1], 0.0)))
+    free = fit_free_g(t, x, z)
+    fixed = fit_fixed_g(t, x, z, g_fixed_mps2, t_ref_s=free.t_ref_s)
+    sigma2_free = free.sse_m2 / max(2 * n - 5, 1)
+    g_var = sigma2_free * free.unit_covariance()[2, 2]
+    sigma2 = fixed.sse_m2 / max(2 * n - 4, 1)
+    v_se = float(np.sqrt(max(sigma2 * fixed.unit_covariance()[1, 1], 0.0)))
 
     fit = FlightFit(
         index=index,
         rows=np.arange(n) if rows is None else np.asarray(rows, int),
         t_start_s=float(t.min()),
         t_end_s=float(t.max()),
-        t_ref_s=t_ref,
-        x0_m=float(cx[0]),
-        z0_m=float(cz_fixed[0]),
-        vx_mps=float(cx[1]),
-        vz_mps=float(cz_fixed[1]),
+        t_ref_s=fixed.t_ref_s,
+        x0_m=fixed.x0_m,
+        z0_m=fixed.z0_m,
+        vx_mps=fixed.vx_mps,
+        vz_mps=fixed.vz_mps,
         vx_se_mps=v_se,
         vz_se_mps=v_se,
-        g_mps2=g_free,
-        g_se_mps2=g_se,
+        g_mps2=free.g_mps2,
+        g_se_mps2=float(np.sqrt(max(g_var, 0.0))),
         g_fixed_mps2=float(g_fixed_mps2),
         rms_m=0.0,
-        rms_free_m=float(np.sqrt((ssx + ssz) / n)),
+        rms_free_m=float(np.sqrt(free.sse_m2 / n)),
         residual_m=np.empty(0),
     )
     px, pz = fit.position(t)
@@ -214,7 +344,21 @@ def fit_flight(
     return fit
 
 
-def _lstsq(design: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, float]:
+def _parabola(t_ref, cx, cz, g, rx, rz, design) -> Parabola:
+    return Parabola(
+        t_ref_s=t_ref,
+        x0_m=float(cx[0]),
+        z0_m=float(cz[0]),
+        vx_mps=float(cx[1]),
+        vz_mps=float(cz[1]),
+        g_mps2=g,
+        residual_x_m=rx,
+        residual_z_m=rz,
+        design=design,
+    )
+
+
+def _lstsq(design: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Least-squares coefficients of ``design @ coef = values`` and the residuals."""
     coef, *_ = np.linalg.lstsq(design, values, rcond=None)
-    resid = values - design @ coef
-    return coef, float(resid @ resid)
+    return coef, values - design @ coef

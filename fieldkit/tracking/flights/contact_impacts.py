@@ -9,8 +9,8 @@ For each contact between two fitted flights
   linear in time and the instant has a closed form), searched near the gap. An
   extended contact (a net, a rolling phase) starts and ends where the deviation from
   the adjacent parabola sets in
-  (:func:`fieldkit.tracking.flights.net_contacts.contact_onset`:
-  an onset power law fitted to the deviations, not the first sample beyond noise).
+  (:func:`fieldkit.tracking.flights.net_contacts.contact_onset`: an onset power law
+  fitted to the deviations, not the first sample beyond noise).
 * **Velocities.** Impact velocity from the flight before, restitution velocity from the
   flight after, both evaluated at the contact time(s) (fixed-g fits).
 * **Surface angle** ``slope_deg`` (psi, ARCHITECTURE §2), always on the side facing

@@ -5,21 +5,24 @@ it is consistent with the flight so far; near a contact a few samples pass that 
 not: one or two just after a small impact (low frame rates), or the tail of a soft
 contact whose force has faded below the noise (a net letting go). Each function here
 takes a flight's sample positions and returns them without such end samples.
+The parabolas are those of :mod:`fieldkit.tracking.flights.ballistic_fit`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from fieldkit.tracking.flights.ballistic_fit import fit_fixed_g, fit_free_g
+
 
 def trim_ends(t, x, z, rows: np.ndarray, sigma: float) -> np.ndarray:
     """Drop end samples further than 3.5 sigma from the flight's own free-g fit."""
     while len(rows) >= 6:
-        fit = fit_flight_free(t[rows], x[rows], z[rows])
+        off = fit_free_g(t[rows], x[rows], z[rows]).residual_m
         limit = 3.5 * sigma * np.sqrt(2.0)
-        if fit[0] > limit:
+        if off[0] > limit:
             rows = rows[1:]
-        elif fit[-1] > limit:
+        elif off[-1] > limit:
             rows = rows[:-1]
         else:
             break
@@ -44,14 +47,7 @@ def trim_kinked_ends(
                     break
                 keep = rows[k:] if at_start else rows[:-k]
                 out = rows[:k] if at_start else rows[-k:]
-                tau = t[keep] - t[keep].mean()
-                design = np.column_stack([np.ones_like(tau), tau])
-                zc = z[keep] + 0.5 * g * tau**2
-                cx = np.linalg.lstsq(design, x[keep], rcond=None)[0]
-                cz = np.linalg.lstsq(design, zc, rcond=None)[0]
-                tau_out = t[out] - t[keep].mean()
-                px = cx[0] + cx[1] * tau_out
-                pz = cz[0] + cz[1] * tau_out - 0.5 * g * tau_out**2
+                px, pz = fit_fixed_g(t[keep], x[keep], z[keep], g).position(t[out])
                 if np.hypot(x[out] - px, z[out] - pz).max() > limit:
                     cut = (at_start, k)
                     break
@@ -76,11 +72,8 @@ def trim_biased_ends(
     for _ in range(len(rows)):
         if len(rows) < 3 * run:
             break
-        tau = t[rows] - t[rows].mean()
-        design = np.column_stack([np.ones_like(tau), tau])
-        zc = z[rows] + 0.5 * g * tau**2
-        rx = x[rows] - design @ np.linalg.lstsq(design, x[rows], rcond=None)[0]
-        rz = zc - design @ np.linalg.lstsq(design, zc, rcond=None)[0]
+        fit = fit_fixed_g(t[rows], x[rows], z[rows], g)
+        rx, rz = fit.residual_x_m, fit.residual_z_m
         head = max(abs(rx[:run].mean()), abs(rz[:run].mean()))
         tail = max(abs(rx[-run:].mean()), abs(rz[-run:].mean()))
         if max(head, tail) <= limit:
@@ -109,14 +102,9 @@ def stable_end(
     v, se = [], []
     for k in range(kmax + 1):
         r = rows[k:] if at_start else rows[: n - k]
-        tau = t[r] - t_b
-        design = np.column_stack([np.ones_like(tau), tau])
-        zc = z[r] + 0.5 * g * tau**2
-        cx = np.linalg.lstsq(design, x[r], rcond=None)[0]
-        cz = np.linalg.lstsq(design, zc, rcond=None)[0]
-        cov = np.linalg.inv(design.T @ design)
-        v.append((cx[1], cz[1]))
-        se.append(sigma * np.sqrt(cov[1, 1]))
+        fit = fit_fixed_g(t[r], x[r], z[r], g, t_ref_s=t_b)
+        v.append((fit.vx_mps, fit.vz_mps))
+        se.append(sigma * np.sqrt(fit.unit_covariance()[1, 1]))
     v = np.array(v)
     se = np.array(se)
     for k in range(kmax + 1):
@@ -124,14 +112,3 @@ def stable_end(
         if np.all(np.abs(v[later] - v[k]).max(axis=1) <= 3.0 * se[later]):
             return rows[k:] if at_start else rows[: n - k]
     return rows
-
-
-def fit_flight_free(t: np.ndarray, x: np.ndarray, z: np.ndarray) -> np.ndarray:
-    """Distance of each sample from the free-g ballistic least-squares fit [m]."""
-    tau = t - t.mean()
-    one = np.ones_like(tau)
-    ax = np.column_stack([one, tau])
-    az = np.column_stack([one, tau, tau**2])
-    rx = x - ax @ np.linalg.lstsq(ax, x, rcond=None)[0]
-    rz = z - az @ np.linalg.lstsq(az, z, rcond=None)[0]
-    return np.hypot(rx, rz)

@@ -8,6 +8,14 @@ mis-detection) is skipped when the two samples after it agree again; two rejecti
 in a row end the segment. The normal equations are updated incrementally and rebuilt
 around the current centre whenever the samples outgrow twice their span, so they stay
 well conditioned.
+
+The model is the free-g parabola of
+:func:`fieldkit.tracking.flights.ballistic_fit.fit_free_g`, but the algorithm is not a
+refit: growing a flight of n samples tests about n candidates, and refitting for each
+would cost O(n^2) per flight. Here each added sample updates the power sums in O(1)
+and each test solves a 2x2 and a 3x3 system (prediction variance included). The
+parameters are never reported; the flights found are fitted by
+:func:`~fieldkit.tracking.flights.ballistic_fit.fit_flight`.
 """
 
 from __future__ import annotations
