@@ -47,6 +47,19 @@ def rotational_energy(
     return 0.5 * inertia * np.asarray(omega_radps, float) ** 2
 
 
+def potential_energy(
+    mass_kg: ArrayLike, height_m: ArrayLike, g: float = G
+) -> np.ndarray:
+    """Potential energy ``PE = m g h`` [J] of a height ``h`` above a datum (eq. 6.13).
+
+    Examples
+    --------
+    >>> float(potential_energy(1000.0, 5.0, g=9.81))
+    49050.0
+    """
+    return np.asarray(mass_kg, float) * g * np.asarray(height_m, float)
+
+
 def energy_head(z_m: ArrayLike, speed_mps: ArrayLike, g: float = G) -> np.ndarray:
     """Energy head ``E = z + v^2 / (2 g)`` [m] (thesis eq. 6.14).
 

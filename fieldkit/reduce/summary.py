@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fieldkit.impact_table import ImpactTable
-from fieldkit.physics.constants import G
+from fieldkit.physics.energy import potential_energy
 
 
 @dataclass(frozen=True)
@@ -95,7 +95,7 @@ def summarize(table: ImpactTable) -> ReductionSummary:
     for _, path in f.groupby("path_id", sort=False):
         m = path["mass_kg"].to_numpy(float)[0]
         z = path["z_m"].to_numpy(float)
-        potential += m * G * (z[0] - z[-1])
+        potential += float(potential_energy(m, z[0] - z[-1]))
     re_change = np.nansum(f["re_f_j"].to_numpy(float) - f["re_i_j"].to_numpy(float))
     fraction = np.array([], dtype=float)
     if "theory_loss_fraction" in f:

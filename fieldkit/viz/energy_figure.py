@@ -18,8 +18,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from fieldkit.impact_table import ImpactTable
-from fieldkit.physics.constants import G
-from fieldkit.physics.energy import energy_head, kinetic_energy
+from fieldkit.physics.energy import energy_head, kinetic_energy, potential_energy
 from fieldkit.physics.flight import flight_samples
 from fieldkit.viz.figure_files import save_png
 
@@ -54,7 +53,7 @@ def energy_profile(table: ImpactTable, n_samples: int = 30) -> dict[str, np.ndar
     return {
         "x_m": x,
         "z_m": z,
-        "pe_j": m * G * (z - z_stop),
+        "pe_j": potential_energy(m, z - z_stop),
         "ke_j": kinetic_energy(m, v),
         "re_j": np.nan_to_num(np.asarray(res)),
         "head_m": energy_head(z, v),

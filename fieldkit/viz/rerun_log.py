@@ -244,8 +244,7 @@ def _log_series(rec: rr.RecordingStream, analysis: TrackAnalysis) -> None:
     measured = np.hypot(*analysis.measured_velocity)
     fitted = np.full(len(f), np.nan)
     for fl in analysis.flights:
-        vx, vz = fl.velocity(t[fl.rows])
-        fitted[fl.rows] = np.hypot(vx, vz)
+        fitted[fl.rows] = fl.speed(t[fl.rows])
     _series(rec, "plots/speed/measured", frames, t, measured, "measured")
     _series(rec, "plots/speed/fitted", frames, t, fitted, "fitted flights")
     _series(rec, "plots/spin", frames, t, f["omega_radps"].to_numpy(float), "omega")

@@ -143,7 +143,7 @@ def _speed_spin_figure(path: Path, a: TrackAnalysis) -> Path:
         tt = np.linspace(fl.t_start_s, fl.t_end_s, 50)
         ax1.plot(
             tt,
-            np.hypot(*fl.velocity(tt)),
+            fl.speed(tt),
             color=_flight_colour(fl.index),
             label=f"flight {fl.index} fit",
         )

@@ -251,6 +251,10 @@ class FlightFit:
         vz = self.vz_mps - self.g_fixed_mps2 * tau
         return vx, vz
 
+    def speed(self, t_s: ArrayLike) -> np.ndarray:
+        """Speed [m/s] on the fitted parabola at time(s) ``t_s``."""
+        return np.hypot(*self.velocity(t_s))
+
     def gravity_warning(self) -> str | None:
         """A warning when the fitted g is > 5 % from 9.81 and the difference is real.
 
