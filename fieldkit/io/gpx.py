@@ -31,8 +31,8 @@ from xml.sax.saxutils import escape, quoteattr
 import pandas as pd
 
 from fieldkit.errors import ArgumentError, InputFileError
-from fieldkit.outputs import write_text_atomic
 from fieldkit.io.csv_table import check_readable, finite_number
+from fieldkit.outputs import write_text_atomic
 
 GPX_11_NAMESPACE = "http://www.topografix.com/GPX/1/1"
 _KINDS = {"waypoints": "wpt", "route": "rtept", "track": "trkpt"}
@@ -121,7 +121,7 @@ def read_gpx_waypoints(
     if points not in (*_KINDS, "auto"):
         raise ArgumentError(
             f"points must be one of waypoints, route, track, auto (not '{points}')",
-            source="--gpx-points",
+            source="gpx_points",
         )
     root = parse_gpx_root(path)
     counts = {kind: len(_collect(root, kind)) for kind in _KINDS}

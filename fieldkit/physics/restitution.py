@@ -166,7 +166,7 @@ class VelocityScaledRestitution:
         return np.broadcast_to(e, shape)[()]
 
 
-#: Restitution laws by name (CLI ``--law`` and model files).
+#: Restitution laws by name (``fieldkit impact`` and model files).
 RESTITUTION_LAWS = {
     "constant": ConstantRestitution,
     "angle": AngleDependentRestitution,

@@ -67,7 +67,7 @@ def test_wrong_capture_rate_scales_gravity_and_warns():
     f = fit_flight(t_given, x, z)
     assert f.g_mps2 == pytest.approx(G * (fps_given / 1205.0) ** 2, rel=1e-9)
     message = f.gravity_warning()
-    assert message is not None and "-16.7 %" in message and "--fps" in message
+    assert message is not None and "-16.7 %" in message and "`fps`" in message
     # the suggested factor restores the true rate
     factor = np.sqrt(G / f.g_mps2)
     assert fps_given / factor == pytest.approx(1205.0, rel=1e-9) or (

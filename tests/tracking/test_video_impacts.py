@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.physics.constants import G
 from fieldkit.physics.local_axes import to_local, to_section
-from fieldkit.tracking.flights.pipeline import analyse_track
+from fieldkit.track import Track
 from fieldkit.tracking.flights.contact_surface import (
     RIGID_SAG_FRACTION,
     extended_contact_angle,
@@ -26,8 +26,8 @@ from fieldkit.tracking.flights.contact_surface import (
     surface_angle_from_spin,
     wrap_angle_deg,
 )
+from fieldkit.tracking.flights.pipeline import analyse_track
 from fieldkit.tracking.flights.synthetic_tracks import bouncing_ball
-from fieldkit.track import Track
 
 FPS = 1205.0
 R = 0.0375
@@ -160,7 +160,7 @@ def test_wrong_capture_rate_warns():
     for f in well_fitted:
         assert abs(f.g_mps2 - expected) < 3 * f.g_se_mps2 + 0.01
         assert any(
-            w.startswith(f"flight {f.index} ") and "--fps" in w for w in a.warnings
+            w.startswith(f"flight {f.index} ") and "`fps`" in w for w in a.warnings
         )
 
 

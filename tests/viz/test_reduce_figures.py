@@ -8,8 +8,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from fieldkit.physics.bodies import resolve_body
 from fieldkit.physics.constants import G
-from fieldkit.reduce.body import resolve_body
 from fieldkit.reduce.pipeline import ReduceOptions, reduce_survey
 from fieldkit.viz.energy_figure import energy_profile, plot_energy_partition
 from fieldkit.viz.restitution_figure import plot_en_theta, plot_et_impacts
