@@ -21,7 +21,7 @@ from pathlib import Path
 
 from fieldkit.io.impacts import read_impacts
 from fieldkit.io.trees import read_trees
-from fieldkit.reduce.body import resolve_body
+from fieldkit.physics.bodies import resolve_body
 from fieldkit.reduce.pipeline import ReduceOptions, reduce_survey
 from fieldkit.reduce.summary import format_summary, summarize
 from fieldkit.survey import Survey

@@ -4,6 +4,13 @@ Every reader, physics guard and command raises :class:`FieldkitError` (or a
 subclass) for problems with the *user's input*. The command line turns it into a
 single line on stderr and a non-zero exit code; anything else escaping is a bug and
 keeps its traceback.
+
+Library messages name the *arguments* of the function the user called, never
+command-line flags: ``source="mass_kg"`` for the argument at fault, and inside a
+message its name (``"mass_kg must be > 0"``). Other arguments a message mentions go
+in backticks (``"unit_weight_kn_m3 needs `shape`"``), to tell them from prose and
+from column names. The command line maps these names to its flags
+(:data:`fieldkit.cli.common.FLAGS`).
 """
 
 from __future__ import annotations
@@ -19,7 +26,8 @@ class FieldkitError(Exception):
     message
         What is wrong, e.g. ``"elevation missing"``.
     source
-        The file (or argument name, e.g. ``"--mass"``) the problem is in.
+        The file (or argument name, e.g. ``"mass_kg"``) the problem is in. Left out
+        of the printed line when the message already starts with it.
     where
         The row, point or frame, e.g. ``"row 7"``, ``"point 12"``, ``"frames 210-245"``.
 
@@ -27,6 +35,8 @@ class FieldkitError(Exception):
     --------
     >>> str(FieldkitError("elevation missing", source="a.gpx", where="point 3"))
     'a.gpx: point 3: elevation missing'
+    >>> str(FieldkitError("mass_kg must be > 0 (got -3)", source="mass_kg"))
+    'mass_kg must be > 0 (got -3)'
     """
 
     def __init__(
@@ -42,7 +52,10 @@ class FieldkitError(Exception):
         super().__init__(str(self))
 
     def __str__(self) -> str:
-        parts = [p for p in (self.source, self.where) if p]
+        source = self.source
+        if source and (self.message + " ").startswith(source + " "):
+            source = None  # "mass_kg must be > 0", not "mass_kg: mass_kg must be > 0"
+        parts = [p for p in (source, self.where) if p]
         return ": ".join([*parts, self.message])
 
 

@@ -1,38 +1,164 @@
-"""What every command shares: one-line errors and shared option types."""
+"""What every command shares: one-line errors naming flags, and shared options.
+
+Library code names the arguments of its functions (``mass_kg``), never command-line
+flags (see :mod:`fieldkit.errors`); :data:`FLAGS` maps those names to the flags, and
+:func:`one_line_errors`, :func:`warn` and :func:`note` show the flags instead.
+"""
 
 from __future__ import annotations
 
 import functools
+import re
 import sys
-from collections.abc import Callable
-from typing import Annotated, ParamSpec, TypeVar
+from collections.abc import Callable, Mapping
+from typing import Annotated, ParamSpec, TypeVar, overload
 
 import typer
 
 from fieldkit.errors import FieldkitError
-from fieldkit.physics.bodies import SHAPES
+from fieldkit.physics.bodies import SHAPES, UNIT_WEIGHT_KN_M3, ResolvedBody
 
 P = ParamSpec("P")
 R = TypeVar("R")
 
+#: Library argument names -> the command-line flags that set them. A command whose
+#: flag for a name differs passes its own mapping to :func:`one_line_errors`.
+FLAGS: dict[str, str] = {
+    # the body (fieldkit.physics.bodies.resolve_body)
+    "mass_kg": "--mass",
+    "radius_m": "--radius",
+    "gyration_m": "--gyration",
+    "inertia_kgm2": "--inertia",
+    "shape": "--shape",
+    "dimensions_m": "--dimensions",
+    "unit_weight_kn_m3": "--unit-weight",
+    # survey reduction and its readers
+    "theta0_deg": "--theta0",
+    "units": "--units",
+    "epsg": "--epsg",
+    "gpx_points": "--gpx-points",
+    "declination_deg": "--declination",
+    "friction": "--friction",
+    # video tracking and track exports
+    "fps": "--fps",
+    "scale_points": "--scale-points",
+    "scale_length_m": "--scale-length",
+    "roi": "--roi",
+    "surface_angle_deg": "--surface-angle",
+    "unit": "--unit",
+    "metres_per_pixel": "--metres-per-pixel",
+    "file_fps": "--file-fps",
+    # the impact calculator
+    "e_n": "--en",
+    "offset_m": "--offset",
+    "v_it_mps": "--vt",
+    "v_in_mps": "--vn",
+    "omega_i_radps": "--spin",
+    "velocity_scale_mps": "--scale-velocity",
+    # the fence calculator
+    "speed_in_mps": "--speed-in",
+    "angle_in_deg": "--angle-in",
+    "spin_in_radps": "--spin-in",
+    "speed_out_mps": "--speed-out",
+    "angle_out_deg": "--angle-out",
+    "spin_out_radps": "--spin-out",
+    "impulse_ns": "--impulse",
+}
 
-def one_line_errors(func: Callable[P, R]) -> Callable[P, R]:
-    """Turn :class:`FieldkitError` into ``error: <one line>`` on stderr, exit 1."""
+_QUOTED = re.compile(r"`(\w+)`")
 
-    @functools.wraps(func)
-    def wrapper(*args: P.args, **kwargs: P.kwargs) -> R:
-        try:
-            return func(*args, **kwargs)
-        except FieldkitError as exc:
-            typer.echo(f"error: {exc}", err=True)
-            raise typer.Exit(1) from None
 
-    return wrapper
+def with_flags(text: str, flags: Mapping[str, str] = FLAGS) -> str:
+    """Replace every argument name in backticks by its flag.
+
+    Examples
+    --------
+    >>> with_flags("unit_weight_kn_m3 needs `shape`")
+    'unit_weight_kn_m3 needs --shape'
+    """
+    return _QUOTED.sub(lambda m: flags.get(m.group(1), m.group(1)), text)
+
+
+def _argument(exc: FieldkitError, flags: Mapping[str, str]) -> str | None:
+    """The argument an error is about: its source, or the name a check begins with
+    (``"e_n must be >= 0"``)."""
+    if exc.source in flags:
+        return exc.source
+    head, _, rest = exc.message.partition(" ")
+    if exc.source is None and head in flags and rest.startswith("must "):
+        return head
+    return None
+
+
+def error_line(exc: FieldkitError, flags: Mapping[str, str] = FLAGS) -> str:
+    """The error as the command line prints it: argument names become flags.
+
+    Examples
+    --------
+    >>> from fieldkit.errors import ArgumentError
+    >>> error_line(ArgumentError("gyration_m must be <= radius_m", source="gyration_m"))
+    '--gyration must be <= --radius'
+    >>> error_line(ArgumentError("lies outside the frame", source="roi"))
+    '--roi: lies outside the frame'
+    """
+    message = with_flags(exc.message, flags)
+    name = _argument(exc, flags)
+    if name is None:
+        parts = [exc.source, exc.where]
+    else:
+        # about an argument: bare argument names (with an underscore, so never prose)
+        # are flags too, and the message may begin with the argument's own name
+        names = sorted((n for n in flags if "_" in n), key=len, reverse=True)
+        if names:
+            pattern = r"\b(" + "|".join(map(re.escape, names)) + r")\b"
+            message = re.sub(pattern, lambda m: flags[m.group(1)], message)
+        flag = flags[name]
+        if (message + " ").startswith(name + " "):
+            message = flag + message[len(name) :]
+        parts = [None if message.startswith(flag) else flag, exc.where]
+    return ": ".join([*(p for p in parts if p), message])
+
+
+@overload
+def one_line_errors(func: Callable[P, R]) -> Callable[P, R]: ...
+
+
+@overload
+def one_line_errors(
+    *, flags: Mapping[str, str]
+) -> Callable[[Callable[P, R]], Callable[P, R]]: ...
+
+
+def one_line_errors(func=None, *, flags=None):
+    """Turn :class:`FieldkitError` into ``error: <one line>`` on stderr, exit 1.
+
+    Argument names in the error become flags (:func:`error_line`), through
+    :data:`FLAGS` updated with ``flags`` (a command whose flags differ).
+    """
+    mapping = {**FLAGS, **(flags or {})}
+
+    def decorate(command: Callable[P, R]) -> Callable[P, R]:
+        @functools.wraps(command)
+        def wrapper(*args: P.args, **kwargs: P.kwargs) -> R:
+            try:
+                return command(*args, **kwargs)
+            except FieldkitError as exc:
+                typer.echo(f"error: {error_line(exc, mapping)}", err=True)
+                raise typer.Exit(1) from None
+
+        return wrapper
+
+    return decorate if func is None else decorate(func)
 
 
 def warn(message: str) -> None:
-    """Print a one-line warning to stderr."""
-    typer.echo(f"warning: {' '.join(message.split())}", err=True)
+    """Print a one-line warning to stderr (argument names in backticks as flags)."""
+    typer.echo(f"warning: {' '.join(with_flags(message).split())}", err=True)
+
+
+def note(message: str) -> None:
+    """Print a one-line note to stderr (argument names in backticks as flags)."""
+    typer.echo(f"note: {' '.join(with_flags(message).split())}", err=True)
 
 
 def echo_err(message: str) -> None:
@@ -40,7 +166,13 @@ def echo_err(message: str) -> None:
     print(message, file=sys.stderr)
 
 
-# Body options shared by `reduce`, `impact` and `track` (SI units).
+def print_body_notes(body: ResolvedBody) -> None:
+    """Print what the body's values say must be stated (overrides, measurements)."""
+    for text in body.notes:
+        note(text)
+
+
+# Body options (SI units), resolved by fieldkit.physics.bodies.resolve_body.
 MassOpt = Annotated[float | None, typer.Option("--mass", help="Body mass (kg).")]
 RadiusOpt = Annotated[
     float | None, typer.Option("--radius", help="Contact radius r (m).")
@@ -49,19 +181,34 @@ GyrationOpt = Annotated[
     float | None,
     typer.Option("--gyration", help="Radius of gyration k (m); I = m k^2."),
 ]
+InertiaOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--inertia", help="Moment of inertia I (kg m^2), instead of --gyration."
+    ),
+]
 ShapeOpt = Annotated[
     str | None,
     typer.Option(
         "--shape",
         help=f"Body shape from thesis Table 4-1: {', '.join(SHAPES)} (gives k, volume, "
-        "mass and contact radius; instead of --mass/--gyration).",
+        "mass and contact radius; instead of --gyration; --mass overrides the "
+        "computed mass, --radius the contact radius within the shape's range).",
     ),
 ]
 DimensionsOpt = Annotated[
     str | None,
     typer.Option(
         "--dimensions",
-        help="Shape dimensions (m), comma-separated: cube L; sphere r (radius); "
-        "cylinder L,r; ellipsoid 2a,2b,2c (full axis lengths, rotating about c).",
+        help="Shape dimensions (m), as 1.6,1.3,1.3 or 1.6x1.3x1.3: cube L; sphere r "
+        "(radius); cylinder L,r; ellipsoid 2a,2b,2c (full axis lengths, rotating "
+        "about c).",
+    ),
+]
+UnitWeightOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--unit-weight",
+        help=f"Rock unit weight for --shape, kN/m3 (default {UNIT_WEIGHT_KN_M3:g}).",
     ),
 ]

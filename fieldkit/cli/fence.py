@@ -13,24 +13,40 @@ from typing import Annotated
 
 import typer
 
-from fieldkit.cli.common import GyrationOpt, MassOpt, RadiusOpt, one_line_errors
+from fieldkit.cli.common import (
+    DimensionsOpt,
+    GyrationOpt,
+    InertiaOpt,
+    MassOpt,
+    RadiusOpt,
+    ShapeOpt,
+    UnitWeightOpt,
+    one_line_errors,
+    print_body_notes,
+)
 from fieldkit.errors import ArgumentError
+from fieldkit.physics.fence_impact import FenceImpact
+from fieldkit.physics.structure_forces import StructureLaw
+
+#: Body values `fence` always needs (a rebound also needs k, a computed one also r).
+BODY_NEEDS = ("mass_kg",)
+
+#: Where `fence`'s flags differ from :data:`fieldkit.cli.common.FLAGS`.
+_FLAGS = {"e_n": "--e-n"}
 
 _LAW_HELP = "as COEFFICIENT,EXPONENT for F = c t^x (N, s)"
 _SLIP_STOPS = "slip stops (rolls off the net)"
 
 
-@one_line_errors
+@one_line_errors(flags=_FLAGS)
 def fence(
     mass: MassOpt = None,
     gyration: GyrationOpt = None,
-    inertia: Annotated[
-        float | None,
-        typer.Option(
-            "--inertia", help="Moment of inertia I (kg m^2), instead of --gyration."
-        ),
-    ] = None,
+    inertia: InertiaOpt = None,
     radius: RadiusOpt = None,
+    shape: ShapeOpt = None,
+    dimensions: DimensionsOpt = None,
+    unit_weight: UnitWeightOpt = None,
     speed_in: Annotated[
         float | None, typer.Option("--speed-in", help="Impact speed v_i (m/s).")
     ] = None,
@@ -138,129 +154,95 @@ def fence(
         --angle-in 50 --spin-in 18
     """
     from fieldkit.outputs import write_text_atomic
-    from fieldkit.physics.fences import fence_energy_split, fence_redirection
-    from fieldkit.physics.structure_forces import StructureLaw, contact_time, peak_force
+    from fieldkit.physics.bodies import resolve_body
+    from fieldkit.physics.fence_impact import fence_impact
 
-    if mass is None:
-        raise ArgumentError("the rock's mass is required", source="--mass")
+    rock = resolve_body(
+        mass_kg=mass,
+        radius_m=radius,
+        gyration_m=gyration,
+        inertia_kgm2=inertia,
+        shape=shape,
+        dimensions_m=dimensions,
+        unit_weight_kn_m3=unit_weight,
+    ).require(*BODY_NEEDS, source="fieldkit fence")
     if speed_in is None:
         raise ArgumentError("the impact speed is required", source="--speed-in")
-    _require(mass > 0, "--mass", f"must be positive, got {mass:g}")
-    _require(speed_in > 0, "--speed-in", f"must be positive, got {speed_in:g}")
-    k = _gyration(mass, gyration, inertia)
     laws = [
-        _law("rigid", rigid, "--rigid", StructureLaw),
-        _law("flexible", flexible, "--flexible", StructureLaw),
-        _law("stiff", stiff, "--stiff", StructureLaw),
+        _law("rigid", rigid, "--rigid"),
+        _law("flexible", flexible, "--flexible"),
+        _law("stiff", stiff, "--stiff"),
     ]
-    if impulse is not None:
-        _require(impulse > 0, "--impulse", f"must be positive, got {impulse:g}")
-    p = mass * speed_in if impulse is None else impulse
     if figure is not None and figure.suffix.lower() != ".png":
         raise ArgumentError("the figure must be a .png file", source="--figure")
-
-    results: dict[str, object] = {
-        "mass_kg": mass,
-        "gyration_m": k,
-        "speed_in_mps": speed_in,
-        "spin_in_radps": spin_in,
-    }
-    lines = [
-        f"rock: m = {mass:g} kg, k = {_fmt(k)} m, I = m k^2 = "
-        f"{_fmt(mass * k * k if k is not None else None)} kg m^2"
-    ]
-    rebound = None
-    for option, value in (("--spin-out", spin_out), ("--angle-out", angle_out)):
-        if value is not None and speed_out is None:
-            raise ArgumentError(
-                "a measured rebound needs --speed-out too", source=option
-            )
     if figure is not None and out is not None and figure.resolve() == out.resolve():
         raise ArgumentError(
             "--figure and --out must be different files", source="--out"
         )
-    if speed_out is not None:
-        _require(
-            speed_out >= 0, "--speed-out", f"must not be negative, got {speed_out:g}"
-        )
-        rebound = (
-            speed_out,
-            0.0 if spin_out is None else spin_out,
-            angle_out,
-            "measured",
-        )
-    elif radius is not None or angle_in is not None:
-        if radius is None:
-            raise ArgumentError(
-                "the computed rebound needs the contact radius", source="--radius"
-            )
-        if angle_in is None:
-            raise ArgumentError(
-                "the computed rebound needs the impact angle to the net",
-                source="--angle-in",
-            )
-        if k is None:
-            raise ArgumentError(
-                "the computed rebound needs --gyration or --inertia",
-                source="--gyration",
-            )
-        _require(radius > 0, "--radius", f"must be positive, got {radius:g}")
-        _require(
-            0 < angle_in <= 90,
-            "--angle-in",
-            f"must be in (0, 90] deg, got {angle_in:g}",
-        )
-        if e_n is not None:
-            _require(e_n >= 0, "--e-n", f"must not be negative, got {e_n:g}")
-        _require(friction >= 0, "--friction", f"must not be negative, got {friction:g}")
-        red = fence_redirection(
-            speed_in,
-            angle_in,
-            spin_in,
-            radius_m=radius,
-            gyration_m=k,
-            e_n=e_n,
-            friction=friction,
-        )
-        rebound = (
-            float(red.speed_out_mps),
-            float(red.omega_f_radps),
-            float(red.angle_out_deg),
-            "computed",
-        )
-        results["redirection"] = {
-            "v_it_mps": float(red.v_it_mps),
-            "v_in_mps": float(red.v_in_mps),
-            "e_n": float(red.e_n),
-            "v_ft_mps": float(red.v_ft_mps),
-            "v_fn_mps": float(red.v_fn_mps),
-            "slip_stops": bool(red.slip_stops),
-        }
+    # a typed --radius or an --angle-in asks for the computed rebound; a shape's
+    # radius alone does not
+    computed = radius is not None or angle_in is not None
+    result = fence_impact(
+        rock.mass_kg,
+        speed_in,
+        gyration_m=rock.gyration_m,
+        spin_in_radps=spin_in,
+        radius_m=rock.radius_m if computed else None,
+        angle_in_deg=angle_in,
+        speed_out_mps=speed_out,
+        spin_out_radps=spin_out,
+        angle_out_deg=angle_out,
+        e_n=e_n,
+        friction=friction,
+        impulse_ns=impulse,
+        structures=laws,
+    )
+    lines = _report(result)
+    if figure is not None:
+        from fieldkit.viz.fence_figure import write_fence_figure
+
+        write_fence_figure(figure, result.impulse_ns, laws, result.split)
+        lines.append(f"figure: {figure}")
+    if out is not None:
+        write_text_atomic(out, json.dumps(_results(result), indent=2) + "\n")
+        lines.append(f"results: {out}")
+    typer.echo("\n".join(lines))
+    print_body_notes(rock)
+
+
+def _report(f: FenceImpact) -> list[str]:
+    """The printed lines: the rock, the rebound and energy split, the structures."""
+    k = f.gyration_m
+    lines = [
+        f"rock: m = {f.mass_kg:g} kg, k = {_fmt(k)} m, I = m k^2 = "
+        f"{_fmt(f.mass_kg * k * k if k is not None else None)} kg m^2"
+    ]
+    red = f.redirection
+    if red is not None:
         lines += [
             f"impact (net axes): v_iT = {float(red.v_it_mps):.2f}, "
-            f"v_iN = {float(red.v_in_mps):.2f} m/s, theta_i = {angle_in:g} deg, "
-            f"omega_i = {spin_in:g} rad/s",
+            f"v_iN = {float(red.v_in_mps):.2f} m/s, theta_i = {f.angle_in_deg:g} deg, "
+            f"omega_i = {f.spin_in_radps:g} rad/s",
             f"rebound by impact mechanics (eqs. 4.20-4.24): e_N = {float(red.e_n):.3f}"
-            f"{' (eq. 5.4)' if e_n is None else ''}, v_fT = {float(red.v_ft_mps):.2f}, "
+            f"{' (eq. 5.4)' if f.e_n_from_angle_law else ''}, "
+            f"v_fT = {float(red.v_ft_mps):.2f}, "
             f"v_fN = {float(red.v_fn_mps):.2f} m/s, omega_f = "
             f"{float(red.omega_f_radps):.2f} rad/s, "
             f"{_SLIP_STOPS if red.slip_stops else 'slips throughout'}",
         ]
-    if rebound is not None:
-        if k is None:
-            raise ArgumentError(
-                "the energy split needs --gyration or --inertia", source="--gyration"
-            )
-        v_f, w_f, a_f, how = rebound
-        split = fence_energy_split(mass, k, speed_in, spin_in, v_f, w_f)
-        results["energy"] = {name: float(v) for name, v in split._asdict().items()}
-        results["speed_out_mps"], results["spin_out_radps"] = v_f, w_f
-        angle_text = "" if a_f is None else f", theta_f = {a_f:.1f} deg"
+    split = f.split
+    if split is not None:
+        angle_text = (
+            ""
+            if f.angle_out_deg is None
+            else (f", theta_f = {f.angle_out_deg:.1f} deg")
+        )
         lines += [
-            f"impact:      v_i = {speed_in:.2f} m/s, omega_i = {spin_in:.2f} rad/s"
-            + ("" if angle_in is None else f", theta_i = {angle_in:g} deg"),
-            f"restitution: v_f = {v_f:.2f} m/s, omega_f = {w_f:.2f} rad/s{angle_text}"
-            f" ({how})",
+            f"impact:      v_i = {f.speed_in_mps:.2f} m/s, "
+            f"omega_i = {f.spin_in_radps:.2f} rad/s"
+            + ("" if f.angle_in_deg is None else f", theta_i = {f.angle_in_deg:g} deg"),
+            f"restitution: v_f = {f.speed_out_mps:.2f} m/s, "
+            f"omega_f = {f.spin_out_radps:.2f} rad/s{angle_text} ({f.rebound})",
             "energy [kJ]      kinetic  rotational     total",
             f"  impact      {split.kinetic_in_j / 1e3:10.2f} "
             f"{split.rotational_in_j / 1e3:11.2f} {split.total_in_j / 1e3:9.2f}",
@@ -269,72 +251,68 @@ def fence(
             f"absorbed by the fence: {split.absorbed_j / 1e3:.2f} kJ "
             f"({split.absorbed_fraction:.1%} of the impact energy)",
             f"energy efficiency E_f/E_i (eq. 8.1): {split.efficiency:.1%}",
-        ]
+        ]  # fmt: skip
     else:
-        split = None
         lines.append(
             "no rebound given: add --speed-out (measured) or --radius and "
             "--angle-in (computed) for the energy split"
         )
-
-    source = "m v_i" if impulse is None else "--impulse"
+    source = "--impulse" if f.impulse_given else "m v_i"
     lines += [
-        f"time-force for impulse p = {p:,.0f} N s ({source}; section 8.3.2)",
+        f"time-force for impulse p = {f.impulse_ns:,.0f} N s ({source}; section 8.3.2)",
         "  structure  law                 contact time [s]  peak force [kN]",
     ]
-    results["impulse_ns"] = p
-    results["structures"] = []
-    for law in laws:
-        t_end, f_max = float(contact_time(law, p)), float(peak_force(law, p))
-        results["structures"].append(
-            {
-                "name": law.name,
-                "coefficient": law.coefficient,
-                "exponent": law.exponent,
-                "contact_time_s": t_end,
-                "peak_force_n": f_max,
-            }
-        )
+    for s in f.structures:
+        law = s.law
         text = f"F = {law.coefficient:g} t^{law.exponent:g}"
-        lines.append(f"  {law.name:<10} {text:<20} {t_end:16.3f} {f_max / 1e3:16.1f}")
-
-    if figure is not None:
-        from fieldkit.viz.fence_figure import write_fence_figure
-
-        write_fence_figure(figure, p, laws, split)
-        lines.append(f"figure: {figure}")
-    if out is not None:
-        write_text_atomic(out, json.dumps(results, indent=2) + "\n")
-        lines.append(f"results: {out}")
-    typer.echo("\n".join(lines))
+        lines.append(
+            f"  {law.name:<10} {text:<20} {s.contact_time_s:16.3f} "
+            f"{s.peak_force_n / 1e3:16.1f}"
+        )
+    return lines
 
 
-def _require(ok: bool, option: str, message: str) -> None:
-    if not ok:
-        raise ArgumentError(message, source=option)
+def _results(f: FenceImpact) -> dict[str, object]:
+    """The JSON written by ``-o``."""
+    results: dict[str, object] = {
+        "mass_kg": f.mass_kg,
+        "gyration_m": f.gyration_m,
+        "speed_in_mps": f.speed_in_mps,
+        "spin_in_radps": f.spin_in_radps,
+    }
+    red = f.redirection
+    if red is not None:
+        results["redirection"] = {
+            "v_it_mps": float(red.v_it_mps),
+            "v_in_mps": float(red.v_in_mps),
+            "e_n": float(red.e_n),
+            "v_ft_mps": float(red.v_ft_mps),
+            "v_fn_mps": float(red.v_fn_mps),
+            "slip_stops": bool(red.slip_stops),
+        }
+    if f.split is not None:
+        results["energy"] = {name: float(v) for name, v in f.split._asdict().items()}
+        results["speed_out_mps"] = f.speed_out_mps
+        results["spin_out_radps"] = f.spin_out_radps
+    results["impulse_ns"] = f.impulse_ns
+    results["structures"] = [
+        {
+            "name": s.law.name,
+            "coefficient": s.law.coefficient,
+            "exponent": s.law.exponent,
+            "contact_time_s": s.contact_time_s,
+            "peak_force_n": s.peak_force_n,
+        }
+        for s in f.structures
+    ]
+    return results
 
 
 def _fmt(value: float | None) -> str:
     return "?" if value is None else f"{value:.4g}"
 
 
-def _gyration(
-    mass: float, gyration: float | None, inertia: float | None
-) -> float | None:
-    if gyration is not None and inertia is not None:
-        raise ArgumentError(
-            "give --gyration or --inertia, not both", source="--inertia"
-        )
-    if gyration is not None:
-        _require(gyration >= 0, "--gyration", f"must not be negative, got {gyration:g}")
-        return gyration
-    if inertia is not None:
-        _require(inertia >= 0, "--inertia", f"must not be negative, got {inertia:g}")
-        return math.sqrt(inertia / mass)
-    return None
-
-
-def _law(name: str, text: str, option: str, law_class: type) -> object:
+def _law(name: str, text: str, option: str) -> StructureLaw:
     parts = text.split(",")
     try:
         if len(parts) != 2:
@@ -353,4 +331,4 @@ def _law(name: str, text: str, option: str, law_class: type) -> object:
         raise ArgumentError(
             f"coefficient and exponent must be positive, got {text!r}", source=option
         )
-    return law_class(name, coefficient, exponent)
+    return StructureLaw(name, coefficient, exponent)

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import math
-import re
 from pathlib import Path
 from typing import Annotated
 
@@ -17,12 +16,14 @@ from fieldkit.cli.common import (
     MassOpt,
     RadiusOpt,
     ShapeOpt,
+    UnitWeightOpt,
     one_line_errors,
+    print_body_notes,
     warn,
 )
 from fieldkit.errors import ArgumentError
 from fieldkit.outputs import write_text_atomic
-from fieldkit.physics.bodies import SHAPES, UNIT_WEIGHT_KN_M3, Body, shape_body
+from fieldkit.physics.bodies import ResolvedBody, resolve_body
 from fieldkit.physics.impact_mechanics import (
     ImpactResult,
     minimum_friction_to_stop_slip,
@@ -38,36 +39,15 @@ from fieldkit.physics.restitution import (
     velocity_scaled_restitution,
 )
 
-#: Library argument names -> the command-line options the user typed.
-_OPTION_NAMES = {
-    "mass_kg": "--mass",
-    "radius_m": "--radius",
-    "gyration_m": "--gyration",
-    "dimensions_m": "--dimensions",
-    "unit_weight_kn_m3": "--unit-weight",
-    "shape": "--shape",
-    "e_n": "--en",
-    "friction": "--friction",
-    "offset_m": "--offset",
-    "v_it_mps": "--vt",
-    "v_in_mps": "--vn",
-    "omega_i_radps": "--spin",
+#: Body values `impact` needs (the mass is optional: it only scales the energies).
+BODY_NEEDS = ("radius_m", "gyration_m")
+
+#: Where `impact`'s flags differ from :data:`fieldkit.cli.common.FLAGS`.
+_FLAGS = {
     "theta_i_deg": "the impact angle (--angle, or atan(-vn/vt))",
     "a": "--a",
     "b": "--b",
-    "velocity_scale_mps": "--scale-velocity",
 }
-
-
-def _as_option_message(message: str) -> str:
-    """Rewrite a library message so it names the command-line option."""
-    head, _, rest = message.partition(" ")
-    if head in _OPTION_NAMES:
-        message = f"{_OPTION_NAMES[head]} {rest}"
-    for name, option in _OPTION_NAMES.items():
-        if "_" in name:
-            message = re.sub(rf"\b{name}\b", option, message)
-    return message
 
 
 def _positive(option: str, value: float) -> None:
@@ -104,52 +84,6 @@ def _impact_velocity(
             f"--vn must be < 0, i.e. moving into the ground (got {vn:g})"
         )
     return vt, vn
-
-
-def _parse_dimensions(text: str) -> list[float]:
-    parts = [p for p in re.split(r"[,x×\s]+", text.strip()) if p]
-    try:
-        return [float(p) for p in parts]
-    except ValueError:
-        raise ArgumentError(
-            f"--dimensions must be numbers separated by commas, e.g. 1.6,1.3,1.3 "
-            f"(got {text!r})"
-        ) from None
-
-
-def _body(
-    mass: float | None,
-    radius: float | None,
-    gyration: float | None,
-    shape: str | None,
-    dimensions: str | None,
-    unit_weight: float,
-) -> tuple[Body, bool]:
-    """The body, and whether its mass is known (energies need it)."""
-    if shape is not None:
-        if gyration is not None:
-            raise ArgumentError(
-                "--gyration is computed from --shape and --dimensions (Table 4-1); "
-                "give one or the other"
-            )
-        if dimensions is None:
-            names = ", ".join(SHAPES[shape].dimension_names) if shape in SHAPES else ""
-            raise ArgumentError(f"--shape needs --dimensions ({names or 'see --help'})")
-        dims = _parse_dimensions(dimensions)
-        body = shape_body(shape, dims, unit_weight, radius_m=radius)
-        if mass is not None:  # a weighed mass overrides volume x unit weight
-            body = Body(
-                mass, body.radius_m, body.gyration_m, body.volume_m3, body.shape
-            )
-        return body, True
-    if dimensions is not None:
-        raise ArgumentError(f"--dimensions needs --shape ({', '.join(SHAPES)})")
-    if radius is None or gyration is None:
-        raise ArgumentError(
-            "give the body: --radius and --gyration (and --mass for energies), "
-            "or --shape and --dimensions"
-        )
-    return Body(1.0 if mass is None else mass, radius, gyration), mass is not None
 
 
 #: --law choices: constant e_N (--en), eq. 5.4 (angle), eq. 7.1 (velocity).
@@ -197,8 +131,7 @@ def _number(value: object) -> float | bool | None:
 
 def _report(
     res: ImpactResult,
-    body: Body,
-    mass_known: bool,
+    body: ResolvedBody,
     v_it: float,
     v_in: float,
     spin: float,
@@ -210,6 +143,7 @@ def _report(
 ) -> str:
     """The printed table."""
     f = {k: float(np.asarray(v)) for k, v in vars(res).items()}
+    mass_known = body.mass_kg is not None
     shape = f"{body.shape} " if body.shape else ""
     lines = [
         "fieldkit impact: rough rotating body on the slope (thesis ch. 4, App. C)",
@@ -271,7 +205,7 @@ def _report(
     return "\n".join(lines)
 
 
-@one_line_errors
+@one_line_errors(flags=_FLAGS)
 def impact(
     speed: Annotated[
         float | None, typer.Option("--speed", help="Impact speed v_i (m/s).")
@@ -305,10 +239,7 @@ def impact(
     gyration: GyrationOpt = None,
     shape: ShapeOpt = None,
     dimensions: DimensionsOpt = None,
-    unit_weight: Annotated[
-        float,
-        typer.Option("--unit-weight", help="Rock unit weight (kN/m^3) for --shape."),
-    ] = UNIT_WEIGHT_KN_M3,
+    unit_weight: UnitWeightOpt = None,
     offset: Annotated[
         float,
         typer.Option(
@@ -368,25 +299,30 @@ def impact(
     Add --friction 0.5 --figure pnv.png for the pN-v diagram (Figs. 4.4/4.5) with a
     slip phase, --json out.json for the numbers.
     """
-    try:
-        v_it, v_in = _impact_velocity(speed, angle, vt, vn)
-        if not math.isfinite(spin):
-            raise ArgumentError(f"--spin must be finite (got {spin:g})")
-        body, mass_known = _body(mass, radius, gyration, shape, dimensions, unit_weight)
-        theta_i = math.degrees(math.atan2(-v_in, v_it))
-        e_n, e_source = _restitution(law, en, a, b, scale_velocity, theta_i, v_in)
-        common = {
-            "radius_m": body.radius_m,
-            "gyration_m": body.gyration_m,
-            "e_n": e_n,
-            "friction": friction,
-            "offset_m": offset,
-            "mass_kg": body.mass_kg if mass_known else None,
-        }
-        res = rough_body_impact(v_it, v_in, spin, **common)
-        history = impulse_history(v_it, v_in, spin, **common) if figure else None
-    except ArgumentError as exc:
-        raise ArgumentError(_as_option_message(exc.message)) from None
+    v_it, v_in = _impact_velocity(speed, angle, vt, vn)
+    if not math.isfinite(spin):
+        raise ArgumentError(f"--spin must be finite (got {spin:g})")
+    body = resolve_body(
+        mass_kg=mass,
+        radius_m=radius,
+        gyration_m=gyration,
+        shape=shape,
+        dimensions_m=dimensions,
+        unit_weight_kn_m3=unit_weight,
+    ).require(*BODY_NEEDS, source="fieldkit impact")
+    mass_known = body.mass_kg is not None
+    theta_i = math.degrees(math.atan2(-v_in, v_it))
+    e_n, e_source = _restitution(law, en, a, b, scale_velocity, theta_i, v_in)
+    common = {
+        "radius_m": body.radius_m,
+        "gyration_m": body.gyration_m,
+        "e_n": e_n,
+        "friction": friction,
+        "offset_m": offset,
+        "mass_kg": body.mass_kg,
+    }
+    res = rough_body_impact(v_it, v_in, spin, **common)
+    history = impulse_history(v_it, v_in, spin, **common) if figure else None
 
     outputs = [p.resolve() for p in (figure, json_out) if p is not None]
     if len(set(outputs)) < len(outputs):
@@ -400,9 +336,9 @@ def impact(
             )
         )  # fmt: skip
     typer.echo(
-        _report(res, body, mass_known, v_it, v_in, spin, e_n, e_source, friction,
-                offset, mu_min)
-    )  # fmt: skip
+        _report(res, body, v_it, v_in, spin, e_n, e_source, friction, offset, mu_min)
+    )
+    print_body_notes(body)
     k2 = body.gyration_m**2
     before = v_it**2 + v_in**2 + k2 * spin**2
     after = float(res.v_f_mps) ** 2 + k2 * float(res.omega_f_radps) ** 2

@@ -14,11 +14,18 @@ from fieldkit.cli.common import (
     MassOpt,
     RadiusOpt,
     ShapeOpt,
+    UnitWeightOpt,
+    note,
     one_line_errors,
+    print_body_notes,
+    with_flags,
 )
 from fieldkit.errors import ArgumentError
 from fieldkit.impact_table import FORMATS
 from fieldkit.outputs import refuse_input_overwrite
+
+#: Body values `reduce` needs: none (columns it cannot fill stay NaN).
+BODY_NEEDS: tuple[str, ...] = ()
 
 FIGURE_NAMES = (
     "section.png",
@@ -72,12 +79,7 @@ def reduce(
     gyration: GyrationOpt = None,
     shape: ShapeOpt = None,
     dimensions: DimensionsOpt = None,
-    unit_weight: Annotated[
-        float | None,
-        typer.Option(
-            "--unit-weight", help="Rock unit weight for --shape, kN/m3 (default 26)."
-        ),
-    ] = None,
+    unit_weight: UnitWeightOpt = None,
     units: Annotated[
         str,
         typer.Option(
@@ -155,7 +157,7 @@ def reduce(
         --trees surveys/tornado_mountain/boulder_a_trees.csv --theta0 32.6 \\
         --mass 3750 --radius 0.725 --gyration 0.46 -o t.csv --figures figs
     """
-    from fieldkit.reduce.body import parse_dimensions, resolve_body
+    from fieldkit.physics.bodies import resolve_body
     from fieldkit.reduce.pipeline import ReduceOptions, reduce_survey
     from fieldkit.reduce.summary import format_summary, summarize
     from fieldkit.survey import Survey
@@ -177,10 +179,16 @@ def reduce(
         raise ArgumentError(
             f"must be between 0 and 180 degrees (got {theta0:g})", source="--theta0"
         )
+    body = resolve_body(
+        mass_kg=mass,
+        radius_m=radius,
+        gyration_m=gyration,
+        shape=shape,
+        dimensions_m=dimensions,
+        unit_weight_kn_m3=unit_weight,
+    ).require(*BODY_NEEDS, source="fieldkit reduce")
     if out is None and figures is None:
-        typer.echo(
-            "note: no -o/--out or --figures given; printing the summary only", err=True
-        )
+        note("no -o/--out or --figures given; printing the summary only")
     if out is not None and out.suffix.lower() not in FORMATS:
         raise ArgumentError(
             f"unknown table format {out.suffix!r}; use one of {', '.join(FORMATS)}",
@@ -192,14 +200,6 @@ def reduce(
         outputs += [figures / name for name in FIGURE_NAMES]
     refuse_input_overwrite(outputs, inputs)
 
-    body = resolve_body(
-        mass_kg=mass,
-        radius_m=radius,
-        gyration_m=gyration,
-        shape=shape,
-        dimensions_m=parse_dimensions(dimensions),
-        unit_weight_kn_m3=unit_weight,
-    )
     if impacts is not None:
         from fieldkit.io.impacts import read_impacts
 
@@ -243,7 +243,8 @@ def reduce(
             table, figures / FIGURE_NAMES[3], figures / FIGURE_NAMES[4]
         )
     typer.echo(f"body: {body.description}")
-    typer.echo(format_summary(summarize(table)))
+    print_body_notes(body)
+    typer.echo(with_flags(format_summary(summarize(table))))
     if out is not None:
         typer.echo(f"wrote {out} ({len(table)} rows)")
     if figures is not None:

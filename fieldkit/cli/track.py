@@ -10,13 +10,27 @@ from typing import Annotated
 
 import typer
 
-from fieldkit.cli.common import GyrationOpt, MassOpt, RadiusOpt, one_line_errors, warn
+from fieldkit.cli.common import (
+    DimensionsOpt,
+    GyrationOpt,
+    MassOpt,
+    RadiusOpt,
+    ShapeOpt,
+    UnitWeightOpt,
+    note,
+    one_line_errors,
+    print_body_notes,
+    warn,
+)
 from fieldkit.errors import ArgumentError
 from fieldkit.impact_table import FORMATS
 from fieldkit.outputs import atomic_path, refuse_input_overwrite
 
 #: show a progress bar for videos longer than this many frames
 PROGRESS_MIN_FRAMES = 300
+
+#: Body values `track` needs; a radius not given is measured from the video.
+BODY_NEEDS = ("radius_m",)
 
 
 @one_line_errors
@@ -68,6 +82,9 @@ def track(
     ] = None,
     mass: MassOpt = None,
     gyration: GyrationOpt = None,
+    shape: ShapeOpt = None,
+    dimensions: DimensionsOpt = None,
+    unit_weight: UnitWeightOpt = None,
     roi: Annotated[
         str | None,
         typer.Option(
@@ -118,6 +135,7 @@ def track(
         --scale-length 1.2 --radius 0.0375 --mass 0.14 --surface-angle 15
         -o out/bounce_track.csv --impacts out/bounce_impacts.csv --figures out/bounce
     """
+    from fieldkit.physics.bodies import resolve_body
     from fieldkit.tracking.flights.pipeline import analyse_track
     from fieldkit.tracking.video.calibration import (
         parse_scale_points,
@@ -137,13 +155,14 @@ def track(
         raise ArgumentError(
             f"must be a positive frame rate, got {fps:g}", source="--fps"
         )
-    for name, value in (
-        ("--radius", radius),
-        ("--mass", mass),
-        ("--gyration", gyration),
-    ):
-        if value is not None and not (math.isfinite(value) and value > 0):
-            raise ArgumentError(f"must be positive, got {value:g}", source=name)
+    body = resolve_body(
+        mass_kg=mass,
+        radius_m=radius,
+        gyration_m=gyration,
+        shape=shape,
+        dimensions_m=dimensions,
+        unit_weight_kn_m3=unit_weight,
+    )
     if surface_angle is not None and not (
         math.isfinite(surface_angle) and -90 < surface_angle < 90
     ):
@@ -170,11 +189,7 @@ def track(
         )
     refuse_input_overwrite([out, impacts, rrd], [video, homography])
     if out is None and impacts is None and rrd is None and figures is None:
-        typer.echo(
-            "note: no -o, --impacts, --rrd or --figures given; printing the "
-            "summary only",
-            err=True,
-        )
+        note("no -o, --impacts, --rrd or --figures given; printing the summary only")
 
     reader = VideoReader(video)
     info = reader.info
@@ -188,27 +203,26 @@ def track(
     search = parse_roi(roi, size)
 
     track_data, detections = _run_tracking(
-        video, reader, fps, calibration, search, radius, show=not quiet
+        video, reader, fps, calibration, search, body.radius_m, show=not quiet
     )
     rate_message = fps_mismatch_message(info, fps)
     for message in [rate_message, *track_data.meta.get("warnings", [])]:
         if message:
             warn(message)
-    radius_m = radius
-    if radius_m is None:
+    if body.radius_m is None:
         whole = track_data.frame.loc[~track_data.frame["partial"], "radius_m"]
-        radius_m = float(whole.median()) if len(whole) else float("nan")
-        typer.echo(
-            f"note: --radius not given; using the measured {radius_m:.4g} m", err=True
-        )
+        if len(whole):
+            body = body.with_measured_radius(float(whole.median()))
+    body.require(*BODY_NEEDS, source="fieldkit track")
     analysis = analyse_track(
         track_data,
-        radius_m=radius_m,
+        radius_m=body.radius_m,
         surface_angle_deg=surface_angle,
-        mass_kg=mass,
-        gyration_m=gyration,
+        mass_kg=body.mass_kg,
+        gyration_m=body.gyration_m,
         path_id=path_id or video.stem,
     )
+    print_body_notes(body)
     for message in analysis.warnings:
         warn(message)
 

@@ -8,11 +8,25 @@ from typing import Annotated
 
 import typer
 
-from fieldkit.cli.common import GyrationOpt, MassOpt, RadiusOpt, one_line_errors, warn
+from fieldkit.cli.common import (
+    DimensionsOpt,
+    GyrationOpt,
+    MassOpt,
+    RadiusOpt,
+    ShapeOpt,
+    UnitWeightOpt,
+    one_line_errors,
+    print_body_notes,
+    warn,
+)
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.impact_table import ImpactTable
 from fieldkit.io.track_files import detect_format, read_track
 from fieldkit.outputs import refuse_input_overwrite
+from fieldkit.physics.bodies import resolve_body
+
+#: Body values `view` needs to analyse a track (an ImpactTable carries its own).
+TRACK_BODY_NEEDS = ("radius_m",)
 
 
 class InputFormat(StrEnum):
@@ -53,6 +67,9 @@ def view(
     ] = None,
     mass: MassOpt = None,
     gyration: GyrationOpt = None,
+    shape: ShapeOpt = None,
+    dimensions: DimensionsOpt = None,
+    unit_weight: UnitWeightOpt = None,
     unit: Annotated[
         str | None,
         typer.Option(
@@ -94,7 +111,7 @@ def view(
     Kinovea export) is first analysed like `fieldkit track` does: flights found and
     fitted (fitted g checked against 9.81), impacts and net contacts; the recording
     shows the track, the fitted flights, velocity vectors, speed, spin and residuals.
-    A track needs --radius.
+    A track needs --radius (or --shape).
 
     Examples:
 
@@ -112,6 +129,14 @@ def view(
         raise ArgumentError(
             f"output must be a .rrd file, got {out.name!r}", source="-o"
         )
+    body = resolve_body(
+        mass_kg=mass,
+        radius_m=radius,
+        gyration_m=gyration,
+        shape=shape,
+        dimensions_m=dimensions,
+        unit_weight_kn_m3=unit_weight,
+    )
     fmt = input_format.value
     if fmt == "auto":
         fmt = detect_format(input_file)
@@ -133,22 +158,24 @@ def view(
         fps=fps,
         file_fps=file_fps,
     )
-    if radius is None:
+    if body.missing(*TRACK_BODY_NEEDS):
         raise ArgumentError(
-            "a track needs the body radius to analyse its impacts", source="--radius"
+            "a track needs the body radius to analyse its impacts (or `shape`)",
+            source="radius_m",
         )
     from fieldkit.tracking.flights.pipeline import analyse_track
 
     analysis = analyse_track(
         track,
-        radius_m=radius,
+        radius_m=body.radius_m,
         surface_angle_deg=surface_angle,
-        mass_kg=mass,
-        gyration_m=gyration,
+        mass_kg=body.mass_kg,
+        gyration_m=body.gyration_m,
         path_id=input_file.stem,
     )
     for message in analysis.warnings:
         warn(message)
+    print_body_notes(body)
     rerun_log.write_recording(out, analysis)
     if figures is not None:
         from fieldkit.viz.track_figure import write_track_figures

@@ -380,9 +380,7 @@ def length_factor(
 
 
 def units_factor(units: str) -> float:
-    """Metres per unit for the ``--units`` option (``m`` or ``ft``, international)."""
+    """Metres per unit of ``units`` (``m`` or ``ft``, international)."""
     if units not in ("m", "ft"):
-        raise ArgumentError(
-            f"units must be 'm' or 'ft', not '{units}'", source="--units"
-        )
+        raise ArgumentError(f"units must be 'm' or 'ft', not '{units}'", source="units")
     return LENGTH_UNITS[units]

@@ -106,7 +106,7 @@ def read_fieldbook(
     if not math.isfinite(declination_deg) or abs(declination_deg) > 180.0:
         raise ArgumentError(
             f"declination {declination_deg} is not in [-180, 180] degrees",
-            source="--declination",
+            source="declination_deg",
         )
     table = read_csv_table(path)
     source = table.source

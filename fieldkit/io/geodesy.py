@@ -217,11 +217,11 @@ def projected_crs(epsg: int | str) -> pyproj.CRS:
     try:
         crs = pyproj.CRS.from_user_input(code)
     except pyproj.exceptions.CRSError:
-        raise ArgumentError(f"unknown CRS '{epsg}'", source="--epsg") from None
+        raise ArgumentError(f"unknown CRS '{epsg}'", source="epsg") from None
     if not crs.is_projected:
         raise ArgumentError(
             f"{code} ({crs.name}) is not a projected CRS with easting/northing",
-            source="--epsg",
+            source="epsg",
         )
     return crs
 
@@ -313,7 +313,7 @@ def from_projected(
 def _as_projected(crs: pyproj.CRS | int | str) -> pyproj.CRS:
     if isinstance(crs, pyproj.CRS):
         if not crs.is_projected:
-            raise ArgumentError(f"{crs.name} is not a projected CRS", source="--epsg")
+            raise ArgumentError(f"{crs.name} is not a projected CRS", source="epsg")
         return crs
     return projected_crs(crs)
 

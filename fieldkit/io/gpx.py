@@ -125,7 +125,7 @@ def read_gpx_waypoints(
     if points not in (*_KINDS, "auto"):
         raise ArgumentError(
             f"points must be one of waypoints, route, track, auto (not '{points}')",
-            source="--gpx-points",
+            source="gpx_points",
         )
     root = parse_gpx_root(path)
     counts = {kind: len(_collect(root, kind)) for kind in _KINDS}

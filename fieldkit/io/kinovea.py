@@ -127,7 +127,7 @@ def read_kinovea(
     length_unit = unit_name(x_unit) or unit
     if length_unit is None:
         raise ArgumentError(
-            "the export does not name its length unit: give it (--unit m|cm|mm|px)",
+            "the export does not name its length unit: give it (`unit` m|cm|mm|px)",
             source=src,
         )
     row_numbers, data = read_number_columns(

@@ -4,7 +4,7 @@ Three layouts, recognised from the header (first match wins):
 
 1. ``lat, lon, elev`` — WGS 84 degrees and an elevation (GNSS apps: Emlid Flow, Bad Elf,
    Trimble exports). ``x_m`` is the cumulative geodesic distance.
-2. ``easting, northing, elevation`` with an EPSG code (``epsg=``/``--epsg``) — the
+2. ``easting, northing, elevation`` with an EPSG code (``epsg=``) — the
    coordinates are converted to latitude/longitude with pyproj and treated as in 1.
    ``x, y`` columns count as easting/northing when an EPSG code is given.
 3. ``x, z`` — section coordinates directly (``x`` increasing in the direction of
@@ -157,7 +157,7 @@ def read_points_csv(
             raise InputFileError(
                 f"easting/northing columns ('{easting_column.header.strip()}', "
                 f"'{northing_column.header.strip()}') need the EPSG code of their "
-                "projection (--epsg, e.g. 32611 for WGS 84 / UTM zone 11N)",
+                "projection (`epsg`, e.g. 32611 for WGS 84 / UTM zone 11N)",
                 source=source,
             )
         crs = geodesy.projected_crs(epsg)
@@ -191,7 +191,7 @@ def read_points_csv(
         x = _require_numbers(table, x_column, length_factor(table, x_column, units))
         z = _require_numbers(table, z_column, length_factor(table, z_column, units))
         if epsg is not None:
-            notes.append("--epsg ignored: the file has section coordinates (x, z)")
+            notes.append("`epsg` ignored: the file has section coordinates (x, z)")
         return point_set_from_section(
             names,
             x,
@@ -204,7 +204,7 @@ def read_points_csv(
         )
     raise InputFileError(
         f"no coordinate columns found (have: {table.header_text()}); need lat, lon, "
-        "elev or easting, northing, elevation (+ --epsg) or x, z",
+        "elev or easting, northing, elevation (+ `epsg`) or x, z",
         source=source,
         where="row 1",
     )

@@ -90,7 +90,7 @@ class LengthScale:
             if self.metres_per_pixel is None or not self.metres_per_pixel > 0:
                 raise ArgumentError(
                     "coordinates are in pixels: give the scale in metres per pixel "
-                    "(--metres-per-pixel, e.g. ball diameter in m / diameter in px)",
+                    "(`metres_per_pixel`, e.g. ball diameter in m / diameter in px)",
                     source=str(source),
                 )
             return float(self.metres_per_pixel)
@@ -142,8 +142,8 @@ def time_factor(file_fps: float | None, fps: float | None, source: object) -> fl
         return 1.0
     if file_fps is None or fps is None:
         raise ArgumentError(
-            "give both the rate the file's times used (--file-fps) and the capture "
-            "rate (--fps) to correct the time base",
+            "give both the rate the file's times used (`file_fps`) and the capture "
+            "rate (`fps`) to correct the time base",
             source=str(source),
         )
     if not (file_fps > 0 and fps > 0):

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from fieldkit.errors import ArgumentError
+from fieldkit.physics._validate import reject
 
 #: Thesis eq. 5.4 best fit to the field data (Fig. 5.5): e_N = 19.5 theta_i^-1.03.
 ANGLE_LAW_A = 19.5
@@ -29,18 +29,8 @@ VELOCITY_SCALE_MPS = 9.144
 
 def _finite(name: str, value: ArrayLike) -> np.ndarray:
     array = np.asarray(value, dtype=float)
-    bad = ~np.isfinite(array)
-    if np.any(bad):
-        raise ArgumentError(f"{name} must be finite (got {array[bad].flat[0]:g})")
+    reject(~np.isfinite(array), name, "be finite", array)
     return array
-
-
-def _require(name: str, bad: np.ndarray, requirement: str, value: np.ndarray) -> None:
-    bad = np.atleast_1d(bad)
-    if np.any(bad):
-        values = np.broadcast_to(np.atleast_1d(np.asarray(value, float)), bad.shape)
-        first = values[bad]
-        raise ArgumentError(f"{name} must be {requirement} (got {first.flat[0]:g})")
 
 
 def constant_restitution(e_n: ArrayLike) -> np.ndarray:
@@ -55,7 +45,7 @@ def constant_restitution(e_n: ArrayLike) -> np.ndarray:
     0.35
     """
     e = np.asarray(e_n, float)
-    _require("e_n", ~(e >= 0), ">= 0", e)
+    reject(~(e >= 0), "e_n", "be >= 0", e)
     return e[()]
 
 
@@ -78,10 +68,10 @@ def angle_dependent_restitution(
     >>> [round(float(e), 2) for e in angle_dependent_restitution([25.0, 50.0])]
     [0.71, 0.35]
     """
-    _require("a", ~(np.asarray(a, float) > 0), "> 0", np.asarray(a, float))
-    _require("b", ~(np.asarray(b, float) >= 0), ">= 0", np.asarray(b, float))
+    reject(~(np.asarray(a, float) > 0), "a", "be > 0", np.asarray(a, float))
+    reject(~(np.asarray(b, float) >= 0), "b", "be >= 0", np.asarray(b, float))
     theta = _finite("theta_i_deg", theta_i_deg)
-    _require("theta_i_deg", ~((theta > 0) & (theta <= 90)), "in (0, 90] deg", theta)
+    reject(~((theta > 0) & (theta <= 90)), "theta_i_deg", "be in (0, 90] deg", theta)
     return a * theta ** (-b)
 
 
@@ -101,7 +91,7 @@ def velocity_scaled_restitution(
     """
     v_in = _finite("v_in_mps", v_in_mps)
     e0 = _finite("e_n", e_n)
-    _require("e_n", ~(e0 >= 0), ">= 0", e0)
+    reject(~(e0 >= 0), "e_n", "be >= 0", e0)
     scale = np.asarray(velocity_scale_mps, float)
-    _require("velocity_scale_mps", ~(scale > 0), "> 0", scale)
+    reject(~(scale > 0), "velocity_scale_mps", "be > 0", scale)
     return e0 / (1.0 + (v_in / scale) ** 2)

@@ -10,7 +10,7 @@ than the two end points; in order of preference:
     a restitution angle to the ground measured for that point (e.g. Ehime
     accelerometers), ``alpha = theta0 - psi`` (eq. 3.6);
 ``assumed``
-    the ``--theta0`` of the command line (thesis: the 33° mean of the tree-defined
+    the ``theta0_deg`` of the reduction (thesis: the 33° mean of the tree-defined
     flights at Tornado Mountain) with ``alpha = theta0 - psi``. The flight that leaves
     the source is a rock detaching from a cliff, not a rebound, so there "assumed"
     means the least-speed launch that reaches the first impact (eq. 3.5 minimised over
@@ -113,7 +113,7 @@ def solve_flights(
         ``"<points file>: point 7: ..."`` for a flight no ballistic path makes;
         ``"<tree file>: row 4: ..."`` for a tree strike no parabola reaches.
     ArgumentError
-        A flight with no way to fix its parabola (no tree, no angle, no ``--theta0``).
+        A flight with no way to fix its parabola (no tree, no angle, no ``theta0_deg``).
 
     Examples
     --------
@@ -155,7 +155,8 @@ def solve_flights(
         else:
             raise ArgumentError(
                 f"the flight from point {launch} to point {arrival} has no tree strike "
-                "and no restitution angle: give --theta0 (the thesis assumes 32.6°)",
+                "and no restitution angle: give `theta0_deg` (the thesis assumes "
+                "32.6°)",
                 source=points_source,
                 where=f"point {launch}",
             )

@@ -6,7 +6,7 @@
    previous point (thesis "slope angle above impact point"), or the surveyed slope;
 2. :meth:`Survey.trees_by_launch` -- tree strikes keyed by the flight they fix;
 3. :func:`fieldkit.reduce.flights.solve_flights` -- each flight's parabola (tree
-   three-point solve, given angle, or assumed ``--theta0``);
+   three-point solve, given angle, or assumed ``theta0_deg``);
 4. :func:`impact_rows` -- primary ImpactTable columns: velocities at the end of each
    flight (impact) and start of the next (restitution), body, spin, flight heights;
 5. :meth:`ImpactTable.derive` -- N/T components, angles, e_n, e_t, energies, heads;
@@ -28,8 +28,8 @@ import pandas as pd
 
 from fieldkit.errors import InputFileError
 from fieldkit.impact_table import ImpactTable
+from fieldkit.physics.bodies import ResolvedBody
 from fieldkit.physics.energy import kinetic_energy
-from fieldkit.reduce.body import BodyProperties
 from fieldkit.reduce.flights import SolvedFlight, solve_flights
 from fieldkit.reduce.impact_theory import DEFAULT_FRICTION, add_theory_columns
 from fieldkit.survey import Survey
@@ -47,7 +47,9 @@ class ReduceOptions:
         Assumed restitution angle to the ground [deg] where no tree or measured angle
         defines a flight (None: every flight must be defined).
     body
-        Mass, contact radius, radius of gyration.
+        Mass, contact radius, radius of gyration
+        (:func:`fieldkit.physics.bodies.resolve_body`); unknown values leave their
+        columns NaN.
     friction
         Contact friction coefficient mu [-] for the impact-mechanics energy beside
         the measured one (:func:`fieldkit.reduce.impact_theory.add_theory_columns`).
@@ -55,7 +57,7 @@ class ReduceOptions:
 
     path_id: str
     theta0_deg: float | None = None
-    body: BodyProperties = field(default_factory=BodyProperties)
+    body: ResolvedBody = field(default_factory=ResolvedBody)
     friction: float = DEFAULT_FRICTION
 
 
@@ -126,7 +128,10 @@ def impact_rows(
     t_s = np.concatenate([[0.0], np.cumsum(t_flight[:-1])])
 
     body = options.body
-    r = body.radius_m
+    mass, r, k = (
+        math.nan if value is None else value
+        for value in (body.mass_kg, body.radius_m, body.gyration_m)
+    )
     speed_f = np.hypot(vf_x, vf_z)
     omega_f = -speed_f / r if math.isfinite(r) else nan.copy()
     omega_i = np.concatenate([[np.nan], omega_f[:-1]])
@@ -139,9 +144,9 @@ def impact_rows(
             "z_m": frame["z_m"].to_numpy(float),
             "slope_deg": slope_deg,
             "material": (frame["material"] if "material" in frame else pd.NA),
-            "mass_kg": body.mass_kg,
-            "radius_m": body.radius_m,
-            "gyration_m": body.gyration_m,
+            "mass_kg": mass,
+            "radius_m": r,
+            "gyration_m": k,
             "theta0_deg": theta0,
             "theta0_source": pd.array(theta0_source, dtype="string"),
             "vi_x_mps": vi_x,

@@ -145,7 +145,7 @@ def format_summary(summary: ReductionSummary) -> str:
             f"potential released {summary.potential_released_j / 1e3:,.0f} kJ",
         ]
     else:
-        lines.append("energy: no mass given (--mass or --shape), energies left out")
+        lines.append("energy: no mass given (`mass_kg` or `shape`), energies left out")
     if summary.theory_fraction_n:
         lines.append(
             "impact mechanics explains a median "

@@ -70,7 +70,7 @@ def plot_energy_partition(table: ImpactTable) -> Figure:
         ax.text(
             0.5,
             0.5,
-            "no mass given (--mass or --shape):\nno energies to partition",
+            "no mass given:\nno energies to partition",
             ha="center",
             va="center",
             transform=ax.transAxes,

@@ -126,7 +126,7 @@ def test_time_force_only(cli):
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["--mass", "-520", "--speed-in", "22"], "--mass: must be positive"),
+        (["--mass", "-520", "--speed-in", "22"], "--mass must be > 0 (got -520)"),
         (["--speed-in", "22"], "--mass"),
         (["--mass", "520"], "--speed-in"),
         ([*ROCK, "--gyration", "-0.3"], "--gyration"),

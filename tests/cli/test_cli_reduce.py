@@ -153,10 +153,6 @@ def test_uphill_flight_no_ballistic_path_makes(cli, tmp_path, fails):
         (("--impacts", "{impacts}", "--theta0", "30", "--units", "yd"), ("--units",)),
         (("--impacts", "{impacts}", "--theta0", "30", "--mass", "-1"), ("--mass",)),
         (
-            ("--impacts", "{impacts}", "--theta0", "30", *BOULDER, "--mass", "10"),
-            ("--mass",),
-        ),
-        (
             (
                 "--impacts",
                 "{impacts}",

@@ -262,7 +262,7 @@ def test_negative_heights_and_bad_declination(tmp_path):
     book = fieldbook(tmp_path, [shot_line("A1", "S1", -1.5, 0, 20, 0, 0)])
     with pytest.raises(InputFileError, match="row 2 \\(point A1\\): instrument and"):
         read_fieldbook(book, stations_csv(tmp_path))
-    with pytest.raises(ArgumentError, match="--declination"):
+    with pytest.raises(ArgumentError, match="declination_deg"):
         read_fieldbook(book, stations_csv(tmp_path), declination_deg=400.0)
 
 

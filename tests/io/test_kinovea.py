@@ -58,7 +58,7 @@ def test_kinematics_export_with_units_in_the_header():
 def test_time_unit_and_rate_overrides():
     tr = read_kinovea(DATA / "kinovea_kinematics_cm.csv", fps=1000.0, file_fps=500.0)
     assert tr.t[1] == pytest.approx(0.001)
-    with pytest.raises(ArgumentError, match="--file-fps"):
+    with pytest.raises(ArgumentError, match="`file_fps`"):
         read_kinovea(DATA / "kinovea_kinematics_cm.csv", fps=1000.0)
 
 

@@ -211,7 +211,7 @@ def test_missing_empty_and_binary_csv(tmp_path):
 
 def test_bad_epsg_argument(tmp_path):
     path = write(tmp_path, "e.csv", "point,easting,northing,elev\nA,1,2,3\n")
-    with pytest.raises(ArgumentError, match="--epsg: EPSG:4326 .* is not a projected"):
+    with pytest.raises(ArgumentError, match="epsg: EPSG:4326 .* is not a projected"):
         read_impacts(path, epsg=4326)
 
 

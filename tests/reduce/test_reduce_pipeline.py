@@ -11,8 +11,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from fieldkit.errors import ArgumentError, InputFileError, PhysicsError
+from fieldkit.physics.bodies import parse_dimensions, resolve_body
 from fieldkit.physics.flight import launch_speed
-from fieldkit.reduce.body import parse_dimensions, resolve_body
 from fieldkit.reduce.flights import least_speed_launch_angle_deg
 from fieldkit.reduce.pipeline import ReduceOptions, reduce_survey, section_slopes
 from fieldkit.reduce.summary import format_summary, summarize
@@ -151,7 +151,7 @@ def test_given_theta0_wins_over_assumed():
 def test_errors_name_the_file_and_point_or_row():
     x, z = np.array([0.0, 10.0, 20.0]), np.array([20.0, 14.0, 8.0])
     pts = points(["a", "b", "c"], x, z)
-    with pytest.raises(ArgumentError, match=r"synthetic.csv: point b: .*--theta0"):
+    with pytest.raises(ArgumentError, match=r"synthetic.csv: point b: .*`theta0_deg`"):
         reduce_survey(Survey(pts, None), ReduceOptions("p", None))
     below = trees([["a", 5.0, 0.5, 14.0]])  # strike at 14.5 m, chord at 17 m
     with pytest.raises(PhysicsError, match=r"trees.csv: row 2: .*no parabola"):
@@ -176,11 +176,11 @@ def test_body_options():
         ).radius_m
         == 0.8
     )  # Table 2-6's r = a
-    with pytest.raises(ArgumentError, match="--gyration"):
+    with pytest.raises(ArgumentError, match="gyration_m"):
         resolve_body(mass_kg=1.0, radius_m=0.2, gyration_m=0.3)  # k > r
-    with pytest.raises(ArgumentError, match="--dimensions"):
+    with pytest.raises(ArgumentError, match="dimensions_m"):
         resolve_body(dimensions_m=(1.0,))
-    with pytest.raises(ArgumentError, match="--dimensions"):
+    with pytest.raises(ArgumentError, match="dimensions_m"):
         parse_dimensions("1.6,,1.3")
 
 

@@ -18,7 +18,7 @@ import pandas as pd
 import pytest
 
 from fieldkit.io.impacts import read_impacts
-from fieldkit.reduce.body import resolve_body
+from fieldkit.physics.bodies import resolve_body
 from fieldkit.reduce.pipeline import ReduceOptions, reduce_survey
 from fieldkit.survey import Survey
 

@@ -50,7 +50,7 @@ def test_two_point_scale_rejects_bad_points(points, length, message):
 def test_parse_scale_points():
     assert parse_scale_points("1,2,3.5,4") == (1.0, 2.0, 3.5, 4.0)
     for bad in ("1,2,3", "a,b,c,d", "1,2,3,4,5", "1,2,nan,4"):
-        with pytest.raises(ArgumentError, match="--scale-points"):
+        with pytest.raises(ArgumentError, match="scale_points"):
             parse_scale_points(bad)
 
 

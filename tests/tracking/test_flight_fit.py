@@ -69,7 +69,7 @@ def test_wrong_capture_rate_scales_gravity_and_warns():
     f = fit_flight(t_given, x, z)
     assert f.g_mps2 == pytest.approx(G * (fps_given / 1205.0) ** 2, rel=1e-9)
     message = f.gravity_warning()
-    assert message is not None and "-16.7 %" in message and "--fps" in message
+    assert message is not None and "-16.7 %" in message and "`fps`" in message
     # the factor the warning suggests restores the true rate: fps_given times it is
     # 1205 (dividing instead would give 1004). Printed with 4 significant digits
     # (1.095 for 1.09545...), so the product is right to 5e-4.

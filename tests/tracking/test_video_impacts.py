@@ -160,7 +160,7 @@ def test_wrong_capture_rate_warns():
     for f in well_fitted:
         assert abs(f.g_mps2 - expected) < 3 * f.g_se_mps2 + 0.01
         assert any(
-            w.startswith(f"flight {f.index} ") and "--fps" in w for w in a.warnings
+            w.startswith(f"flight {f.index} ") and "`fps`" in w for w in a.warnings
         )
 
 

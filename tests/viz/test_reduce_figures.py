@@ -6,8 +6,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from fieldkit.physics.bodies import resolve_body
 from fieldkit.physics.constants import G
-from fieldkit.reduce.body import resolve_body
 from fieldkit.reduce.pipeline import ReduceOptions, reduce_survey
 from fieldkit.survey import PointSet, Survey, TreeStrikes
 from fieldkit.viz.energy_figure import energy_profile, plot_energy_partition

@@ -272,7 +272,7 @@ class FlightFit:
             f"flight {self.index} (t = {self.t_start_s:.4f}-{self.t_end_s:.4f} s): "
             f"fitted g = {self.g_mps2:.2f} +/- {self.g_se_mps2:.2f} m/s^2 is "
             f"{100 * rel:+.1f} % "
-            f"from 9.81; check the capture rate (--fps; times {factor:.4g} would fit) "
+            f"from 9.81; check the capture rate (`fps`; times {factor:.4g} would fit) "
             "or the length scale"
         )
 

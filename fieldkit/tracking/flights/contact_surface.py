@@ -15,7 +15,7 @@ sign of T.
 
 Where psi comes from (:func:`surface_angles`):
 
-* ``--surface-angle`` when given (its side is chosen facing the body, with a warning
+* ``surface_angle_deg`` when given (its side is chosen facing the body, with a warning
   when that flips it);
 * short impacts, two or more: the least-squares line through the centres at the
   impact instants (one radius off a plane surface, so parallel to it);
@@ -38,7 +38,7 @@ Where psi comes from (:func:`surface_angles`):
     net impulse leans by the friction (13 deg on ``video/net``); on ``video/net``
     they give e_n = 0.743 and 0.356 against the true 0.664. psi, and so ``vin``,
     ``vfn``, e_n, e_t and the angles, are left NaN with a warning (give
-    ``--surface-angle`` or film a marker for the spin).
+    ``surface_angle_deg`` or film a marker for the spin).
 
 A surface estimated from the data that the body does not leave (``vfn <= 0``) is
 likewise left NaN with a warning.
@@ -184,7 +184,7 @@ def surface_angles(
         note = f" +/- {se:.2f}" if np.isfinite(se) else ""
         warnings.append(
             f"surface angle estimated from {int(short.sum())} contact points: "
-            f"{psi:.2f}{note} deg (give --surface-angle to override)"
+            f"{psi:.2f}{note} deg (give `surface_angle_deg` to override)"
         )
     elif surface_angle_deg is None and short.sum() == 1:
         i = int(np.flatnonzero(short)[0])
@@ -202,14 +202,15 @@ def surface_angles(
             warnings.append(
                 f"surface angle {psi:.2f} deg estimated from the single impact's "
                 "velocity and spin change (angular-momentum balance, "
-                f"k = {gyration_m:.4g} m); give --surface-angle if the surface is known"
+                f"k = {gyration_m:.4g} m); give `surface_angle_deg` if the surface is "
+                "known"
             )
         else:
             slope[i] = 0.0
             source[i] = "assumed"
             warnings.append(
                 "no surface angle from a single impact without spin: "
-                "0 deg assumed; give --surface-angle"
+                "0 deg assumed; give `surface_angle_deg`"
             )
     if surface_angle_deg is None:
         for i in np.flatnonzero(extended):
@@ -244,7 +245,7 @@ def surface_angles(
             slope[i], source[i] = np.nan, None
             warnings.append(
                 f"contact {i + 1} at t = {r.t_s:.4f} s: the contact surface cannot be "
-                f"identified ({what}): e_n, e_t left NaN; give --surface-angle"
+                f"identified ({what}): e_n, e_t left NaN; give `surface_angle_deg`"
             )
     return slope, source, warnings
 
@@ -290,5 +291,5 @@ def extended_contact_angle(
         f"the contact surface cannot be identified without spin: the centre sags "
         f"{sag * 1e3:.1f} mm RMS off the chord ({chord:.2f} deg) into a deforming "
         "surface, whose chord and impulse direction are biased by its damping and "
-        "friction; e_n, e_t left NaN (give --surface-angle, or film a marker)"
+        "friction; e_n, e_t left NaN (give `surface_angle_deg`, or film a marker)"
     )

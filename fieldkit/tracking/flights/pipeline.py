@@ -129,12 +129,14 @@ def analyse_track(
     (2, 0.6)
     """
     if not np.isfinite(radius_m) or radius_m <= 0:
-        raise ArgumentError(f"radius must be > 0 m, got {radius_m}", source="--radius")
+        raise ArgumentError(
+            f"radius_m must be > 0 (got {radius_m:g})", source="radius_m"
+        )
     if mass_kg is not None and not mass_kg > 0:
-        raise ArgumentError(f"mass must be > 0 kg, got {mass_kg}", source="--mass")
+        raise ArgumentError(f"mass_kg must be > 0 (got {mass_kg:g})", source="mass_kg")
     if gyration_m is not None and not gyration_m > 0:
         raise ArgumentError(
-            f"radius of gyration must be > 0 m, got {gyration_m}", source="--gyration"
+            f"gyration_m must be > 0 (got {gyration_m:g})", source="gyration_m"
         )
     frame = track.frame.sort_values("t_s", kind="stable").reset_index(drop=True)
     track = Track(

@@ -62,7 +62,7 @@ def bouncing_ball(
         True capture rate [1/s]; samples are at ``k / fps``.
     fps_reported
         Rate used to compute the track's time column (default ``fps``); a different
-        value imitates a user giving the wrong ``--fps``.
+        value imitates a user giving the wrong capture rate ``fps``.
     start_xz_m, start_velocity_mps
         Centre position [m] and velocity [m/s] at t = 0 (must be above the plane).
     surface_angle_deg

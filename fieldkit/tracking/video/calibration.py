@@ -80,26 +80,28 @@ class Calibration:
         }
 
 
-def parse_scale_points(text: str) -> tuple[float, float, float, float]:
-    """Parse ``"U1,V1,U2,V2"`` (pixels) for ``--scale-points``.
+def parse_scale_points(scale_points: str) -> tuple[float, float, float, float]:
+    """Parse ``"U1,V1,U2,V2"`` (pixels): the ``scale_points`` of
+    :func:`two_point_scale`.
 
     Examples
     --------
     >>> parse_scale_points("100,30, 700,30")
     (100.0, 30.0, 700.0, 30.0)
     """
+    text = scale_points
     parts = [p for p in str(text).replace(";", ",").split(",") if p.strip()]
     try:
         values = tuple(float(p) for p in parts)
     except ValueError:
         raise ArgumentError(
             f"expected four numbers U1,V1,U2,V2 (pixels), got {text!r}",
-            source="--scale-points",
+            source="scale_points",
         ) from None
     if len(values) != 4 or not all(np.isfinite(values)):
         raise ArgumentError(
             f"expected four numbers U1,V1,U2,V2 (pixels), got {text!r}",
-            source="--scale-points",
+            source="scale_points",
         )
     return values  # type: ignore[return-value]
 
@@ -117,34 +119,35 @@ def _check_inside(u: float, v: float, image_size, source: str, where: str) -> No
 
 
 def two_point_scale(
-    points: tuple[float, float, float, float],
-    length_m: float,
+    scale_points: tuple[float, float, float, float],
+    scale_length_m: float,
     image_size: tuple[int, int] | None = None,
 ) -> Calibration:
     """Calibration from two image points a known distance apart (level camera).
 
     Parameters
     ----------
-    points
+    scale_points
         ``(U1, V1, U2, V2)`` [px].
-    length_m
+    scale_length_m
         Their distance in the scene [m].
     image_size
         ``(width, height)`` [px]; when given, both points must lie inside the frame.
     """
-    u1, v1, u2, v2 = (float(p) for p in points)
+    u1, v1, u2, v2 = (float(p) for p in scale_points)
+    length_m = scale_length_m
     if length_m is None or not np.isfinite(length_m) or length_m <= 0:
         raise ArgumentError(
             f"must be a positive length in metres, got {length_m}",
-            source="--scale-length",
+            source="scale_length_m",
         )
-    _check_inside(u1, v1, image_size, "--scale-points", "point 1")
-    _check_inside(u2, v2, image_size, "--scale-points", "point 2")
+    _check_inside(u1, v1, image_size, "scale_points", "point 1")
+    _check_inside(u2, v2, image_size, "scale_points", "point 2")
     distance = float(np.hypot(u2 - u1, v2 - v1))
     if distance < 1.0:
         raise ArgumentError(
             f"the two scale points are identical ({distance:.2g} px apart)",
-            source="--scale-points",
+            source="scale_points",
         )
     s = length_m / distance
     h = np.array([[s, 0.0, -s * u1], [0.0, -s, s * v1], [0.0, 0.0, 1.0]])

@@ -105,7 +105,7 @@ class BallDetector:
     roi
         ``(u0, v0, width, height)`` [px]: only bodies centred inside are found.
     expected_radius_px
-        Body radius in pixels when known (``--radius`` and the calibration); otherwise
+        Body radius in pixels when known (``radius_m`` and the calibration); otherwise
         learnt from the first confident detections.
     compensate_flicker
         Scale the background by each frame's brightness (:func:`brightness_gain`);

@@ -57,29 +57,30 @@ def frame_ranges(frames: np.ndarray) -> str:
 
 
 def parse_roi(
-    text: str | None, image_size: tuple[int, int]
+    roi: str | None, image_size: tuple[int, int]
 ) -> tuple[int, int, int, int] | None:
-    """Parse ``--roi U,V,WIDTH,HEIGHT`` [px] and check it overlaps the frame.
+    """Parse ``roi`` ``"U,V,WIDTH,HEIGHT"`` [px] and check it overlaps the frame.
 
     Examples
     --------
     >>> parse_roi("10,20,300,200", (800, 480))
     (10, 20, 300, 200)
     """
-    if text is None:
+    if roi is None:
         return None
+    text = roi
     try:
         values = [int(round(float(p))) for p in str(text).split(",")]
     except ValueError:
         values = []
     if len(values) != 4 or values[2] <= 0 or values[3] <= 0:
         raise ArgumentError(
-            f"expected U,V,WIDTH,HEIGHT in pixels, got {text!r}", source="--roi"
+            f"expected U,V,WIDTH,HEIGHT in pixels, got {text!r}", source="roi"
         )
     u, v, w, h = values
     width, height = image_size
     if u >= width or v >= height or u + w <= 0 or v + h <= 0:
-        raise ArgumentError(f"lies outside the {width}x{height} frame", source="--roi")
+        raise ArgumentError(f"lies outside the {width}x{height} frame", source="roi")
     return u, v, w, h
 
 
@@ -129,7 +130,7 @@ def track_video(
     """
     if fps is None or not np.isfinite(fps) or fps <= 0:
         raise ArgumentError(
-            f"the capture rate must be positive, got {fps}", source="--fps"
+            f"the capture rate must be positive, got {fps}", source="fps"
         )
     reader = reader or VideoReader(path)
     info = reader.info
@@ -213,7 +214,7 @@ def track_video(
     found = detections[detections["found"]].copy()
     if found.empty:
         raise InputFileError(
-            "no body found in any frame (check --roi, the contrast and that the "
+            "no body found in any frame (check `roi`, the contrast and that the "
             "body moves)",
             source=path,
             where=f"frames 0-{decoded - 1}",

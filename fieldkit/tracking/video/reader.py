@@ -238,13 +238,13 @@ def fps_mismatch_message(info: VideoInfo, capture_fps: float) -> str | None:
     """Warn when the container's playback rate differs from the stated capture rate."""
     if info.container_fps <= 0:
         return (
-            f"{info.path}: the file stores no frame rate; using --fps {capture_fps:g}"
+            f"{info.path}: the file stores no frame rate; using `fps` {capture_fps:g}"
         )
     if abs(info.container_fps - capture_fps) > 1e-3 * capture_fps:
         return (
             f"{info.path}: the container's frame rate is {info.container_fps:g} "
             "frames/s but "
-            f"--fps is {capture_fps:g}; times use --fps (high-speed cameras store a "
+            f"`fps` is {capture_fps:g}; times use `fps` (high-speed cameras store a "
             "playback "
             "rate — check the fitted gravity)"
         )
