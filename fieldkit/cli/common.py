@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import functools
 import re
-import sys
 from collections.abc import Callable, Mapping
 from typing import Annotated, ParamSpec, TypeVar, overload
 
@@ -48,6 +47,7 @@ FLAGS: dict[str, str] = {
     "unit": "--unit",
     "metres_per_pixel": "--metres-per-pixel",
     "file_fps": "--file-fps",
+    "input_format": "--format",
     # the impact calculator
     "e_n": "--en",
     "offset_m": "--offset",
@@ -159,11 +159,6 @@ def warn(message: str) -> None:
 def note(message: str) -> None:
     """Print a one-line note to stderr (argument names in backticks as flags)."""
     typer.echo(f"note: {' '.join(with_flags(message).split())}", err=True)
-
-
-def echo_err(message: str) -> None:
-    """Print a line to stderr (progress and notes that must not pollute stdout)."""
-    print(message, file=sys.stderr)
 
 
 def print_body_notes(body: ResolvedBody) -> None:

@@ -1,4 +1,4 @@
-"""Impact points from a GPX or CSV file: the one reader behind ``--impacts``.
+"""Impact points from a GPX or CSV file: the one reader of an impacts file.
 
 :func:`read_impacts` detects the format (content first, then extension) and hands
 over to :func:`read_gpx_impacts` or :func:`fieldkit.io.points_csv.read_points_csv`.

@@ -49,7 +49,7 @@ def detect_format(path: Path) -> str:
             return "tracker"
     raise InputFileError(
         "cannot tell what this file is (ImpactTable, track CSV, Tracker or Kinovea "
-        "export); give --format",
+        "export); give `input_format`",
         source=path,
         where="row 1",
     )

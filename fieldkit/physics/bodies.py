@@ -260,11 +260,6 @@ class Body:
         """Moment of inertia ``I = m k^2`` [kg m^2] (eq. 4.18)."""
         return self.mass_kg * self.gyration_m**2
 
-    @property
-    def density_kg_m3(self) -> float | None:
-        """Mass over volume [kg/m^3], or None when the volume is unknown."""
-        return None if self.volume_m3 is None else self.mass_kg / self.volume_m3
-
 
 #: Separators between dimensions: ``1.6,1.3,1.3``, ``1.6x1.3x1.3``, ``1.6 X 1.3 X 1.3``.
 _DIMENSION_SEPARATOR = re.compile(r"\s*[,;xX×]\s*|\s+")
