@@ -69,3 +69,8 @@ class PhysicsError(FieldkitError):
 
 class ArgumentError(FieldkitError):
     """A parameter outside its physical range (negative mass, e_n < 0, ...)."""
+
+
+class OutputFileError(FieldkitError):
+    """An output that cannot be written: it would overwrite an input, its folder is
+    read-only, the disk is full, ... (:mod:`fieldkit.outputs`)."""

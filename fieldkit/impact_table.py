@@ -17,7 +17,13 @@ import numpy as np
 import pandas as pd
 
 from fieldkit.errors import InputFileError
-from fieldkit.outputs import write_atomic
+from fieldkit.outputs import (
+    OutputSet,
+    escape_formulas,
+    protect_formula_cells,
+    unescape_formulas,
+    write_file,
+)
 from fieldkit.physics.energy import energy_head, kinetic_energy, rotational_energy
 from fieldkit.physics.local_axes import angle_to_ground_deg, to_local
 
@@ -264,7 +270,11 @@ class ImpactTable:
     # ------------------------------------------------------------------ files
     @classmethod
     def read(cls, path: str | os.PathLike[str]) -> ImpactTable:
-        """Read a CSV, Parquet or XLSX ImpactTable (format from the extension)."""
+        """Read a CSV, Parquet or XLSX ImpactTable (format from the extension).
+
+        In a CSV, the ``'`` that :meth:`write` puts before formula-like text cells is
+        removed (:func:`fieldkit.outputs.unescape_formulas`).
+        """
         p = Path(path)
         fmt = _format_of(p)
         if not p.is_file():
@@ -289,20 +299,38 @@ class ImpactTable:
             ) from None
         if frame.empty:
             raise InputFileError("table has no rows", source=p)
+        if fmt == "csv":  # written by `write`: formula-like text was quoted
+            frame = unescape_formulas(frame)
         return cls(frame, source=str(p))
 
-    def write(self, path: str | os.PathLike[str]) -> Path:
-        """Write atomically as CSV, Parquet or XLSX (format from the extension)."""
+    def write(
+        self, path: str | os.PathLike[str], *, outputs: OutputSet | None = None
+    ) -> Path:
+        """Write as CSV, Parquet or XLSX (format from the extension).
+
+        The file goes into ``outputs`` (written when the set commits) or, without
+        one, is written at once on its own (:func:`fieldkit.outputs.write_file`).
+        Text cells a spreadsheet would run as formulas are kept as text: quoted with
+        ``'`` in CSV (removed again by :meth:`read`), typed as text in XLSX
+        (:mod:`fieldkit.outputs`, "Spreadsheet safety").
+        """
         p = Path(path)
         fmt = _format_of(p)
         frame = self.frame
         if fmt == "csv":
-            return write_atomic(p, lambda tmp: frame.to_csv(tmp, index=False))
+            safe = escape_formulas(frame)
+            return write_file(p, lambda tmp: safe.to_csv(tmp, index=False), outputs)
         if fmt == "parquet":
-            return write_atomic(p, lambda tmp: frame.to_parquet(tmp, index=False))
-        return write_atomic(
-            p, lambda tmp: frame.to_excel(tmp, index=False, sheet_name="impacts")
-        )
+            return write_file(
+                p, lambda tmp: frame.to_parquet(tmp, index=False), outputs
+            )
+
+        def write_xlsx(tmp: Path) -> None:
+            with pd.ExcelWriter(tmp, engine="openpyxl") as book:
+                frame.to_excel(book, index=False, sheet_name="impacts")
+                protect_formula_cells(book.sheets["impacts"])
+
+        return write_file(p, write_xlsx, outputs)
 
 
 def _format_of(path: Path) -> str:

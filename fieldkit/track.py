@@ -22,7 +22,7 @@ import numpy as np
 import pandas as pd
 
 from fieldkit.errors import InputFileError
-from fieldkit.outputs import write_atomic
+from fieldkit.outputs import OutputSet, write_file
 
 #: Columns every Track frame holds, in order. NaN where unknown.
 TRACK_COLUMNS: tuple[str, ...] = (
@@ -131,9 +131,18 @@ class Track:
             frame[col] = values
         return cls(frame, source=str(path), fps=fps)
 
-    def write(self, path: str | os.PathLike[str]) -> Path:
-        """Write the track as CSV (9 significant digits), atomically."""
+    def write(
+        self, path: str | os.PathLike[str], *, outputs: OutputSet | None = None
+    ) -> Path:
+        """Write the track as CSV (9 significant digits).
+
+        Into ``outputs`` (written when the set commits) or, without one, at once
+        (:func:`fieldkit.outputs.write_file`). A track file holds numbers for
+        programs, not text for spreadsheets, so no cell is quoted.
+        """
         frame = self.frame
-        return write_atomic(
-            path, lambda tmp: frame.to_csv(tmp, index=False, float_format="%.9g")
+        return write_file(
+            path,
+            lambda tmp: frame.to_csv(tmp, index=False, float_format="%.9g"),
+            outputs,
         )

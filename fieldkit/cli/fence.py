@@ -153,7 +153,7 @@ def fence(
         fieldkit fence --mass 520 --gyration 0.35 --radius 0.43 --speed-in 22
         --angle-in 50 --spin-in 18
     """
-    from fieldkit.outputs import write_text_atomic
+    from fieldkit.outputs import OutputSet, write_text
     from fieldkit.physics.bodies import resolve_body
     from fieldkit.physics.fence_impact import fence_impact
 
@@ -175,10 +175,10 @@ def fence(
     ]
     if figure is not None and figure.suffix.lower() != ".png":
         raise ArgumentError("the figure must be a .png file", source="--figure")
-    if figure is not None and out is not None and figure.resolve() == out.resolve():
-        raise ArgumentError(
-            "--figure and --out must be different files", source="--out"
-        )
+    outputs = OutputSet()
+    for path, flag in ((figure, "--figure"), (out, "--out")):
+        if path is not None:
+            outputs.plan(path, argument=flag)
     # a typed --radius or an --angle-in asks for the computed rebound; a shape's
     # radius alone does not
     computed = radius is not None or angle_in is not None
@@ -201,11 +201,14 @@ def fence(
     if figure is not None:
         from fieldkit.viz.fence_figure import write_fence_figure
 
-        write_fence_figure(figure, result.impulse_ns, laws, result.split)
+        write_fence_figure(
+            figure, result.impulse_ns, laws, result.split, outputs=outputs
+        )
         lines.append(f"figure: {figure}")
     if out is not None:
-        write_text_atomic(out, json.dumps(_results(result), indent=2) + "\n")
+        write_text(out, json.dumps(_results(result), indent=2) + "\n", outputs)
         lines.append(f"results: {out}")
+    outputs.commit()
     typer.echo("\n".join(lines))
     print_body_notes(rock)
 

@@ -22,7 +22,7 @@ from fieldkit.cli.common import (
     warn,
 )
 from fieldkit.errors import ArgumentError
-from fieldkit.outputs import write_text_atomic
+from fieldkit.outputs import OutputSet, write_text
 from fieldkit.physics.bodies import ResolvedBody, resolve_body
 from fieldkit.physics.impact_mechanics import (
     ImpactResult,
@@ -310,6 +310,10 @@ def impact(
         dimensions_m=dimensions,
         unit_weight_kn_m3=unit_weight,
     ).require(*BODY_NEEDS, source="fieldkit impact")
+    outputs = OutputSet()
+    for path, flag in ((figure, "--figure"), (json_out, "--json")):
+        if path is not None:
+            outputs.plan(path, argument=flag)
     mass_known = body.mass_kg is not None
     theta_i = math.degrees(math.atan2(-v_in, v_it))
     e_n, e_source = _restitution(law, en, a, b, scale_velocity, theta_i, v_in)
@@ -324,9 +328,6 @@ def impact(
     res = rough_body_impact(v_it, v_in, spin, **common)
     history = impulse_history(v_it, v_in, spin, **common) if figure else None
 
-    outputs = [p.resolve() for p in (figure, json_out) if p is not None]
-    if len(set(outputs)) < len(outputs):
-        raise ArgumentError("--figure and --json must be different files")
     mu_min = None
     if offset == 0.0:
         mu_min = float(
@@ -359,9 +360,8 @@ def impact(
         )
         save_pnv_figure(
             history, figure, title=title,
-            impulse_unit=None if mass_known else "N s/kg",
+            impulse_unit=None if mass_known else "N s/kg", outputs=outputs,
         )  # fmt: skip
-        typer.echo(f"wrote {figure}")
     if json_out is not None:
         payload = {
             "inputs": {
@@ -379,5 +379,6 @@ def impact(
             "minimum_friction_to_stop_slip": mu_min,
             "impulse_unit": "N s" if mass_known else "N s/kg",
         }  # fmt: skip
-        write_text_atomic(json_out, json.dumps(payload, indent=2) + "\n")
-        typer.echo(f"wrote {json_out}")
+        write_text(json_out, json.dumps(payload, indent=2) + "\n", outputs)
+    for path in outputs.commit():
+        typer.echo(f"wrote {path}")

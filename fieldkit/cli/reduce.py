@@ -22,7 +22,7 @@ from fieldkit.cli.common import (
 )
 from fieldkit.errors import ArgumentError
 from fieldkit.impact_table import FORMATS
-from fieldkit.outputs import refuse_input_overwrite
+from fieldkit.outputs import OutputSet
 
 #: Body values `reduce` needs: none (columns it cannot fill stay NaN).
 BODY_NEEDS: tuple[str, ...] = ()
@@ -194,11 +194,11 @@ def reduce(
             f"unknown table format {out.suffix!r}; use one of {', '.join(FORMATS)}",
             source=str(out),
         )
-    inputs = [impacts, fieldbook, stations, trees]
-    outputs: list[Path | None] = [out]
-    if figures is not None:
-        outputs += [figures / name for name in FIGURE_NAMES]
-    refuse_input_overwrite(outputs, inputs)
+    outputs = OutputSet(inputs=[impacts, fieldbook, stations, trees])
+    if out is not None:
+        outputs.plan(out, argument="-o")
+    for name in FIGURE_NAMES if figures is not None else ():
+        outputs.plan(figures / name, argument="--figures")
 
     if impacts is not None:
         from fieldkit.io.impacts import read_impacts
@@ -229,19 +229,17 @@ def reduce(
     table = reduce_survey(survey, options)
 
     if out is not None:
-        table.write(out)
+        table.write(out, outputs=outputs)
     if figures is not None:
         from fieldkit.viz.energy_figure import write_energy_figures
         from fieldkit.viz.restitution_figure import write_restitution_figures
         from fieldkit.viz.section_figure import write_section_figure
 
-        write_section_figure(table, figures / FIGURE_NAMES[0], survey=survey)
-        write_restitution_figures(
-            table, figures / FIGURE_NAMES[1], figures / FIGURE_NAMES[2]
-        )
-        write_energy_figures(
-            table, figures / FIGURE_NAMES[3], figures / FIGURE_NAMES[4]
-        )
+        paths = [figures / name for name in FIGURE_NAMES]
+        write_section_figure(table, paths[0], survey=survey, outputs=outputs)
+        write_restitution_figures(table, paths[1], paths[2], outputs=outputs)
+        write_energy_figures(table, paths[3], paths[4], outputs=outputs)
+    outputs.commit()
     typer.echo(f"body: {body.description}")
     print_body_notes(body)
     typer.echo(with_flags(format_summary(summarize(table))))

@@ -24,7 +24,7 @@ from fieldkit.cli.common import (
 )
 from fieldkit.errors import ArgumentError
 from fieldkit.impact_table import FORMATS
-from fieldkit.outputs import atomic_path, refuse_input_overwrite
+from fieldkit.outputs import OutputSet
 
 #: show a progress bar for videos longer than this many frames
 PROGRESS_MIN_FRAMES = 300
@@ -187,7 +187,15 @@ def track(
             f"unknown table format {impacts.suffix!r}; use one of {', '.join(FORMATS)}",
             source=str(impacts),
         )
-    refuse_input_overwrite([out, impacts, rrd], [video, homography])
+    outputs = OutputSet(inputs=[video, homography])
+    for path, flag in ((out, "-o"), (impacts, "--impacts"), (rrd, "--rrd")):
+        if path is not None:
+            outputs.plan(path, argument=flag)
+    if figures is not None:
+        from fieldkit.viz.track_figure import TRACK_FIGURE_NAMES
+
+        for name in TRACK_FIGURE_NAMES:
+            outputs.plan(figures / name, argument="--figures")
     if out is None and impacts is None and rrd is None and figures is None:
         note("no -o, --impacts, --rrd or --figures given; printing the summary only")
 
@@ -227,27 +235,28 @@ def track(
         warn(message)
 
     if out is not None:
-        analysis.track.write(out)
+        analysis.track.write(out, outputs=outputs)
     if impacts is not None:
-        analysis.impacts.write(impacts)
+        analysis.impacts.write(impacts, outputs=outputs)
     if rrd is not None:
         from fieldkit.viz.rerun_log import write_recording
 
-        with atomic_path(rrd) as tmp:
-            write_recording(
-                tmp, analysis, frames=reader.frames(), detections=detections
-            )
-    written = []
+        frames = reader.frames()  # read when the recording is written
+        write_recording(
+            rrd, analysis, frames=frames, detections=detections, outputs=outputs
+        )
     if figures is not None:
         from fieldkit.viz.track_figure import write_track_figures
 
         middle = reader.read_frames([max(len(detections) // 2, 0)])
         background = middle[0][1] if middle else None
-        written = write_track_figures(figures, analysis, background_frame=background)
+        write_track_figures(
+            figures, analysis, background_frame=background, outputs=outputs
+        )
+    written = outputs.commit()
     _summary(video, track_data, detections, analysis, calibration.description)
-    for path in [out, impacts, rrd, *written]:
-        if path is not None:
-            typer.echo(f"wrote {path}")
+    for path in written:
+        typer.echo(f"wrote {path}")
 
 
 def _run_tracking(video, reader, fps, calibration, roi, radius, *, show: bool):

@@ -22,7 +22,7 @@ from fieldkit.cli.common import (
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.impact_table import ImpactTable
 from fieldkit.io.track_files import detect_format, read_track
-from fieldkit.outputs import refuse_input_overwrite
+from fieldkit.outputs import OutputSet
 from fieldkit.physics.bodies import resolve_body
 
 #: Body values `view` needs to analyse a track (an ImpactTable carries its own).
@@ -124,7 +124,8 @@ def view(
 
     Then open the recording with `rerun impacts.rrd`.
     """
-    refuse_input_overwrite([out, figures], [input_file])
+    outputs = OutputSet(inputs=[input_file])
+    outputs.plan(out, argument="-o")
     if out.suffix.lower() != ".rrd":
         raise ArgumentError(
             f"output must be a .rrd file, got {out.name!r}", source="-o"
@@ -146,9 +147,15 @@ def view(
         table = ImpactTable.read(input_file)
         if len(table) == 0:
             raise InputFileError("table has no rows", source=input_file)
-        rerun_log.write_impact_recording(out, table.derive())
+        rerun_log.write_impact_recording(out, table.derive(), outputs=outputs)
+        outputs.commit()
         typer.echo(f"wrote {out}: {len(table)} impacts, {len(table.paths())} path(s)")
         return
+    if figures is not None:
+        from fieldkit.viz.track_figure import TRACK_FIGURE_NAMES, write_track_figures
+
+        for name in TRACK_FIGURE_NAMES:
+            outputs.plan(figures / name, argument="--figures")
     track = read_track(
         input_file,
         fmt,
@@ -176,11 +183,10 @@ def view(
     for message in analysis.warnings:
         warn(message)
     print_body_notes(body)
-    rerun_log.write_recording(out, analysis)
+    rerun_log.write_recording(out, analysis, outputs=outputs)
     if figures is not None:
-        from fieldkit.viz.track_figure import write_track_figures
-
-        write_track_figures(figures, analysis)
+        write_track_figures(figures, analysis, outputs=outputs)
+    outputs.commit()
     typer.echo(
         f"wrote {out}: {len(analysis.track)} samples, {len(analysis.flights)} flights, "
         f"{len(analysis.impacts)} impacts, {len(analysis.contacts)} net contacts"

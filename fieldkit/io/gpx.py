@@ -32,7 +32,7 @@ import pandas as pd
 
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.io.csv_table import check_readable, finite_number
-from fieldkit.outputs import write_text_atomic
+from fieldkit.outputs import OutputSet, write_text
 
 GPX_HEIGHT_REFERENCE = (
     "GPX <ele> as given (usually above sea level); no geoid conversion"
@@ -276,9 +276,15 @@ def gpx_waypoints_text(frame: pd.DataFrame, *, creator: str = "fieldkit") -> str
 
 
 def write_gpx_waypoints(
-    path: str | PathLike[str], frame: pd.DataFrame, *, creator: str = "fieldkit"
+    path: str | PathLike[str],
+    frame: pd.DataFrame,
+    *,
+    creator: str = "fieldkit",
+    outputs: OutputSet | None = None,
 ) -> None:
-    """Write ``frame`` as GPX 1.1 waypoints atomically (:func:`gpx_waypoints_text`).
+    """Write ``frame`` as GPX 1.1 waypoints (:func:`gpx_waypoints_text`).
+
+    Into ``outputs`` when given (written when it commits), else at once.
 
     Examples
     --------
@@ -290,4 +296,4 @@ def write_gpx_waypoints(
     >>> "<ele>1500.000</ele>" in target.read_text()
     True
     """
-    write_text_atomic(path, gpx_waypoints_text(frame, creator=creator))
+    write_text(path, gpx_waypoints_text(frame, creator=creator), outputs)

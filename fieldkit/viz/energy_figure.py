@@ -18,6 +18,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from fieldkit.impact_table import ImpactTable
+from fieldkit.outputs import OutputSet
 from fieldkit.physics.energy import energy_head, kinetic_energy, potential_energy
 from fieldkit.physics.flight import flight_samples
 from fieldkit.viz.figure_files import save_png
@@ -145,12 +146,14 @@ def write_energy_figures(
     table: ImpactTable,
     partition_path: str | os.PathLike[str],
     head_path: str | os.PathLike[str],
+    *,
+    outputs: OutputSet | None = None,
 ) -> tuple[Path, Path]:
-    """Write the energy partition and energy head PNGs.
+    """Write the energy partition and energy head PNGs (into ``outputs`` if given).
 
     Without a mass the partition diagram has no energies; the energy head needs none.
     """
     return (
-        save_png(plot_energy_partition(table), partition_path),
-        save_png(plot_energy_head(table), head_path),
+        save_png(plot_energy_partition(table), partition_path, outputs=outputs),
+        save_png(plot_energy_head(table), head_path, outputs=outputs),
     )

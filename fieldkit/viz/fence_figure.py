@@ -19,6 +19,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
+from fieldkit.outputs import OutputSet
 from fieldkit.physics.fences import FenceEnergySplit
 from fieldkit.physics.structure_forces import (
     THESIS_STRUCTURES,
@@ -175,6 +176,8 @@ def write_fence_figure(
     impulse_ns: float,
     laws: Iterable[StructureLaw] = THESIS_STRUCTURES.values(),
     split: FenceEnergySplit | None = None,
+    *,
+    outputs: OutputSet | None = None,
 ) -> Path:
-    """Save :func:`plot_fence` as a PNG (atomically)."""
-    return save_png(plot_fence(impulse_ns, laws, split), path)
+    """Save :func:`plot_fence` as a PNG (into ``outputs`` if given)."""
+    return save_png(plot_fence(impulse_ns, laws, split), path, outputs=outputs)

@@ -1,7 +1,8 @@
-"""Saving figures: headless backend, atomic PNG files, one consistent look."""
+"""Saving figures: headless backend, PNG outputs, one consistent look."""
 
 from __future__ import annotations
 
+import io
 import os
 from pathlib import Path
 
@@ -12,7 +13,7 @@ matplotlib.use("Agg")  # headless everywhere; set before pyplot is imported
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
-from fieldkit.outputs import write_atomic  # noqa: E402
+from fieldkit.outputs import OutputSet, write_file  # noqa: E402
 
 DPI = 150
 
@@ -24,9 +25,18 @@ def new_figure(width_in: float = 8.0, height_in: float = 5.0) -> tuple[Figure, o
     return fig, ax
 
 
-def save_png(fig: Figure, path: str | os.PathLike[str]) -> Path:
-    """Write ``fig`` to ``path`` as PNG atomically and close it."""
+def save_png(
+    fig: Figure, path: str | os.PathLike[str], *, outputs: OutputSet | None = None
+) -> Path:
+    """Render ``fig`` as PNG into memory, close it, and write it to ``path``.
+
+    Into ``outputs`` (written when the set commits) or, without one, at once
+    (:func:`fieldkit.outputs.write_file`).
+    """
     try:
-        return write_atomic(path, lambda tmp: fig.savefig(tmp, dpi=DPI, format="png"))
+        buffer = io.BytesIO()
+        fig.savefig(buffer, dpi=DPI, format="png")
     finally:
         plt.close(fig)
+    data = buffer.getvalue()
+    return write_file(path, lambda tmp: tmp.write_bytes(data), outputs)

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
+from fieldkit.outputs import OutputSet
 from fieldkit.physics.impulse_history import ImpulseHistory
 from fieldkit.viz.figure_files import new_figure, save_png
 
@@ -124,6 +125,8 @@ def save_pnv_figure(
     *,
     title: str | None = None,
     impulse_unit: str | None = None,
+    outputs: OutputSet | None = None,
 ) -> Path:
-    """Draw :func:`pnv_figure` and write it as PNG atomically."""
-    return save_png(pnv_figure(history, title=title, impulse_unit=impulse_unit), path)
+    """Draw :func:`pnv_figure` and write it as PNG (into ``outputs`` if given)."""
+    fig = pnv_figure(history, title=title, impulse_unit=impulse_unit)
+    return save_png(fig, path, outputs=outputs)

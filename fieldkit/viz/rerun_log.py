@@ -3,7 +3,9 @@
 Every rerun call of fieldkit lives in this module (the rerun API changes between
 minor versions; this file is pinned to rerun-sdk 0.41). Recordings are written
 without a viewer: ``RecordingStream`` -> ``save`` -> log -> ``disconnect`` (the footer
-is written only then), to a temporary file renamed into place when complete. Log and
+is written only then). ``save`` writes to a path itself, so the recording is a writer
+of a :class:`~fieldkit.outputs.OutputSet`: it is pointed at the set's temporary file,
+which is renamed into place with the command's other outputs. Log and
 tick times are disabled and the recording id is fixed, so the same input gives the
 same content.
 
@@ -35,7 +37,7 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from fieldkit.impact_table import ImpactTable
-from fieldkit.outputs import atomic_path
+from fieldkit.outputs import OutputSet, write_file
 from fieldkit.physics.local_axes import to_section
 from fieldkit.tracking.flights.pipeline import TrackAnalysis
 from fieldkit.viz.image_projection import project, world_to_image
@@ -69,13 +71,15 @@ def write_recording(
     analysis: TrackAnalysis,
     frames: Iterable[tuple[int, np.ndarray]] | None = None,
     detections: pd.DataFrame | None = None,
+    *,
+    outputs: OutputSet | None = None,
 ) -> Path:
     """Write a rerun recording of a track analysis (and optionally its video frames).
 
     Parameters
     ----------
     path
-        Output ``.rrd`` file (written atomically).
+        Output ``.rrd`` file.
     analysis
         From :func:`fieldkit.tracking.flights.pipeline.analyse_track`.
     frames
@@ -85,14 +89,17 @@ def write_recording(
     detections
         Per-frame detections with ``frame``, ``u_px``, ``v_px`` and optionally
         ``marker_du_px``, ``marker_dv_px`` (offset of the marker from the centre).
+    outputs
+        Add the recording to this set (recorded when it commits; ``frames`` is read
+        then) instead of writing it at once.
 
     Returns
     -------
     Path
         ``path``.
     """
-    out = Path(path)
-    with atomic_path(out) as tmp:
+
+    def record(tmp: Path) -> None:
         rec = _open(tmp, "track")
         try:
             rec.send_blueprint(_track_blueprint(frames is not None))
@@ -103,18 +110,25 @@ def write_recording(
                 _log_frames(rec, analysis, frames, detections)
         finally:
             rec.disconnect()
-    return out
+
+    return write_file(path, record, outputs)
 
 
-def write_impact_recording(path: str | os.PathLike[str], table: ImpactTable) -> Path:
+def write_impact_recording(
+    path: str | os.PathLike[str],
+    table: ImpactTable,
+    *,
+    outputs: OutputSet | None = None,
+) -> Path:
     """Write a rerun recording of an ImpactTable: the section view of every path.
 
     Impact points (labelled with point, e_n, e_t), impact and restitution velocity
     arrows, a short slope tick at each impact (``slope_deg``), and e_n, e_t, speeds
-    against the impact order.
+    against the impact order. Into ``outputs`` when given (recorded when it
+    commits), else at once.
     """
-    out = Path(path)
-    with atomic_path(out) as tmp:
+
+    def record(tmp: Path) -> None:
         rec = _open(tmp, "impacts")
         try:
             rec.log("section", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
@@ -124,7 +138,8 @@ def write_impact_recording(path: str | os.PathLike[str], table: ImpactTable) -> 
                 )
         finally:
             rec.disconnect()
-    return out
+
+    return write_file(path, record, outputs)
 
 
 # ---------------------------------------------------------------- track pieces

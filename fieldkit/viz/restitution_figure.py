@@ -18,6 +18,7 @@ from matplotlib.figure import Figure
 from numpy.typing import ArrayLike
 
 from fieldkit.impact_table import ImpactTable
+from fieldkit.outputs import OutputSet
 from fieldkit.physics.restitution import (
     ANGLE_LAW_A,
     ANGLE_LAW_B,
@@ -176,8 +177,10 @@ def write_restitution_figures(
     et_path: str | os.PathLike[str],
     *,
     law: tuple[float, float] | None = (ANGLE_LAW_A, ANGLE_LAW_B),
+    outputs: OutputSet | None = None,
 ) -> tuple[Path, Path]:
-    """Write the Fig. 5.7 and Fig. 5.8 PNGs of an ImpactTable's impacts."""
+    """Write the Fig. 5.7 and Fig. 5.8 PNGs of an ImpactTable's impacts (into
+    ``outputs`` when given, see :func:`fieldkit.viz.figure_files.save_png`)."""
     f = table.frame
     impacts = f[
         np.isfinite(f["e_n"].to_numpy(float)) | np.isfinite(f["e_t"].to_numpy(float))
@@ -199,4 +202,7 @@ def write_restitution_figures(
         material=mat,
         title=f"{name}: $e_T$ per impact (thesis Fig. 5.8)",
     )
-    return save_png(en_fig, en_path), save_png(et_fig, et_path)
+    return (
+        save_png(en_fig, en_path, outputs=outputs),
+        save_png(et_fig, et_path, outputs=outputs),
+    )

@@ -17,6 +17,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from fieldkit.impact_table import ImpactTable
+from fieldkit.outputs import OutputSet
 from fieldkit.physics.flight import flight_samples
 from fieldkit.physics.local_axes import to_section
 from fieldkit.survey import Survey
@@ -237,7 +238,11 @@ def _draw_detail(ax: Axes, row, f, i: int) -> None:
 
 
 def write_section_figure(
-    table: ImpactTable, path: str | os.PathLike[str], survey: Survey | None = None
+    table: ImpactTable,
+    path: str | os.PathLike[str],
+    survey: Survey | None = None,
+    *,
+    outputs: OutputSet | None = None,
 ) -> Path:
-    """Draw :func:`plot_section` and save it as a PNG (atomically)."""
-    return save_png(plot_section(table, survey=survey), path)
+    """Draw :func:`plot_section` and save it as a PNG (into ``outputs`` if given)."""
+    return save_png(plot_section(table, survey=survey), path, outputs=outputs)

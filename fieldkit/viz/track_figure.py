@@ -15,22 +15,30 @@
 
 from __future__ import annotations
 
+import functools
 import os
 from pathlib import Path
 
 import numpy as np
+from matplotlib.figure import Figure
 
+from fieldkit.outputs import OutputSet
 from fieldkit.tracking.flights.pipeline import TrackAnalysis
 from fieldkit.viz.figure_files import new_figure, save_png
 from fieldkit.viz.image_projection import project, world_to_image
 
 _CONTACT_SHADE = dict(color="0.85", zorder=0)
 
+#: The figures every track gets (net contacts add ``net_contact_<i>.png``).
+TRACK_FIGURE_NAMES: tuple[str, ...] = ("track.png", "speed_spin.png", "residuals.png")
+
 
 def write_track_figures(
     directory: str | os.PathLike[str],
     analysis: TrackAnalysis,
     background_frame: np.ndarray | None = None,
+    *,
+    outputs: OutputSet | None = None,
 ) -> list[Path]:
     """Write the PNG figures of a track analysis into ``directory``.
 
@@ -43,21 +51,30 @@ def write_track_figures(
     background_frame
         A BGR video frame to draw the track over (needs ``u_px``/``v_px`` columns in
         the track).
+    outputs
+        Add the figures to this :class:`~fieldkit.outputs.OutputSet` (written when
+        it commits) instead of writing them at once.
 
     Returns
     -------
     list of Path
-        The files written.
+        The files written: :data:`TRACK_FIGURE_NAMES`, then
+        ``net_contact_<i>.png`` for each extended contact.
     """
     out = Path(directory)
-    out.mkdir(parents=True, exist_ok=True)
-    paths = [
-        _track_figure(out / "track.png", analysis, background_frame),
-        _speed_spin_figure(out / "speed_spin.png", analysis),
-        _residual_figure(out / "residuals.png", analysis),
+    drawings = [
+        (TRACK_FIGURE_NAMES[0], lambda: _track_figure(analysis, background_frame)),
+        (TRACK_FIGURE_NAMES[1], lambda: _speed_spin_figure(analysis)),
+        (TRACK_FIGURE_NAMES[2], lambda: _residual_figure(analysis)),
     ]
-    for c in analysis.contacts:
-        paths.append(_net_figure(out / f"net_contact_{c.index}.png", c))
+    drawings += [
+        (f"net_contact_{c.index}.png", functools.partial(_net_figure, c))
+        for c in analysis.contacts
+    ]
+    into = OutputSet() if outputs is None else outputs
+    paths = [save_png(draw(), out / name, outputs=into) for name, draw in drawings]
+    if outputs is None:
+        into.commit()
     return paths
 
 
@@ -67,7 +84,7 @@ def _flight_colour(i: int):
     return matplotlib.colormaps["tab10"](i % 10)
 
 
-def _track_figure(path: Path, a: TrackAnalysis, background) -> Path:
+def _track_figure(a: TrackAnalysis, background) -> Figure:
     f = a.track.frame
     h = world_to_image(f) if background is not None else None
     fig, ax = new_figure(8.0, 5.5)
@@ -118,7 +135,7 @@ def _track_figure(path: Path, a: TrackAnalysis, background) -> Path:
                 textcoords="offset points",
             )
     ax.legend(fontsize=7, loc="best")
-    return save_png(fig, path)
+    return fig
 
 
 def _shade_contacts(ax, a: TrackAnalysis) -> None:
@@ -127,7 +144,7 @@ def _shade_contacts(ax, a: TrackAnalysis) -> None:
         ax.axvspan(t0, t1, **_CONTACT_SHADE)
 
 
-def _speed_spin_figure(path: Path, a: TrackAnalysis) -> Path:
+def _speed_spin_figure(a: TrackAnalysis) -> Figure:
     import matplotlib.pyplot as plt
 
     f = a.track.frame
@@ -166,10 +183,10 @@ def _speed_spin_figure(path: Path, a: TrackAnalysis) -> Path:
     for ax in (ax1, ax2):
         ax.grid(True, alpha=0.3)
         _shade_contacts(ax, a)
-    return save_png(fig, path)
+    return fig
 
 
-def _residual_figure(path: Path, a: TrackAnalysis) -> Path:
+def _residual_figure(a: TrackAnalysis) -> Figure:
     f = a.track.frame
     fig, ax = new_figure(8.0, 4.0)
     for fl in a.flights:
@@ -194,10 +211,10 @@ def _residual_figure(path: Path, a: TrackAnalysis) -> Path:
     ax.set_xlabel("t [s]")
     ax.set_ylabel("distance from fitted flight [mm]")
     ax.legend(fontsize=7)
-    return save_png(fig, path)
+    return fig
 
 
-def _net_figure(path: Path, c) -> Path:
+def _net_figure(c) -> Figure:
     import matplotlib.pyplot as plt
 
     fig, (ax1, ax2) = plt.subplots(
@@ -218,4 +235,4 @@ def _net_figure(path: Path, c) -> Path:
     ax2.set_xlabel("time from contact start [ms]")
     for ax in (ax1, ax2):
         ax.grid(True, alpha=0.3)
-    return save_png(fig, path)
+    return fig
