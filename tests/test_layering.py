@@ -4,7 +4,7 @@ Layers, lowest first (a module may import its own layer's package and any lower 
 
 0. ``errors`` -- the one error type;
 1. ``physics`` (pure thesis equations: imports nothing of ours but ``errors``) and
-   ``outputs`` (atomic, safe file writing);
+   ``outputs`` (safe file writing: all or nothing, never over an input);
 2. the three data types ``survey``, ``track``, ``impact_table`` (the ImpactTable's
    derived columns are thesis equations, so it imports ``physics``);
 3. ``io`` -- field formats in, data types out;
