@@ -484,8 +484,8 @@ def _quote_error(error: csv.Error, start: int, end: int) -> str:
     if "field larger than field limit" in str(error):
         if spans:
             return (
-                f"a quote opened in this row does not close: its cell runs on past "
-                f"line {end} ({csv.field_size_limit()} characters)"
+                f"a quoted cell opened in this row runs on past line {end}, longer "
+                f"than {csv.field_size_limit()} characters: a quote that never closes?"
             )
         return f"a cell is longer than {csv.field_size_limit()} characters"
     if "unexpected end of data" in str(error):
