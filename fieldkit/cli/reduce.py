@@ -81,13 +81,14 @@ def reduce(
     dimensions: DimensionsOpt = None,
     unit_weight: UnitWeightOpt = None,
     units: Annotated[
-        str,
+        str | None,
         typer.Option(
             "--units",
-            help="Length unit of CSV inputs without units in their column "
-            "names: m or ft.",
+            help="Length unit of CSV columns without a unit in their names: m or ft "
+            "(none assumed: such a column is an error without --units; x_m, "
+            "'elev (ft)' carry their own; GPX <ele> is metres).",
         ),
-    ] = "m",
+    ] = None,
     path_id: Annotated[
         str | None,
         typer.Option(
@@ -173,7 +174,7 @@ def reduce(
         )
     if stations is not None and fieldbook is None:
         raise ArgumentError("--stations goes with --fieldbook", source="--stations")
-    if units not in ("m", "ft"):
+    if units is not None and units not in ("m", "ft"):
         raise ArgumentError(f"must be m or ft (got {units!r})", source="--units")
     if theta0 is not None and not (math.isfinite(theta0) and 0.0 < theta0 < 180.0):
         raise ArgumentError(

@@ -5,7 +5,8 @@ Field book CSV columns (aliases accepted, see the ``*_ALIASES`` tuples)::
     point, station, instrument_height_m, target_height_m, sentence
 
 ``sentence`` is the ``$PLTIT,HV,…*cs`` line the TruPulse sent (checksum verified unless
-``lenient``). Optional ``material`` and ``slope_deg`` columns are carried through.
+``lenient``), quoted, or unquoted as the last column. Optional ``material`` and
+``slope_deg`` columns are carried through.
 Stations come from a GPX (waypoint name = station id) or a CSV (see
 :mod:`fieldkit.io.stations`).
 
@@ -30,7 +31,7 @@ import numpy as np
 
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.io import geodesy
-from fieldkit.io.csv_table import Column, CsvTable, length_factor, read_csv_table
+from fieldkit.io.csv_table import length_factor, read_csv_table
 from fieldkit.io.point_sets import check_unique_points, point_set_from_geographic
 from fieldkit.io.points_csv import MATERIAL_ALIASES, NAME_ALIASES, SLOPE_ALIASES
 from fieldkit.io.stations import read_stations
@@ -49,20 +50,13 @@ TARGET_HEIGHT_ALIASES = ("target_height", "th", "ht", "rod_height", "target_h")
 SENTENCE_ALIASES = ("sentence", "trupulse", "nmea", "message", "raw")
 
 
-def _sentence(table: CsvTable, row: tuple[str, ...], column: Column) -> str:
-    """The sentence cell; an unquoted sentence in the last column is re-joined."""
-    if column.index == len(table.columns) - 1 and len(row) > len(table.columns):
-        return table.delimiter.join(row[column.index :]).strip()
-    return table.cell(row, column)
-
-
 def read_fieldbook(
     path: str | PathLike[str],
     stations_path: str | PathLike[str],
     *,
     declination_deg: float = 0.0,
     lenient: bool = False,
-    units: str = "m",
+    units: str | None = None,
     epsg: int | str | None = None,
 ) -> PointSet:
     """Positions of rangefinder targets from a field book and station coordinates.
@@ -80,7 +74,8 @@ def read_fieldbook(
         Accept TruPulse sentences with a wrong or missing checksum (noted).
     units
         ``"m"``/``"ft"`` for height columns without a unit in their names (and for a
-        stations CSV elevation). The sentences carry their own units.
+        stations CSV elevation); None: such a column is an error. The sentences carry
+        their own units.
     epsg
         CRS for ``easting_m``/``northing_m`` (default: UTM zone of the targets).
 
@@ -108,7 +103,7 @@ def read_fieldbook(
             f"declination {declination_deg} is not in [-180, 180] degrees",
             source="declination_deg",
         )
-    table = read_csv_table(path)
+    table = read_csv_table(path, open_last=SENTENCE_ALIASES)
     source = table.source
     columns = table.require(
         {
@@ -164,7 +159,7 @@ def read_fieldbook(
                 where=where_point,
             )
         try:
-            text = _sentence(table, row, columns["sentence"])
+            text = table.cell(row, columns["sentence"])
             shot = parse_trupulse(text, lenient=lenient)
         except InputFileError as error:
             raise InputFileError(

@@ -31,7 +31,7 @@ from xml.sax.saxutils import escape, quoteattr
 import pandas as pd
 
 from fieldkit.errors import ArgumentError, InputFileError
-from fieldkit.io.csv_table import check_readable, finite_number
+from fieldkit.io.csv_table import check_readable, encoding_problem, finite_number
 from fieldkit.outputs import OutputSet, write_text
 
 GPX_HEIGHT_REFERENCE = (
@@ -57,18 +57,33 @@ def _child_text(element: ElementTree.Element, name: str) -> str | None:
 def parse_gpx_root(path: str | PathLike[str]) -> ElementTree.Element:
     """Parse a GPX file and return its ``<gpx>`` root element.
 
-    Raises :class:`InputFileError`: file missing or empty, binary ("not a GPX file"),
-    XML errors ("GPX is truncated or malformed (XML error at line N)"), or another
-    root element.
+    Raises :class:`InputFileError`: file missing or empty, UTF-16 ("save it as
+    UTF-8"), binary ("not a GPX file"), a document type or entity declaration
+    (``<!DOCTYPE``, ``<!ENTITY``: refused before parsing, so no entity is ever
+    expanded), XML errors ("GPX is truncated or malformed (XML error at line N)"), or
+    another root element.
     """
     file = check_readable(path)
     data = file.read_bytes()
     if not data.strip():
         raise InputFileError("file is empty", source=path)
+    problem = encoding_problem(data)
+    if problem and problem != "binary content":
+        raise InputFileError(f"GPX is {problem}", source=path)
     head = data[:4096]
     stripped = head.lstrip(b"\xef\xbb\xbf \t\r\n")
     if b"\x00" in head or not stripped.startswith(b"<"):
         raise InputFileError("not a GPX file (it does not start with XML)", source=path)
+    for declaration in (b"<!DOCTYPE", b"<!ENTITY"):
+        at = data.find(declaration)
+        if at >= 0:
+            line = data.count(b"\n", 0, at) + 1
+            raise InputFileError(
+                f"GPX declares {declaration.decode()}: document types and entities "
+                "are not allowed in GPX (remove the declaration)",
+                source=path,
+                where=f"line {line}",
+            )
     try:
         root = ElementTree.fromstring(data)
     except ElementTree.ParseError as error:

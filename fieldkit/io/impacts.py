@@ -24,7 +24,7 @@ from fieldkit.survey import PointSet
 def read_gpx_impacts(
     path: str | PathLike[str],
     *,
-    units: str = "m",
+    units: str | None = None,
     epsg: int | str | None = None,
     gpx_points: str = "waypoints",
 ) -> PointSet:
@@ -48,7 +48,7 @@ def read_gpx_impacts(
     names = [str(n) for n in table["point"]]
     check_unique_points(names, wheres, source)
     notes = []
-    if units != "m":
+    if units not in (None, "m"):
         notes.append(f"units {units} ignored: GPX <ele> is in metres by definition")
     extra: dict[str, Sequence] = {}
     if table["time"].notna().any():
@@ -72,7 +72,7 @@ def read_gpx_impacts(
 def read_impacts(
     path: str | PathLike[str],
     *,
-    units: str = "m",
+    units: str | None = None,
     epsg: int | str | None = None,
     gpx_points: str = "waypoints",
 ) -> PointSet:
@@ -89,7 +89,8 @@ def read_impacts(
         ``easting, northing, elevation`` (+ ``epsg``); see
         :func:`fieldkit.io.points_csv.read_points_csv`.
     units
-        ``"m"`` or ``"ft"`` for lengths in a CSV without units in its column names.
+        ``"m"`` or ``"ft"`` for lengths in a CSV without units in its column names
+        (None: such a column is an error; GPX ``<ele>`` is metres and needs none).
     epsg
         Projected CRS of easting/northing columns, or the CRS wanted for
         ``easting_m``/``northing_m`` of geographic input (default: UTM zone).

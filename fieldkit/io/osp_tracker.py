@@ -96,6 +96,14 @@ def read_osp_tracker(
     header_line = lines[i]
     delim = detect_delimiter(header_line, default=" ")
     header = [h.strip() for h in split_row(header_line, delim)]
+    for axis in ("x", "y"):
+        if axis not in header:
+            raise InputFileError(
+                f"the {axis} column is missing (columns found: {', '.join(header)}); "
+                "export t, x and y from Tracker",
+                source=src,
+                where=f"row {numbered[i][0]}",
+            )
     t_col = header.index("t")
     x_col, y_col = _xy_columns(header, names_line, delim, track_name, src)
     if names_line is not None:
@@ -122,9 +130,10 @@ def read_osp_tracker(
 
 
 def _is_header(line: str) -> bool:
+    """A column-name line: ``t`` with ``x`` or ``y`` (a missing one is reported)."""
     delim = detect_delimiter(line, default=" ")
     cells = [c.strip().strip('"') for c in split_row(line, delim)]
-    return "t" in cells and "x" in cells and "y" in cells
+    return "t" in cells and ("x" in cells or "y" in cells)
 
 
 def _track_names(names_line: str, delim: str) -> dict[int, str]:

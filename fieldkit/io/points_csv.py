@@ -14,10 +14,12 @@ Column names are matched once, here, after lower-casing and dropping units writt
 ``_m``/``_ft`` suffixes or in brackets (``Altitude (ft)``); see the ``*_ALIASES``
 tuples. A point-name column is optional (rows are then named 1, 2, 3 …).
 
-Units: a unit in a column name wins; otherwise ``units="ft"`` converts elevations,
-section coordinates and metre-grid eastings/northings from international feet
-(0.3048 m). Latitude and longitude are never scaled. A CRS whose own unit is a foot
-(e.g. US State Plane in US survey feet) is read in that unit regardless of ``units``.
+Units: a unit in a column name wins; otherwise ``units`` (``"m"`` or ``"ft"``,
+international feet of 0.3048 m) says what elevations and section coordinates are in.
+Such a column with no unit in its name and no ``units`` is an error: metres are never
+assumed. Eastings/northings are in the unit of their CRS (``units`` may still say
+feet on a metre grid; a CRS in US survey feet is read in those regardless).
+Latitude and longitude are never scaled.
 """
 
 from __future__ import annotations
@@ -96,7 +98,10 @@ def _check_range(
 
 
 def read_points_csv(
-    path: str | PathLike[str], *, units: str = "m", epsg: int | str | None = None
+    path: str | PathLike[str],
+    *,
+    units: str | None = None,
+    epsg: int | str | None = None,
 ) -> PointSet:
     """Read a points CSV into a :class:`PointSet` (layouts in the module docstring).
 
@@ -104,7 +109,7 @@ def read_points_csv(
     --------
     >>> import tempfile, pathlib
     >>> f = pathlib.Path(tempfile.mkdtemp()) / "p.csv"
-    >>> _ = f.write_text("Name,Latitude,Longitude,Elevation\\nA,49,-117,1500\\n"
+    >>> _ = f.write_text("Name,Latitude,Longitude,Elevation (m)\\nA,49,-117,1500\\n"
     ...                  "B,49.0009,-117,1450\\n")
     >>> ps = read_points_csv(f)
     >>> ps.crs, round(float(ps.frame.x_m.iloc[1]), 2)
@@ -131,7 +136,7 @@ def read_points_csv(
     extra = _optional_columns(table, units)
     notes = list(extra.pop("_notes", []))
     labelled = [c.header.strip() for c in table.columns if c.unit in ("m", "mm", "cm")]
-    if units != "m" and labelled:
+    if units not in (None, "m") and labelled:
         notes.append(
             f"units {units} not applied to {', '.join(labelled)}: the column names "
             "say metres"
@@ -162,9 +167,9 @@ def read_points_csv(
             )
         crs = geodesy.projected_crs(epsg)
         native = geodesy.metres_per_crs_unit(crs)
-        if native == 1.0:
-            e_factor = length_factor(table, easting_column, units)
-            n_factor = length_factor(table, northing_column, units)
+        if native == 1.0:  # a metre grid: unlabelled columns are in its metres
+            e_factor = length_factor(table, easting_column, units or "m")
+            n_factor = length_factor(table, northing_column, units or "m")
         else:
             e_factor = n_factor = 1.0  # values are in the CRS's own unit
             notes.append(

@@ -23,10 +23,11 @@ from fieldkit.survey import Stations
 STATION_ALIASES = ("station", "station_id", "stn", "name", "id", "point", "point_id")
 
 
-def read_stations(path: str | PathLike[str], *, units: str = "m") -> Stations:
+def read_stations(path: str | PathLike[str], *, units: str | None = None) -> Stations:
     """Read stations from a GPX (waypoints) or CSV file (by content, then extension).
 
-    ``units="ft"`` applies to a CSV elevation column without a unit in its name.
+    ``units`` (``"m"``/``"ft"``) applies to a CSV elevation column without a unit in
+    its name; such a column without ``units`` is an error (GPX ``<ele>`` is metres).
     """
     file = check_readable(path)
     with file.open("rb") as handle:

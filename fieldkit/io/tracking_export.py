@@ -14,7 +14,12 @@ import numpy as np
 import pandas as pd
 
 from fieldkit.errors import ArgumentError, InputFileError
-from fieldkit.io.csv_table import LENGTH_UNITS, parse_number, split_row
+from fieldkit.io.csv_table import (
+    LENGTH_UNITS,
+    check_cell_count,
+    parse_number,
+    split_row,
+)
 from fieldkit.track import Track
 
 #: Metres per unit for the length units tracking programs export.
@@ -32,31 +37,40 @@ def read_number_columns(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Row numbers and the numbers in ``columns`` of the numbered data ``rows``.
 
-    Cells missing at the end of a row are NaN. Raises :class:`InputFileError` naming
-    the row for a cell that is not a number, for more cells than ``header`` columns
-    in a comma-separated file (decimal commas), and for no rows at all.
+    Cells missing at the end of a row are NaN (a value not tracked). Raises
+    :class:`InputFileError` naming the row for a cell that is not a finite number,
+    for more cells than ``header`` columns (:func:`check_cell_count`: decimal commas
+    with a comma separator), and for no rows at all.
     """
     row_numbers, data = [], []
     for row_number, line in rows:
-        cells = split_row(line, delimiter)
-        if delimiter == "," and len(cells) > len(header):
-            raise InputFileError(
-                f"{len(cells)} cells for {len(header)} columns: decimal commas with a "
-                "comma separator are ambiguous; export with tab or semicolon",
-                source=source,
-                where=f"row {row_number}",
-            )
+        where = f"row {row_number}"
+        cells = check_cell_count(
+            split_row(line, delimiter),
+            header,
+            delimiter,
+            source=source,
+            where=where,
+            allow_short=True,
+        )
         values = []
         for c in columns:
             cell = cells[c] if c < len(cells) else ""
             try:
-                values.append(parse_number(cell, delimiter))
+                value = parse_number(cell, delimiter)
             except ValueError:
                 raise InputFileError(
                     f"column {header[c]!r}: {cell.strip()!r} is not a number",
                     source=source,
-                    where=f"row {row_number}",
+                    where=where,
                 ) from None
+            if np.isinf(value):
+                raise InputFileError(
+                    f"column {header[c]!r}: {cell.strip()!r} is not a finite number",
+                    source=source,
+                    where=where,
+                )
+            values.append(value)
         row_numbers.append(row_number)
         data.append(values)
     if not data:

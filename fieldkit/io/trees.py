@@ -21,8 +21,9 @@ Two CSV layouts (aliases accepted, see the ``*_ALIASES`` tuples):
 elevation at the tree (``ground_z_m``) is NaN unless the file gives it; the reduction
 then interpolates it on the line between the two impacts.
 
-``units="ft"`` converts distances, strike heights and ground elevations given without a
-unit in their column names; ``dbh`` is read from ``dbh_mm``, ``dbh_cm`` or ``dbh_in``.
+``units`` (``"m"``/``"ft"``) gives the unit of distances, strike heights and ground
+elevations without a unit in their column names (without it such a column is an
+error); ``dbh`` is read from ``dbh_mm``, ``dbh_cm`` or ``dbh_in`` (``dbh``: mm).
 """
 
 from __future__ import annotations
@@ -56,23 +57,23 @@ DBH_UNITS = {"mm": 1.0, "cm": 10.0, "in": 25.4}
 
 
 def _dbh_column(table: CsvTable) -> tuple[Column | None, float]:
-    for column in table.columns:
-        if column.name == "dbh":
-            unit = column.unit or "mm"
-            if unit not in DBH_UNITS:
-                raise InputFileError(
-                    f"column '{column.header.strip()}': dbh unit must be mm, cm or in",
-                    source=table.source,
-                    where="row 1",
-                )
-            return column, DBH_UNITS[unit]
-        if column.name in ("dbh_in", "dbh_cm", "dbh_mm"):
-            return column, DBH_UNITS[column.name[4:]]
-    return None, 1.0
+    column = table.find(("dbh", "dbh_in", "dbh_cm", "dbh_mm"), "the dbh")
+    if column is None:
+        return None, 1.0
+    if column.name != "dbh":
+        return column, DBH_UNITS[column.name[4:]]
+    unit = column.unit or "mm"
+    if unit not in DBH_UNITS:
+        raise InputFileError(
+            f"column '{column.header.strip()}': dbh unit must be mm, cm or in",
+            source=table.source,
+            where="row 1",
+        )
+    return column, DBH_UNITS[unit]
 
 
 def read_trees(
-    path: str | PathLike[str], impacts: PointSet, *, units: str = "m"
+    path: str | PathLike[str], impacts: PointSet, *, units: str | None = None
 ) -> TreeStrikes:
     """Read tree strikes and tie each to the flight it interrupted.
 
@@ -83,7 +84,8 @@ def read_trees(
     impacts
         The impacts of the same path (from :func:`fieldkit.io.impacts.read_impacts`).
     units
-        ``"m"`` or ``"ft"`` for lengths without units in their column names.
+        ``"m"`` or ``"ft"`` for lengths without units in their column names (None:
+        such a column is an error).
 
     Raises
     ------

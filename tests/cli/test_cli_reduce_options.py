@@ -21,7 +21,7 @@ def test_easting_northing_needs_and_uses_epsg(cli, tmp_path):
             "name": ["A", "B", "C"],
             "easting": e0 + d * np.sin(az),
             "northing": n0 + d * np.cos(az),
-            "elevation": [1000.0, 985.0, 972.0],
+            "elevation_m": [1000.0, 985.0, 972.0],
         }
     ).to_csv(csv, index=False)
     out = tmp_path / "t.csv"

@@ -276,7 +276,7 @@ def test_stations_csv_aliases_and_duplicates(tmp_path):
     assert (row["lat_deg"], row["lon_deg"]) == (49.5, -117.25)
     assert row["elev_m"] == pytest.approx(5000 * 0.3048)
     assert stations.lookup("S2") is None
-    path.write_text("station,lat,lon,elev\nS1,49,-117,1\nS1,49.1,-117,2\n")
+    path.write_text("station,lat,lon,elev_m\nS1,49,-117,1\nS1,49.1,-117,2\n")
     with pytest.raises(
         InputFileError, match="'S1' appears twice \\(row 2 and row 3\\)"
     ):

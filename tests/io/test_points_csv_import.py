@@ -55,7 +55,7 @@ def test_geographic_csv_gnss_app_header(tmp_path):
         f"I1,imp,{FLINDERS[1]:.9f},{FLINDERS[0]:.9f},347.2,350.948\n"
         f"I2,imp,{float(lon2):.9f},{float(lat2):.9f},330.0,333.75\n"
     )
-    points = read_impacts(write(tmp_path, "emlid.csv", text))
+    points = read_impacts(write(tmp_path, "emlid.csv", text), units="m")
     frame = points.frame
     assert points.crs == "EPSG:32755"
     assert "'Elevation'" in points.height_reference
@@ -67,7 +67,7 @@ def test_geographic_csv_gnss_app_header(tmp_path):
 
 def test_ellipsoidal_height_only_is_labelled(tmp_path):
     text = "id,lat,lon,hae\nA,49,-117,1510\nB,49.0005,-117,1490\n"
-    points = read_impacts(write(tmp_path, "hae.csv", text))
+    points = read_impacts(write(tmp_path, "hae.csv", text), units="m")
     assert "ellipsoidal" in points.height_reference
     assert points.frame["z_m"].tolist() == [1510.0, 1490.0]
 
@@ -79,7 +79,7 @@ def test_projected_csv_published_utm_to_lat_lon(tmp_path):
         f"F,{FLINDERS_UTM55[0]},{FLINDERS_UTM55[1]},347.2\n"
         f"G,{east2},{north2},330.1\n"
     )
-    points = read_impacts(write(tmp_path, "en.csv", text), epsg=32755)
+    points = read_impacts(write(tmp_path, "en.csv", text), epsg=32755, units="m")
     frame = points.frame
     assert points.crs == "EPSG:32755"
     assert frame["lat_deg"].iloc[0] == pytest.approx(FLINDERS[0], abs=2e-8)
@@ -111,7 +111,7 @@ def test_projected_csv_in_a_us_survey_foot_crs(tmp_path):
 
     to_2229 = pyproj.Transformer.from_crs(4326, 2229, always_xy=True)
     e, n = to_2229.transform(-118.25, 34.05)
-    text = f"point,x,y,z\nA,{e},{n},300\nB,{e + 100},{n},290\n"
+    text = f"point,x,y,z_ft\nA,{e},{n},300\nB,{e + 100},{n},290\n"
     points = read_impacts(write(tmp_path, "sp.csv", text), epsg=2229)
     frame = points.frame
     assert frame["lat_deg"].iloc[0] == pytest.approx(34.05, abs=1e-9)
@@ -135,13 +135,13 @@ def test_unit_in_column_name_wins_over_units_option(tmp_path):
 
 def test_semicolon_and_decimal_comma(tmp_path):
     text = "Punkt;X;Z\nA;0;100,5\nB;12,25;90\n".replace("Punkt", "point")
-    frame = read_impacts(write(tmp_path, "eu.csv", text)).frame
+    frame = read_impacts(write(tmp_path, "eu.csv", text), units="m").frame
     assert frame["x_m"].tolist() == [0.0, 12.25]
     assert frame["z_m"].tolist() == [100.5, 90.0]
 
 
 def test_no_name_column_numbers_the_points(tmp_path):
-    points = read_impacts(write(tmp_path, "n.csv", "x,z\n0,10\n3,8\n"))
+    points = read_impacts(write(tmp_path, "n.csv", "x,z\n0,10\n3,8\n"), units="m")
     assert points.frame["point"].tolist() == ["1", "2"]
     assert any("no point-name column" in note for note in points.notes)
 
@@ -149,7 +149,7 @@ def test_no_name_column_numbers_the_points(tmp_path):
 def test_comments_and_blank_lines_keep_row_numbers(tmp_path):
     text = "# survey 2023\npoint,x,z\n\nA,0,10\nB,abc,8\n"
     with pytest.raises(InputFileError) as error:
-        read_impacts(write(tmp_path, "c.csv", text))
+        read_impacts(write(tmp_path, "c.csv", text), units="m")
     assert str(error.value).endswith("c.csv: row 5: column 'x': 'abc' is not a number")
 
 
@@ -161,7 +161,7 @@ def test_text_in_a_number_names_column_value_and_row(tmp_path):
         tmp_path, "t.csv", "point,lat,lon,elev\nA,49,-117,1500\nB,49.1,-117,15O0\n"
     )
     with pytest.raises(InputFileError) as error:
-        read_impacts(path)
+        read_impacts(path, units="m")
     assert str(error.value) == f"{path}: row 3: column 'elev': '15O0' is not a number"
 
 
@@ -194,7 +194,7 @@ def test_duplicated_point_names_both_rows(tmp_path):
 )
 def test_bad_csv(tmp_path, text, message):
     with pytest.raises(InputFileError, match=message):
-        read_points_csv(write(tmp_path, "bad.csv", text))
+        read_points_csv(write(tmp_path, "bad.csv", text), units="m")
 
 
 def test_missing_empty_and_binary_csv(tmp_path):
@@ -232,4 +232,4 @@ def test_dispatch_by_content_not_extension(tmp_path):
     )
     assert read_impacts(gpx_as_txt).frame["z_m"].tolist() == [1500.0, 1480.0]
     csv_no_ext = write(tmp_path, "impacts", "point,x,z\nA,0,1\nB,1,0\n")
-    assert read_impacts(csv_no_ext).frame["x_m"].tolist() == [0.0, 1.0]
+    assert read_impacts(csv_no_ext, units="m").frame["x_m"].tolist() == [0.0, 1.0]

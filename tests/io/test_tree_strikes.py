@@ -182,7 +182,7 @@ def test_layout_errors(tmp_path, section_impacts, geographic_impacts):
             write(tmp_path, "lat,lon,strike_height_m\n49,-117,1\n"), section_impacts
         )
     with pytest.raises(InputFileError, match="not between two impacts"):
-        read_trees(write(tmp_path, "x,strike_height_m\n31,1\n"), section_impacts)
+        read_trees(write(tmp_path, "x_m,strike_height_m\n31,1\n"), section_impacts)
     with pytest.raises(InputFileError, match="not between any two successive impacts"):
         read_trees(
             write(tmp_path, "lat,lon,strike_height_m\n49.6,-117.4,1\n"),

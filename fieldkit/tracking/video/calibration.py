@@ -25,15 +25,15 @@ image orientation: a camera on its side or mirrored just has a different ``H``.
 
 from __future__ import annotations
 
-import json
 import os
 from dataclasses import dataclass, field
+from itertools import combinations
 from pathlib import Path
 
 import numpy as np
 
 from fieldkit.errors import ArgumentError, InputFileError
-from fieldkit.io.csv_table import length_factor, read_csv_table
+from fieldkit.io.csv_table import length_factor, read_csv_table, read_json
 
 
 @dataclass(frozen=True)
@@ -167,9 +167,12 @@ def homography_from_points(
 ) -> Calibration:
     """Least-squares homography from >= 4 image <-> world point pairs.
 
-    Raises :class:`~fieldkit.errors.InputFileError` naming the point when there are too
-    few points, a point lies outside the frame, points repeat, or the points are
-    degenerate (three or more on a line leaves the mapping undetermined).
+    Raises :class:`~fieldkit.errors.InputFileError` (``source``: the points' file)
+    naming the point when there are too few points, a point lies outside the frame or
+    points repeat; and for layouts no homography comes from: all image or all world
+    points on one line, three of four on a line (the mapping is undetermined or
+    singular), or the world points in another arrangement than the image points (the
+    mapping would fold the picture through infinity).
     """
     img = np.asarray(image_points, dtype=float).reshape(-1, 2)
     wld = np.asarray(world_points, dtype=float).reshape(-1, 2)
@@ -203,17 +206,33 @@ def homography_from_points(
                     source=source,
                     where=f"point {i + 1}",
                 )
-    centred = img - img.mean(axis=0)
-    singular = np.linalg.svd(centred, compute_uv=False)
-    if singular[-1] < 1e-3 * singular[0]:
-        raise InputFileError(
-            "the image points lie on one line; the mapping is undetermined",
-            source=source,
-        )
+    for points, where in ((img, "image"), (wld, "world")):
+        centred = points - points.mean(axis=0)
+        singular = np.linalg.svd(centred, compute_uv=False)
+        if singular[-1] < 1e-3 * singular[0]:
+            raise InputFileError(
+                f"the {where} points lie on one line; the mapping is undetermined "
+                "(give at least 4 points with no three on a line)",
+                source=source,
+            )
     h = _direct_linear_transform(img, wld)
     if h is None or not np.all(np.isfinite(h)):
+        line = _three_on_a_line(img, wld)
+        detail = f" (points {line})" if line else ""
         raise InputFileError(
-            "no homography fits these points (degenerate layout)", source=source
+            f"these points do not fix a homography{detail}: give at least 4 points "
+            "with no three on a line, in the image and in the world",
+            source=source,
+        )
+    w = h[2, 0] * img[:, 0] + h[2, 1] * img[:, 1] + h[2, 2]
+    if np.any(w > 0) and np.any(w < 0):
+        side = w > 0 if np.count_nonzero(w > 0) <= np.count_nonzero(w < 0) else w < 0
+        odd = ", ".join(str(i + 1) for i in np.flatnonzero(side))
+        raise InputFileError(
+            "the world points are not in the same arrangement as the image points "
+            f"(points {odd} are on the wrong side: two points swapped?); the mapping "
+            "would fold the picture through infinity",
+            source=source,
         )
     cal = Calibration(np.asarray(h, float))
     x, z = cal.to_world(img[:, 0], img[:, 1])
@@ -224,6 +243,17 @@ def homography_from_points(
         residual,
         {"homography_points": int(len(img))},
     )
+
+
+def _three_on_a_line(img: np.ndarray, wld: np.ndarray) -> str | None:
+    """``"i, j, k on one line in the image"`` (1-based) for the first such triple."""
+    for points, where in ((img, "image"), (wld, "world")):
+        scale = float(np.ptp(points, axis=0).max()) or 1.0
+        for i, j, k in combinations(range(min(len(points), 60)), 3):
+            a, b = points[j] - points[i], points[k] - points[i]
+            if abs(a[0] * b[1] - a[1] * b[0]) < 1e-6 * scale * scale:
+                return f"{i + 1}, {j + 1}, {k + 1} on one line in the {where}"
+    return None
 
 
 def _normalising_transform(points: np.ndarray) -> np.ndarray:
@@ -245,9 +275,13 @@ def _direct_linear_transform(src: np.ndarray, dst: np.ndarray) -> np.ndarray | N
         rows.append([-x, -y, -1, 0, 0, 0, u * x, u * y, u])
         rows.append([0, 0, 0, -x, -y, -1, v * x, v * y, v])
     _, singular, vt = np.linalg.svd(np.asarray(rows, float))
-    if singular[-2] < 1e-12 * singular[0]:
+    if singular[7] < 1e-8 * singular[0]:  # more than one solution: degenerate
         return None
-    h = np.linalg.inv(td) @ vt[-1].reshape(3, 3) @ ts
+    normalised = vt[-1].reshape(3, 3)
+    scales = np.linalg.svd(normalised, compute_uv=False)
+    if scales[-1] < 1e-8 * scales[0]:  # singular: the image maps onto a line
+        return None
+    h = np.linalg.inv(td) @ normalised @ ts
     if abs(h[2, 2]) < 1e-300:
         return None
     return h / h[2, 2]
@@ -256,19 +290,20 @@ def _direct_linear_transform(src: np.ndarray, dst: np.ndarray) -> np.ndarray | N
 def read_homography_file(
     path: str | os.PathLike[str], image_size: tuple[int, int] | None = None
 ) -> Calibration:
-    """Read image <-> world points (JSON or CSV, see the module docstring) and fit."""
+    """Read image <-> world points (JSON or CSV, see the module docstring) and fit.
+
+    Every problem is reported against the file (and the point at fault): bad JSON
+    or CSV, too few points, and layouts no homography can come from
+    (:func:`homography_from_points`).
+    """
     path = Path(path)
     if not path.is_file():
         raise InputFileError("homography file not found", source=path)
-    text = path.read_text(encoding="utf-8-sig")
+    with path.open("rb") as handle:
+        head = handle.read(512).lstrip(b"\xef\xbb\xbf \t\r\n")
     rows: list[list[float]] = []
-    if path.suffix.lower() == ".json" or text.lstrip().startswith(("{", "[")):
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise InputFileError(
-                f"not valid JSON ({exc.msg})", source=path, where=f"line {exc.lineno}"
-            ) from None
+    if path.suffix.lower() == ".json" or head.startswith((b"{", b"[")):
+        data = read_json(path, kind="homography")
         items = data.get("points") if isinstance(data, dict) else data
         if not isinstance(items, list):
             raise InputFileError(
@@ -282,9 +317,10 @@ def read_homography_file(
                         [float(item[k]) for k in ("u_px", "v_px", "x_m", "z_m")]
                     )
                 else:
-                    rows.append([float(v) for v in item][:4])
-                    if len(rows[-1]) != 4:
+                    values = [float(v) for v in item]
+                    if len(values) != 4:
                         raise ValueError
+                    rows.append(values)
             except (KeyError, TypeError, ValueError):
                 raise InputFileError(
                     "needs numbers u_px, v_px, x_m, z_m",
@@ -298,7 +334,7 @@ def read_homography_file(
             "homography CSV needs columns u_px, v_px, x_m, z_m",
         )
         factors = {
-            key: length_factor(table, column, "m") if key in ("x_m", "z_m") else 1.0
+            key: length_factor(table, column, None) if key in ("x_m", "z_m") else 1.0
             for key, column in columns.items()
         }
         for number, row in table.rows:

@@ -134,6 +134,9 @@ class BallDetector:
         u0, v0, rw, rh = (int(round(x)) for x in roi)
         self.roi = (max(u0, 0), max(v0, 0), min(u0 + rw, w), min(v0 + rh, h))
         self.expected_radius_px = expected_radius_px
+        #: radii [px] of bodies passed over because they were not of the given size
+        #: (``expected_radius_px``): a radius off by 2 is a diameter or a wrong scale
+        self.off_size_radii: list[float] = []
         self._radii: list[float] = []
         self._gain = 1.0  # brightness of the current frame relative to the background
 
@@ -206,6 +209,8 @@ class BallDetector:
             if expected is not None:
                 rel = abs(r / expected - 1.0)
                 if rel > self.settings.radius_tolerance:
+                    if self.expected_radius_px is not None:
+                        self.off_size_radii.append(float(r))
                     continue
                 cost += rel
             if prediction is not None:

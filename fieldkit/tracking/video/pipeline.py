@@ -214,8 +214,7 @@ def track_video(
     found = detections[detections["found"]].copy()
     if found.empty:
         raise InputFileError(
-            "no body found in any frame (check `roi`, the contrast and that the "
-            "body moves)",
+            _nothing_found(detector, radius_m, calibration.metres_per_pixel(*centre)),
             source=path,
             where=f"frames 0-{decoded - 1}",
         )
@@ -313,6 +312,34 @@ def track_video(
         "warnings": warnings,
     }
     return Track(frame, source=str(path), fps=float(fps), meta=meta), detections
+
+
+def _nothing_found(
+    detector: BallDetector, radius_m: float | None, metres_per_pixel: float
+) -> str:
+    """Why no frame had a body: the size looked for and the sizes seen, if any."""
+    expected = detector.expected_radius_px
+    if expected is None:
+        return (
+            "no body found in any frame (check `roi`, the contrast and that the body "
+            "moves)"
+        )
+    looked = (
+        f"no body of radius {expected:.1f} px found in any frame (`radius_m` "
+        f"{radius_m:g} m at {metres_per_pixel * 1000:.3g} mm/px)"
+    )
+    seen = np.asarray(detector.off_size_radii, dtype=float)
+    if seen.size == 0:
+        return (
+            f"{looked}, nor a moving body of any other size (check `roi`, the "
+            "contrast and that the body moves)"
+        )
+    low, mid, high = np.percentile(seen, [5, 50, 95])
+    sizes = f"{mid:.1f} px" if high - low < 1.0 else f"{low:.1f}-{high:.1f} px"
+    return (
+        f"{looked}; bodies seen have radius {sizes} ({mid * metres_per_pixel:.3g} m "
+        "at that scale): a diameter given as the radius, or a wrong scale?"
+    )
 
 
 def _classify_gaps(missing: np.ndarray, found: pd.DataFrame):

@@ -75,7 +75,8 @@ class VideoReader:
     Raises
     ------
     InputFileError
-        The file does not exist, cannot be opened, or holds no decodable frame.
+        The file does not exist, is not a video OpenCV can decode, or holds no
+        decodable frame or only one (a still image).
 
     Examples
     --------
@@ -93,7 +94,8 @@ class VideoReader:
         capture = _open_capture(self.path)
         if not capture.isOpened():
             raise InputFileError(
-                "cannot open as a video (unknown format or damaged header)",
+                "cannot open as a video: not a container and codec OpenCV can decode "
+                "(another kind of file renamed, or a damaged header)",
                 source=self.path,
             )
         width = int(capture.get(cv2.CAP_PROP_FRAME_WIDTH))
@@ -102,10 +104,15 @@ class VideoReader:
         fps = float(capture.get(cv2.CAP_PROP_FPS) or 0.0)
         codec = _fourcc_text(capture.get(cv2.CAP_PROP_FOURCC))
         ok, first = capture.read()
+        second = capture.read()[0] if ok and count <= 1 else True
         capture.release()
         if not ok or first is None:
             raise InputFileError(
                 "video holds no decodable frame (0 frames)", source=self.path
+            )
+        if not second:
+            raise InputFileError(
+                "holds a single frame: a still image, not a video", source=self.path
             )
         height, width = first.shape[:2] if first.ndim >= 2 else (height, width)
         self.info = VideoInfo(
