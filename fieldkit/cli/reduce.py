@@ -149,7 +149,9 @@ def reduce(
     Each flight between two impacts is a parabola (eq. 3.5): fixed exactly by a tree
     strike (three-point solve), else by the restitution angle --theta0. Velocities,
     N/T components on the chord slope, e_N, e_T, energies (KE, RE with omega = v/r,
-    energy head) and flight heights go to one row per impact.
+    energy head) and flight heights go to one row per impact, with quality flags
+    (qa_flags) and standard uncertainties (e_n_sd, e_t_sd, vi_sd_mps) propagated from a
+    position error of 0.5 m in plan and in height (stated in the summary).
 
     Example (thesis Table 2-4, Tornado Mountain boulder A):
 
@@ -158,7 +160,7 @@ def reduce(
         --mass 3750 --radius 0.725 --gyration 0.46 -o t.csv --figures figs
     """
     from fieldkit.physics.bodies import resolve_body
-    from fieldkit.reduce.pipeline import ReduceOptions, reduce_survey
+    from fieldkit.reduce.pipeline import ReduceOptions, reduce_path
     from fieldkit.reduce.summary import format_summary, summarize
     from fieldkit.survey import Survey
 
@@ -226,7 +228,8 @@ def reduce(
         path_id=path_id or name, theta0_deg=theta0, body=body, friction=friction
     )
     survey = Survey(points, tree_set)
-    table = reduce_survey(survey, options)
+    reduction = reduce_path(survey, options)
+    table = reduction.table
 
     if out is not None:
         table.write(out)
@@ -244,7 +247,10 @@ def reduce(
         )
     typer.echo(f"body: {body.description}")
     print_body_notes(body)
-    typer.echo(with_flags(format_summary(summarize(table))))
+    for text in (*points.notes, *(tree_set.notes if tree_set else ())):
+        note(text)
+    summary = summarize(table, reduction.uncertainty)
+    typer.echo(with_flags(format_summary(summary)))
     if out is not None:
         typer.echo(f"wrote {out} ({len(table)} rows)")
     if figures is not None:
