@@ -108,6 +108,14 @@ def reduce(
             help="Which GPX points are the impacts: waypoints, route, track or auto.",
         ),
     ] = "waypoints",
+    gpx_track: Annotated[
+        str | None,
+        typer.Option(
+            "--gpx-track",
+            help="With --gpx-points track or route: the track (or route) to reduce, "
+            "by name or number (1 = first), when the GPX has several.",
+        ),
+    ] = None,
     lenient_checksum: Annotated[
         bool,
         typer.Option(
@@ -124,13 +132,14 @@ def reduce(
         ),
     ] = 0.68,
     declination: Annotated[
-        float,
+        float | None,
         typer.Option(
             "--declination",
-            help="Magnetic declination (degrees, east positive) added to "
-            "field-book azimuths.",
+            help="Magnetic declination (degrees, east positive) added to magnetic "
+            "field-book azimuths. Required (0 included) unless the field book's "
+            "azimuth_reference column says the azimuths are true.",
         ),
-    ] = 0.0,
+    ] = None,
     out: Annotated[
         Path | None,
         typer.Option("-o", "--out", help="Output table: .csv, .parquet or .xlsx."),
@@ -175,6 +184,16 @@ def reduce(
         )
     if stations is not None and fieldbook is None:
         raise ArgumentError("--stations goes with --fieldbook", source="--stations")
+    if gpx_track is not None and impacts is None:
+        raise ArgumentError(
+            "--gpx-track goes with --impacts FILE.gpx", source="--gpx-track"
+        )
+    if declination is not None and fieldbook is None:
+        raise ArgumentError(
+            "--declination goes with --fieldbook (GPX and CSV positions have no "
+            "azimuths)",
+            source="--declination",
+        )
     if units not in ("m", "ft"):
         raise ArgumentError(f"must be m or ft (got {units!r})", source="--units")
     if theta0 is not None and not (math.isfinite(theta0) and 0.0 < theta0 < 180.0):
@@ -205,7 +224,13 @@ def reduce(
     if impacts is not None:
         from fieldkit.io.impacts import read_impacts
 
-        points = read_impacts(impacts, units=units, epsg=epsg, gpx_points=gpx_points)
+        points = read_impacts(
+            impacts,
+            units=units,
+            epsg=epsg,
+            gpx_points=gpx_points,
+            gpx_track=gpx_track,
+        )
         name = impacts.stem
     else:
         from fieldkit.io.fieldbook import read_fieldbook
