@@ -13,7 +13,7 @@ North reference of the azimuths
     A TruPulse 360 sends magnetic azimuths unless its declination was set in the
     instrument, and the ``$PLTIT,HV`` sentence does not say which. So the field book
     says it, in an ``azimuth_reference`` column (aliases ``azimuth_ref``,
-    ``north_reference``, ``north``): ``true`` (the instrument's declination was set,
+    ``north_reference``): ``true`` (the instrument's declination was set,
     or the azimuths were corrected before they were written) or ``magnetic``, per
     row. A row whose azimuth is magnetic -- or unstated, because the column is absent
     or the cell empty -- needs ``declination_deg`` (0 must be given explicitly: a
@@ -59,12 +59,7 @@ INSTRUMENT_HEIGHT_ALIASES = (
 )
 TARGET_HEIGHT_ALIASES = ("target_height", "th", "ht", "rod_height", "target_h")
 SENTENCE_ALIASES = ("sentence", "trupulse", "nmea", "message", "raw")
-AZIMUTH_REFERENCE_ALIASES = (
-    "azimuth_reference",
-    "azimuth_ref",
-    "north_reference",
-    "north",
-)
+AZIMUTH_REFERENCE_ALIASES = ("azimuth_reference", "azimuth_ref", "north_reference")
 #: Words an ``azimuth_reference`` cell may hold, and what they mean.
 AZIMUTH_REFERENCES = {"true": "true", "magnetic": "magnetic", "mag": "magnetic"}
 
@@ -152,6 +147,17 @@ def read_fieldbook(
         )
     table = read_csv_table(path)
     source = table.source
+    columns = table.require(
+        {
+            "point": NAME_ALIASES,
+            "station": STATION_COLUMN_ALIASES,
+            "instrument_height_m": INSTRUMENT_HEIGHT_ALIASES,
+            "target_height_m": TARGET_HEIGHT_ALIASES,
+            "sentence": SENTENCE_ALIASES,
+        },
+        "field book needs columns point, station, instrument_height_m, "
+        "target_height_m, sentence",
+    )
     references = _azimuth_references(table)
     magnetic = [ref != "true" for ref in references]
     if declination_deg is None and any(magnetic):
@@ -169,17 +175,6 @@ def read_fieldbook(
             source=source,
             where=f"row {table.rows[first][0]}",
         )
-    columns = table.require(
-        {
-            "point": NAME_ALIASES,
-            "station": STATION_COLUMN_ALIASES,
-            "instrument_height_m": INSTRUMENT_HEIGHT_ALIASES,
-            "target_height_m": TARGET_HEIGHT_ALIASES,
-            "sentence": SENTENCE_ALIASES,
-        },
-        "field book needs columns point, station, instrument_height_m, "
-        "target_height_m, sentence",
-    )
     stations = read_stations(stations_path, units=units)
     ih_factor = length_factor(table, columns["instrument_height_m"], units)
     th_factor = length_factor(table, columns["target_height_m"], units)
