@@ -22,7 +22,7 @@ from pathlib import Path
 from fieldkit.io.impacts import read_impacts
 from fieldkit.io.trees import read_trees
 from fieldkit.physics.bodies import resolve_body
-from fieldkit.reduce.pipeline import ReduceOptions, reduce_survey
+from fieldkit.reduce.pipeline import ReduceOptions, reduce_path
 from fieldkit.reduce.summary import format_summary, summarize
 from fieldkit.survey import Survey
 from fieldkit.viz.section_figure import write_section_figure
@@ -38,8 +38,9 @@ def main(out_dir: Path) -> None:
 
     body = resolve_body(mass_kg=3750, radius_m=0.725, gyration_m=0.46)
     options = ReduceOptions(path_id="boulder_a", theta0_deg=32.6, body=body)
-    table = reduce_survey(Survey(points, trees), options)
-    print(format_summary(summarize(table)))
+    reduction = reduce_path(Survey(points, trees), options)
+    table = reduction.table  # e_n_sd etc. from the default position error, stated:
+    print(format_summary(summarize(table, reduction.uncertainty)))
 
     row = table.frame.set_index("point").loc["26"]
     print(

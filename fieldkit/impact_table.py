@@ -5,6 +5,11 @@ consume it. The column names and meanings are a contract (ARCHITECTURE §3); uni
 the names. Primary columns (positions, slope, section-frame velocities, body, spin) are
 what a producer measures; :meth:`ImpactTable.derive` computes every derived column from
 them with the conventions of ARCHITECTURE §2, so both producers agree by construction.
+
+Every derived table carries ``qa_flags`` (ARCHITECTURE §3): the quality flags of
+:data:`QA_FLAGS`, ``;``-separated, computed in one place (:func:`quality_flags`, applied
+by :meth:`ImpactTable.derive`) from the table's own columns, so survey reduction, video
+tracking and simulation all flag the same things the same way.
 """
 
 from __future__ import annotations
@@ -98,6 +103,7 @@ CONTRACT_COLUMNS: tuple[Column, ...] = (
     Column("hmax_normal_m", "float", False, "max height normal to the chord [m]"),
     Column("tree_strike", "bool", False, "the flight arriving here struck a tree"),
     Column("t_s", "float", False, "time of the impact [s]"),
+    Column("qa_flags", "str", False, "';'-separated quality flags (see QA_FLAGS)"),
 )
 
 #: Documented extension columns that fieldkit producers may add (kept on read/write).
@@ -115,6 +121,16 @@ EXTENSION_COLUMNS: tuple[Column, ...] = (
     Column(
         "theory_loss_fraction", "float", False, "dke_theory_j / dke_j (thesis §6.3)"
     ),
+    Column(
+        "e_n_next_chord",
+        "float",
+        False,
+        "e_n with the chord to the next point as the slope (where slope_deg is the "
+        "chord from the previous point)",
+    ),
+    Column("e_n_sd", "float", False, "standard uncertainty of e_n [-]"),
+    Column("e_t_sd", "float", False, "standard uncertainty of e_t [-]"),
+    Column("vi_sd_mps", "float", False, "standard uncertainty of vi_mps [m/s]"),
 )
 
 COLUMNS_BY_NAME: dict[str, Column] = {
@@ -127,6 +143,127 @@ THETA0_SOURCES: frozenset[str] = frozenset({"tree", "assumed", "video", "given"}
 FORMATS: dict[str, str] = {".csv": "csv", ".parquet": "parquet", ".xlsx": "xlsx"}
 
 _EPS = 1e-12
+
+#: Quality flags: short stable names -> one-line meanings (the ``qa_flags`` column).
+QA_FLAGS: dict[str, str] = {
+    "energy_gained": "the rock left faster than it arrived (ke_f > ke_i beyond "
+    "rounding): kinetic energy gained at the impact",
+    "e_n_negative": "e_n < 0: the restitution velocity points into the ground",
+    "e_t_above_1": "e_t > 1: tangential speed gained at the impact (spin turned "
+    "into translation, or survey error)",
+    "speed_high": "impact or restitution speed above 60 m/s, beyond any rock fall "
+    "the thesis reports (48 m/s at Mt. Stephen, §2.1.1)",
+    "flight_high": "the flight leaving the impact rises more than 10 m normal to its "
+    "chord (thesis §3.2: usually 1-2 m, 4 m the highest observed)",
+    "slope_from_chord": "slope_deg is the chord from the previous point, not a "
+    "surveyed slope (ARCHITECTURE §2 default)",
+    "slope_sensitive": "taking the chord to the next point as the slope moves e_n by "
+    "more than its standard uncertainty e_n_sd",
+    "spin_estimated": "omega is estimated as v/r (eq. 3.17), not measured",
+}
+
+#: ``energy_gained``: relative KE gain that is more than rounding (KE ~ v^2).
+ENERGY_GAIN_TOLERANCE = 1e-6
+#: ``speed_high`` limit [m/s]: 25 % above the fastest impact the thesis reports (48
+#: m/s, a barrier 70-100 m below the source at Mt. Stephen, §2.1.1); free fall from
+#: 180 m without any impact loss.
+MAX_PLAUSIBLE_SPEED_MPS = 60.0
+#: ``flight_high`` limit [m]: 2.5 times the highest trajectory the thesis reports
+#: (4 m on a polished 43° slope, §3.2; 99 % of the 235 Ehime flights < 2 m).
+MAX_PLAUSIBLE_FLIGHT_HEIGHT_M = 10.0
+
+
+def quality_flags(frame: pd.DataFrame) -> pd.Series:
+    """The ``qa_flags`` of every row, from the table's own columns (:data:`QA_FLAGS`).
+
+    A flag is raised only where its columns are known (NaN never raises one). Flags
+    already in ``qa_flags`` that are not in :data:`QA_FLAGS` (a producer's own) are
+    kept; those in it are recomputed. Rows without a flag get ``<NA>``.
+
+    Examples
+    --------
+    >>> f = pd.DataFrame({"vi_mps": [10.0, 5.0], "vf_mps": [8.0, 6.0],
+    ...                   "e_n": [0.5, -0.1], "slope_source": ["chord", "surveyed"]})
+    >>> quality_flags(f).tolist()
+    ['slope_from_chord', 'energy_gained;e_n_negative']
+    """
+    n = len(frame)
+
+    def col(name: str) -> np.ndarray:
+        if name not in frame:
+            return np.full(n, np.nan)
+        return pd.to_numeric(frame[name], errors="coerce").to_numpy(float)
+
+    def text(name: str) -> np.ndarray:
+        if name not in frame:
+            return np.full(n, "", dtype=object)
+        return frame[name].astype("string").fillna("").to_numpy(dtype=object)
+
+    vi, vf = col("vi_mps"), col("vf_mps")
+    e_n, e_t = col("e_n"), col("e_t")
+    spin = np.isfinite(col("omega_i_radps")) | np.isfinite(col("omega_f_radps"))
+    slope_known = np.isfinite(col("slope_deg")) if "slope_deg" in frame else True
+    with np.errstate(invalid="ignore"):
+        raised = {
+            "energy_gained": vf**2 > vi**2 * (1.0 + ENERGY_GAIN_TOLERANCE),
+            "e_n_negative": e_n < 0.0,
+            "e_t_above_1": e_t > 1.0 + 1e-9,
+            "speed_high": (vi > MAX_PLAUSIBLE_SPEED_MPS)
+            | (vf > MAX_PLAUSIBLE_SPEED_MPS),
+            "flight_high": col("hmax_normal_m") > MAX_PLAUSIBLE_FLIGHT_HEIGHT_M,
+            "slope_from_chord": (text("slope_source") == "chord") & slope_known,
+            "slope_sensitive": np.abs(col("e_n_next_chord") - e_n) > col("e_n_sd"),
+            "spin_estimated": (text("omega_source") == "estimated") & spin,
+        }
+    given = text("qa_flags")
+    out: list[str | None] = []
+    for i in range(n):
+        names = [name for name in QA_FLAGS if raised[name][i]]
+        names += [
+            name
+            for name in str(given[i]).split(";")
+            if name.strip() and name.strip() not in QA_FLAGS
+        ]
+        out.append(";".join(dict.fromkeys(name.strip() for name in names)) or None)
+    return pd.Series(out, index=frame.index, dtype="string")
+
+
+def restitution(
+    vi_x_mps: np.ndarray,
+    vi_z_mps: np.ndarray,
+    vf_x_mps: np.ndarray,
+    vf_z_mps: np.ndarray,
+    slope_deg: np.ndarray,
+) -> dict[str, np.ndarray]:
+    """Speeds, N/T components, angles to the ground and ``e_n``, ``e_t`` [arrays].
+
+    The kinematic half of :meth:`ImpactTable.derive` (ARCHITECTURE §2; eqs. 4.6,
+    4.7), as plain arrays so that a Monte Carlo can repeat it without building tables.
+
+    Examples
+    --------
+    >>> r = restitution(np.array([3.0]), np.array([-4.0]), np.array([3.0]),
+    ...                 np.array([2.0]), np.array([0.0]))
+    >>> float(r["e_n"][0]), float(r["e_t"][0])
+    (0.5, 1.0)
+    """
+    vit, vin = to_local(vi_x_mps, vi_z_mps, slope_deg)
+    vft, vfn = to_local(vf_x_mps, vf_z_mps, slope_deg)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        e_n = np.where(np.abs(vin) > _EPS, -vfn / vin, np.nan)
+        e_t = np.where(np.abs(vit) > _EPS, vft / vit, np.nan)
+    return {
+        "vi_mps": np.hypot(vi_x_mps, vi_z_mps),
+        "vf_mps": np.hypot(vf_x_mps, vf_z_mps),
+        "vin_mps": vin,
+        "vit_mps": vit,
+        "vfn_mps": vfn,
+        "vft_mps": vft,
+        "theta_i_deg": angle_to_ground_deg(vit, vin),
+        "theta_f_deg": angle_to_ground_deg(vft, vfn),
+        "e_n": e_n,
+        "e_t": e_t,
+    }
 
 
 class ImpactTable:
@@ -221,23 +358,21 @@ class ImpactTable:
 
         Speeds, N/T components on ``slope_deg`` (ARCHITECTURE §2), angles to the ground,
         ``e_n = -vfn/vin`` and ``e_t = vft/vit`` (eqs. 4.6, 4.7), kinetic and rotational
-        energies (``I = m k^2``), ``dke_j`` and energy heads (eq. 6.14). Values the data
-        do not allow (no mass, no spin) stay NaN.
+        energies (``I = m k^2``), ``dke_j``, energy heads (eq. 6.14) and ``qa_flags``
+        (:func:`quality_flags`). Values the data do not allow (no mass, no spin) stay
+        NaN.
         """
         f = self.frame.copy()
-        vix, viz = f["vi_x_mps"].to_numpy(), f["vi_z_mps"].to_numpy()
-        vfx, vfz = f["vf_x_mps"].to_numpy(), f["vf_z_mps"].to_numpy()
-        psi = f["slope_deg"].to_numpy()
-        vit, vin = to_local(vix, viz, psi)
-        vft, vfn = to_local(vfx, vfz, psi)
-        vi, vf = np.hypot(vix, viz), np.hypot(vfx, vfz)
-        f["vi_mps"], f["vf_mps"] = vi, vf
-        f["vin_mps"], f["vit_mps"], f["vfn_mps"], f["vft_mps"] = vin, vit, vfn, vft
-        f["theta_i_deg"] = angle_to_ground_deg(vit, vin)
-        f["theta_f_deg"] = angle_to_ground_deg(vft, vfn)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            f["e_n"] = np.where(np.abs(vin) > _EPS, -vfn / vin, np.nan)
-            f["e_t"] = np.where(np.abs(vit) > _EPS, vft / vit, np.nan)
+        kinematics = restitution(
+            f["vi_x_mps"].to_numpy(),
+            f["vi_z_mps"].to_numpy(),
+            f["vf_x_mps"].to_numpy(),
+            f["vf_z_mps"].to_numpy(),
+            f["slope_deg"].to_numpy(),
+        )
+        for name, values in kinematics.items():
+            f[name] = values
+        vi, vf = kinematics["vi_mps"], kinematics["vf_mps"]
         m = f["mass_kg"].to_numpy()
         k = f["gyration_m"].to_numpy()
         f["ke_i_j"], f["ke_f_j"] = kinetic_energy(m, vi), kinetic_energy(m, vf)
@@ -249,6 +384,7 @@ class ImpactTable:
             energy_head(z, vi),
             energy_head(z, vf),
         )
+        f["qa_flags"] = quality_flags(f)
         return ImpactTable(f, source=self.source)
 
     # ------------------------------------------------------------------ access

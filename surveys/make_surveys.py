@@ -362,12 +362,26 @@ def rangefinder(rows: list[dict], positions: list, folder: Path) -> None:
             round(hd, 1), round(az_mag, 1), round(inc, 1), round(sd, 1), units="M"
         )
         book.append(
-            [row["point"], st["name"], fmt(instrument_h, 2), fmt(target_h, 2), sentence]
+            [
+                row["point"],
+                st["name"],
+                fmt(instrument_h, 2),
+                fmt(target_h, 2),
+                "magnetic",  # the TruPulse 360's own declination left at 0
+                sentence,
+            ]
         )
     write(
         folder / "boulder_a_fieldbook.csv",
         csv_text(
-            ["point", "station", "instrument_height_m", "target_height_m", "sentence"],
+            [
+                "point",
+                "station",
+                "instrument_height_m",
+                "target_height_m",
+                "azimuth_reference",
+                "sentence",
+            ],
             book,
         ),
     )

@@ -36,6 +36,7 @@ FLAGS: dict[str, str] = {
     "units": "--units",
     "epsg": "--epsg",
     "gpx_points": "--gpx-points",
+    "gpx_track": "--gpx-track",
     "declination_deg": "--declination",
     "friction": "--friction",
     # video tracking and track exports

@@ -109,6 +109,14 @@ def reduce(
             help="Which GPX points are the impacts: waypoints, route, track or auto.",
         ),
     ] = "waypoints",
+    gpx_track: Annotated[
+        str | None,
+        typer.Option(
+            "--gpx-track",
+            help="With --gpx-points track or route: the track (or route) to reduce, "
+            "by name or number (1 = first), when the GPX has several.",
+        ),
+    ] = None,
     lenient_checksum: Annotated[
         bool,
         typer.Option(
@@ -125,13 +133,14 @@ def reduce(
         ),
     ] = 0.68,
     declination: Annotated[
-        float,
+        float | None,
         typer.Option(
             "--declination",
-            help="Magnetic declination (degrees, east positive) added to "
-            "field-book azimuths.",
+            help="Magnetic declination (degrees, east positive) added to magnetic "
+            "field-book azimuths. Required (0 included) unless the field book's "
+            "azimuth_reference column says the azimuths are true.",
         ),
-    ] = 0.0,
+    ] = None,
     out: Annotated[
         Path | None,
         typer.Option("-o", "--out", help="Output table: .csv, .parquet or .xlsx."),
@@ -150,7 +159,9 @@ def reduce(
     Each flight between two impacts is a parabola (eq. 3.5): fixed exactly by a tree
     strike (three-point solve), else by the restitution angle --theta0. Velocities,
     N/T components on the chord slope, e_N, e_T, energies (KE, RE with omega = v/r,
-    energy head) and flight heights go to one row per impact.
+    energy head) and flight heights go to one row per impact, with quality flags
+    (qa_flags) and standard uncertainties (e_n_sd, e_t_sd, vi_sd_mps) propagated from a
+    position error of 0.5 m in plan and in height (stated in the summary).
 
     Example (thesis Table 2-4, Tornado Mountain boulder A):
 
@@ -159,7 +170,7 @@ def reduce(
         --mass 3750 --radius 0.725 --gyration 0.46 -o t.csv --figures figs
     """
     from fieldkit.physics.bodies import resolve_body
-    from fieldkit.reduce.pipeline import ReduceOptions, reduce_survey
+    from fieldkit.reduce.pipeline import ReduceOptions, reduce_path
     from fieldkit.reduce.summary import format_summary, summarize
     from fieldkit.survey import Survey
 
@@ -174,6 +185,16 @@ def reduce(
         )
     if stations is not None and fieldbook is None:
         raise ArgumentError("--stations goes with --fieldbook", source="--stations")
+    if gpx_track is not None and impacts is None:
+        raise ArgumentError(
+            "--gpx-track goes with --impacts FILE.gpx", source="--gpx-track"
+        )
+    if declination is not None and fieldbook is None:
+        raise ArgumentError(
+            "--declination goes with --fieldbook (GPX and CSV positions have no "
+            "azimuths)",
+            source="--declination",
+        )
     if units is not None and units not in ("m", "ft"):
         raise ArgumentError(f"must be m or ft (got {units!r})", source="--units")
     if theta0 is not None and not (math.isfinite(theta0) and 0.0 < theta0 < 180.0):
@@ -204,7 +225,13 @@ def reduce(
     if impacts is not None:
         from fieldkit.io.impacts import read_impacts
 
-        points = read_impacts(impacts, units=units, epsg=epsg, gpx_points=gpx_points)
+        points = read_impacts(
+            impacts,
+            units=units,
+            epsg=epsg,
+            gpx_points=gpx_points,
+            gpx_track=gpx_track,
+        )
         name = impacts.stem
     else:
         from fieldkit.io.fieldbook import read_fieldbook
@@ -227,7 +254,8 @@ def reduce(
         path_id=path_id or name, theta0_deg=theta0, body=body, friction=friction
     )
     survey = Survey(points, tree_set)
-    table = reduce_survey(survey, options)
+    reduction = reduce_path(survey, options)
+    table = reduction.table
 
     if out is not None:
         table.write(out, outputs=outputs)
@@ -243,7 +271,10 @@ def reduce(
     outputs.commit()
     typer.echo(f"body: {body.description}")
     print_body_notes(body)
-    typer.echo(with_flags(format_summary(summarize(table))))
+    for text in (*points.notes, *(tree_set.notes if tree_set else ())):
+        note(text)
+    summary = summarize(table, reduction.uncertainty)
+    typer.echo(with_flags(format_summary(summary)))
     if out is not None:
         typer.echo(f"wrote {out} ({len(table)} rows)")
     if figures is not None:

@@ -10,6 +10,18 @@ Field book CSV columns (aliases accepted, see the ``*_ALIASES`` tuples)::
 Stations come from a GPX (waypoint name = station id) or a CSV (see
 :mod:`fieldkit.io.stations`).
 
+North reference of the azimuths
+    A TruPulse 360 sends magnetic azimuths unless its declination was set in the
+    instrument, and the ``$PLTIT,HV`` sentence does not say which. So the field book
+    says it, in an ``azimuth_reference`` column (aliases ``azimuth_ref``,
+    ``north_reference``): ``true`` (the instrument's declination was set,
+    or the azimuths were corrected before they were written) or ``magnetic``, per
+    row. A row whose azimuth is magnetic -- or unstated, because the column is absent
+    or the cell empty -- needs ``declination_deg`` (0 must be given explicitly: a
+    silent 0 swings every shot by the local declination, 14° at Tornado Mountain);
+    the declination is added to those rows only. Given for a book whose azimuths are
+    all true, it is not applied and a note says so.
+
 Geometry of each shot
     true azimuth = magnetic azimuth + declination (east positive);
     target (lat, lon) = geodesic destination from the station along the true azimuth
@@ -31,7 +43,7 @@ import numpy as np
 
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.io import geodesy
-from fieldkit.io.csv_table import length_factor, read_csv_table
+from fieldkit.io.csv_table import CsvTable, length_factor, read_csv_table
 from fieldkit.io.point_sets import check_unique_points, point_set_from_geographic
 from fieldkit.io.points_csv import MATERIAL_ALIASES, NAME_ALIASES, SLOPE_ALIASES
 from fieldkit.io.stations import read_stations
@@ -48,13 +60,35 @@ INSTRUMENT_HEIGHT_ALIASES = (
 )
 TARGET_HEIGHT_ALIASES = ("target_height", "th", "ht", "rod_height", "target_h")
 SENTENCE_ALIASES = ("sentence", "trupulse", "nmea", "message", "raw")
+AZIMUTH_REFERENCE_ALIASES = ("azimuth_reference", "azimuth_ref", "north_reference")
+#: Words an ``azimuth_reference`` cell may hold, and what they mean.
+AZIMUTH_REFERENCES = {"true": "true", "magnetic": "magnetic", "mag": "magnetic"}
+
+
+def _azimuth_references(table: CsvTable) -> list[str | None]:
+    """Per row: ``"true"``, ``"magnetic"`` or None (not stated)."""
+    column = table.find(AZIMUTH_REFERENCE_ALIASES)
+    if column is None:
+        return [None] * len(table.rows)
+    out: list[str | None] = []
+    for number, row in table.rows:
+        text = table.cell(row, column).lower()
+        if text and text not in AZIMUTH_REFERENCES:
+            raise InputFileError(
+                f"column '{column.header.strip()}': '{table.cell(row, column)}' is not "
+                "true or magnetic",
+                source=table.source,
+                where=f"row {number}",
+            )
+        out.append(AZIMUTH_REFERENCES.get(text))
+    return out
 
 
 def read_fieldbook(
     path: str | PathLike[str],
     stations_path: str | PathLike[str],
     *,
-    declination_deg: float = 0.0,
+    declination_deg: float | None = None,
     lenient: bool = False,
     units: str | None = None,
     epsg: int | str | None = None,
@@ -68,8 +102,9 @@ def read_fieldbook(
     stations_path
         Stations GPX or CSV.
     declination_deg
-        Magnetic declination added to every azimuth, east positive [deg]. Leave 0 if
-        the instrument was already set to true north.
+        Magnetic declination added to the magnetic (or unstated) azimuths, east
+        positive [deg]. Required unless the book's ``azimuth_reference`` column says
+        every azimuth is true (module docstring); 0 must be given, never assumed.
     lenient
         Accept TruPulse sentences with a wrong or missing checksum (noted).
     units
@@ -94,11 +129,13 @@ def read_fieldbook(
     >>> _ = (folder / "fb.csv").write_text(
     ...     "point,station,instrument_height_m,target_height_m,sentence\\n"
     ...     f"A1,S1,1.5,0,{shot}\\n")
-    >>> ps = read_fieldbook(folder / "fb.csv", folder / "st.csv")
+    >>> ps = read_fieldbook(folder / "fb.csv", folder / "st.csv", declination_deg=0)
     >>> round(float(ps.frame.lat_deg[0]) - 49, 6), round(float(ps.frame.z_m[0]), 2)
     (0.000899, 1483.87)
     """
-    if not math.isfinite(declination_deg) or abs(declination_deg) > 180.0:
+    if declination_deg is not None and (
+        not math.isfinite(declination_deg) or abs(declination_deg) > 180.0
+    ):
         raise ArgumentError(
             f"declination {declination_deg} is not in [-180, 180] degrees",
             source="declination_deg",
@@ -116,6 +153,23 @@ def read_fieldbook(
         "field book needs columns point, station, instrument_height_m, "
         "target_height_m, sentence",
     )
+    references = _azimuth_references(table)
+    magnetic = [ref != "true" for ref in references]
+    if declination_deg is None and any(magnetic):
+        first = magnetic.index(True)
+        said = (
+            "its azimuth is magnetic (azimuth_reference)"
+            if references[first] == "magnetic"
+            else "the book does not say whether its azimuths are true or magnetic (no "
+            "azimuth_reference)"
+        )
+        raise ArgumentError(
+            f"{said}: give the magnetic declination `declination_deg` (degrees, east "
+            "positive; 0 only where it is 0), or mark true azimuths with "
+            "azimuth_reference true",
+            source=source,
+            where=f"row {table.rows[first][0]}",
+        )
     stations = read_stations(stations_path, units=units)
     ih_factor = length_factor(table, columns["instrument_height_m"], units)
     th_factor = length_factor(table, columns["target_height_m"], units)
@@ -125,7 +179,7 @@ def read_fieldbook(
     names, wheres, lats, lons, elevs = [], [], [], [], []
     materials, slopes, notes = [], [], []
     zero_azimuths = 0
-    for number, row in table.rows:
+    for index, (number, row) in enumerate(table.rows):
         where = f"row {number}"
         name = table.cell(row, columns["point"])
         if not name:
@@ -188,7 +242,8 @@ def read_fieldbook(
             rise = shot.horizontal_distance_m * math.tan(
                 math.radians(shot.inclination_deg)
             )
-        azimuth = (shot.azimuth_deg + declination_deg) % 360.0
+        correction = declination_deg if magnetic[index] else 0.0
+        azimuth = (shot.azimuth_deg + (correction or 0.0)) % 360.0
         lat, lon = geodesy.destination(
             float(station["lat_deg"]),
             float(station["lon_deg"]),
@@ -210,8 +265,16 @@ def read_fieldbook(
             "every azimuth is 0.00: a TruPulse 200 has no compass, so all targets "
             "were placed due north of their stations"
         )
-    if declination_deg:
-        notes.append(f"declination {declination_deg:+g}° added to every azimuth")
+    if declination_deg is not None and any(magnetic):
+        which = (
+            "every azimuth" if all(magnetic) else f"{sum(magnetic)} magnetic azimuths"
+        )
+        notes.append(f"declination {declination_deg:+g}° added to {which}")
+    if declination_deg is not None and not all(magnetic):
+        which = "every azimuth is" if not any(magnetic) else "some azimuths are"
+        notes.append(
+            f"the field book says {which} true: declination not applied to those"
+        )
     extra: dict[str, list] = {}
     if material_column is not None:
         extra["material"] = materials
@@ -231,4 +294,5 @@ def read_fieldbook(
         epsg=epsg,
         notes=notes,
         extra=extra or None,
+        wheres=[f"{w} (point {n})" for w, n in zip(wheres, names, strict=True)],
     )

@@ -15,12 +15,19 @@ path by up to 0.25 m.
 
 Heights are never converted here (no geoid grids are available): they are carried as
 given and labelled by the readers.
+
+A CRS given by the user must fit the points: :func:`check_area_of_use` refuses points
+farther than :data:`AREA_OF_USE_MARGIN_DEG` outside the CRS's EPSG area of use
+(``pyproj.CRS.area_of_use``), e.g. EPSG:32755 (UTM 55S, Australia) for a site in
+Canada, naming the CRS, its area and the first point outside.
+:func:`to_projected` applies it whenever a CRS is given.
 """
 
 from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Sequence
 
 import numpy as np
 import pyproj
@@ -35,6 +42,93 @@ GEOD = pyproj.Geod(ellps="WGS84")
 
 #: Geographic WGS 84, the CRS of GPX files and GNSS latitude/longitude columns.
 WGS84_GEOGRAPHIC = "EPSG:4326"
+
+#: How far outside a CRS's area of use a point may lie [deg]. EPSG areas are the
+#: official extents (a UTM zone is a 6° band), but a site straddling a zone edge is
+#: often kept in one zone, where the projection is still accurate (scale error
+#: ~1e-4 one degree past the edge at mid-latitudes); a wrong zone or hemisphere is
+#: many degrees off.
+AREA_OF_USE_MARGIN_DEG = 1.0
+
+
+def _latitude_text(lat: float) -> str:
+    return f"{abs(lat):.5f}°{'N' if lat >= 0 else 'S'}"
+
+
+def _longitude_text(lon: float) -> str:
+    return f"{abs(lon):.5f}°{'E' if lon >= 0 else 'W'}"
+
+
+def check_area_of_use(
+    crs: pyproj.CRS,
+    lat_deg: ArrayLike,
+    lon_deg: ArrayLike,
+    *,
+    names: Sequence[str] | None = None,
+    source: str | None = None,
+) -> None:
+    """Raise if a point lies outside the area of use of ``crs`` (beyond the margin).
+
+    Parameters
+    ----------
+    crs
+        The CRS the user chose (its ``area_of_use``; a CRS without one passes).
+    lat_deg, lon_deg
+        WGS 84 positions of the points [deg].
+    names, source
+        Point names and their file, for the message.
+
+    Raises
+    ------
+    ArgumentError
+        ``source="epsg"``, naming the CRS, its area (bounds and name) and the first
+        point outside it.
+
+    Examples
+    --------
+    >>> check_area_of_use(pyproj.CRS.from_epsg(32611), [49.97], [-114.68])
+    >>> check_area_of_use(pyproj.CRS.from_epsg(32755), [49.97], [-114.68],
+    ...                   names=["A"])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    fieldkit.errors.ArgumentError: epsg: EPSG:32755 (WGS 84 / UTM zone 55S) is for...
+    """
+    area = crs.area_of_use
+    if area is None:
+        return
+    west, south, east, north = area.bounds
+    lat = np.atleast_1d(np.asarray(lat_deg, dtype=float))
+    lon = np.atleast_1d(np.asarray(lon_deg, dtype=float))
+    m = AREA_OF_USE_MARGIN_DEG
+    inside = (lat >= south - m) & (lat <= north + m)
+    if east - west >= 360.0 - 2 * m:
+        pass  # the whole circle of longitude
+    elif west <= east:
+        inside &= (lon >= west - m) & (lon <= east + m)
+    else:  # the area crosses the antimeridian
+        inside &= (lon >= west - m) | (lon <= east + m)
+    outside = np.flatnonzero(~inside)
+    if outside.size == 0:
+        return
+    i = int(outside[0])
+    name = names[i] if names is not None else str(i + 1)
+    where = f" of {source}" if source else ""
+    text = area.name if len(area.name) <= 90 else area.name[:87].rstrip() + "..."
+
+    def lon_text(value: float) -> str:
+        return f"{abs(value):g}°{'E' if value >= 0 else 'W'}"
+
+    def lat_text(value: float) -> str:
+        return f"{abs(value):g}°{'N' if value >= 0 else 'S'}"
+
+    raise ArgumentError(
+        f"{crs_label(crs)} ({crs.name}) is for {lon_text(west)} to {lon_text(east)}, "
+        f"{lat_text(south)} to {lat_text(north)} ({text}); point {name}{where} at "
+        f"{_latitude_text(float(lat[i]))}, {_longitude_text(float(lon[i]))} lies "
+        f"outside it ({outside.size} of {lat.size} points do): give the EPSG code of "
+        "the zone the points are in",
+        source="epsg",
+    )
 
 
 def geodesic_inverse(
@@ -243,7 +337,12 @@ def _transformer(source: str, target: str) -> pyproj.Transformer:
 
 
 def to_projected(
-    lat_deg: ArrayLike, lon_deg: ArrayLike, crs: pyproj.CRS | int | str | None = None
+    lat_deg: ArrayLike,
+    lon_deg: ArrayLike,
+    crs: pyproj.CRS | int | str | None = None,
+    *,
+    names: Sequence[str] | None = None,
+    source: str | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], pyproj.CRS]:
     """Easting and northing of WGS 84 latitudes/longitudes in a projected CRS.
 
@@ -253,7 +352,10 @@ def to_projected(
         WGS 84 coordinates [deg].
     crs
         Target projected CRS (pyproj CRS or EPSG code); ``None`` picks the UTM zone of
-        the points with :func:`utm_crs_for`.
+        the points with :func:`utm_crs_for`. A given CRS must contain the points
+        (:func:`check_area_of_use`).
+    names, source
+        Point names and file, for the area-of-use message.
 
     Returns
     -------
@@ -268,7 +370,11 @@ def to_projected(
     """
     lat = np.asarray(lat_deg, dtype=float)
     lon = np.asarray(lon_deg, dtype=float)
-    target = utm_crs_for(lat, lon) if crs is None else _as_projected(crs)
+    if crs is None:
+        target = utm_crs_for(lat, lon)
+    else:
+        target = _as_projected(crs)
+        check_area_of_use(target, lat, lon, names=names, source=source)
     transformer = _transformer(WGS84_GEOGRAPHIC, target.to_wkt())
     easting, northing = transformer.transform(lon, lat)
     return np.asarray(easting, dtype=float), np.asarray(northing, dtype=float), target

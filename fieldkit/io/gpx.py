@@ -7,9 +7,18 @@ namespace, a UTF-8 byte-order mark and vendor ``<extensions>`` all work.
 Which points are read
     ``points="waypoints"`` (default) reads ``<wpt>``: mapped impacts are waypoints. A
     file without waypoints raises an error that says how many track and route points it
-    has. ``points="route"`` reads ``<rtept>``, ``points="track"`` reads ``<trkpt>`` of
-    every segment in order, and ``points="auto"`` takes waypoints, else route points,
-    else track points.
+    has. ``points="route"`` reads ``<rtept>`` of one route, ``points="track"`` reads
+    ``<trkpt>`` of one track (its segments in order: a segment break is the receiver
+    losing its fix on the same walk), and ``points="auto"`` takes waypoints, else route
+    points, else track points.
+
+One track, one path
+    A file with several tracks (or routes) that have points is several paths. They
+    are never joined into one path (that would invent a flight from the end of one
+    track to the start of the next): reading it raises an error listing the tracks,
+    and ``track=`` (``gpx_track`` of :func:`fieldkit.io.impacts.read_impacts`) picks
+    one, by its ``<name>`` or by its number in the file (1 = first). Reduce the others
+    with their own runs and path ids. Empty tracks are ignored.
 
 Names
     A point without ``<name>`` is called ``wpt7`` / ``rtept7`` / ``trkpt7`` (1-based
@@ -106,8 +115,71 @@ def _collect(root: ElementTree.Element, kind: str) -> list[ElementTree.Element]:
     return [e for e in root.iter() if _local(e.tag) == tag]
 
 
+_CONTAINERS = {"track": "trk", "route": "rte"}
+
+
+def _groups(
+    root: ElementTree.Element, kind: str
+) -> list[tuple[str, list[ElementTree.Element]]]:
+    """Each ``<trk>`` (or ``<rte>``) in file order: its name and its points."""
+    out = []
+    for element in root.iter():
+        if _local(element.tag) != _CONTAINERS[kind]:
+            continue
+        points = [e for e in element.iter() if _local(e.tag) == _KINDS[kind]]
+        out.append((_child_text(element, "name") or "", points))
+    return out
+
+
+def _one_group(
+    root: ElementTree.Element,
+    kind: str,
+    track: str | None,
+    path: str | PathLike[str],
+) -> list[ElementTree.Element]:
+    """The points of the one track/route to read (see "One track, one path")."""
+    groups = _groups(root, kind)
+    word = "track" if kind == "track" else "route"
+
+    def label(i: int, count: bool = True) -> str:
+        name, points = groups[i]
+        named = f" '{name}'" if name else ""
+        size = f" ({len(points)} points)" if count else ""
+        return f"{word} {i + 1}{named}{size}"
+
+    if track is not None:
+        wanted = str(track).strip()
+        matches = [i for i, (name, _) in enumerate(groups) if name == wanted]
+        if not matches and wanted.isdigit() and 1 <= int(wanted) <= len(groups):
+            matches = [int(wanted) - 1]
+        if not matches:
+            listed = ", ".join(label(i) for i in range(min(len(groups), 8)))
+            raise ArgumentError(
+                f"no {word} '{wanted}' in {path} (it has {len(groups)} {word}s: "
+                f"{listed or 'none'})",
+                source="gpx_track",
+            )
+        chosen = groups[matches[0]][1]
+        if not chosen:
+            raise InputFileError(
+                f"{label(matches[0], count=False)} has no points", source=path
+            )
+        return chosen
+    full = [i for i, (_, points) in enumerate(groups) if points]
+    if len(full) > 1:
+        listed = ", ".join(label(i) for i in full[:8])
+        more = f" and {len(full) - 8} more" if len(full) > 8 else ""
+        raise InputFileError(
+            f"{len(full)} {word}s with points ({listed}{more}): each is its own path, "
+            f"never joined into one; choose one with `gpx_track` (name or number) "
+            "and reduce the others separately",
+            source=path,
+        )
+    return groups[full[0]][1] if full else []
+
+
 def read_gpx_waypoints(
-    path: str | PathLike[str], *, points: str = "waypoints"
+    path: str | PathLike[str], *, points: str = "waypoints", track: str | None = None
 ) -> pd.DataFrame:
     """Read GPX points into a table.
 
@@ -118,6 +190,10 @@ def read_gpx_waypoints(
     points
         ``"waypoints"`` (default), ``"route"``, ``"track"`` or ``"auto"`` (see module
         docstring).
+    track
+        The track (or route) to read when ``points`` selects tracks (routes): its
+        ``<name>`` or its number in the file (1 = first). Needed when the file has
+        several with points.
 
     Returns
     -------
@@ -149,7 +225,16 @@ def read_gpx_waypoints(
         kind = next(
             (k for k in ("waypoints", "route", "track") if counts[k]), "waypoints"
         )
-    elements = _collect(root, kind)
+    if track is not None and kind == "waypoints":
+        raise ArgumentError(
+            "`gpx_track` picks one track or route; waypoints are read as one path "
+            "(ask for track or route points with `gpx_points`)",
+            source="gpx_track",
+        )
+    if kind == "waypoints" or not counts[kind]:
+        elements = _collect(root, kind)
+    else:
+        elements = _one_group(root, kind, track, path)
     if not elements:
         if points == "waypoints":
             raise InputFileError(

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from fieldkit.errors import InputFileError
+from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.io.csv_table import check_readable
 from fieldkit.io.gpx import GPX_HEIGHT_REFERENCE, read_gpx_waypoints
 from fieldkit.io.point_sets import check_unique_points, point_set_from_geographic
@@ -27,15 +27,18 @@ def read_gpx_impacts(
     units: str | None = None,
     epsg: int | str | None = None,
     gpx_points: str = "waypoints",
+    gpx_track: str | None = None,
 ) -> PointSet:
-    """Impact points from GPX waypoints (or route/track points if asked).
+    """Impact points from GPX waypoints (or the points of one route or track if asked).
 
     Every point needs an ``<ele>``; names must be unique. A waypoint ``<type>`` becomes
     the ``material`` column. ``<ele>`` is metres by the
-    GPX standard, so ``units="ft"`` does not apply (a note says so).
+    GPX standard, so ``units="ft"`` does not apply (a note says so). Several tracks or
+    routes are several paths: ``gpx_track`` picks one (name or number), else it is an
+    error (:mod:`fieldkit.io.gpx`, "One track, one path").
     """
     source = str(path)
-    table = read_gpx_waypoints(path, points=gpx_points)
+    table = read_gpx_waypoints(path, points=gpx_points, track=gpx_track)
     kind = {"waypoints": "waypoint"}.get(gpx_points, "point")
     wheres = [f"{kind} {i}" for i in range(1, len(table) + 1)]
     for i, row in enumerate(table.itertuples(index=False)):
@@ -66,6 +69,7 @@ def read_gpx_impacts(
         epsg=epsg,
         notes=notes,
         extra=extra or None,
+        wheres=wheres,
     )
 
 
@@ -75,6 +79,7 @@ def read_impacts(
     units: str | None = None,
     epsg: int | str | None = None,
     gpx_points: str = "waypoints",
+    gpx_track: str | None = None,
 ) -> PointSet:
     """Read impact points from a GPX or CSV file.
 
@@ -96,6 +101,8 @@ def read_impacts(
         ``easting_m``/``northing_m`` of geographic input (default: UTM zone).
     gpx_points
         ``"waypoints"``, ``"route"``, ``"track"`` or ``"auto"`` (GPX only).
+    gpx_track
+        Which track or route of a GPX with several (its name or number, 1 = first).
 
     Examples
     --------
@@ -110,7 +117,14 @@ def read_impacts(
         head = handle.read(512).lstrip(b"\xef\xbb\xbf \t\r\n")
     suffix = Path(path).suffix.lower()
     if head.startswith(b"<") or suffix == ".gpx":
-        return read_gpx_impacts(path, units=units, epsg=epsg, gpx_points=gpx_points)
+        return read_gpx_impacts(
+            path, units=units, epsg=epsg, gpx_points=gpx_points, gpx_track=gpx_track
+        )
+    if gpx_track is not None:
+        raise ArgumentError(
+            f"`gpx_track` picks a track of a GPX file; {path} is not GPX",
+            source="gpx_track",
+        )
     if suffix in (".csv", ".txt", ".tsv"):
         return read_points_csv(path, units=units, epsg=epsg)
     try:

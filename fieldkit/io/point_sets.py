@@ -2,7 +2,15 @@
 
 Every point reader (GPX, CSV, rangefinder field book) ends here: geographic points get
 their section ``x_m`` as the cumulative geodesic plan distance and projected
-coordinates; section points are checked to run in the order of travel.
+coordinates; points on a local x, y grid the cumulative plan distance
+``sqrt(dx² + dy²)``; section points are checked to run in the order of travel.
+
+Coordinates must be sane before any physics sees them (:func:`check_coordinates`):
+plan coordinates (section ``x``, local ``x``/``y``) within
+:data:`MAX_PLAN_COORDINATE_M` = 10,000 km and elevations within
+:data:`MAX_ELEVATION_M` = 11,000 m of zero. Beyond that a value is a typo, a unit
+mix-up or an overflow waiting to happen (``1e308`` is a finite number, but its square
+is not), and the error names the file and the row or point.
 """
 
 from __future__ import annotations
@@ -15,6 +23,45 @@ import pandas as pd
 from fieldkit.errors import InputFileError
 from fieldkit.io import geodesy
 from fieldkit.survey import OPTIONAL_COLUMNS, PointSet
+
+#: Largest plan coordinate accepted [m]: a quarter meridian. A fall path, or a local
+#: grid coordinate, beyond it is a typo.
+MAX_PLAN_COORDINATE_M = 1.0e7
+#: Largest elevation magnitude accepted [m]: deeper than the deepest ocean trench
+#: (10,935 m) and higher than the highest summit (8,849 m). A height in feet read as
+#: metres stays inside only below 3,350 m.
+MAX_ELEVATION_M = 11_000.0
+#: What a PointSet's ``crs`` says for points on a local x, y grid.
+LOCAL_GRID = "local grid"
+
+
+def check_coordinates(
+    values: Sequence[float] | np.ndarray,
+    what: str,
+    limit: float,
+    *,
+    source: str,
+    wheres: Sequence[str],
+) -> None:
+    """Raise naming the first row/point whose ``what`` is not finite or beyond ±limit.
+
+    Examples
+    --------
+    >>> check_coordinates([0.0, 1e308], "x", MAX_PLAN_COORDINATE_M, source="a.csv",
+    ...                   wheres=["row 2", "row 3"])
+    Traceback (most recent call last):
+    ...
+    fieldkit.errors.InputFileError: a.csv: row 3: x 1e+308 m is beyond ±1e+07 m (...)
+    """
+    array = np.asarray(values, dtype=float)
+    bad = np.flatnonzero(~(np.abs(array) <= limit))  # NaN and inf fail too
+    if bad.size:
+        i = int(bad[0])
+        raise InputFileError(
+            f"{what} {array[i]:g} m is beyond ±{limit:g} m (a typo or the wrong unit?)",
+            source=source,
+            where=wheres[i],
+        )
 
 
 def check_unique_points(
@@ -62,17 +109,26 @@ def point_set_from_geographic(
     epsg: int | str | None = None,
     notes: Sequence[str] = (),
     extra: dict[str, Sequence] | None = None,
+    wheres: Sequence[str] | None = None,
 ) -> PointSet:
     """Build a PointSet from WGS 84 positions and elevations.
 
     ``x_m`` is the cumulative geodesic distance
     (:func:`geodesy.section_from_geographic`);
-    easting/northing are in ``epsg`` or, by default, the UTM zone of the points.
+    easting/northing are in ``epsg`` (which must contain the points,
+    :func:`geodesy.check_area_of_use`) or, by default, the UTM zone of the points.
+    ``wheres`` (e.g. ``"row 7"``) name the points in errors.
     """
     lat = np.asarray(lat_deg, dtype=float)
     lon = np.asarray(lon_deg, dtype=float)
+    wheres = list(wheres) if wheres is not None else [f"point {n}" for n in names]
+    check_coordinates(
+        elev_m, "elevation", MAX_ELEVATION_M, source=source, wheres=wheres
+    )
     x = geodesy.section_from_geographic(lat, lon)
-    easting, northing, crs = geodesy.to_projected(lat, lon, epsg)
+    easting, northing, crs = geodesy.to_projected(
+        lat, lon, epsg, names=[str(n) for n in names], source=source
+    )
     factor = geodesy.metres_per_crs_unit(crs)
     notes = list(notes)
     steps = np.diff(x)
@@ -119,6 +175,8 @@ def point_set_from_section(
     """Build a PointSet from section coordinates; ``x`` must not decrease."""
     x = np.asarray(x_m, dtype=float)
     wheres = list(wheres) if wheres is not None else [f"point {n}" for n in names]
+    check_coordinates(x, "x", MAX_PLAN_COORDINATE_M, source=source, wheres=wheres)
+    check_coordinates(z_m, "z", MAX_ELEVATION_M, source=source, wheres=wheres)
     notes = list(notes)
     for i in range(1, len(x)):
         if x[i] < x[i - 1]:
@@ -146,6 +204,68 @@ def point_set_from_section(
         frame=_optional(frame, extra),
         source=source,
         crs="section",
+        height_reference=height_reference,
+        notes=tuple(notes),
+    )
+
+
+def point_set_from_local_grid(
+    names: Sequence[str],
+    x_m: Sequence[float],
+    y_m: Sequence[float],
+    z_m: Sequence[float],
+    *,
+    source: str,
+    wheres: Sequence[str] | None = None,
+    height_reference: str = "z as given in the file",
+    notes: Sequence[str] = (),
+    extra: dict[str, Sequence] | None = None,
+) -> PointSet:
+    """Build a PointSet from points on a local plan grid (x, y) with elevations z.
+
+    Section ``x_m`` is the cumulative plan distance ``sum sqrt(dx² + dy²)`` between
+    successive points (ARCHITECTURE §2), not the grid ``x``; the grid coordinates are
+    kept in ``easting_m``/``northing_m`` with ``crs`` :data:`LOCAL_GRID`.
+
+    Examples
+    --------
+    >>> ps = point_set_from_local_grid(["A", "B", "C"], [0.0, 3.0, 3.0],
+    ...                                [0.0, 4.0, 10.0], [9.0, 5.0, 1.0],
+    ...                                source="grid.csv")
+    >>> ps.frame["x_m"].tolist(), ps.crs
+    ([0.0, 5.0, 11.0], 'local grid')
+    """
+    gx = np.asarray(x_m, dtype=float)
+    gy = np.asarray(y_m, dtype=float)
+    wheres = list(wheres) if wheres is not None else [f"point {n}" for n in names]
+    check_coordinates(gx, "x", MAX_PLAN_COORDINATE_M, source=source, wheres=wheres)
+    check_coordinates(gy, "y", MAX_PLAN_COORDINATE_M, source=source, wheres=wheres)
+    check_coordinates(z_m, "z", MAX_ELEVATION_M, source=source, wheres=wheres)
+    steps = np.hypot(np.diff(gx), np.diff(gy))
+    notes = list(notes)
+    notes.append(
+        "x, y, z read as a local plan grid (no EPSG code): section x is the "
+        "cumulative plan distance sqrt(dx² + dy²) between successive points"
+    )
+    for i in np.flatnonzero(steps < 1e-3):
+        notes.append(
+            f"points '{names[i]}' and '{names[i + 1]}' are at the same plan position"
+        )
+    frame = pd.DataFrame(
+        {
+            "point": pd.Series([str(n) for n in names], dtype="str"),
+            "x_m": np.concatenate([[0.0], np.cumsum(steps)]) if len(gx) else gx,
+            "z_m": np.asarray(z_m, dtype=float),
+            "lat_deg": np.nan,
+            "lon_deg": np.nan,
+            "easting_m": gx,
+            "northing_m": gy,
+        }
+    )
+    return PointSet(
+        frame=_optional(frame, extra),
+        source=source,
+        crs=LOCAL_GRID,
         height_reference=height_reference,
         notes=tuple(notes),
     )

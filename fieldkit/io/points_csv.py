@@ -7,7 +7,11 @@ Three layouts, recognised from the header (first match wins):
 2. ``easting, northing, elevation`` with an EPSG code (``epsg=``) — the
    coordinates are converted to latitude/longitude with pyproj and treated as in 1.
    ``x, y`` columns count as easting/northing when an EPSG code is given.
-3. ``x, z`` — section coordinates directly (``x`` increasing in the direction of
+3. ``x, y, z`` without an EPSG code — a local plan grid (site coordinates from a
+   total station or a CAD drawing): section ``x_m`` is the cumulative plan distance
+   ``sqrt(dx² + dy²)`` between successive points, so a path that turns, or runs along
+   y, keeps its true length; the grid coordinates go to ``easting_m``/``northing_m``.
+4. ``x, z`` — section coordinates directly (``x`` increasing in the direction of
    travel).
 
 Column names are matched once, here, after lower-casing and dropping units written as
@@ -35,6 +39,7 @@ from fieldkit.io.csv_table import Column, CsvTable, length_factor, read_csv_tabl
 from fieldkit.io.point_sets import (
     check_unique_points,
     point_set_from_geographic,
+    point_set_from_local_grid,
     point_set_from_section,
 )
 from fieldkit.survey import PointSet
@@ -70,6 +75,8 @@ ELLIPSOIDAL_ALIASES = (
 EASTING_ALIASES = ("easting", "east", "e")
 NORTHING_ALIASES = ("northing", "north", "n")
 SECTION_X_ALIASES = ("x", "chainage", "distance", "horizontal_distance")
+GRID_X_ALIASES = ("x",)
+GRID_Y_ALIASES = ("y",)
 MATERIAL_ALIASES = ("material", "surface", "terrain", "slope_material")
 SLOPE_ALIASES = ("slope", "slope_angle", "psi", "ground_slope")
 THETA0_ALIASES = ("theta0", "theta_0", "restitution_angle")
@@ -179,12 +186,37 @@ def read_points_csv(
         easting = _require_numbers(table, easting_column, e_factor)
         northing = _require_numbers(table, northing_column, n_factor)
         lat, lon = geodesy.from_projected(easting, northing, crs)
-        if not (np.all(np.isfinite(lat)) and np.all(np.isfinite(lon))):
+        bad = np.flatnonzero(~(np.isfinite(lat) & np.isfinite(lon)))
+        if bad.size:
             raise InputFileError(
-                f"easting/northing cannot be converted from {geodesy.crs_label(crs)}",
+                f"easting/northing {easting[bad[0]]:g}, {northing[bad[0]]:g} cannot be "
+                f"converted from {geodesy.crs_label(crs)}",
                 source=source,
+                where=wheres[int(bad[0])],
             )
         return _geographic_points(table, units, names, lat, lon, crs, notes, extra)
+    grid_x, grid_y = table.find(GRID_X_ALIASES), table.find(GRID_Y_ALIASES)
+    if grid_x is not None and grid_y is not None:
+        z_column = table.find(ELEVATION_ALIASES)
+        if z_column is None:
+            raise InputFileError(
+                f"local grid columns '{grid_x.header.strip()}', "
+                f"'{grid_y.header.strip()}' found but no elevation column (one of: "
+                f"{', '.join(ELEVATION_ALIASES)})",
+                source=source,
+                where="row 1",
+            )
+        return point_set_from_local_grid(
+            names,
+            _require_numbers(table, grid_x, length_factor(table, grid_x, units)),
+            _require_numbers(table, grid_y, length_factor(table, grid_y, units)),
+            _require_numbers(table, z_column, length_factor(table, z_column, units)),
+            source=source,
+            wheres=wheres,
+            height_reference=f"column '{z_column.header.strip()}' as given",
+            notes=notes,
+            extra=extra,
+        )
     if x_column is not None:
         z_column = table.find(ELEVATION_ALIASES)
         if z_column is None:
@@ -228,6 +260,7 @@ def _geographic_points(table: CsvTable, units, names, lat, lon, epsg, notes, ext
         epsg=epsg,
         notes=notes,
         extra=extra,
+        wheres=[f"row {number}" for number, _ in table.rows],
     )
 
 
@@ -249,6 +282,25 @@ def _elevations(table: CsvTable, units: str) -> tuple[np.ndarray, str]:
     return values, f"column '{column.header.strip()}' {reference}"
 
 
+def _check_angles(
+    table: CsvTable,
+    column: Column,
+    values: list[float],
+    low: float,
+    high: float,
+    what: str,
+) -> None:
+    """Angles strictly inside (low, high) [deg] (empty cells pass)."""
+    for (number, _), value in zip(table.rows, values, strict=True):
+        if not np.isnan(value) and not low < value < high:
+            raise InputFileError(
+                f"column '{column.header.strip()}': {value:g}° is not {what} "
+                f"(must be between {low:g} and {high:g} degrees)",
+                source=table.source,
+                where=f"row {number}",
+            )
+
+
 def _optional_columns(table: CsvTable, units: str) -> dict[str, object]:
     extra: dict[str, object] = {"_notes": []}
     material = table.find(MATERIAL_ALIASES)
@@ -256,14 +308,14 @@ def _optional_columns(table: CsvTable, units: str) -> dict[str, object]:
         extra["material"] = [table.cell(row, material) or None for _, row in table.rows]
     slope = table.find(SLOPE_ALIASES)
     if slope is not None:
-        extra["slope_deg"] = [
-            table.number(n, row, slope, required=False) for n, row in table.rows
-        ]
+        values = [table.number(n, row, slope, required=False) for n, row in table.rows]
+        _check_angles(table, slope, values, -90.0, 90.0, "a ground dip")
+        extra["slope_deg"] = values
     theta0 = table.find(THETA0_ALIASES)
     if theta0 is not None:
-        extra["theta0_deg"] = [
-            table.number(n, row, theta0, required=False) for n, row in table.rows
-        ]
+        values = [table.number(n, row, theta0, required=False) for n, row in table.rows]
+        _check_angles(table, theta0, values, 0.0, 180.0, "a restitution angle")
+        extra["theta0_deg"] = values
     time = table.find(TIME_ALIASES)
     if time is not None:
         texts = [table.cell(row, time) or None for _, row in table.rows]

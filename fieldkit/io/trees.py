@@ -11,11 +11,13 @@ Two CSV layouts (aliases accepted, see the ``*_ALIASES`` tuples):
    the next impact.
 
 2. Tree coordinates plus strike height: ``lat, lon`` (impacts must have latitude and
-   longitude) or section ``x_m`` (``x``), with ``strike_height_m`` and optionally
-   ``after_impact``. A lat/lon tree is projected in plan onto the line between the two
-   impacts (along-line distance); its offset from the line is kept in ``offset_m``.
-   Without ``after_impact`` the flight whose plan line passes nearest the tree (among
-   those it lies between) is chosen and a note says so.
+   longitude), ``x, y`` on the impacts' local grid (impacts read as a local x, y, z
+   grid), or section ``x_m`` (``x``), with ``strike_height_m`` and optionally
+   ``after_impact``. A lat/lon or grid tree is projected in plan onto the line between
+   the two impacts (along-line distance); its offset from the line is kept in
+   ``offset_m``. Without ``after_impact`` the flight whose plan line passes nearest
+   the tree (among those it lies between) is chosen and a note says so. With impacts
+   on a local grid, a tree ``x`` without ``y`` is refused: grid x is not section x.
 
 ``strike_height_m`` is the height of the scar above the ground at the tree. The ground
 elevation at the tree (``ground_z_m``) is NaN unless the file gives it; the reduction
@@ -24,6 +26,10 @@ then interpolates it on the line between the two impacts.
 ``units`` (``"m"``/``"ft"``) gives the unit of distances, strike heights and ground
 elevations without a unit in their column names (without it such a column is an
 error); ``dbh`` is read from ``dbh_mm``, ``dbh_cm`` or ``dbh_in`` (``dbh``: mm).
+
+Strike heights above :data:`MAX_STRIKE_HEIGHT_M` (taller than any tree) and ground
+elevations beyond the sane range of :mod:`fieldkit.io.point_sets` are refused, naming
+the row.
 """
 
 from __future__ import annotations
@@ -37,8 +43,12 @@ import pandas as pd
 from fieldkit.errors import InputFileError
 from fieldkit.io import geodesy
 from fieldkit.io.csv_table import Column, CsvTable, length_factor, read_csv_table
+from fieldkit.io.point_sets import LOCAL_GRID, MAX_ELEVATION_M, check_coordinates
 from fieldkit.io.points_csv import LAT_ALIASES, LON_ALIASES
 from fieldkit.survey import TREE_COLUMNS, PointSet, TreeStrikes
+
+#: Highest strike accepted [m]: the tallest measured tree (a coast redwood) is 116 m.
+MAX_STRIKE_HEIGHT_M = 120.0
 
 AFTER_IMPACT_ALIASES = ("after_impact", "after", "from_impact", "impact", "after_point")
 DISTANCE_ALIASES = (
@@ -53,6 +63,7 @@ GROUND_ALIASES = ("ground_z", "ground_elev", "ground_elevation", "ground")
 SPECIES_ALIASES = ("species", "tree_species")
 TREE_ALIASES = ("tree", "tree_id", "name", "id")
 SECTION_X_ALIASES = ("x", "x_section", "chainage")
+GRID_Y_ALIASES = ("y",)
 DBH_UNITS = {"mm": 1.0, "cm": 10.0, "in": 25.4}
 
 
@@ -117,6 +128,8 @@ def read_trees(
     height_column = table.find(STRIKE_HEIGHT_ALIASES)
     lat_column, lon_column = table.find(LAT_ALIASES), table.find(LON_ALIASES)
     x_column = table.find(SECTION_X_ALIASES)
+    y_column = table.find(GRID_Y_ALIASES)
+    grid = impacts.crs == LOCAL_GRID
     ground_column = table.find(GROUND_ALIASES)
     species_column = table.find(SPECIES_ALIASES)
     tree_column = table.find(TREE_ALIASES)
@@ -145,6 +158,16 @@ def read_trees(
                 source=source,
                 where="row 1",
             )
+    elif x_column is not None and grid:
+        if y_column is None or x_column.name != "x":
+            raise InputFileError(
+                f"the impacts ({impacts.source}) are on a local x, y grid: give each "
+                "tree's grid x and y, or after_impact + horizontal_distance_m "
+                f"(have: {have})",
+                source=source,
+                where="row 1",
+            )
+        mode = "grid"
     elif x_column is not None:
         mode = "section"
     else:
@@ -180,6 +203,18 @@ def read_trees(
         if mode == "distance":
             factor = length_factor(table, distance_column, units)
             distance = table.number(number, row, distance_column) * factor
+        elif mode == "grid":
+            tree_x = table.number(number, row, x_column) * length_factor(
+                table, x_column, units
+            )
+            tree_y = table.number(number, row, y_column) * length_factor(
+                table, y_column, units
+            )
+            after, distance, offset, note = _place_on_grid(
+                impacts, after, tree_x, tree_y, source, where
+            )
+            if note:
+                notes.append(note)
         elif mode == "section":
             x_tree = table.number(number, row, x_column) * length_factor(
                 table, x_column, units
@@ -209,7 +244,7 @@ def read_trees(
         length = x_impacts[i + 1] - x_impacts[i]
         if not 0.0 < distance < length:
             raise InputFileError(
-                f"horizontal distance {distance:.3f} m is outside the flight from "
+                f"horizontal distance {distance:.6g} m is outside the flight from "
                 f"'{after}' to '{names[i + 1]}' (must be between 0 and "
                 f"{length:.3f} m)",
                 source=source,
@@ -220,11 +255,26 @@ def read_trees(
             raise InputFileError(
                 f"strike height {height:g} m is negative", source=source, where=where
             )
+        if height > MAX_STRIKE_HEIGHT_M:
+            raise InputFileError(
+                f"strike height {height:g} m is above {MAX_STRIKE_HEIGHT_M:g} m, "
+                "taller than any tree (a typo or the wrong unit?)",
+                source=source,
+                where=where,
+            )
         ground = (
             table.number(number, row, ground_column, required=False) * ground_factor
             if ground_column is not None
             else math.nan
         )
+        if math.isfinite(ground):
+            check_coordinates(
+                [ground],
+                "ground elevation",
+                MAX_ELEVATION_M,
+                source=source,
+                wheres=[where],
+            )
         species = table.cell(row, species_column) if species_column else ""
         dbh = (
             table.number(number, row, dbh_column, required=False) * dbh_factor
@@ -289,3 +339,40 @@ def _place_geographic(
             "line)"
         )
     return names[i], along_m, across_m, note
+
+
+def _place_on_grid(
+    impacts: PointSet, after: str, x: float, y: float, source: str, where: str
+) -> tuple[str, float, float, str]:
+    """(after_impact, along-line distance, offset, note) of a tree on the local grid."""
+    frame = impacts.frame
+    names = impacts.names
+    gx = frame["easting_m"].to_numpy(float)
+    gy = frame["northing_m"].to_numpy(float)
+    candidates = [names.index(after)] if after else range(len(names) - 1)
+    best = None
+    for i in candidates:
+        dx, dy = gx[i + 1] - gx[i], gy[i + 1] - gy[i]
+        length = math.hypot(dx, dy)
+        if length == 0.0:
+            continue
+        along = ((x - gx[i]) * dx + (y - gy[i]) * dy) / length
+        across = ((x - gx[i]) * dy - (y - gy[i]) * dx) / length  # right of the line
+        if after or 0.0 < along < length:
+            if best is None or abs(across) < abs(best[2]):
+                best = (i, along, across)
+    if best is None:
+        raise InputFileError(
+            f"tree at x = {x:g}, y = {y:g} is not between any two successive impacts "
+            "in plan; give after_impact",
+            source=source,
+            where=where,
+        )
+    i, along, across = best
+    note = ""
+    if not after:
+        note = (
+            f"{where}: no after_impact given; tree placed on the flight "
+            f"'{names[i]}' → '{names[i + 1]}' ({abs(across):.1f} m from its plan line)"
+        )
+    return names[i], along, across, note

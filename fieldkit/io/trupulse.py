@@ -11,7 +11,8 @@ Formats (TruPulse 200 User's Manual, 6th ed., Section 8 "Serial Data Interface";
 be negative; an "inclination only" shot leaves HD and SD empty. The checksum is the XOR
 of every character between ``$`` and ``*``, in two hex digits. The TruPulse 200 has no
 compass and always sends azimuth 0.00; the 360's azimuth is magnetic unless the user set
-a declination in the instrument.
+a declination in the instrument, and the sentence does not say which (the field book
+does: :mod:`fieldkit.io.fieldbook`, ``azimuth_reference``).
 
 Checksums are verified strictly by default. ``lenient=True`` accepts a wrong or missing
 checksum and records it in :attr:`TruPulseShot.checksum_ok` (the manual's own

@@ -9,9 +9,16 @@
    three-point solve, given angle, or assumed ``theta0_deg``);
 4. :func:`impact_rows` -- primary ImpactTable columns: velocities at the end of each
    flight (impact) and start of the next (restitution), body, spin, flight heights;
-5. :meth:`ImpactTable.derive` -- N/T components, angles, e_n, e_t, energies, heads;
-6. :func:`add_flight_energy` -- KE gained in each flight (``flight_dke_j``).
-7. :func:`~fieldkit.reduce.impact_theory.add_theory_columns` -- impact-mechanics
+5. :func:`next_chord_e_n` -- ``e_n`` again with the chord to the *next* point as the
+   slope, where the slope is the default chord from the previous one
+   (``e_n_next_chord``): how much ``e_n`` hangs on that choice;
+6. :func:`~fieldkit.reduce.uncertainty.propagate` -- ``e_n_sd``, ``e_t_sd``,
+   ``vi_sd_mps`` from the position error, by repeating steps 1-4 on perturbed points
+   (:func:`point_kinematics`);
+7. :meth:`ImpactTable.derive` -- N/T components, angles, e_n, e_t, energies, heads and
+   the quality flags (``qa_flags``);
+8. :func:`add_flight_energy` -- KE gained in each flight (``flight_dke_j``).
+9. :func:`~fieldkit.reduce.impact_theory.add_theory_columns` -- impact-mechanics
    energy change beside the measured one (``dke_theory_j``, thesis §6.3).
 
 The source (first point) has no impact velocity and the stopped point (last) no
@@ -21,17 +28,18 @@ restitution velocity: those stay NaN.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
 
 from fieldkit.errors import InputFileError
-from fieldkit.impact_table import ImpactTable
+from fieldkit.impact_table import ImpactTable, restitution
 from fieldkit.physics.bodies import ResolvedBody
 from fieldkit.physics.energy import kinetic_energy
 from fieldkit.reduce.flights import SolvedFlight, solve_flights
 from fieldkit.reduce.impact_theory import DEFAULT_FRICTION, add_theory_columns
+from fieldkit.reduce.uncertainty import PositionError, Propagated, propagate
 from fieldkit.survey import Survey
 
 
@@ -53,12 +61,25 @@ class ReduceOptions:
     friction
         Contact friction coefficient mu [-] for the impact-mechanics energy beside
         the measured one (:func:`fieldkit.reduce.impact_theory.add_theory_columns`).
+    position_error
+        The survey's position error, propagated to ``e_n_sd``, ``e_t_sd`` and
+        ``vi_sd_mps`` (:mod:`fieldkit.reduce.uncertainty`; default 0.5 m in plan and
+        in height); None leaves those columns out.
     """
 
     path_id: str
     theta0_deg: float | None = None
     body: ResolvedBody = field(default_factory=ResolvedBody)
     friction: float = DEFAULT_FRICTION
+    position_error: PositionError | None = field(default_factory=PositionError)
+
+
+@dataclass(frozen=True)
+class Reduction:
+    """A reduced path: the table and how its uncertainties were obtained."""
+
+    table: ImpactTable
+    uncertainty: Propagated | None = None
 
 
 def section_slopes(
@@ -111,15 +132,13 @@ def impact_rows(
     """
     n = len(frame)
     nan = np.full(n, np.nan)
-    vi_x, vi_z, vf_x, vf_z = nan.copy(), nan.copy(), nan.copy(), nan.copy()
+    vi_x, vi_z, vf_x, vf_z = flight_velocities(flights, n)
     t_flight, length, h_vert, h_norm = nan.copy(), nan.copy(), nan.copy(), nan.copy()
     theta0 = nan.copy()
     theta0_source: list[str | None] = [None] * n
     tree_strike: list[bool | None] = [None] * n
     for j, f in enumerate(flights):
         fl = f.flight
-        vf_x[j], vf_z[j] = float(fl.launch_vx_mps), float(fl.launch_vz_mps)
-        vi_x[j + 1], vi_z[j + 1] = float(fl.arrival_vx_mps), float(fl.arrival_vz_mps)
         t_flight[j], length[j] = float(fl.time_s), float(fl.dx_m)
         h_vert[j], h_norm[j] = float(fl.hmax_vertical_m), float(fl.hmax_normal_m)
         theta0[j], theta0_source[j] = f.theta0_deg, f.theta0_source
@@ -169,6 +188,84 @@ def impact_rows(
     return out
 
 
+def flight_velocities(
+    flights: list[SolvedFlight], n: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``vi_x, vi_z, vf_x, vf_z`` [m/s] of ``n`` points from the ``n - 1`` flights.
+
+    Point ``j`` arrives at the end of flight ``j - 1`` and leaves on flight ``j``;
+    NaN where there is no such flight (the source's impact, the stop's restitution).
+    """
+    vi_x, vi_z, vf_x, vf_z = (np.full(n, np.nan) for _ in range(4))
+    for j, f in enumerate(flights):
+        fl = f.flight
+        vf_x[j], vf_z[j] = float(fl.launch_vx_mps), float(fl.launch_vz_mps)
+        vi_x[j + 1], vi_z[j + 1] = float(fl.arrival_vx_mps), float(fl.arrival_vz_mps)
+    return vi_x, vi_z, vf_x, vf_z
+
+
+def next_chord_e_n(
+    x_m: np.ndarray,
+    z_m: np.ndarray,
+    slope_source: list[str | None],
+    velocities: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+) -> np.ndarray:
+    """``e_n`` with the chord to the next point as the slope [-].
+
+    The default slope at an impact is the chord from the previous point (thesis "slope
+    angle above impact point"); the chord to the next point is the ground on the other
+    side. On a bent slope the two bracket the ground at the impact, so the difference
+    of the two ``e_n`` is how much the result hangs on the choice. NaN where the slope
+    was surveyed (no choice made) and at the last point (no next point).
+    """
+    x = np.asarray(x_m, float)
+    z = np.asarray(z_m, float)
+    psi = np.full(len(x), np.nan)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        psi[:-1] = np.degrees(np.arctan2(-(z[1:] - z[:-1]), x[1:] - x[:-1]))
+    chord = np.array([source == "chord" for source in slope_source], dtype=bool)
+    psi = np.where(chord, psi, np.nan)
+    return restitution(*velocities, psi)["e_n"]
+
+
+def _solve(
+    survey: Survey, options: ReduceOptions, x: np.ndarray, z: np.ndarray
+) -> tuple[np.ndarray, list[str | None], list[SolvedFlight]]:
+    """Steps 1-3 for points at ``(x, z)``: slopes, their sources and the flights."""
+    frame = survey.points.frame
+    surveyed = frame["slope_deg"].to_numpy(float) if "slope_deg" in frame else None
+    given = frame["theta0_deg"].to_numpy(float) if "theta0_deg" in frame else None
+    slope, slope_source = section_slopes(x, z, surveyed)
+    flights = solve_flights(
+        survey.points.names,
+        x,
+        z,
+        slope,
+        theta0_deg=options.theta0_deg,
+        given_theta0_deg=given,
+        trees=survey.trees_by_launch(),
+        points_source=survey.source,
+        trees_source=None if survey.trees is None else survey.trees.source,
+    )
+    return slope, slope_source, flights
+
+
+def point_kinematics(
+    survey: Survey, options: ReduceOptions, x_m: np.ndarray, z_m: np.ndarray
+) -> dict[str, np.ndarray]:
+    """``e_n``, ``e_t`` and ``vi_mps`` of every point with the points moved to
+    ``(x_m, z_m)``: steps 1-4 of :func:`reduce_survey` without building a table (what
+    :func:`~fieldkit.reduce.uncertainty.propagate` repeats). Tree strikes keep their
+    distance and height from the (moved) launch point.
+    """
+    frame = survey.points.frame.reset_index(drop=True).copy()
+    frame["x_m"], frame["z_m"] = x_m, z_m
+    moved = replace(survey, points=replace(survey.points, frame=frame))
+    slope, _, flights = _solve(moved, options, np.asarray(x_m), np.asarray(z_m))
+    values = restitution(*flight_velocities(flights, len(frame)), slope)
+    return {name: values[name] for name in ("e_n", "e_t", "vi_mps")}
+
+
 def add_flight_energy(table: ImpactTable) -> ImpactTable:
     """Add ``flight_dke_j``: KE gained in the flight arriving at each point [J].
 
@@ -197,13 +294,14 @@ def reduce_survey(survey: Survey, options: ReduceOptions | None = None) -> Impac
         ``material``, ``slope_deg`` (surveyed psi) and ``theta0_deg`` (measured
         restitution angle)) and its tree strikes, if a tree file was given.
     options
-        Path id, assumed ``theta0_deg``, body and friction.
+        Path id, assumed ``theta0_deg``, body, friction and position error.
 
     Returns
     -------
     ImpactTable
-        Every contract column the data allow, plus ``omega_source``, ``slope_source``
-        and ``flight_dke_j``.
+        Every contract column the data allow, plus ``omega_source``, ``slope_source``,
+        ``flight_dke_j``, ``e_n_next_chord`` and the ``*_sd`` columns
+        (:func:`reduce_path` also says how the uncertainties were obtained).
 
     Raises
     ------
@@ -211,6 +309,11 @@ def reduce_survey(survey: Survey, options: ReduceOptions | None = None) -> Impac
         One line naming the file and point or row (see
         :func:`fieldkit.reduce.flights.solve_flights`).
     """
+    return reduce_path(survey, options).table
+
+
+def reduce_path(survey: Survey, options: ReduceOptions | None = None) -> Reduction:
+    """:func:`reduce_survey`, with the record of the uncertainty propagation."""
     frame = survey.points.frame.reset_index(drop=True)
     source = survey.source
     options = options or ReduceOptions(path_id="path")
@@ -222,23 +325,7 @@ def reduce_survey(survey: Survey, options: ReduceOptions | None = None) -> Impac
         )
     x = frame["x_m"].to_numpy(float)
     z = frame["z_m"].to_numpy(float)
-    surveyed = frame["slope_deg"].to_numpy(float) if "slope_deg" in frame else None
-    given = frame["theta0_deg"].to_numpy(float) if "theta0_deg" in frame else None
-
-    slope, slope_source = section_slopes(x, z, surveyed)
-    names = frame["point"].astype(str).tolist()
-    by_launch = survey.trees_by_launch()
-    flights = solve_flights(
-        names,
-        x,
-        z,
-        slope,
-        theta0_deg=options.theta0_deg,
-        given_theta0_deg=given,
-        trees=by_launch,
-        points_source=source,
-        trees_source=None if survey.trees is None else survey.trees.source,
-    )
+    slope, slope_source, flights = _solve(survey, options, x, z)
     rows = impact_rows(
         frame,
         slope,
@@ -247,6 +334,20 @@ def reduce_survey(survey: Survey, options: ReduceOptions | None = None) -> Impac
         options,
         trees_given=survey.trees is not None,
     )
+    rows["e_n_next_chord"] = next_chord_e_n(
+        x, z, slope_source, flight_velocities(flights, len(frame))
+    )
+    spread = None
+    if options.position_error is not None:
+        spread = propagate(
+            lambda xs, zs: point_kinematics(survey, options, xs, zs),
+            x,
+            z,
+            options.position_error,
+        )
+        for name, values in spread.sd.items():
+            rows[name] = values
     table = ImpactTable(rows, source=source).derive()
     table = add_flight_energy(table)
-    return add_theory_columns(table, friction=options.friction)
+    table = add_theory_columns(table, friction=options.friction)
+    return Reduction(table=table, uncertainty=spread)

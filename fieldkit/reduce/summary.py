@@ -2,18 +2,38 @@
 
 Restitution coefficients by slope material (mean, standard deviation, count; the way
 thesis Table 2-7 and Figs. 5.7-5.8 report them), how each flight was fixed (tree,
-given, assumed), and the energy budget: kinetic energy lost on impacts against energy
-gained in flights, and the potential energy released.
+given, assumed), the energy budget (kinetic energy lost on impacts against energy
+gained in flights, and the potential energy released), how many rows carry each
+quality flag (``qa_flags``), the position error the ``*_sd`` columns come from, and a
+warning when the default chord slope moves ``e_n`` by more than that error does.
+
+The impact-mechanics share of the measured loss (thesis §6.3) is a median over the
+impacts that lost kinetic energy. It is printed only when it means something
+(:func:`theory_verdict`): at least :data:`THEORY_MIN_IMPACTS` such impacts, kinetic
+energy gained at no more than :data:`THEORY_MAX_GAINED_SHARE` of the impacts, and the
+share outside 0-100 % at no more than :data:`THEORY_MAX_OUTSIDE_SHARE` of them;
+otherwise the summary says which condition failed instead of giving a number.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from fieldkit.impact_table import ImpactTable
+from fieldkit.impact_table import QA_FLAGS, ImpactTable
 from fieldkit.physics.energy import potential_energy
+from fieldkit.reduce.uncertainty import Propagated
+
+#: Fewest impacts with a measured loss for a median share to mean anything.
+THEORY_MIN_IMPACTS = 5
+#: Largest share of impacts that may have *gained* kinetic energy: beyond it the
+#: measured "losses" are dominated by survey error or spin turned into translation.
+THEORY_MAX_GAINED_SHARE = 0.25
+#: Largest share of the losing impacts whose theory share lies outside 0-100 % (the
+#: theory predicts a gain, e.g. e_n > 1, or more than the whole loss): beyond it the
+#: velocities do not support the comparison and the median of the rest is cherry-picked.
+THEORY_MAX_OUTSIDE_SHARE = 0.25
 
 
 @dataclass(frozen=True)
@@ -46,18 +66,77 @@ class ReductionSummary:
     theory_fraction_n: int = 0
     #: The spin entering the theory was estimated (omega = v/r, eq. 3.17), not measured.
     theory_spin_estimated: bool = False
+    #: Quartiles of those fractions.
+    theory_fraction_quartiles: tuple[float, float] = (float("nan"), float("nan"))
+    #: Why the median means nothing here (None: it is printed).
+    theory_not_meaningful: str | None = None
+    #: Rows carrying each quality flag, in the order of ``QA_FLAGS`` (then others).
+    flag_counts: dict[str, int] = field(default_factory=dict)
+    #: Impacts whose slope is the chord from the previous point and have e_n.
+    chord_impacts: int = 0
+    #: Of those, how many move by more than e_n_sd with the chord to the next point.
+    slope_sensitive: int = 0
+    slope_shift_median: float = float("nan")
+    e_n_sd_median: float = float("nan")
+    #: How the ``*_sd`` columns were obtained (None: not propagated).
+    uncertainty: str | None = None
 
 
 def _sd(values: np.ndarray) -> float:
     return float(np.std(values, ddof=1)) if len(values) > 1 else float("nan")
 
 
-def summarize(table: ImpactTable) -> ReductionSummary:
+def theory_verdict(
+    fractions: np.ndarray, dke_j: np.ndarray, impacts: int
+) -> str | None:
+    """Why a median of ``theory_loss_fraction`` would mean nothing, or None.
+
+    ``fractions`` are those of the impacts that lost kinetic energy (finite);
+    ``dke_j`` the measured change at every impact; ``impacts`` how many impacts.
+
+    Examples
+    --------
+    >>> theory_verdict(np.array([0.2, 0.25, 0.3]), np.array([-1.0] * 3), 3)
+    'only 3 impacts lost kinetic energy and have a theory value (a median needs 5)'
+    >>> theory_verdict(np.full(6, 0.2), np.array([-1.0] * 6), 6) is None
+    True
+    """
+    gained = int(np.sum(dke_j > 0))
+    if impacts and gained > THEORY_MAX_GAINED_SHARE * impacts:
+        return (
+            f"kinetic energy was gained at {gained} of {impacts} impacts (more than "
+            f"{THEORY_MAX_GAINED_SHARE:.0%}): survey error or spin turned into "
+            "translation dominates the measured losses"
+        )
+    n = len(fractions)
+    if n < THEORY_MIN_IMPACTS:
+        return (
+            f"only {n} impact{'' if n == 1 else 's'} lost kinetic energy and "
+            f"{'has' if n == 1 else 'have'} a theory value (a median needs "
+            f"{THEORY_MIN_IMPACTS})"
+        )
+    outside = int(np.sum((fractions < 0) | (fractions > 1)))
+    if outside > THEORY_MAX_OUTSIDE_SHARE * n:
+        return (
+            f"at {outside} of the {n} impacts that lost kinetic energy the theory "
+            f"share lies outside 0-100 % (from {100 * fractions.min():.0f} % to "
+            f"{100 * fractions.max():.0f} %): the theory predicts a gain (e_n > 1) or "
+            "more than the whole loss there, so these velocities do not support the "
+            "comparison"
+        )
+    return None
+
+
+def summarize(
+    table: ImpactTable, uncertainty: Propagated | None = None
+) -> ReductionSummary:
     """Statistics of a reduced table.
 
     ``impact_ke_change_j`` sums ``dke_j`` over impacts (negative = lost);
     ``flight_ke_gain_j`` sums ``flight_dke_j``; ``potential_released_j`` is
-    ``m g (z_first - z_last)`` per path.
+    ``m g (z_first - z_last)`` per path. ``uncertainty`` (from
+    :func:`fieldkit.reduce.pipeline.reduce_path`) says how the ``*_sd`` columns were
+    obtained.
 
     Examples
     --------
@@ -98,10 +177,25 @@ def summarize(table: ImpactTable) -> ReductionSummary:
         potential += float(potential_energy(m, z[0] - z[-1]))
     re_change = np.nansum(f["re_f_j"].to_numpy(float) - f["re_i_j"].to_numpy(float))
     fraction = np.array([], dtype=float)
-    if "theory_loss_fraction" in f:
-        lost = f["dke_j"].to_numpy(float) < 0
-        fraction = f["theory_loss_fraction"].to_numpy(float)[lost]
-        fraction = fraction[np.isfinite(fraction)]
+    dke = impacts["dke_j"].to_numpy(float)
+    verdict = None
+    if "theory_loss_fraction" in impacts:
+        theory = impacts["theory_loss_fraction"].to_numpy(float)
+        fraction = theory[(dke < 0) & np.isfinite(theory)]
+        if np.isfinite(theory).any():
+            verdict = theory_verdict(fraction, dke[np.isfinite(dke)], len(impacts))
+    flags = _flag_counts(f)
+    chord = np.zeros(len(impacts), dtype=bool)
+    if "slope_source" in impacts:
+        chord = impacts["slope_source"].eq("chord").fillna(False).to_numpy(bool)
+    chord &= np.isfinite(impacts["e_n"].to_numpy(float))
+    shift = sd = np.array([], dtype=float)
+    if "e_n_next_chord" in impacts:
+        shift = np.abs(impacts["e_n_next_chord"] - impacts["e_n"]).to_numpy(float)
+        shift = shift[chord & np.isfinite(shift)]
+    if "e_n_sd" in impacts:
+        sd = impacts["e_n_sd"].to_numpy(float)[chord]
+        sd = sd[np.isfinite(sd)]
     return ReductionSummary(
         path_ids=tuple(str(p) for p in table.paths()),
         n_points=len(f),
@@ -119,7 +213,33 @@ def summarize(table: ImpactTable) -> ReductionSummary:
         theory_spin_estimated=bool(
             "omega_source" in f and f["omega_source"].eq("estimated").any()
         ),
+        theory_fraction_quartiles=(
+            (float(np.percentile(fraction, 25)), float(np.percentile(fraction, 75)))
+            if len(fraction)
+            else (np.nan, np.nan)
+        ),
+        theory_not_meaningful=verdict,
+        flag_counts=flags,
+        chord_impacts=int(chord.sum()),
+        slope_sensitive=int(
+            impacts["qa_flags"].str.contains("slope_sensitive").fillna(False).sum()
+        ),
+        slope_shift_median=float(np.median(shift)) if len(shift) else np.nan,
+        e_n_sd_median=float(np.median(sd)) if len(sd) else np.nan,
+        uncertainty=None if uncertainty is None else uncertainty.describe(),
     )
+
+
+def _flag_counts(frame) -> dict[str, int]:
+    """Rows carrying each flag of ``qa_flags``: QA_FLAGS order, then others."""
+    counts: dict[str, int] = {}
+    for text in frame["qa_flags"].dropna():
+        for name in str(text).split(";"):
+            if name:
+                counts[name] = counts.get(name, 0) + 1
+    order = [name for name in QA_FLAGS if name in counts]
+    order += sorted(name for name in counts if name not in QA_FLAGS)
+    return {name: counts[name] for name in order}
 
 
 def format_summary(summary: ReductionSummary) -> str:
@@ -146,11 +266,20 @@ def format_summary(summary: ReductionSummary) -> str:
         ]
     else:
         lines.append("energy: no mass given (`mass_kg` or `shape`), energies left out")
-    if summary.theory_fraction_n:
+    if summary.theory_not_meaningful is not None:
+        lines.append(
+            "impact mechanics against the measured KE loss (thesis §6.3): no median "
+            f"given, {summary.theory_not_meaningful}; see theory_loss_fraction per "
+            "impact"
+        )
+    elif summary.theory_fraction_n:
+        q1, q3 = summary.theory_fraction_quartiles
         lines.append(
             "impact mechanics explains a median "
-            f"{100 * summary.theory_fraction_median:.0f} % of the measured KE loss "
-            f"({summary.theory_fraction_n} impacts; thesis §6.3 finds ~20-30 %; "
+            f"{100 * summary.theory_fraction_median:.0f} % (quartiles "
+            f"{100 * q1:.0f}-{100 * q3:.0f} %) of the measured KE loss, median over "
+            f"the {summary.theory_fraction_n} of {summary.n_impacts} impacts that "
+            "lost kinetic energy and have a theory value (thesis §6.3 finds ~20-30 %; "
             "see theory_loss_fraction)"
         )
         if summary.theory_spin_estimated:
@@ -158,4 +287,26 @@ def format_summary(summary: ReductionSummary) -> str:
                 "  (spin estimated as v/r: a rolling body slips little, so friction "
                 "loss is a lower bound)"
             )
+    if summary.uncertainty is not None:
+        median = (
+            f"; median e_n_sd {summary.e_n_sd_median:.2f}"
+            if np.isfinite(summary.e_n_sd_median)
+            else ""
+        )
+        lines.append(f"uncertainty: {summary.uncertainty}{median}")
+    if summary.flag_counts:
+        lines.append(
+            "quality flags (qa_flags; meanings in fieldkit.impact_table.QA_FLAGS): "
+            + ", ".join(f"{k} {v}" for k, v in summary.flag_counts.items())
+        )
+    if summary.slope_sensitive:
+        lines.append(
+            f"warning: at {summary.slope_sensitive} of {summary.chord_impacts} impacts "
+            "whose slope is the chord from the previous point, the chord to the next "
+            "point moves e_n by more than its standard uncertainty e_n_sd (median "
+            f"|change| {summary.slope_shift_median:.2f}, median e_n_sd "
+            f"{summary.e_n_sd_median:.2f}): there e_n rests on the slope assumed more "
+            "than on the survey; survey the ground slope at the impacts (a slope_deg "
+            "column) to settle it"
+        )
     return "\n".join(lines)

@@ -288,6 +288,8 @@ def test_reader_errors_reach_the_command_line_as_one_line(cli, repo, tmp_path, f
             book,
             "--stations",
             folder / "boulder_a_stations.gpx",
+            "--declination",
+            "14.2",
             "--theta0",
             "30",
             "-o",

@@ -50,6 +50,7 @@ def test_bad_checksum_strict_by_default_lenient_on_request(cli, repo, tmp_path):
     stations = repo / TORNADO / "boulder_a_stations.gpx"
     out = tmp_path / "t.csv"
     args = ("reduce", "--fieldbook", bad, "--stations", stations, "--theta0", 32.6)
+    args += ("--declination", 14.2)
     r = cli(*args, "-o", out)
     assert r.exit_code != 0 and "checksum" in r.stderr and "row 3" in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1 and not out.exists()
@@ -92,7 +93,11 @@ def test_summary_reports_theory_fraction(cli, repo, tmp_path):
         tmp_path / "t.parquet",
     )
     assert r.exit_code == 0, r.stderr
-    assert "impact mechanics explains a median" in r.stdout
+    # Tornado Mountain: e_n > 1 at many impacts, where the theory predicts a gain; the
+    # summary says why it gives no median (the median case: test_cli_reduce_no_...).
+    assert "impact mechanics explains a median" not in r.stdout
+    assert "impact mechanics against the measured KE loss (thesis §6.3)" in r.stdout
+    assert "theory share lies outside 0-100 %" in r.stdout
     t = pd.read_parquet(tmp_path / "t.parquet")
     ok = np.isfinite(t["theory_loss_fraction"])
     assert ok.sum() > 30

@@ -223,7 +223,7 @@ def test_two_fieldbook_or_station_columns_for_one_quantity(
     reduce_fails(
         cli,
         tmp_path,
-        ["--fieldbook", book, "--stations", stations],
+        ["--fieldbook", book, "--stations", stations, "--declination", "0"],
         f"{culprit}: row 1: columns {both}",
         inputs=[book, stations],
     )
@@ -301,7 +301,7 @@ def test_fieldbook_and_station_lengths_need_a_unit(
     cli, tmp_path, book_header, stations_header, message
 ):
     book, stations = fieldbook_files(tmp_path, book_header, stations_header)
-    args = ["--fieldbook", book, "--stations", stations]
+    args = ["--fieldbook", book, "--stations", stations, "--declination", "0"]
     reduce_fails(cli, tmp_path, args, message, "--units", inputs=[book, stations])
     table = reduce_reads(cli, tmp_path, [*args, "--units", "m"])
     assert table["point"].tolist() == ["A", "B", "C"]
@@ -410,7 +410,7 @@ def test_utf16_trees_and_stations_say_save_as_utf8(cli, tmp_path):
     reduce_fails(
         cli,
         tmp_path,
-        ["--fieldbook", book, "--stations", stations],
+        ["--fieldbook", book, "--stations", stations, "--declination", "0"],
         f"{stations}: UTF-16 encoded; save it as UTF-8",
         inputs=[book, stations],
     )
@@ -452,7 +452,10 @@ def test_gpx_with_entities_is_refused(cli, tmp_path, option):
         book, _ = fieldbook_files(
             tmp_path, "point,station,instrument_height_m,target_height_m,sentence"
         )
-        args, inputs = ["--fieldbook", book, "--stations", gpx], [book, gpx]
+        args, inputs = (
+            ["--fieldbook", book, "--stations", gpx, "--declination", "0"],
+            [book, gpx],
+        )
     reduce_fails(
         cli,
         tmp_path,

@@ -58,7 +58,7 @@ def enu_offset(lat0, lon0, h0, lat, lon, h):
 
 def test_hand_case_hundred_metres_north(tmp_path):
     book = fieldbook(tmp_path, [shot_line("A1", "S1", 1.5, 0.0, 100.0, 0.0, 0.0)])
-    points = read_fieldbook(book, stations_csv(tmp_path))
+    points = read_fieldbook(book, stations_csv(tmp_path), declination_deg=0.0)
     frame = points.frame
     assert frame["lat_deg"].iloc[0] - STATION["lat"] == pytest.approx(0.0009, abs=2e-6)
     assert frame["lon_deg"].iloc[0] == pytest.approx(STATION["lon"], abs=1e-12)
@@ -145,7 +145,9 @@ def test_vertical_from_hd_tan_when_sd_missing_and_feet(tmp_path):
     hd_ft = 200.0
     body = f"PLTIT,HV,{hd_ft:.2f},F,90.00,D,-12.50,D,,"
     line = f'C1,S1,5.0,0.0,"${body}*{nmea_checksum(body)}"\n'
-    points = read_fieldbook(fieldbook(tmp_path, [line]), stations_csv(tmp_path))
+    points = read_fieldbook(
+        fieldbook(tmp_path, [line]), stations_csv(tmp_path), declination_deg=0.0
+    )
     rise = hd_ft * 0.3048 * math.tan(math.radians(-12.5))
     assert points.frame["z_m"].iloc[0] == pytest.approx(STATION["elev"] + 5.0 + rise)
     _, _, distance = pyproj.Geod(ellps="WGS84").inv(
@@ -160,7 +162,7 @@ def test_vertical_from_hd_tan_when_sd_missing_and_feet(tmp_path):
 def test_unquoted_sentence_in_last_column(tmp_path):
     sentence = format_trupulse_hv(50.0, 45.0, 0.0, 50.0)
     book = fieldbook(tmp_path, [f"D1,S1,1.5,1.5,{sentence}\n"])
-    points = read_fieldbook(book, stations_csv(tmp_path))
+    points = read_fieldbook(book, stations_csv(tmp_path), declination_deg=0.0)
     assert points.frame["z_m"].iloc[0] == pytest.approx(STATION["elev"])
 
 
@@ -171,7 +173,9 @@ def test_ft_heights_and_notes(tmp_path):
         + shot_line("E1", "S1", 5.0, 0.0, 30.0, 0.0, 0.0)
         + shot_line("E2", "S1", 5.0, 0.0, 60.0, 0.0, 0.0)
     )
-    points = read_fieldbook(book, stations_csv(tmp_path), units="ft")
+    points = read_fieldbook(
+        book, stations_csv(tmp_path), units="ft", declination_deg=0.0
+    )
     assert points.frame["z_m"].tolist() == pytest.approx([STATION["elev"] + 1.524] * 2)
     assert any("TruPulse 200 has no compass" in note for note in points.notes)
 
@@ -186,10 +190,12 @@ def test_bad_checksum_names_row_and_point(tmp_path):
         tmp_path, [shot_line("A1", "S1", 1.5, 0, 20, 0, 0), f'A2,S1,1.5,0,"{bad}"\n']
     )
     with pytest.raises(InputFileError) as error:
-        read_fieldbook(book, stations_csv(tmp_path))
+        read_fieldbook(book, stations_csv(tmp_path), declination_deg=0.0)
     message = str(error.value)
     assert message.startswith(f"{book}: row 3 (point A2): bad TruPulse checksum")
-    lenient = read_fieldbook(book, stations_csv(tmp_path), lenient=True)
+    lenient = read_fieldbook(
+        book, stations_csv(tmp_path), lenient=True, declination_deg=0.0
+    )
     assert len(lenient) == 2
     assert any("checksum wrong, accepted" in note for note in lenient.notes)
 
@@ -198,7 +204,7 @@ def test_unknown_station_named(tmp_path):
     book = fieldbook(tmp_path, [shot_line("A1", "S9", 1.5, 0, 20, 0, 0)])
     stations = stations_csv(tmp_path)
     with pytest.raises(InputFileError) as error:
-        read_fieldbook(book, stations)
+        read_fieldbook(book, stations, declination_deg=0.0)
     assert str(error.value) == (
         f"{book}: row 2 (point A1): station 'S9' is not in {stations} "
         "(stations there: S1)"
@@ -212,7 +218,7 @@ def test_station_without_elevation_in_gpx(tmp_path):
     )
     book = fieldbook(tmp_path, [shot_line("A1", "S1", 1.5, 0, 20, 0, 0)])
     with pytest.raises(InputFileError, match="station 'S1' has no elevation"):
-        read_fieldbook(book, gpx)
+        read_fieldbook(book, gpx, declination_deg=0.0)
 
 
 @pytest.mark.parametrize(
@@ -228,7 +234,9 @@ def test_station_without_elevation_in_gpx(tmp_path):
 )
 def test_unusable_shots(tmp_path, line, message):
     with pytest.raises(InputFileError, match=message):
-        read_fieldbook(fieldbook(tmp_path, [line]), stations_csv(tmp_path))
+        read_fieldbook(
+            fieldbook(tmp_path, [line]), stations_csv(tmp_path), declination_deg=0.0
+        )
 
 
 def test_duplicated_point_in_fieldbook(tmp_path):
@@ -239,7 +247,9 @@ def test_duplicated_point_in_fieldbook(tmp_path):
     with pytest.raises(
         InputFileError, match="point 'A1' appears twice \\(row 2 and row 3\\)"
     ):
-        read_fieldbook(fieldbook(tmp_path, lines), stations_csv(tmp_path))
+        read_fieldbook(
+            fieldbook(tmp_path, lines), stations_csv(tmp_path), declination_deg=0.0
+        )
 
 
 def test_missing_columns_and_files(tmp_path):
@@ -248,11 +258,12 @@ def test_missing_columns_and_files(tmp_path):
     with pytest.raises(
         InputFileError, match="missing instrument_height_m, target_height_m"
     ):
-        read_fieldbook(book, stations_csv(tmp_path))
+        read_fieldbook(book, stations_csv(tmp_path), declination_deg=0.0)
     with pytest.raises(InputFileError, match="nostations.csv: file not found"):
         read_fieldbook(
             fieldbook(tmp_path, [shot_line("A1", "S1", 1.5, 0, 20, 0, 0)]),
             tmp_path / "nostations.csv",
+            declination_deg=0.0,
         )
 
 
@@ -261,7 +272,7 @@ def test_negative_heights_and_bad_declination(tmp_path):
 
     book = fieldbook(tmp_path, [shot_line("A1", "S1", -1.5, 0, 20, 0, 0)])
     with pytest.raises(InputFileError, match="row 2 \\(point A1\\): instrument and"):
-        read_fieldbook(book, stations_csv(tmp_path))
+        read_fieldbook(book, stations_csv(tmp_path), declination_deg=0.0)
     with pytest.raises(ArgumentError, match="declination_deg"):
         read_fieldbook(book, stations_csv(tmp_path), declination_deg=400.0)
 

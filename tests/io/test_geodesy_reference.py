@@ -156,3 +156,23 @@ def test_utm_round_trip(lat, lon):
     back_lat, back_lon = geodesy.from_projected(easting, northing, label)
     assert float(back_lat[0]) == pytest.approx(lat, abs=1e-9)
     assert float(back_lon[0]) == pytest.approx(lon, abs=1e-9)
+
+
+def test_area_of_use_margin_and_antimeridian():
+    from fieldkit.errors import ArgumentError
+    from fieldkit.io.geodesy import check_area_of_use, to_projected
+
+    zone11 = pyproj.CRS.from_epsg(32611)  # 120°W to 114°W
+    check_area_of_use(zone11, [49.0], [-120.5])  # half a degree past the edge: kept
+    with pytest.raises(ArgumentError, match=r"point P2 of a\.csv at 49\.00000°N"):
+        check_area_of_use(
+            zone11, [49.0, 49.0], [-117.0, -121.5], names=["P1", "P2"], source="a.csv"
+        )
+    nz = pyproj.CRS.from_epsg(3994)  # 155°E to 170°W, across the antimeridian
+    check_area_of_use(nz, [-40.0, -40.0], [178.0, -175.0])
+    with pytest.raises(ArgumentError, match="1 of 2 points"):
+        check_area_of_use(nz, [-40.0, -40.0], [178.0, 100.0])
+    # to_projected checks a CRS it is given, not the one it picks itself
+    with pytest.raises(ArgumentError, match="EPSG:32755"):
+        to_projected([49.97], [-114.68], 32755)
+    assert to_projected([-37.95], [144.42])[2].to_epsg() == 32755

@@ -145,7 +145,7 @@ def test_bad_trupulse_checksum(cli, tmp_path):
     message = run_and_check(
         cli,
         tmp_path,
-        ["--fieldbook", book, "--stations", stations],
+        ["--fieldbook", book, "--stations", stations, "--declination", "0"],
         f"{book}: row 3 (point B): bad TruPulse checksum",
         [book, stations],
     )

@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from fieldkit.errors import ArgumentError
 from fieldkit.io.fieldbook import read_fieldbook
 from fieldkit.io.geodesy import geodesic_inverse
 from fieldkit.io.impacts import read_impacts
@@ -47,11 +48,17 @@ def test_positions_within_0_15_m(both):
 
 
 def test_without_declination_the_positions_are_wrong(both, repo):
-    """The declination matters: ignoring it swings every shot by 14°."""
+    """The declination matters: a 0 swings every shot by 14°, so it is never assumed."""
     gpx, _ = both
     folder = repo / "surveys" / "tornado_mountain"
+    with pytest.raises(ArgumentError, match="row 2: its azimuth is magnetic"):
+        read_fieldbook(
+            folder / "boulder_a_fieldbook.csv", folder / "boulder_a_stations.gpx"
+        )
     raw = read_fieldbook(
-        folder / "boulder_a_fieldbook.csv", folder / "boulder_a_stations.gpx"
+        folder / "boulder_a_fieldbook.csv",
+        folder / "boulder_a_stations.gpx",
+        declination_deg=0.0,
     ).frame
     plan, _, _ = geodesic_inverse(
         gpx["lat_deg"], gpx["lon_deg"], raw["lat_deg"], raw["lon_deg"]
