@@ -1,10 +1,11 @@
 """The ImpactTable: one row per impact, the spine every stage reads or writes.
 
 Survey reduction and video tracking produce it; fitting, diagnosis, figures and exports
-consume it. The column names and meanings are a contract (ARCHITECTURE §3); units are in
-the names. Primary columns (positions, slope, section-frame velocities, body, spin) are
-what a producer measures; :meth:`ImpactTable.derive` computes every derived column from
-them with the conventions of ARCHITECTURE §2, so both producers agree by construction.
+consume it. The column names and meanings are a contract (docs/architecture.md §3);
+units are in the names. Primary columns (positions, slope, section-frame velocities,
+body, spin) are what a producer measures; :meth:`ImpactTable.derive` computes every
+derived column from them with the conventions of docs/architecture.md §2, so both
+producers agree by construction.
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ class Column:
     description: str
 
 
-#: Contract columns in their canonical order (ARCHITECTURE §3).
+#: Contract columns in their canonical order (docs/architecture.md §3).
 CONTRACT_COLUMNS: tuple[Column, ...] = (
     Column("path_id", "str", True, "rock / test identifier"),
     Column("point", "str", True, "impact identifier"),
@@ -213,10 +214,10 @@ class ImpactTable:
     def derive(self) -> ImpactTable:
         """Return a copy with every derived column recomputed from the primary ones.
 
-        Speeds, N/T components on ``slope_deg`` (ARCHITECTURE §2), angles to the ground,
-        ``e_n = -vfn/vin`` and ``e_t = vft/vit`` (eqs. 4.6, 4.7), kinetic and rotational
-        energies (``I = m k^2``), ``dke_j`` and energy heads (eq. 6.14). Values the data
-        do not allow (no mass, no spin) stay NaN.
+        Speeds, N/T components on ``slope_deg`` (docs/architecture.md §2), angles to
+        the ground, ``e_n = -vfn/vin`` and ``e_t = vft/vit`` (eqs. 4.6, 4.7), kinetic
+        and rotational energies (``I = m k^2``), ``dke_j`` and energy heads (eq. 6.14).
+        Values the data do not allow (no mass, no spin) stay NaN.
         """
         f = self.frame.copy()
         vix, viz = f["vi_x_mps"].to_numpy(), f["vi_z_mps"].to_numpy()

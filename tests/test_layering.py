@@ -1,4 +1,4 @@
-"""The import graph of the package follows the layering of ARCHITECTURE §6.
+"""The import graph of the package follows the layering of docs/architecture.md §6.
 
 Layers, lowest first (a module may import its own layer's package and any lower layer):
 
