@@ -9,7 +9,6 @@ import pytest
 from typer.testing import CliRunner
 
 REPO = Path(__file__).resolve().parents[1]
-SHARED = REPO.parent / "shared"
 
 
 @pytest.fixture(scope="session")
@@ -20,11 +19,11 @@ def repo() -> Path:
 
 @pytest.fixture(scope="session")
 def external_data() -> Path:
-    """Third-party reference data beside the repository (skips if absent)."""
-    path = SHARED / "data" / "external"
-    if not path.is_dir():
-        pytest.skip("shared/data/external not available")
-    return path
+    """Third-party reference data copied into ``tests/data/`` with its licences.
+
+    Part of the repository, so a fresh clone runs every test that reads it.
+    """
+    return REPO / "tests" / "data"
 
 
 @pytest.fixture()
