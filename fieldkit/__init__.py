@@ -6,8 +6,8 @@ The data flow (docs/architecture.md §1): ``io`` readers -> ``reduce`` (survey) 
 ``physics`` holds the thesis equations as pure functions.
 """
 
+from fieldkit._version import __version__
 from fieldkit.errors import FieldkitError
 from fieldkit.impact_table import ImpactTable
 
-__version__ = "0.1.0"
 __all__ = ["FieldkitError", "ImpactTable", "__version__"]

@@ -12,7 +12,7 @@ from typing import Annotated
 
 import typer
 
-from fieldkit import __version__
+from fieldkit._version import __version__
 from fieldkit.cli import fence, impact, reduce, track, view
 
 app = typer.Typer(
@@ -38,7 +38,7 @@ def _options(
             "--version",
             callback=_print_version,
             is_eager=True,
-            help="Print the version (fieldkit.__version__) and exit.",
+            help="Print the version and exit.",
         ),
     ] = False,
 ) -> None:

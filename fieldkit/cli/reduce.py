@@ -154,8 +154,7 @@ def reduce(
     Example (thesis Table 2-4, Tornado Mountain boulder A; from the
     repository root):
 
-        fieldkit reduce \\
-          --impacts surveys/tornado_mountain/boulder_a_impacts.gpx \\
+        fieldkit reduce --impacts surveys/tornado_mountain/boulder_a_impacts.gpx \\
           --trees surveys/tornado_mountain/boulder_a_trees.csv --theta0 32.6 \\
           --mass 3750 --radius 0.725 --gyration 0.46 \\
           -o out/boulder_a.csv --figures out/figures

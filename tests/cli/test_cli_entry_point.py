@@ -83,7 +83,7 @@ def test_version_has_one_source(cli):
     assert "version" not in project["project"]
     assert project["project"]["dynamic"] == ["version"]
     dynamic = project["tool"]["setuptools"]["dynamic"]["version"]
-    assert dynamic == {"attr": "fieldkit.__version__"}
+    assert dynamic == {"attr": "fieldkit._version.__version__"}
 
 
 def test_version_from_the_console_script():
