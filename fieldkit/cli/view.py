@@ -190,3 +190,5 @@ def view(
         f"wrote {out}: {len(analysis.track)} samples, {len(analysis.flights)} flights, "
         f"{len(analysis.impacts)} impacts, {len(analysis.contacts)} net contacts"
     )
+    for contact in analysis.contacts:
+        typer.echo(f"  {contact.summary()}")
