@@ -1,20 +1,22 @@
 """The ImpactTable: one row per impact, the spine every stage reads or writes.
 
 Survey reduction and video tracking produce it; fitting, diagnosis, figures and exports
-consume it. The column names and meanings are a contract (ARCHITECTURE §3); units are in
-the names. Primary columns (positions, slope, section-frame velocities, body, spin) are
-what a producer measures; :meth:`ImpactTable.derive` computes every derived column from
-them with the conventions of ARCHITECTURE §2, so both producers agree by construction.
+consume it. The column names and meanings are a contract (docs/architecture.md §3);
+units are in the names. Primary columns (positions, slope, section-frame velocities,
+body, spin) are what a producer measures; :meth:`ImpactTable.derive` computes every
+derived column from them with the conventions of docs/architecture.md §2, so both
+producers agree by construction.
 
-Every derived table carries ``qa_flags`` (ARCHITECTURE §3): the quality flags of
-:data:`QA_FLAGS`, ``;``-separated, computed in one place (:func:`quality_flags`, applied
-by :meth:`ImpactTable.derive`) from the table's own columns, so survey reduction, video
-tracking and simulation all flag the same things the same way.
+Every derived table carries ``qa_flags`` (docs/architecture.md §3): the quality flags
+of :data:`QA_FLAGS`, ``;``-separated, computed in one place (:func:`quality_flags`,
+applied by :meth:`ImpactTable.derive`) from the table's own columns, so survey
+reduction, video tracking and simulation all flag the same things the same way.
 """
 
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -43,7 +45,7 @@ class Column:
     description: str
 
 
-#: Contract columns in their canonical order (ARCHITECTURE §3).
+#: Contract columns in their canonical order (docs/architecture.md §3).
 CONTRACT_COLUMNS: tuple[Column, ...] = (
     Column("path_id", "str", True, "rock / test identifier"),
     Column("point", "str", True, "impact identifier"),
@@ -156,7 +158,7 @@ QA_FLAGS: dict[str, str] = {
     "flight_high": "the flight leaving the impact rises more than 10 m normal to its "
     "chord (thesis §3.2: usually 1-2 m, 4 m the highest observed)",
     "slope_from_chord": "slope_deg is the chord from the previous point, not a "
-    "surveyed slope (ARCHITECTURE §2 default)",
+    "surveyed slope (docs/architecture.md §2 default)",
     "slope_sensitive": "taking the chord to the next point as the slope moves e_n by "
     "more than its standard uncertainty e_n_sd",
     "spin_estimated": "omega is estimated as v/r (eq. 3.17), not measured",
@@ -237,7 +239,7 @@ def restitution(
 ) -> dict[str, np.ndarray]:
     """Speeds, N/T components, angles to the ground and ``e_n``, ``e_t`` [arrays].
 
-    The kinematic half of :meth:`ImpactTable.derive` (ARCHITECTURE §2; eqs. 4.6,
+    The kinematic half of :meth:`ImpactTable.derive` (docs/architecture.md §2; eqs. 4.6,
     4.7), as plain arrays so that a Monte Carlo can repeat it without building tables.
 
     Examples
@@ -356,11 +358,11 @@ class ImpactTable:
     def derive(self) -> ImpactTable:
         """Return a copy with every derived column recomputed from the primary ones.
 
-        Speeds, N/T components on ``slope_deg`` (ARCHITECTURE §2), angles to the ground,
-        ``e_n = -vfn/vin`` and ``e_t = vft/vit`` (eqs. 4.6, 4.7), kinetic and rotational
-        energies (``I = m k^2``), ``dke_j``, energy heads (eq. 6.14) and ``qa_flags``
-        (:func:`quality_flags`). Values the data do not allow (no mass, no spin) stay
-        NaN.
+        Speeds, N/T components on ``slope_deg`` (docs/architecture.md §2), angles to
+        the ground, ``e_n = -vfn/vin`` and ``e_t = vft/vit`` (eqs. 4.6, 4.7), kinetic
+        and rotational energies (``I = m k^2``), ``dke_j``, energy heads (eq. 6.14) and
+        ``qa_flags`` (:func:`quality_flags`). Values the data do not allow (no mass, no
+        spin) stay NaN.
         """
         f = self.frame.copy()
         kinematics = restitution(
@@ -461,12 +463,38 @@ class ImpactTable:
                 p, lambda tmp: frame.to_parquet(tmp, index=False), outputs
             )
 
+        _check_xlsx_text(frame, p)
+
         def write_xlsx(tmp: Path) -> None:
             with pd.ExcelWriter(tmp, engine="openpyxl") as book:
                 frame.to_excel(book, index=False, sheet_name="impacts")
                 protect_formula_cells(book.sheets["impacts"])
 
         return write_file(p, write_xlsx, outputs)
+
+
+#: Characters XLSX cannot hold (control characters other than tab, LF, CR).
+_XLSX_ILLEGAL = re.compile(r"[\x00-\x08\x0b\x0c\x0e-\x1f]")
+
+
+def _check_xlsx_text(frame: pd.DataFrame, path: Path) -> None:
+    """One-line error naming the column and row of a text cell XLSX cannot hold."""
+    for name in frame.columns:
+        column = frame[name]
+        if column.dtype.kind not in "OUT" and str(column.dtype) not in (
+            "string",
+            "str",
+        ):
+            continue
+        bad = column.map(lambda v: isinstance(v, str) and bool(_XLSX_ILLEGAL.search(v)))
+        if bad.any():
+            i = int(np.flatnonzero(bad.to_numpy(bool))[0])
+            raise InputFileError(
+                f"column {name}: {column.iloc[i]!r} holds a control character that "
+                "XLSX cannot store; write CSV or Parquet, or remove it",
+                source=path,
+                where=f"row {i + 1}",
+            )
 
 
 def _format_of(path: Path) -> str:

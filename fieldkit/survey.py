@@ -1,6 +1,6 @@
 """The Survey: what a geologist brings back from a slope, in section coordinates.
 
-One of the three data types of fieldkit (ARCHITECTURE §1), beside
+One of the three data types of fieldkit (docs/architecture.md §1), beside
 :class:`~fieldkit.track.Track` and :class:`~fieldkit.impact_table.ImpactTable`:
 
 * :class:`PointSet` -- impact points along one fall path, in order of travel, with

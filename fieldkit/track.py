@@ -1,10 +1,10 @@
 """The Track: a body's position (and marker angle) against time, in world metres.
 
-One of the three data types of fieldkit (ARCHITECTURE §1), beside
+One of the three data types of fieldkit (docs/architecture.md §1), beside
 :class:`~fieldkit.survey.Survey` and :class:`~fieldkit.impact_table.ImpactTable`.
 Every video tracker and track importer (OSP Tracker, Kinovea) returns a :class:`Track`;
 flight segmentation and impact analysis read it. World axes: ``x`` horizontal along the
-direction of travel, ``z`` up (ARCHITECTURE §2).
+direction of travel, ``z`` up (docs/architecture.md §2).
 
 fieldkit's own track file is a CSV of :data:`TRACK_COLUMNS` (plus any extra columns,
 e.g. ``flight``, ``u_px``) written by :meth:`Track.write` and read by

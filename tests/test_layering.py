@@ -1,8 +1,8 @@
-"""The import graph of the package follows the layering of ARCHITECTURE §6.
+"""The import graph of the package follows the layering of docs/architecture.md §6.
 
 Layers, lowest first (a module may import its own layer's package and any lower layer):
 
-0. ``errors`` -- the one error type;
+0. ``errors`` -- the one error type; ``_version`` -- the version string;
 1. ``physics`` (pure thesis equations: imports nothing of ours but ``errors``) and
    ``outputs`` (safe file writing: all or nothing, never over an input);
 2. the three data types ``survey``, ``track``, ``impact_table`` (the ImpactTable's
@@ -28,6 +28,7 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[1] / "fieldkit"
 
 LAYERS: dict[str, int] = {
+    "_version": 0,
     "errors": 0,
     "physics": 1,
     "outputs": 1,

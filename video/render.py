@@ -322,6 +322,29 @@ def _plain(value):
     return value
 
 
+#: Significant digits of every float in the JSON files. The last bits of a float can
+#: differ between machines (numpy picks SIMD code paths by CPU), so full ``repr`` digits
+#: would make ``make video`` write different bytes elsewhere; 12 digits are far below
+#: any tolerance and reproduce byte for byte (the truth CSV keeps 10).
+JSON_DIGITS = 12
+
+
+def _rounded(value):
+    """``value`` with every float rounded to :data:`JSON_DIGITS` significant digits."""
+    value = _plain(value)
+    if isinstance(value, float):
+        return float(f"{value:.{JSON_DIGITS}g}") if math.isfinite(value) else value
+    if isinstance(value, dict):
+        return {k: _rounded(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_rounded(v) for v in value]
+    return value
+
+
+def _write_json(path: Path, data: dict) -> None:
+    path.write_text(json.dumps(_rounded(data), indent=1))
+
+
 # ----------------------------------------------------------------------------- images
 def background(camera: Camera, rng: np.random.Generator, scene) -> np.ndarray:
     """Static textured background with the plate (or net anchors) and scale crosses."""
@@ -641,10 +664,8 @@ def render(
         )
         for u, v in marks
     ]
-    (out_dir / f"{name}.homography.json").write_text(
-        json.dumps({"points": hpoints}, indent=1)
-    )
-    (out_dir / f"{name}.calibration.json").write_text(json.dumps(calib, indent=1))
+    _write_json(out_dir / f"{name}.homography.json", {"points": hpoints})
+    _write_json(out_dir / f"{name}.calibration.json", calib)
     u_first = scale_pts[0]
     truth = dict(
         clip=path.name,
@@ -660,9 +681,8 @@ def render(
             float((camera.origin_v_px - u_first[1]) * camera.scale_m_per_px),
         ],
     )
-    (out_dir / f"{name}.truth.json").write_text(
-        json.dumps(truth, indent=1, default=_plain)
-    )
+    truth = _rounded(truth)
+    _write_json(out_dir / f"{name}.truth.json", truth)
     return truth
 
 

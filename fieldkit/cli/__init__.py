@@ -8,9 +8,11 @@ Each command module defines a single function decorated with
 from __future__ import annotations
 
 import sys
+from typing import Annotated
 
 import typer
 
+from fieldkit._version import __version__
 from fieldkit.cli import fence, impact, reduce, track, view
 
 app = typer.Typer(
@@ -20,6 +22,28 @@ app = typer.Typer(
     add_completion=False,
     pretty_exceptions_enable=False,
 )
+
+
+def _print_version(value: bool) -> None:
+    if value:
+        typer.echo(f"fieldkit {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _options(
+    version: Annotated[
+        bool,
+        typer.Option(
+            "--version",
+            callback=_print_version,
+            is_eager=True,
+            help="Print the version and exit.",
+        ),
+    ] = False,
+) -> None:
+    pass
+
 
 app.command("reduce")(reduce.reduce)
 app.command("impact")(impact.impact)

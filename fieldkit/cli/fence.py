@@ -145,13 +145,14 @@ def fence(
 
     Example (thesis worked example 8B: the net absorbs 97.4 kJ, 72 %):
 
-        fieldkit fence --mass 520 --gyration 0.35 --speed-in 22 --spin-in 18
-        --speed-out 11.5 --spin-out=-11.6 --figure fence.png
+        fieldkit fence --mass 520 --gyration 0.35 --speed-in 22 \\
+          --spin-in 18 --speed-out 11.5 --spin-out=-11.6 \\
+          --figure out/fence.png
 
     Computed rebound (worked example 8A inputs, e_N by eq. 5.4):
 
-        fieldkit fence --mass 520 --gyration 0.35 --radius 0.43 --speed-in 22
-        --angle-in 50 --spin-in 18
+        fieldkit fence --mass 520 --gyration 0.35 --radius 0.43 \\
+          --speed-in 22 --angle-in 50 --spin-in 18
     """
     from fieldkit.outputs import OutputSet, write_text
     from fieldkit.physics.bodies import resolve_body

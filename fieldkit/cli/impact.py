@@ -287,17 +287,22 @@ def impact(
 ) -> None:
     r"""Impact of a rough, rotating rock on the slope: final velocities, spin, energies.
 
-    Local axes at the impact: T along the ground down-slope, N out of the ground
-    (v_iN < 0); spin negative = clockwise. Thesis ch. 4 and appendix C.
+    Local axes at the impact: T along the ground down-slope, N out of the
+    ground (v_iN < 0); spin negative = clockwise. Thesis ch. 4 and appendix C.
 
-    Worked example 4A (1.5 m sphere, 22 m/s at 25 deg, spin -15 rad/s, e_N from
-    eq. 5.4) gives v_fT 17.5, v_fN 6.6 m/s, omega_f -23.3 rad/s, theta_f 20.7 deg:
+    Worked example 4A (1.5 m sphere, 22 m/s at 25 deg, spin -15 rad/s, e_N
+    from eq. 5.4) gives v_fT 17.5, v_fN 6.6 m/s, omega_f -23.3 rad/s,
+    theta_f 20.7 deg:
 
-    fieldkit impact --speed 22 --angle 25 --spin -15 \
-      --shape sphere --dimensions 0.75 --law angle
+        fieldkit impact --speed 22 --angle 25 --spin -15 \
+          --shape sphere --dimensions 0.75 --law angle
 
-    Add --friction 0.5 --figure pnv.png for the pN-v diagram (Figs. 4.4/4.5) with a
-    slip phase, --json out.json for the numbers.
+    With friction 0.5 (a slip phase), the pN-v diagram (Figs. 4.4/4.5) and
+    the numbers as JSON:
+
+        fieldkit impact --speed 22 --angle 25 --spin -15 \
+          --shape sphere --dimensions 0.75 --law angle --friction 0.5 \
+          --figure out/pnv.png --json out/impact.json
     """
     v_it, v_in = _impact_velocity(speed, angle, vt, vn)
     if not math.isfinite(spin):

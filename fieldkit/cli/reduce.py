@@ -156,18 +156,21 @@ def reduce(
 ) -> None:
     """Reduce a rockfall survey to a per-impact table (thesis §2, §3, §7.1).
 
-    Each flight between two impacts is a parabola (eq. 3.5): fixed exactly by a tree
-    strike (three-point solve), else by the restitution angle --theta0. Velocities,
-    N/T components on the chord slope, e_N, e_T, energies (KE, RE with omega = v/r,
-    energy head) and flight heights go to one row per impact, with quality flags
-    (qa_flags) and standard uncertainties (e_n_sd, e_t_sd, vi_sd_mps) propagated from a
-    position error of 0.5 m in plan and in height (stated in the summary).
+    Each flight between two impacts is a parabola (eq. 3.5): fixed exactly by
+    a tree strike (three-point solve), else by the restitution angle --theta0.
+    Velocities, N/T components on the chord slope, e_N, e_T, energies (KE, RE
+    with omega = v/r, energy head) and flight heights go to one row per impact,
+    with quality flags (qa_flags) and standard uncertainties (e_n_sd, e_t_sd,
+    vi_sd_mps) propagated from a position error of 0.5 m in plan and in height
+    (stated in the summary).
 
-    Example (thesis Table 2-4, Tornado Mountain boulder A):
+    Example (thesis Table 2-4, Tornado Mountain boulder A; from the
+    repository root):
 
         fieldkit reduce --impacts surveys/tornado_mountain/boulder_a_impacts.gpx \\
-        --trees surveys/tornado_mountain/boulder_a_trees.csv --theta0 32.6 \\
-        --mass 3750 --radius 0.725 --gyration 0.46 -o t.csv --figures figs
+          --trees surveys/tornado_mountain/boulder_a_trees.csv --theta0 32.6 \\
+          --mass 3750 --radius 0.725 --gyration 0.46 \\
+          -o out/boulder_a.csv --figures out/figures
     """
     from fieldkit.physics.bodies import resolve_body
     from fieldkit.reduce.pipeline import ReduceOptions, reduce_path

@@ -105,24 +105,29 @@ def view(
 ) -> None:
     """Write a rerun recording of an impact table or a track, for the rerun viewer.
 
-    An ImpactTable becomes a section view: impact points labelled with e_n and e_t,
-    impact and restitution velocity arrows, slope ticks, and e_n, e_t and speeds
-    against the impact order. A track (fieldkit's track.csv, or an OSP Tracker or
-    Kinovea export) is first analysed like `fieldkit track` does: flights found and
-    fitted (fitted g checked against 9.81), impacts and net contacts; the recording
-    shows the track, the fitted flights, velocity vectors, speed, spin and residuals.
-    A track needs --radius (or --shape).
+    An ImpactTable becomes a section view: impact points labelled with e_n and
+    e_t, impact and restitution velocity arrows, slope ticks, and e_n, e_t and
+    speeds against the impact order. A track (fieldkit's track.csv, or an OSP
+    Tracker or Kinovea export) is first analysed like `fieldkit track` does:
+    flights found and fitted (fitted g checked against 9.81), impacts and net
+    contacts (with their energy efficiency); the recording shows the track,
+    the fitted flights, velocity vectors, speed, spin and residuals. A track
+    needs --radius (or --shape).
 
-    Examples:
+    Examples (from the repository root): an ImpactTable, the true track of
+    the rendered net clip, an OSP Tracker export in centimetres:
 
-        fieldkit view impacts.csv -o impacts.rrd
+        fieldkit reduce --impacts surveys/tornado_mountain/boulder_a_impacts.gpx \\
+          --theta0 32.6 -o out/boulder_a.csv
+        fieldkit view out/boulder_a.csv -o out/boulder_a.rrd
 
-        fieldkit view track.csv --radius 0.0375 -o track.rrd --figures figs/
+        fieldkit view video/net.truth.csv --radius 0.0375 --mass 0.14 \\
+          --gyration 0.02372 -o out/net.rrd --figures out/net
 
-        fieldkit view ball.txt --format tracker --unit cm --radius 0.0375
-        --fps 1205 --file-fps 30 -o ball.rrd
+        fieldkit view tests/io/data/osp_tracker_multi_comma_cm.csv \\
+          --format tracker --unit cm --radius 0.0375 -o out/ball.rrd
 
-    Then open the recording with `rerun impacts.rrd`.
+    Then open a recording with `rerun out/boulder_a.rrd`.
     """
     outputs = OutputSet(inputs=[input_file])
     outputs.plan(out, argument="-o")
@@ -191,3 +196,5 @@ def view(
         f"wrote {out}: {len(analysis.track)} samples, {len(analysis.flights)} flights, "
         f"{len(analysis.impacts)} impacts, {len(analysis.contacts)} net contacts"
     )
+    for contact in analysis.contacts:
+        typer.echo(f"  {contact.summary()}")

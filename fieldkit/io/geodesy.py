@@ -179,7 +179,7 @@ def section_from_geographic(
     -------
     x_m
         0 at the first point, then the running sum of the geodesic distances between
-        successive points [m] (ARCHITECTURE §2).
+        successive points [m] (docs/architecture.md §2).
 
     Examples
     --------

@@ -224,8 +224,9 @@ def point_set_from_local_grid(
     """Build a PointSet from points on a local plan grid (x, y) with elevations z.
 
     Section ``x_m`` is the cumulative plan distance ``sum sqrt(dx² + dy²)`` between
-    successive points (ARCHITECTURE §2), not the grid ``x``; the grid coordinates are
-    kept in ``easting_m``/``northing_m`` with ``crs`` :data:`LOCAL_GRID`.
+    successive points (docs/architecture.md §2), not the grid ``x``; the grid
+    coordinates are kept in ``easting_m``/``northing_m`` with ``crs``
+    :data:`LOCAL_GRID`.
 
     Examples
     --------

@@ -170,8 +170,8 @@ def compression_energy(
 
     With ``beta = beta3 + mu beta2`` it is eq. 6.7 **corrected**: the thesis prints
     ``-m v_iN^2 / beta``, dropping the factor 1/2 in the last line of its own integral
-    (THESIS-NOTES erratum). Worked example 6B inherits the slip (-12.9 kJ printed; the
-    integral is -6.4 kJ).
+    (docs/thesis-notes.md erratum). Worked example 6B inherits the slip (-12.9 kJ
+    printed; the integral is -6.4 kJ).
 
     Parameters
     ----------

@@ -220,7 +220,7 @@ def velocity_ratio(
     Examples
     --------
     Tornado Mountain, V = 12.5 m/s after H = 250 m (the thesis prints 0.39; the
-    correct value is 0.18, see THESIS-NOTES errata):
+    correct value is 0.18, see docs/thesis-notes.md errata):
 
     >>> round(float(velocity_ratio(12.5, 250.0)), 3)
     0.178

@@ -18,7 +18,7 @@ The energy split (worked example 8B) compares the rock's total energy
 ``1/2 m v^2 + 1/2 I omega^2`` before and after; the difference is what the fence
 absorbs, and the energy efficiency (eq. 8.1) is ``E_f / E_i``.
 
-Worked example 8A is internally inconsistent (THESIS-NOTES): with r = 0.43 m,
+Worked example 8A is internally inconsistent (docs/thesis-notes.md): with r = 0.43 m,
 k = 0.35 m and omega_i = +18 rad/s, eq. 4.20 gives v_fT = 5.4 m/s and eq. 4.22
 omega_f = -12.6 rad/s (omega_i = -18 gives 11.6 m/s), not the printed 9.9 m/s and
 -11.6 rad/s; only the printed v_f = 11.5 m/s follows from the printed components.

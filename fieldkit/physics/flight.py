@@ -1,10 +1,10 @@
 """Ballistic flight of a rock between impacts (thesis ch. 3, eqs. 3.1-3.12).
 
 Drag-free flight in the section plane: ``a_x = 0``, ``a_z = -g``. Positions are
-relative to the launch point, ``x`` along travel, ``z`` up (ARCHITECTURE §2). The
-launch angle ``alpha`` is measured above the horizontal in the direction of travel; the
-restitution angle ``theta0`` is measured from the ground of dip ``psi`` (positive when
-the ground descends toward +x), related by ``alpha = theta0 - psi`` (eq. 3.6).
+relative to the launch point, ``x`` along travel, ``z`` up (docs/architecture.md §2).
+The launch angle ``alpha`` is measured above the horizontal in the direction of travel;
+the restitution angle ``theta0`` is measured from the ground of dip ``psi`` (positive
+when the ground descends toward +x), related by ``alpha = theta0 - psi`` (eq. 3.6).
 
 All functions are pure and broadcast their arguments like numpy. NaN inputs propagate
 (missing data); only definite violations raise. Scalars come back as numpy scalars.

@@ -1,7 +1,7 @@
 """Impact of a rough, rotating body on the slope in local N/T axes (ch. 4, App. C).
 
-Axes (ARCHITECTURE §2, thesis Fig. 4.6): T along the ground down-slope, N out of the
-ground; the impact normal velocity is negative, ``omega`` is negative clockwise (the
+Axes (docs/architecture.md §2, thesis Fig. 4.6): T along the ground down-slope, N out of
+the ground; the impact normal velocity is negative, ``omega`` is negative clockwise (the
 usual spin for travel down-slope). Impulses are the thesis's: ``p`` is the normal
 impulse, the independent variable of the [p_N - v] diagram (eq. 4.3).
 
@@ -246,8 +246,8 @@ class ImpactResult:
     work_compression_j, work_restitution_j, work_friction_j
         Work of the contact force: normal impulse up to ``p_c`` (<= 0), normal impulse
         from ``p_c`` to ``p_f`` (>= 0), and friction (<= 0); they sum to
-        ``energy_change_j`` (thesis eqs. 6.7-6.9, generalised; see THESIS-NOTES for the
-        eq. 6.7 factor 1/2).
+        ``energy_change_j`` (thesis eqs. 6.7-6.9, generalised; see docs/thesis-notes.md
+        for the eq. 6.7 factor 1/2).
     """
 
     v_ft_mps: np.ndarray

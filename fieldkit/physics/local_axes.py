@@ -1,7 +1,7 @@
 """Section frame (x, z) <-> local impact axes (T, N) at a slope of dip psi.
 
 T runs along the ground down-slope (direction of travel); N is the outward normal.
-With psi positive when the ground descends toward +x (ARCHITECTURE §2):
+With psi positive when the ground descends toward +x (docs/architecture.md §2):
 
     T = ( cos psi, -sin psi),   N = ( sin psi, cos psi)
 
@@ -60,8 +60,8 @@ def angle_to_ground_deg(v_t: ArrayLike, v_n: ArrayLike) -> np.ndarray:
     """Angle between a velocity and the ground [deg], always in [0, 180].
 
     For an impact (``v_n < 0``) this is ``theta_i = atan(-v_n/v_t)``; for a rebound
-    (``v_n > 0``) ``theta_f = atan(v_n/v_t)`` (ARCHITECTURE §2). Angles above 90 deg
-    mean motion up-slope (``v_t < 0``).
+    (``v_n > 0``) ``theta_f = atan(v_n/v_t)`` (docs/architecture.md §2). Angles above 90
+    deg mean motion up-slope (``v_t < 0``).
     """
     return np.degrees(
         np.arctan2(np.abs(np.asarray(v_n, float)), np.asarray(v_t, float))

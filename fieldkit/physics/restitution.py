@@ -9,8 +9,8 @@ Three pure functions, each returning ``e_N``:
 * :func:`velocity_scaled_restitution` - ``v_fN = e_N |v_iN| / (1 + (v_iN/K)^2)``
   (eq. 7.1, RocFall/CRSP; K = 9.144 m/s = 30 ft/s, the thesis's "9.14 m/s").
 
-The last two carry the effect names of ARCHITECTURE §5. ``e_N > 1`` is legal (shallow
-impacts, thesis §5.2.1); laws never cap it.
+The last two carry the effect names of docs/architecture.md §5. ``e_N > 1`` is legal
+(shallow impacts, thesis §5.2.1); laws never cap it.
 """
 
 from __future__ import annotations

@@ -12,9 +12,9 @@ The impulse absorbed up to time t is the area under the curve,
 ``m v_i`` is absorbed, ``t = ((x+1) p / c)^(1/(x+1))``, and the force then is the peak
 force. For the thesis's example (520 kg at 22 m/s, p = 11,440 N s) this gives
 t = 0.15, 0.95, 0.73 s and F = 151, 36.1 and 24.9 kN: the thesis prints 22.0 kN for the
-stiff structure, which its own law does not give (THESIS-NOTES erratum), so the stiff
-fence carries 16 % of the rigid wall's force and 69 % of the flexible fence's (printed:
-15 % and 61 %).
+stiff structure, which its own law does not give (docs/thesis-notes.md erratum), so the
+stiff fence carries 16 % of the rigid wall's force and 69 % of the flexible fence's
+(printed: 15 % and 61 %).
 
 The coefficient ``c`` has units N s^-x (the thesis writes [M L T^-3] for n).
 """

@@ -1,11 +1,11 @@
 """Standard uncertainties of reduced values, from the survey's position error.
 
-The ``<column>_sd`` columns of an ImpactTable (ARCHITECTURE §3: ``e_n_sd``, ``e_t_sd``,
-``vi_sd_mps``) come from :func:`propagate`: a Monte Carlo that perturbs every surveyed
-point, runs the *same* reduction again (passed in as a callable) and takes the standard
-deviation of each output over the draws. Nothing is linearised, so the non-linear
-three-point and eq. 3.5 solutions, the chord slopes and the N/T decomposition all carry
-the error the way they carry the data.
+The ``<column>_sd`` columns of an ImpactTable (docs/architecture.md §3: ``e_n_sd``,
+``e_t_sd``, ``vi_sd_mps``) come from :func:`propagate`: a Monte Carlo that perturbs
+every surveyed point, runs the *same* reduction again (passed in as a callable) and
+takes the standard deviation of each output over the draws. Nothing is linearised, so
+the non-linear three-point and eq. 3.5 solutions, the chord slopes and the N/T
+decomposition all carry the error the way they carry the data.
 
 Error model (:class:`PositionError`)
     Each point's section coordinates get independent normal errors: ``x_m`` with
@@ -79,7 +79,7 @@ _UNITS = ("_mps", "_m", "_deg", "_j", "_s", "_radps", "_kg")
 
 
 def sd_column(name: str) -> str:
-    """The name of the standard-uncertainty column of ``name`` (ARCHITECTURE §3).
+    """The standard-uncertainty column of ``name`` (docs/architecture.md §3).
 
     Examples
     --------

@@ -7,6 +7,9 @@
   impact; RE is constant in flight.
 * :func:`plot_energy_head` -- §6.4.2: the energy head ``E = z + v^2/(2g)`` (eq. 6.14),
   level during each flight and dropping at each impact, above the ground profile.
+
+Legends sit outside the axes; impacts with quality flags (``qa_flags``) are ringed in
+red.
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ from fieldkit.outputs import OutputSet
 from fieldkit.physics.energy import energy_head, kinetic_energy, potential_energy
 from fieldkit.physics.flight import flight_samples
 from fieldkit.viz.figure_files import save_png
+from fieldkit.viz.marks import mark_flagged, outside_legend, qa_flagged
 
 
 def energy_profile(table: ImpactTable, n_samples: int = 30) -> dict[str, np.ndarray]:
@@ -111,7 +115,10 @@ def plot_energy_partition(table: ImpactTable) -> Figure:
         f"{table.paths()[0]}: energy partition (thesis Fig. 6.5), "
         f"m = {f['mass_kg'].iloc[0]:.0f} kg"
     )
-    ax.legend(loc="lower right", fontsize=8)
+    flags = qa_flagged(impacts)
+    if flags.any():  # ring the impact labels' rows at the right edge
+        mark_flagged(ax, np.full(len(impacts), total), impacts["z_m"], flags)
+    outside_legend(ax)
     return fig
 
 
@@ -134,11 +141,12 @@ def plot_energy_head(table: ImpactTable) -> Figure:
     ax.plot(p["x_m"], p["z_m"], color="#1f4e9c", lw=0.7, ls="--", label="flight paths")
     head_i = f["energy_head_i_m"].to_numpy(float)
     ax.plot(x, head_i, "v", color="#c62828", ms=3.5, label="before impact")
+    mark_flagged(ax, x, head_i, qa_flagged(f))
     ax.set_xlabel("x, horizontal distance along the path [m]")
     ax.set_ylabel("elevation / energy head [m]")
     ax.set_title(f"{table.paths()[0]}: energy head line (thesis §6.4.2)")
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
+    outside_legend(ax)
     return fig
 
 

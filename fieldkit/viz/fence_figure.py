@@ -29,6 +29,7 @@ from fieldkit.physics.structure_forces import (
     impulse_absorbed,
 )
 from fieldkit.viz.figure_files import save_png
+from fieldkit.viz.marks import outside_legend
 
 #: One colour per thesis structure; other labels cycle through the default colours.
 COLOURS = {"rigid": "#d62728", "flexible": "#1f77b4", "stiff": "#2ca02c"}
@@ -94,8 +95,8 @@ def _draw_time_force(
         ylabel="force in the structure F [kN]",
         title="time - force (Figs. 8.6, 8.8, eqs. 8.2-8.4)",
     )
-    ax_impulse.legend(fontsize=8, loc="lower right")
-    ax_force.legend(fontsize=8, loc="upper right")
+    outside_legend(ax_impulse)
+    outside_legend(ax_force)
     for ax in (ax_impulse, ax_force):
         ax.grid(True, alpha=0.3)
 
@@ -136,7 +137,7 @@ def _draw_energy(ax: Axes, split: FenceEnergySplit) -> None:
     )
     ax.set_ylim(0, 1.25 * float(split.total_in_j) / 1e3)
     ax.grid(True, axis="y", alpha=0.3)
-    ax.legend(fontsize=8, loc="upper right")
+    outside_legend(ax)
 
 
 def plot_time_force(

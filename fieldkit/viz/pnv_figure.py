@@ -18,6 +18,7 @@ from matplotlib.figure import Figure
 from fieldkit.outputs import OutputSet
 from fieldkit.physics.impulse_history import ImpulseHistory
 from fieldkit.viz.figure_files import new_figure, save_png
+from fieldkit.viz.marks import outside_legend
 
 NORMAL_COLOUR = "#1f77b4"
 TANGENTIAL_COLOUR = "#d62728"
@@ -93,7 +94,7 @@ def draw_pnv(ax, history: ImpulseHistory, *, impulse_unit: str | None = None) ->
     ax.set_xlim(min(0.0, p[0]) - 0.02 * p_f, p_f * 1.02)
     ax.set_xlabel(f"normal impulse $p_N$ [{unit}]")
     ax.set_ylabel("velocity [m/s]")
-    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    outside_legend(ax)
 
 
 def pnv_figure(

@@ -1,8 +1,13 @@
 """Coefficients of restitution as the thesis plots them (Figs. 5.7 and 5.8).
 
 * :func:`plot_en_theta` -- [theta_i - e_N] scatter by slope material with the power law
-  of eq. 5.4, ``e_N = 19.5 theta_i^-1.03`` (Fig. 5.7). Reusable: takes plain arrays, so
-  video tracks, simulations and fits can draw the same figure with their own law.
+  of eq. 5.4, ``e_N = 19.5 theta_i^-1.03`` (Fig. 5.7); impacts whose restitution angle
+  theta0 a tree strike fixed (or that were measured) are filled, those on the assumed
+  theta0 open. Reusable: takes plain arrays, so video tracks, simulations and fits can
+  draw the same figure with their own law.
+
+Impacts with quality flags (``qa_flags``) are ringed in red; legends sit outside the
+axes.
 * :func:`plot_et_impacts` -- e_T against impact number, with the mean per material in
   the legend (Fig. 5.8).
 """
@@ -25,6 +30,7 @@ from fieldkit.physics.restitution import (
     angle_dependent_restitution,
 )
 from fieldkit.viz.figure_files import save_png
+from fieldkit.viz.marks import mark_flagged, outside_legend, qa_flagged
 
 MARKERS = {
     "rock": "s",
@@ -34,6 +40,9 @@ MARKERS = {
     "concrete": "v",
     "bench": "P",
 }
+
+#: ``theta0_source`` values that fix the restitution angle (the rest were assumed).
+FIXED_SOURCES = ("tree", "given", "video")
 
 
 def _groups(material: Sequence[str] | None, n: int) -> tuple[np.ndarray, list[str]]:
@@ -60,6 +69,8 @@ def plot_en_theta(
     law: tuple[float, float] | None = (ANGLE_LAW_A, ANGLE_LAW_B),
     law_label: str | None = None,
     title: str | None = None,
+    theta0_source: Sequence[str] | None = None,
+    flagged: ArrayLike | None = None,
 ) -> Figure:
     """[theta_i - e_N] scatter with a power law ``e_N = a theta_i^-b`` (Fig. 5.7).
 
@@ -78,6 +89,13 @@ def plot_en_theta(
         None draws no curve.
     law_label, title
         Legend text for the curve and figure title (defaults describe eq. 5.4).
+    theta0_source
+        Where each impact's restitution angle came from (``theta0_source``): impacts
+        fixed by a tree strike or measured (:data:`FIXED_SOURCES`) are drawn filled
+        (collection gid ``theta0-fixed``), the others open (``theta0-assumed``), each
+        group with a legend entry. None: all filled, no such entries.
+    flagged
+        Per point, True for impacts with quality flags: ringed in red.
 
     Returns
     -------
@@ -87,19 +105,62 @@ def plot_en_theta(
     en = np.asarray(e_n, float)
     ok = np.isfinite(theta) & np.isfinite(en)
     labels, names = _groups(material, len(theta))
+    fixed = (
+        np.ones(len(theta), bool)
+        if theta0_source is None
+        else np.array([str(s) in FIXED_SOURCES for s in theta0_source], bool)
+    )
     fig, ax = _figure()
-    for name in names:
+    for i, name in enumerate(names):
         sel = ok & (labels == name)
-        ax.scatter(
-            theta[sel],
-            en[sel],
-            marker=MARKERS.get(name, "o"),
-            s=28,
-            edgecolor="black",
-            linewidth=0.5,
-            label=f"{name} ({sel.sum()})",
-            zorder=3,
-        )
+        colour = f"C{i}"
+        label = f"{name} ({sel.sum()})"
+        for group, gid, style in (
+            (
+                sel & fixed,
+                "theta0-fixed",
+                dict(facecolors=colour, edgecolors="black", linewidths=0.5),
+            ),
+            (
+                sel & ~fixed,
+                "theta0-assumed",
+                dict(facecolors="none", edgecolors=colour, linewidths=1.2),
+            ),
+        ):
+            if not group.any():
+                continue
+            ax.scatter(
+                theta[group],
+                en[group],
+                marker=MARKERS.get(name, "o"),
+                s=28,
+                label=label,
+                zorder=3,
+                gid=None if theta0_source is None else gid,
+                **style,
+            )
+            label = None
+    if theta0_source is not None:
+        for group, style, text in (
+            (
+                fixed,
+                dict(facecolors="0.4", edgecolors="black"),
+                "θ0 fixed by a tree strike or measured",
+            ),
+            (~fixed, dict(facecolors="none", edgecolors="0.4"), "θ0 assumed"),
+        ):
+            if (ok & group).any():
+                ax.scatter(
+                    [],
+                    [],
+                    marker="o",
+                    s=28,
+                    linewidths=0.8,
+                    label=f"{text} ({(ok & group).sum()})",
+                    **style,
+                )
+    if flagged is not None:
+        mark_flagged(ax, theta, en, np.asarray(flagged, bool) & ok)
     if law is not None:
         a, b = law
         t = np.linspace(3.0, 90.0, 300)
@@ -117,7 +178,7 @@ def plot_en_theta(
     ax.set_xlabel(r"impact angle $\theta_i$ [deg]")
     ax.set_ylabel(r"normal coefficient of restitution $e_N$")
     ax.set_title(title or r"[$\theta_i$ - $e_N$] relationship (thesis Fig. 5.7)")
-    ax.legend(fontsize=8)
+    outside_legend(ax)
     return fig
 
 
@@ -127,6 +188,7 @@ def plot_et_impacts(
     impact_number: ArrayLike | None = None,
     material: Sequence[str] | None = None,
     title: str | None = None,
+    flagged: ArrayLike | None = None,
 ) -> Figure:
     """Tangential coefficient of restitution per impact (thesis Fig. 5.8).
 
@@ -138,6 +200,8 @@ def plot_et_impacts(
         Horizontal axis ("calculation #"); default 1, 2, ...
     material
         Slope material per impact; the legend gives each material's mean e_T.
+    flagged
+        Per impact, True for impacts with quality flags: ringed in red.
     """
     et = np.asarray(e_t, float)
     number = (
@@ -166,8 +230,10 @@ def plot_et_impacts(
     ax.set_ylim(0, max(1.4, float(np.nanmax(et)) * 1.1 if ok.any() else 1.4))
     ax.set_xlabel("impact (calculation #)")
     ax.set_ylabel(r"tangential coefficient of restitution $e_T$")
+    if flagged is not None:
+        mark_flagged(ax, number, et, np.asarray(flagged, bool) & ok)
     ax.set_title(title or r"$e_T$ per impact (thesis Fig. 5.8)")
-    ax.legend(fontsize=8)
+    outside_legend(ax)
     return fig
 
 
@@ -190,17 +256,21 @@ def write_restitution_figures(
     )
     mat = None if impacts["material"].isna().all() else material.tolist()
     name = ", ".join(table.paths())
+    flagged = qa_flagged(impacts)
     en_fig = plot_en_theta(
         impacts["theta_i_deg"],
         impacts["e_n"],
         material=mat,
         law=law,
         title=f"{name}: [θi - eN] with eq. 5.4 (thesis Fig. 5.7)",
+        theta0_source=impacts["theta0_source"].tolist(),
+        flagged=flagged,
     )
     et_fig = plot_et_impacts(
         impacts["e_t"],
         material=mat,
         title=f"{name}: $e_T$ per impact (thesis Fig. 5.8)",
+        flagged=flagged,
     )
     return (
         save_png(en_fig, en_path, outputs=outputs),

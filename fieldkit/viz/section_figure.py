@@ -2,9 +2,11 @@
 
 Left: the whole section at true scale -- ground line through the impact points, each
 flight's parabola (solid where a tree strike fixed it, dashed where the restitution
-angle was assumed), broken trees as down arrows, impact numbers. Right: the detail the
-thesis draws as an inset -- one impact with its impact and restitution velocity
-vectors, their N and T components on the local ground, and e_N, e_T.
+angle was assumed), broken trees as down arrows, impact numbers, the restitution
+velocity at each impact with its scale ("10 m/s"), impacts with quality flags ringed;
+the legend sits outside the axes. Right: the detail the thesis draws as an inset -- one
+impact with its impact and restitution velocity vectors, their N and T components on
+the local ground, and e_N, e_T.
 """
 
 from __future__ import annotations
@@ -22,6 +24,13 @@ from fieldkit.physics.flight import flight_samples
 from fieldkit.physics.local_axes import to_section
 from fieldkit.survey import Survey
 from fieldkit.viz.figure_files import save_png
+from fieldkit.viz.marks import (
+    mark_flagged,
+    nice_speed,
+    outside_legend,
+    qa_flagged,
+    velocity_key,
+)
 
 TREE_COLOUR = "#2e7d32"
 FLIGHT_COLOUR = "#1f4e9c"
@@ -98,8 +107,8 @@ def plot_section(table: ImpactTable, survey: Survey | None = None) -> Figure:
     vfx, vfz = f["vf_x_mps"].to_numpy(float), f["vf_z_mps"].to_numpy(float)
     ok = np.isfinite(vfx) & np.isfinite(vfz)
     if ok.any():
-        top = float(np.nanmax(f["vf_mps"].to_numpy(float)[ok]))
-        ax.quiver(
+        top = float(np.nanmax(np.hypot(vfx[ok], vfz[ok])))
+        arrows = ax.quiver(
             x[ok],
             z[ok],
             vfx[ok],
@@ -113,6 +122,7 @@ def plot_section(table: ImpactTable, survey: Survey | None = None) -> Figure:
             zorder=6,
             label="restitution velocity $v_f$ (∝ speed)",
         )
+    mark_flagged(ax, x, z, qa_flagged(f))
     step = max(1, len(f) // 15)
     for i, row in enumerate(f.itertuples(index=False)):
         if i % step == 0 or i == len(f) - 1:
@@ -143,7 +153,17 @@ def plot_section(table: ImpactTable, survey: Survey | None = None) -> Figure:
         f"{', '.join(table.paths())}: mapped impact points ({len(f)}) and trajectories"
     )
     ax.grid(True, alpha=0.3)
-    ax.legend(loc="upper right", fontsize=8)
+    outside_legend(ax, below=True)
+    if ok.any():  # after the limits are set: the key goes where nothing is drawn
+        drawn = [(x, z), *((xs, zs) for xs, zs, _ in flight_paths(table))]
+        drawn.append((x[ok] + vfx[ok] / arrows.scale, z[ok] + vfz[ok] / arrows.scale))
+        velocity_key(
+            ax,
+            arrows,
+            top,
+            np.concatenate([d[0] for d in drawn]),
+            np.concatenate([d[1] for d in drawn]),
+        )
 
     i = detail_row(table)
     if i is not None:
@@ -201,6 +221,17 @@ def _draw_detail(ax: Axes, row, f, i: int) -> None:
     )
     for start, vec, colour in comps:
         arrow(start, vec, colour, style=(0, (3, 2)), width=1.0)
+    key = nice_speed(max(row.vi_mps, row.vf_mps))  # the scale of these arrows
+    key_start = p + np.array([0.15, -1.45])
+    arrow(key_start, np.array([key * scale, 0.0]), "0.25", width=1.5)
+    ax.text(
+        *(key_start + np.array([key * scale / 2, 0.06])),
+        f"{key:g} m/s",
+        fontsize=8,
+        ha="center",
+        va="bottom",
+        color="0.25",
+    )
     ax.text(
         *(p - vi_s + 0.08 * normal),
         f"$v_i$ = {row.vi_mps:.1f} m/s\n$\\theta_i$ = {row.theta_i_deg:.0f}°",

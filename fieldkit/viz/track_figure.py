@@ -2,15 +2,20 @@
 
 :func:`write_track_figures` writes into a folder:
 
-* ``track.png`` — the tracked centres coloured by flight with the fitted parabolas and
-  the impacts, over a video frame (pixels) when one is given and the track carries
-  image coordinates, else in the section plane x-z (metres, equal axes);
+* ``track.png`` — the tracked centres coloured by flight with the fitted parabolas, the
+  impacts with their impact and restitution velocity arrows (and the arrows' scale),
+  the ground at each impact (the surface of dip ``slope_deg`` one radius below the
+  centre), impacts with quality flags ringed, over a video frame (pixels) when one is
+  given and the track carries image coordinates, else in the section plane x-z
+  (metres, equal axes);
 * ``speed_spin.png`` — speed (measured by local differentiation, and from the flight
   fits) and spin against time, contacts shaded;
 * ``residuals.png`` — distance of each sample from its fitted flight [mm], with the
   estimated position noise;
 * ``net_contact_<i>.png`` — for each extended contact, speed and share of impulse
   absorbed against time from contact start (thesis Figs. 8.14 and 8.15).
+
+Every axis names its unit; legends sit outside the axes.
 """
 
 from __future__ import annotations
@@ -23,11 +28,17 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from fieldkit.outputs import OutputSet
+from fieldkit.tracking.flights.net_contacts import NetContact
 from fieldkit.tracking.flights.pipeline import TrackAnalysis
 from fieldkit.viz.figure_files import new_figure, save_png
 from fieldkit.viz.image_projection import project, world_to_image
+from fieldkit.viz.marks import mark_flagged, outside_legend, qa_flagged, velocity_key
 
 _CONTACT_SHADE = dict(color="0.85", zorder=0)
+GROUND_COLOUR = "#6b4f2a"
+VI_COLOUR, VF_COLOUR = "crimson", "#1f4e9c"
+#: The longest velocity arrow spans this share of the track's horizontal extent.
+ARROW_SHARE = 0.12
 
 #: The figures every track gets (net contacts add ``net_contact_<i>.png``).
 TRACK_FIGURE_NAMES: tuple[str, ...] = ("track.png", "speed_spin.png", "residuals.png")
@@ -63,12 +74,12 @@ def write_track_figures(
     """
     out = Path(directory)
     drawings = [
-        (TRACK_FIGURE_NAMES[0], lambda: _track_figure(analysis, background_frame)),
-        (TRACK_FIGURE_NAMES[1], lambda: _speed_spin_figure(analysis)),
-        (TRACK_FIGURE_NAMES[2], lambda: _residual_figure(analysis)),
+        (TRACK_FIGURE_NAMES[0], lambda: plot_track(analysis, background_frame)),
+        (TRACK_FIGURE_NAMES[1], lambda: plot_speed_spin(analysis)),
+        (TRACK_FIGURE_NAMES[2], lambda: plot_residuals(analysis)),
     ]
     drawings += [
-        (f"net_contact_{c.index}.png", functools.partial(_net_figure, c))
+        (f"net_contact_{c.index}.png", functools.partial(plot_net_contact, c))
         for c in analysis.contacts
     ]
     into = OutputSet() if outputs is None else outputs
@@ -84,7 +95,9 @@ def _flight_colour(i: int):
     return matplotlib.colormaps["tab10"](i % 10)
 
 
-def _track_figure(a: TrackAnalysis, background) -> Figure:
+def plot_track(a: TrackAnalysis, background: np.ndarray | None = None) -> Figure:
+    """``track.png`` (see the module docstring): over ``background`` (a BGR frame) in
+    pixels when the track has image coordinates, else in the section plane."""
     f = a.track.frame
     h = world_to_image(f) if background is not None else None
     fig, ax = new_figure(8.0, 5.5)
@@ -119,10 +132,13 @@ def _track_figure(a: TrackAnalysis, background) -> Figure:
             label=f"flight {fl.index}: g = {fl.g_mps2:.2f} ± {fl.g_se_mps2:.2f}",
         )
     imp = a.impacts.frame
+    arrows = None
     if len(imp):
         sx = -1.0 if any("mirrored" in w for w in a.warnings) else 1.0
+        span_m = float(np.nanmax(f["x_m"]) - np.nanmin(f["x_m"]))
         x, z = sx * imp["x_m"].to_numpy(float), imp["z_m"].to_numpy(float)
-        pts = project(h, x, z) if h is not None else np.column_stack([x, z])
+        pts = _plot_points(h, x, z)
+        _draw_ground(ax, imp, sx, h, span_m=span_m)
         ax.plot(pts[:, 0], pts[:, 1], "x", color="crimson", ms=8, label="impacts")
         for (px, py), p, en, et in zip(
             pts, imp["point"], imp["e_n"], imp["e_t"], strict=True
@@ -134,8 +150,102 @@ def _track_figure(a: TrackAnalysis, background) -> Figure:
                 xytext=(4, -10),
                 textcoords="offset points",
             )
-    ax.legend(fontsize=7, loc="best")
+        mark_flagged(ax, pts[:, 0], pts[:, 1], qa_flagged(imp))
+        arrows = _draw_velocities(ax, imp, sx, h, span_m=span_m)
+    outside_legend(ax, fontsize=7)
+    if arrows is not None:  # after the limits are set: the key goes where nothing is
+        quiver, largest, tips = arrows
+        drawn = np.vstack([np.column_stack([u, v]), pts, tips])
+        velocity_key(ax, quiver, largest, drawn[:, 0], drawn[:, 1])
     return fig
+
+
+def _plot_points(h, x, z) -> np.ndarray:
+    """``(n, 2)`` plot coordinates of world points: pixels over a frame, else metres."""
+    return project(h, x, z) if h is not None else np.column_stack([x, z])
+
+
+def _draw_ground(ax, imp, sx: float, h, *, span_m: float) -> None:
+    """The surface at each impact: the line of dip ``slope_deg`` through the contact
+    point one radius below the centre (along -N), reaching halfway to the neighbouring
+    impacts (a quarter of the track's extent for a single impact)."""
+    psi = np.radians(imp["slope_deg"].to_numpy(float))
+    x, z = sx * imp["x_m"].to_numpy(float), imp["z_m"].to_numpy(float)
+    radius = np.nan_to_num(imp["radius_m"].to_numpy(float))
+    tangent = np.column_stack([sx * np.cos(psi), -np.sin(psi)])  # T, track frame
+    normal = np.column_stack([sx * np.sin(psi), np.cos(psi)])  # N, track frame
+    contact = np.column_stack([x, z]) - radius[:, None] * normal
+    gaps = np.abs(np.diff(x))
+    reach = np.full(len(x), 0.25 * span_m)
+    if len(x) > 1:
+        left = np.concatenate([[np.inf], gaps])
+        right = np.concatenate([gaps, [np.inf]])
+        reach = 0.5 * np.minimum(left, right)
+    label = "ground at each impact (slope_deg)"
+    for c, t, r, ok in zip(contact, tangent, reach, np.isfinite(psi), strict=True):
+        if not ok:
+            continue
+        ends = np.array([c - r * t, c + r * t])
+        line = _plot_points(h, ends[:, 0], ends[:, 1])
+        ax.plot(line[:, 0], line[:, 1], "-", color=GROUND_COLOUR, lw=2.0, label=label)
+        label = None
+
+
+def _draw_velocities(ax, imp, sx: float, h, *, span_m: float):
+    """Impact velocity arrows ending at each impact and restitution velocity arrows
+    leaving it, at one scale. Returns ``(quiver, largest speed, arrow tips)`` for the
+    key, or None when no velocity is finite.
+
+    Over a video frame the arrows are the projected displacements, scaled by the
+    median image scale at the impacts [px/m], so the key is exact for a camera
+    square to the plane."""
+    centre = np.column_stack(
+        [sx * imp["x_m"].to_numpy(float), imp["z_m"].to_numpy(float)]
+    )
+    vi = np.column_stack(
+        [sx * imp["vi_x_mps"].to_numpy(float), imp["vi_z_mps"].to_numpy(float)]
+    )
+    vf = np.column_stack(
+        [sx * imp["vf_x_mps"].to_numpy(float), imp["vf_z_mps"].to_numpy(float)]
+    )
+    speeds = np.concatenate([np.hypot(*vi.T), np.hypot(*vf.T)])
+    if not np.isfinite(speeds).any():
+        return None
+    largest = float(np.nanmax(speeds))
+    tau = ARROW_SHARE * max(span_m, 1e-9) / largest  # [s]: arrow length = v tau [m]
+    scale = 1.0  # plot units per metre
+    if h is not None:
+        step = _plot_points(h, centre[:, 0] + 1.0, centre[:, 1]) - _plot_points(
+            h, centre[:, 0], centre[:, 1]
+        )
+        scale = float(np.nanmedian(np.hypot(*step.T)))
+    starts, vectors, colours = [], [], []
+    for start_m, end_m, colour in (
+        (centre - vi * tau, centre, VI_COLOUR),
+        (centre, centre + vf * tau, VF_COLOUR),
+    ):
+        ok = np.isfinite(start_m).all(axis=1) & np.isfinite(end_m).all(axis=1)
+        a = _plot_points(h, start_m[ok, 0], start_m[ok, 1])
+        b = _plot_points(h, end_m[ok, 0], end_m[ok, 1])
+        starts.append(a)
+        vectors.append((b - a) / (tau * scale))  # m/s along the plot's axes
+        colours += [colour] * int(ok.sum())
+    starts, vectors = np.vstack(starts), np.vstack(vectors)
+    quiver = ax.quiver(
+        starts[:, 0],
+        starts[:, 1],
+        vectors[:, 0],
+        vectors[:, 1],
+        color=colours,
+        angles="xy",
+        scale_units="xy",
+        scale=1.0 / (tau * scale),
+        width=0.004,
+        zorder=6,
+    )
+    ax.plot([], [], color=VI_COLOUR, lw=2, label="impact velocity (∝ speed)")
+    ax.plot([], [], color=VF_COLOUR, lw=2, label="restitution velocity (∝ speed)")
+    return quiver, largest, starts + vectors * tau * scale
 
 
 def _shade_contacts(ax, a: TrackAnalysis) -> None:
@@ -144,7 +254,8 @@ def _shade_contacts(ax, a: TrackAnalysis) -> None:
         ax.axvspan(t0, t1, **_CONTACT_SHADE)
 
 
-def _speed_spin_figure(a: TrackAnalysis) -> Figure:
+def plot_speed_spin(a: TrackAnalysis) -> Figure:
+    """``speed_spin.png``: speed and spin against time, contacts shaded."""
     import matplotlib.pyplot as plt
 
     f = a.track.frame
@@ -165,7 +276,7 @@ def _speed_spin_figure(a: TrackAnalysis) -> Figure:
             label=f"flight {fl.index} fit",
         )
     ax1.set_ylabel("speed [m/s]")
-    ax1.legend(fontsize=7)
+    outside_legend(ax1, fontsize=7)
     omega = f["omega_radps"].to_numpy(float)
     if np.isfinite(omega).any():
         ax2.plot(t, omega, ".", ms=2, color="0.3", label="omega (track)")
@@ -177,7 +288,7 @@ def _speed_spin_figure(a: TrackAnalysis) -> Figure:
     if len(imp):
         ax2.plot(imp["t_s"], imp["omega_i_radps"], "v", color="crimson", label="before")
         ax2.plot(imp["t_s"], imp["omega_f_radps"], "^", color="green", label="after")
-        ax2.legend(fontsize=7)
+        outside_legend(ax2, fontsize=7)
     ax2.set_ylabel("spin omega [rad/s]")
     ax2.set_xlabel("t [s]")
     for ax in (ax1, ax2):
@@ -186,7 +297,8 @@ def _speed_spin_figure(a: TrackAnalysis) -> Figure:
     return fig
 
 
-def _residual_figure(a: TrackAnalysis) -> Figure:
+def plot_residuals(a: TrackAnalysis) -> Figure:
+    """``residuals.png``: distance of each sample from its fitted flight [mm]."""
     f = a.track.frame
     fig, ax = new_figure(8.0, 4.0)
     for fl in a.flights:
@@ -210,11 +322,12 @@ def _residual_figure(a: TrackAnalysis) -> Figure:
     _shade_contacts(ax, a)
     ax.set_xlabel("t [s]")
     ax.set_ylabel("distance from fitted flight [mm]")
-    ax.legend(fontsize=7)
+    outside_legend(ax, fontsize=7)
     return fig
 
 
-def _net_figure(c) -> Figure:
+def plot_net_contact(c: NetContact) -> Figure:
+    """``net_contact_<i>.png``: speed and impulse absorbed through a net contact."""
     import matplotlib.pyplot as plt
 
     fig, (ax1, ax2) = plt.subplots(

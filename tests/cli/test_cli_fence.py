@@ -63,7 +63,7 @@ def test_time_force_table_section_8_3_2(cli):
         )
         assert row, name
         assert float(row.group(1)) == pytest.approx(t, abs=0.005)
-        # stiff: 24.9 kN by eq. 8.4 (thesis prints 22.0, THESIS-NOTES erratum)
+        # stiff: 24.9 kN by eq. 8.4 (thesis prints 22.0, docs/thesis-notes.md erratum)
         assert float(row.group(2)) == pytest.approx(
             force, abs=0.5 if force > 100 else 0.05
         )
@@ -71,7 +71,8 @@ def test_time_force_table_section_8_3_2(cli):
 
 def test_computed_rebound_8a_inputs(cli):
     # 8A inputs; eq. 4.20-4.22 give v_fT 5.4, omega_f -12.6 (thesis prints 9.9, -11.6:
-    # THESIS-NOTES), v_fN = 16.85 * 0.347 = 5.84 (thesis 5.9 with e_N rounded to 0.35).
+    # docs/thesis-notes.md), v_fN = 16.85 * 0.347 = 5.84 (thesis 5.9 with e_N rounded to
+    # 0.35).
     result = cli(
         "fence",
         "--mass",

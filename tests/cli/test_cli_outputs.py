@@ -415,3 +415,21 @@ def test_formula_text_is_quoted_in_csv_and_read_back(cli, work, formula_survey):
     table = ImpactTable.read(work / "t.csv").frame
     assert table["point"].tolist() == FORMULAS  # lossless round trip
     assert set(table["path_id"]) == {FORMULAS[0]}
+
+
+def test_xlsx_refuses_a_control_character_in_one_line(cli, tmp_path):
+    """openpyxl cannot store control characters: one line naming the cell, no file."""
+    table = tmp_path / "bell.csv"
+    table.write_text(
+        "path_id,point,x_m,z_m,slope_deg,vi_x_mps,vi_z_mps,vf_x_mps,vf_z_mps\n"
+        'p,"a\x07b",0,10,30,5,-5,4,2\n'
+    )
+    from fieldkit.errors import FieldkitError
+    from fieldkit.impact_table import ImpactTable
+
+    out = tmp_path / "bell.xlsx"
+    with pytest.raises(
+        FieldkitError, match=r"bell.xlsx: row 1: column point: .*control"
+    ):
+        ImpactTable.read(table).write(out)
+    assert not out.exists()

@@ -366,7 +366,7 @@ def test_gpx_track_only_for_gpx_tracks(cli, tmp_path, fails, digest):
 
 
 def test_a_real_multi_track_file(cli, external_data, tmp_path, fails, digest):
-    gpx = external_data / "gpx_gpxpy" / "test_files" / "cerknicko-jezero.gpx"
+    gpx = external_data / "gpx_gpxpy" / "cerknicko-jezero.gpx"
     args = ("--impacts", gpx, "--gpx-points", "track", "--theta0", "30")
     fails_cleanly(
         cli,

@@ -74,9 +74,8 @@ def clip(render, tmp_path_factory):
 def test_help_has_an_example(cli):
     result = cli("track", "--help")
     assert result.exit_code == 0
-    assert (
-        "--scale-points" in result.stdout and "fieldkit track video/" in result.stdout
-    )
+    assert "fieldkit track out/clips/bounce_short.avi --fps 1205" in result.stdout
+    assert "--homography out/clips/bounce_short.homography.json" in result.stdout
 
 
 def test_track_writes_track_and_warns_about_playback_rate(cli, clip, tmp_path, digest):

@@ -36,7 +36,7 @@ def summary(path: Path) -> str:
 def test_help_has_an_example(cli):
     result = cli("view", "--help")
     assert result.exit_code == 0
-    assert "fieldkit view impacts.csv -o impacts.rrd" in result.stdout
+    assert "fieldkit view out/boulder_a.csv -o out/boulder_a.rrd" in result.stdout
 
 
 def test_track_csv_to_recording_and_figures(cli, track_csv, tmp_path):

@@ -15,7 +15,7 @@ from fieldkit.io import geodesy
 from fieldkit.io.gpx import read_gpx_waypoints, write_gpx_waypoints
 from fieldkit.io.impacts import read_impacts
 
-GPXPY = "gpx_gpxpy/test_files"
+GPXPY = "gpx_gpxpy"
 
 
 def sample_frame() -> pd.DataFrame:

@@ -2,8 +2,8 @@
 
 Worked examples are typed in from the thesis with their section; tolerances follow the
 printed precision (0.1 kJ printed -> +-0.05 kJ). Where the thesis is wrong
-(THESIS-NOTES erratum of eq. 6.7) the correct physics is asserted and the printed value
-is quoted in a comment.
+(docs/thesis-notes.md erratum of eq. 6.7) the correct physics is asserted and the
+printed value is quoted in a comment.
 """
 
 from __future__ import annotations
@@ -88,7 +88,7 @@ def test_6b_impulses():
 
 
 def test_6b_compression_energy_corrected_eq_6_7():
-    # Erratum (THESIS-NOTES): eq. 6.7 drops a factor 1/2. The integral is
+    # Erratum (docs/thesis-notes.md): eq. 6.7 drops a factor 1/2. The integral is
     # -m v_iN^2 / (2 (beta3 + mu beta2)) = -6.38 kJ; the thesis prints -12.9 kJ.
     beta = B3 + MU * B2
     expected = -3750.0 * 4.4**2 / (2 * beta)
@@ -111,7 +111,8 @@ def test_6b_restitution_energy_eq_6_8():
 
 
 def test_6b_friction_energy_eq_6_9():
-    # THESIS-NOTES: eq. 6.9 with the printed inputs is -30.8 kJ (thesis prints -31.3).
+    # docs/thesis-notes.md: eq. 6.9 with the printed inputs is -30.8 kJ (thesis:
+    # -31.3 kJ).
     r = _6b()
     assert r.friction_j / 1e3 == pytest.approx(-30.8, abs=0.05)
     assert sliding_friction_energy(

@@ -1,7 +1,7 @@
 """Energy ratios of six real impacts (Caviezel et al. 2019, Earth Surf. Dynam. 7:199).
 
 Chant Sura test site, 780 kg EOTA block; the table (MIT-licensed preprocessing of the
-CC BY 4.0 article tables, read in place via the ``external_data`` fixture, not copied)
+CC BY 4.0 article tables, in tests/data/chant_sura_2019 with their attribution)
 gives incoming speed and its normal/tangential split, translational energy before and
 after each impact, and the published energy ratio E_out/E_in. One impact *gains*
 energy (ratio 1.11): nothing here may assume KE_out <= KE_in.
@@ -18,7 +18,7 @@ import pytest
 from fieldkit.physics.energy import kinetic_energy
 from fieldkit.physics.fences import energy_efficiency
 
-FOLDER = "tschamut2014_and_esurf2019/scarring_single_impact"
+FOLDER = "chant_sura_2019"
 FILE = f"{FOLDER}/chant_sura_esurf_2019_impacts.csv"
 
 #: Rows whose published ratio does not follow from the published energies at the

@@ -1,5 +1,5 @@
 """Fall velocity with slope angle and effective friction (thesis eqs. 3.13-3.16,
-Table 3-1, worked example 3C with the erratum of THESIS-NOTES)."""
+Table 3-1, worked example 3C with the erratum of docs/thesis-notes.md)."""
 
 from __future__ import annotations
 
@@ -48,8 +48,8 @@ def test_example_3c_table_values_reproduce_the_observed_eta():
 
 def test_example_3c_tornado_mountain_corrected():
     # Thesis: eta = 12.5 / (2 g 250)^0.5 = 0.39 and mu' = tan 22 (1 - 0.39^2) = 0.34.
-    # ERRATUM (THESIS-NOTES): 12.5 / sqrt(2 * 9.81 * 250) = 12.5 / 70.04 = 0.178, which
-    # gives mu' = tan 22 (1 - 0.178^2) = 0.391.
+    # ERRATUM (docs/thesis-notes.md): 12.5 / sqrt(2 * 9.81 * 250) = 12.5 / 70.04 =
+    # 0.178, which gives mu' = tan 22 (1 - 0.178^2) = 0.391.
     eta = velocity_ratio(12.5, 250.0)
     assert float(eta) == pytest.approx(0.1785, abs=1e-4)
     assert float(eta) != pytest.approx(0.39, abs=0.05)

@@ -86,9 +86,9 @@ def test_8a_components_and_restitution():
 
 
 def test_8a_tangential_and_spin_corrected():
-    """THESIS-NOTES: 8A is inconsistent. Eq. 4.20 with omega_i = +18 gives v_fT = 5.4
-    (printed 9.9) and eq. 4.22 omega_f = -12.6 (printed -11.6); omega_i = -18 would
-    give v_fT = 11.6. Checked by hand: beta1 = 1 + 0.43^2/0.35^2."""
+    """docs/thesis-notes.md: 8A is inconsistent. Eq. 4.20 with omega_i = +18 gives v_fT
+    = 5.4 (printed 9.9) and eq. 4.22 omega_f = -12.6 (printed -11.6); omega_i = -18
+    would give v_fT = 11.6. Checked by hand: beta1 = 1 + 0.43^2/0.35^2."""
     beta1 = 1 + 0.43**2 / 0.35**2
     v_it = 22 * math.cos(math.radians(50))
     by_hand = v_it - (v_it + 0.43 * 18) / beta1

@@ -2,7 +2,7 @@
 conservation laws.
 
 References: thesis worked examples 3A, 3B and §3.3.1, re-derived by hand in
-shared/design/THESIS-NOTES.md. Where the thesis rounded, the unrounded physics is
+docs/thesis-notes.md. Where the thesis rounded, the unrounded physics is
 asserted and the printed figure is cited in a comment.
 """
 

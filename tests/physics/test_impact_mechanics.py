@@ -84,8 +84,8 @@ def test_figure_4_9_a_and_b():
 def test_figure_4_9_c_erratum():
     # Fig. 4.9 c) omega_i = +15 rad/s: thesis prints v_f = 12.9 m/s, theta_f = 27.1 deg.
     # With the thesis's own rounded inputs (19.9, -9.3, k = 0.47, e_N = 0.71) eq. 4.20
-    # gives v_f = 12.93 (as printed) but theta_f = 30.7 deg, not 27.1 (THESIS-NOTES);
-    # the unrounded inputs give 12.84 m/s at 30.8 deg.
+    # gives v_f = 12.93 (as printed) but theta_f = 30.7 deg, not 27.1
+    # (docs/thesis-notes.md); the unrounded inputs give 12.84 m/s at 30.8 deg.
     printed = rough_body_impact(19.9, -9.3, 15.0, radius_m=R, gyration_m=0.47, e_n=0.71)
     assert printed.v_f_mps == pytest.approx(12.9, abs=0.05)
     assert printed.theta_f_deg == pytest.approx(30.7, abs=0.05)  # thesis: 27.1
@@ -131,7 +131,7 @@ def test_impulses_worked_example_6b():
 def test_general_solver_reproduces_c16_c18_and_corrected_energies_6b():
     # The general solver in the constant-slip regime of 6B (omega_i = 0, slip never
     # stops) must give C.16/C.18 with the unrounded betas, and the energies of eqs.
-    # 6.7 (corrected by 1/2, THESIS-NOTES: about -6.4 kJ, thesis prints -12.9),
+    # 6.7 (corrected by 1/2, docs/thesis-notes.md: about -6.4 kJ, thesis prints -12.9),
     # 6.8 (thesis 10.7 kJ, truncated: its own p_c, p_f give 10.77) and 6.9 (about
     # -30.8 kJ; thesis prints -31.3 from rounded intermediates).
     m, mu = 3750.0, 0.68

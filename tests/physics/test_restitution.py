@@ -18,7 +18,7 @@ from fieldkit.physics.restitution import (
 
 def test_equation_5_4_thesis_values():
     # Thesis §5.2.3 / worked example 4A: theta_i = 25 deg -> e_N = 0.71;
-    # theta_i = 50 deg -> 0.35 (THESIS-NOTES).
+    # theta_i = 50 deg -> 0.35 (docs/thesis-notes.md).
     assert (ANGLE_LAW_A, ANGLE_LAW_B) == (19.5, 1.03)
     e = angle_dependent_restitution([25.0, 50.0])
     assert e == pytest.approx([0.71, 0.35], abs=0.005)

@@ -31,7 +31,7 @@ def test_thesis_impulse():
         ("rigid", 0.15, 151),  # n = 1e6: t1 = 0.15 s, F = 151 kN
         ("flexible", 0.95, 36.1),  # a = 4e4, x = 2.0: t2 = 0.95 s, F = 36.1 kN
         # b = 3e4, x = 0.6: t3 = 0.73 s; F = 24.9 kN by eq. 8.4. The thesis prints
-        # 22.0 kN (THESIS-NOTES erratum of section 8.3.2).
+        # 22.0 kN (docs/thesis-notes.md erratum of section 8.3.2).
         ("stiff", 0.73, 24.9),
     ],
 )

@@ -1,9 +1,9 @@
 """The other thesis case studies in surveys/ against the rows that reproduce.
 
-THESIS-NOTES: Tables 2-1, 2-2, 2-3 were derived partly from instrument data the thesis
-does not give, so only some rows reproduce from coordinates: asphalt #2 (Table 2-5:
-e_N 0.38, e_T 0.24, V_i 21.5 m/s, theta_i 50° in §2.3) and the Oregon ditch impact #3
-(Table 2-2: e_N 0.24, e_T 0.55). Those are checked to the table's printed precision.
+docs/thesis-notes.md: Tables 2-1, 2-2, 2-3 were derived partly from instrument data the
+thesis does not give, so only some rows reproduce from coordinates: asphalt #2 (Table
+2-5: e_N 0.38, e_T 0.24, V_i 21.5 m/s, theta_i 50° in §2.3) and the Oregon ditch impact
+#3 (Table 2-2: e_N 0.24, e_T 0.55). Those are checked to the table's printed precision.
 
 The section files carry the thesis's restitution angle per point as ``theta0_deg``
 (theta0 = 180 - alpha_f + psi); the points reader does not keep that column yet, so

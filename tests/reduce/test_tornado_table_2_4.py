@@ -13,7 +13,7 @@ theta0 = 32.6° (see that folder's README). The command is the one of issue 2's
 
 Tolerances (issue 2): KE loss within 1 %, e_T within 0.05, e_N within 0.06. Rows that
 do not reproduce from the thesis's own printed inputs are listed explicitly with the
-reason (THESIS-NOTES errata); they are not hidden behind a looser tolerance.
+reason (docs/thesis-notes.md errata); they are not hidden behind a looser tolerance.
 """
 
 from __future__ import annotations
@@ -78,10 +78,11 @@ E 185.0 32.0 1.19 0.74 -649674
 """
 
 #: Rows whose printed value the thesis's own printed inputs do not reproduce.
-#: 22/23 and 32/33: coordinate typos (THESIS-NOTES), row 23's psi is not the chord.
+#: 22/23 and 32/33: coordinate typos (docs/thesis-notes.md), row 23's psi is not
+#: the chord.
 TYPOS = {"22", "23", "32", "33"}
 NOT_REPRODUCIBLE_KE = {
-    **dict.fromkeys(TYPOS, "coordinate typo in Table 2-4 (THESIS-NOTES errata)"),
+    **dict.fromkeys(TYPOS, "coordinate typo in Table 2-4 (docs/thesis-notes.md)"),
     "B": "thesis uses free fall from rest, sqrt(2 g 34 m) = 25.8 m/s, at B; no "
     "ballistic path from rest reaches a point 8 m out (least-speed path: -615 kJ "
     "vs -597 kJ printed)",
@@ -180,7 +181,7 @@ def _outside(reduced, column, ref, within) -> set[str]:
 def test_ke_loss_within_1_percent_for_reproducible_rows(reduced):
     table = thesis_rows()
     rows = [p for p in table.index if p not in NOT_REPRODUCIBLE_KE]
-    assert len(rows) == 41  # THESIS-NOTES: 41 of 48 rows reproduce
+    assert len(rows) == 41  # docs/thesis-notes.md: 41 of 48 rows reproduce
     ratio = reduced.loc[rows, "dke_j"] / table.loc[rows, "dke"]
     assert np.all(np.abs(ratio - 1.0) < 0.01), ratio[np.abs(ratio - 1) >= 0.01]
 
@@ -188,7 +189,7 @@ def test_ke_loss_within_1_percent_for_reproducible_rows(reduced):
 def test_e_t_within_0_05_for_reproducible_rows(reduced):
     table = thesis_rows()
     rows = [p for p in table.index if p not in NOT_REPRODUCIBLE_ET]
-    assert len(rows) == 39  # THESIS-NOTES: 39 of 48
+    assert len(rows) == 39  # docs/thesis-notes.md: 39 of 48
     diff = reduced.loc[rows, "e_t"] - table.loc[rows, "e_t"]
     assert np.all(np.abs(diff) <= 0.05), diff[np.abs(diff) > 0.05]
 
@@ -196,7 +197,7 @@ def test_e_t_within_0_05_for_reproducible_rows(reduced):
 def test_e_n_within_0_06_for_reproducible_rows(reduced):
     table = thesis_rows()
     rows = [p for p in table.index if p not in NOT_REPRODUCIBLE_EN]
-    assert len(rows) == 30  # THESIS-NOTES: 30 of 48
+    assert len(rows) == 30  # docs/thesis-notes.md: 30 of 48
     diff = reduced.loc[rows, "e_n"] - table.loc[rows, "e_n"]
     assert np.all(np.abs(diff) <= 0.06), diff[np.abs(diff) > 0.06]
 

@@ -103,7 +103,7 @@ def test_efficiency_without_mass_is_per_unit_mass(capture):
     assert c.efficiency == pytest.approx(analysis.contacts[0].efficiency)
 
 
-# --- the local frame of a net contact (ARCHITECTURE §2: N faces the body, vin < 0) ---
+# --- the local frame of a net contact (docs/architecture.md §2: N faces the body) ---
 
 
 def with_marker(track: Track, omega_radps: float, seed: int) -> Track:

@@ -13,10 +13,10 @@ For each contact between two fitted flights
   fitted to the deviations, not the first sample beyond noise).
 * **Velocities.** Impact velocity from the flight before, restitution velocity from the
   flight after, both evaluated at the contact time(s) (fixed-g fits).
-* **Surface angle** ``slope_deg`` (psi, ARCHITECTURE §2), always on the side facing
-  the incoming body so that ``vin < 0``: given, or estimated from the contact points,
-  the spin balance or the contact's chord; left NaN (e_n, e_t NaN, with a warning)
-  when the data cannot identify it (a net without spin). Details and measured
+* **Surface angle** ``slope_deg`` (psi, docs/architecture.md §2), always on the side
+  facing the incoming body so that ``vin < 0``: given, or estimated from the contact
+  points, the spin balance or the contact's chord; left NaN (e_n, e_t NaN, with a
+  warning) when the data cannot identify it (a net without spin). Details and measured
   accuracy in :mod:`fieldkit.tracking.flights.contact_surface`.
 * **Spin** before and after: slope of a straight line through the unwrapped marker
   angle over the whole adjacent flight (spin is constant in free flight), else the

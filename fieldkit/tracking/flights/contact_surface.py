@@ -1,6 +1,6 @@
 """The surface at a contact: its dip psi, on the side facing the body.
 
-``slope_deg`` (psi) fixes the local axes of an impact (ARCHITECTURE §2,
+``slope_deg`` (psi) fixes the local axes of an impact (docs/architecture.md §2,
 :mod:`fieldkit.physics.local_axes`): ``N = (sin psi, cos psi)`` is the outward normal,
 ``T = (cos psi, -sin psi)`` its right-handed partner along the surface. A dip alone
 fixes the surface *line*; psi and psi - 180 are the same line with opposite normals.
@@ -8,10 +8,10 @@ Here the normal is always the one facing the incoming body (:func:`facing_body`)
 ``vin < 0`` and, for a body that leaves the surface, ``vfn > 0``. psi lies in
 (-180, 180]: beyond +/-90 deg the body met the surface from below (an overhanging net,
 a ceiling). N then faces down toward the body and T, the right-handed partner of N
-(which keeps the slip velocity ``v_s = v_T + r omega`` of ARCHITECTURE §2 valid), points
-*up* the surface: a body sliding down an overhang has ``vit < 0`` and angles to the
-surface above 90 deg. e_n is unaffected and ``e_t = vft/vit`` does not depend on the
-sign of T.
+(which keeps the slip velocity ``v_s = v_T + r omega`` of docs/architecture.md §2
+valid), points *up* the surface: a body sliding down an overhang has ``vit < 0`` and
+angles to the surface above 90 deg. e_n is unaffected and ``e_t = vft/vit`` does not
+depend on the sign of T.
 
 Where psi comes from (:func:`surface_angles`):
 
@@ -98,9 +98,9 @@ def facing_body(psi_deg: float, vi: tuple[float, float]) -> float:
     A dip fixes the surface line only up to its side: ``psi`` and ``psi - 180`` are
     the same line with opposite normals ``N = (sin psi, cos psi)``. The body strikes
     the side it comes from, so the outward normal is the one with ``vi . N < 0``
-    (ARCHITECTURE §2: ``vin < 0``). |psi| > 90 deg is a surface met from below (an
-    overhanging net, a ceiling); ``T = (cos psi, -sin psi)`` is then the right-handed
-    partner of N and points up the surface.
+    (docs/architecture.md §2: ``vin < 0``). |psi| > 90 deg is a surface met from below
+    (an overhanging net, a ceiling); ``T = (cos psi, -sin psi)`` is then the
+    right-handed partner of N and points up the surface.
 
     Examples
     --------
@@ -126,13 +126,14 @@ def surface_angle_from_spin(
     About its centre the friction impulse ``P_T`` changes both the tangential velocity
     and the spin of a rigid sphere (normal forces pass through the centre):
     ``m dv_T = P_T`` and ``m k^2 d_omega = r P_T`` (thesis ch. 4; sign convention of
-    ARCHITECTURE §2), so ``dv . T = k^2 d_omega / r`` with ``T = (cos psi, -sin psi)``.
-    ``dv`` is the change the surface caused: for a contact lasting ``duration_s`` the
-    gravity impulse is removed, ``dv = v_f - v_i + g duration z`` (for velocities taken
-    from ballistic fits at the contact ends this does not depend on where exactly the
-    ends are put). Of the two roots the one whose normal impulse ``dv . N`` is
-    outward (positive) is returned, in (-180, 180]: beyond +/-90 deg the surface was
-    met from below (an overhang, see :func:`facing_body`).
+    docs/architecture.md §2), so ``dv . T = k^2 d_omega / r`` with
+    ``T = (cos psi, -sin psi)``. ``dv`` is the change the surface caused: for a
+    contact lasting ``duration_s`` the gravity impulse is removed,
+    ``dv = v_f - v_i + g duration z`` (for velocities taken from ballistic fits at the
+    contact ends this does not depend on where exactly the ends are put). Of the two
+    roots the one whose normal impulse ``dv . N`` is outward (positive) is returned, in
+    (-180, 180]: beyond +/-90 deg the surface was met from below (an overhang, see
+    :func:`facing_body`).
 
     Examples
     --------

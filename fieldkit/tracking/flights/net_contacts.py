@@ -65,6 +65,9 @@ class NetContact:
         Eq. 8.1, ``E_f / E_i`` [-] (per unit mass when no mass is given), over the
         force contact (``video/net``: 71.34 % against 71.44 % at the true ends of the
         force, 72.95 % at the end of penetration, after 5 ballistic frames).
+    rotation_included
+        Whether the energies include the rotational energy (gyration and the spin
+        before and after known); without it they are translational only.
     """
 
     index: int
@@ -87,10 +90,29 @@ class NetContact:
     energy_f_j: float = float("nan")
     absorbed_j: float = float("nan")
     efficiency: float = float("nan")
+    rotation_included: bool = False
 
     @property
     def duration_s(self) -> float:
         return self.t_end_s - self.t_start_s
+
+    def summary(self) -> str:
+        """One line for the console: times, speeds and the energy efficiency (eq. 8.1),
+        saying what the energies include."""
+        notes = [
+            f"absorbed {self.absorbed_j:.3g} J"
+            if np.isfinite(self.absorbed_j)
+            else "per unit mass (no mass given)",
+            "translational + rotational energy"
+            if self.rotation_included
+            else "translational energy only (no spin or gyration)",
+        ]
+        return (
+            f"net contact {self.index}: t {self.t_start_s:.4f}-{self.t_end_s:.4f} s "
+            f"({1e3 * self.duration_s:.1f} ms), V_i {self.vi_mps:.3f} -> V_min "
+            f"{self.v_min_mps:.3f} -> V_f {self.vf_mps:.3f} m/s; energy efficiency "
+            f"E_f/E_i (eq. 8.1) {100 * self.efficiency:.1f} %; {'; '.join(notes)}"
+        )
 
     def to_frame(self) -> pd.DataFrame:
         """The contact time series (time from contact start)."""
@@ -276,4 +298,5 @@ def analyse_net_contact(
         energy_f_j=m * e_f_per_kg,
         absorbed_j=m * (e_i_per_kg - e_f_per_kg),
         efficiency=float(energy_efficiency(e_i_per_kg, e_f_per_kg)),
+        rotation_included=spin_known,
     )

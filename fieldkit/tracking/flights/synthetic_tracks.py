@@ -5,8 +5,8 @@ generators return the sampled :class:`~fieldkit.track.Track` together with the
 exact truth, so analysis can be checked against numbers it never saw.
 
 * :func:`bouncing_ball` — exact parabolas between instantaneous impacts on the plane
-  ``z = -x tan(psi)`` (psi positive descending toward +x, ARCHITECTURE §2). At each
-  impact ``v_fN = -e_n v_iN``, ``v_fT = e_t v_iT`` and the spin follows from the
+  ``z = -x tan(psi)`` (psi positive descending toward +x, docs/architecture.md §2). At
+  each impact ``v_fN = -e_n v_iN``, ``v_fT = e_t v_iT`` and the spin follows from the
   angular-momentum balance about the contact point of a rigid sphere,
   ``omega_f = omega_i + r (v_fT - v_iT) / k^2`` (the friction impulse that changes
   ``v_T`` also spins the body; thesis ch. 4).

@@ -6,7 +6,7 @@ direction from the body's centre to the marker's centroid (for a stripe through 
 centre: its principal axis, known modulo half a turn and unwrapped with that period),
 mapped into world axes (x right, z up, counter-clockwise positive), so a mirrored or
 rotated camera still gives the thesis sign: omega < 0 is clockwise, the rolling sense
-for travel toward +x (ARCHITECTURE §2).
+for travel toward +x (docs/architecture.md §2).
 
 omega is the slope of a local straight-line fit to the unwrapped angle over a short
 window (a smoothed derivative); its standard error comes from the scatter of the angle
