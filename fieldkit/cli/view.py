@@ -15,6 +15,7 @@ from fieldkit.cli.common import (
     RadiusOpt,
     ShapeOpt,
     UnitWeightOpt,
+    note,
     one_line_errors,
     print_body_notes,
     warn,
@@ -185,6 +186,8 @@ def view(
         gyration_m=body.gyration_m,
         path_id=input_file.stem,
     )
+    for text in track.meta.get("notes", ()):
+        note(text)
     for message in analysis.warnings:
         warn(message)
     print_body_notes(body)

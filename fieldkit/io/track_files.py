@@ -72,13 +72,19 @@ def read_track(
     (:func:`fieldkit.io.tracking_export.time_factor`).
     """
     if fmt == "tracker":
-        return read_osp_tracker(
+        track = read_osp_tracker(
             path,
             unit=unit or "m",
             metres_per_pixel=metres_per_pixel,
             fps=fps,
             file_fps=file_fps,
         )
+        if unit is None:  # the export does not say: state Tracker's default
+            track.meta.setdefault("notes", []).append(
+                "Tracker export read in metres (Tracker's default length unit; the "
+                "file does not say): give `unit` if its calibration used another"
+            )
+        return track
     if fmt == "kinovea":
         return read_kinovea(
             path,

@@ -92,6 +92,21 @@ def test_track_exports_are_detected_and_read(cli, tmp_path, sample, args):
     assert out.is_file()
 
 
+def test_tracker_metres_default_is_stated_not_silent(cli, tmp_path):
+    """A Tracker export does not say its unit: the metres default is printed; an
+    explicit --unit says it and the note goes away."""
+    sample = DATA / "osp_tracker_ball_tab_decimal_comma.txt"
+    quiet = cli("view", sample, "--radius", "0.03", "-o", tmp_path / "a.rrd")
+    assert quiet.exit_code == 0, quiet.stderr
+    assert "note: Tracker export read in metres" in quiet.stderr
+    assert "--unit" in quiet.stderr
+    told = cli(
+        "view", sample, "--radius", "0.03", "--unit", "m", "-o", tmp_path / "b.rrd"
+    )
+    assert told.exit_code == 0, told.stderr
+    assert "read in metres" not in told.stderr
+
+
 def test_wrong_playback_rate_is_flagged(cli, tmp_path):
     out = tmp_path / "x.rrd"
     result = cli(
