@@ -28,6 +28,7 @@ nodata cell, is an error naming the point.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 from os import PathLike
 from pathlib import Path
@@ -152,7 +153,8 @@ class DemGrid:
         -------
         z_m, dzdx, dzdy, status
             Elevation [m], gradient (dimensionless, of the bilinear surface in the
-            cell holding the point) and per point :data:`INSIDE`, :data:`OUTSIDE`
+            cell holding the point; on a cell edge the mean over the cells meeting
+            there) and per point :data:`INSIDE`, :data:`OUTSIDE`
             (off the cell-centre rectangle) or :data:`NODATA` (a cell the
             interpolation uses is nodata); z and gradient are NaN unless INSIDE.
         """
@@ -188,14 +190,44 @@ class DemGrid:
             used_nan |= (w > 0) & np.isnan(z)
         z = sum(np.where(w > 0, w * np.nan_to_num(c), 0.0) for w, c in zip(
             weights, corners, strict=True))  # fmt: skip
-        dzdx = ((1 - fr) * (z01 - z00) + fr * (z11 - z10)) / self.dx_m
-        dzdy = -((1 - fc) * (z10 - z00) + fc * (z11 - z01)) / self.dy_m
+        dzdx, dzdy = self._gradient(r0, c0, fr, fc)
         status = np.where(inside, np.where(used_nan, NODATA, INSIDE), OUTSIDE)
         bad = status != INSIDE
         z = np.where(bad, np.nan, z)
         dzdx = np.where(bad, np.nan, dzdx)
         dzdy = np.where(bad, np.nan, dzdy)
         return z, dzdx, dzdy, status
+
+    def _gradient(self, r0, c0, fr, fc) -> tuple[np.ndarray, np.ndarray]:
+        """Gradient of the bilinear surface; on a cell edge, the mean over the cells
+        meeting there that have data (the surface has a kink along cell edges: the
+        mean keeps a line running along an edge from being pulled to one side)."""
+        nrows, ncols = self.shape
+        sum_x = np.zeros(np.shape(fr))
+        sum_y = np.zeros(np.shape(fr))
+        count = np.zeros(np.shape(fr))
+        for dr in (0, -1):
+            for dc in (0, -1):
+                use = np.ones(np.shape(fr), bool)
+                if dr:
+                    use &= (fr == 0) & (r0 > 0)
+                if dc:
+                    use &= (fc == 0) & (c0 > 0)
+                if not use.any():
+                    continue
+                r, c = np.where(use, r0 + dr, r0), np.where(use, c0 + dc, c0)
+                gr, gc = np.where(use & (dr != 0), 1.0, fr), np.where(
+                    use & (dc != 0), 1.0, fc)  # fmt: skip
+                z00, z01 = self.values[r, c], self.values[r, c + 1]
+                z10, z11 = self.values[r + 1, c], self.values[r + 1, c + 1]
+                gx = ((1 - gr) * (z01 - z00) + gr * (z11 - z10)) / self.dx_m
+                gy = -((1 - gc) * (z10 - z00) + gc * (z11 - z01)) / self.dy_m
+                ok = use & np.isfinite(gx) & np.isfinite(gy)
+                sum_x += np.where(ok, gx, 0.0)
+                sum_y += np.where(ok, gy, 0.0)
+                count += ok
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return sum_x / count, sum_y / count
 
     def elevation(self, x_m, y_m) -> np.ndarray:
         """Bilinear elevation [m] at plan points ``(x_m, y_m)``.
@@ -232,12 +264,18 @@ class DemGrid:
         """Why a point has no elevation: off the grid, or nodata (row, column)."""
         if status == OUTSIDE:
             return f"outside the grid ({self.extent_text()})"
-        row = int(np.clip(round((self.y_m[0] - y_m) / self.dy_m), 0, self.shape[0] - 1))
-        col = int(np.clip(round((x_m - self.x_m[0]) / self.dx_m), 0, self.shape[1] - 1))
-        return (
-            f"nodata in the grid near row {row + 1}, column {col + 1}: no elevation "
-            "there"
+        row = (self.y_m[0] - y_m) / self.dy_m
+        col = (x_m - self.x_m[0]) / self.dx_m
+        corners = [
+            (r, c)
+            for r in sorted({math.floor(row), math.ceil(row)})
+            for c in sorted({math.floor(col), math.ceil(col)})
+            if 0 <= r < self.shape[0] and 0 <= c < self.shape[1]
+        ]
+        r, c = next(
+            ((r, c) for r, c in corners if np.isnan(self.values[r, c])), corners[0]
         )
+        return f"nodata in the grid at row {r + 1}, column {c + 1}: no elevation there"
 
 
 def read_dem(path: str | PathLike[str]) -> DemGrid:
@@ -437,7 +475,7 @@ def _read_geotiff(file: Path) -> DemGrid:
     source = str(file)
     try:
         import rasterio
-        from rasterio.errors import RasterioError
+        from rasterio.errors import NotGeoreferencedWarning, RasterioError
     except ImportError:  # pragma: no cover - rasterio is a dependency
         raise InputFileError(
             "reading a GeoTIFF needs rasterio (pip install rasterio); or convert it "
@@ -445,7 +483,16 @@ def _read_geotiff(file: Path) -> DemGrid:
             source=source,
         ) from None
     try:
-        with rasterio.open(file) as src:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", NotGeoreferencedWarning)
+            src = rasterio.open(file)
+        with src:
+            if src.transform.is_identity and src.crs is None:
+                raise InputFileError(
+                    "not georeferenced (no geotransform): a plain TIFF image, not a "
+                    "GeoTIFF DEM",
+                    source=source,
+                )
             if src.count != 1:
                 raise InputFileError(
                     f"has {src.count} bands; a DEM has one (elevation)", source=source
