@@ -136,6 +136,7 @@ def profile(
         str | None,
         typer.Option(
             "--from",
+            metavar="X,Y",
             help="Start of the section X,Y in the DEM's coordinates (m): the release "
             "point (required with a DEM).",
         ),
@@ -144,6 +145,7 @@ def profile(
         list[str] | None,
         typer.Option(
             "--to",
+            metavar="X,Y",
             help="Next plan vertex X,Y (m), repeatable: the section follows the "
             "polyline --from, --to, --to ... Without it: the line of steepest "
             "descent from --from.",
@@ -197,14 +199,15 @@ def profile(
     Example (Tschamut 2014: steepest descent from the release point of run v020,
     rock for the first 40 m, talus beyond):
 
-        fieldkit profile tests/data/tschamut2014/terrain.asc --from 30.602,235.28 \
-          --materials "0-40:rock,40-:talus" -o out/profile.csv \
-          --figure out/profile.png
+        fieldkit profile tests/data/tschamut2014/terrain.asc \
+          --from 30.602,235.28 --materials "0-40:rock,40-:talus" \
+          -o out/profile.csv --figure out/profile.png
 
     Along a straight line from the release point to where v020 stopped:
 
-        fieldkit profile tests/data/tschamut2014/terrain.asc --from 30.602,235.28 \
-          --to 102.22,151.49 --step 1 -o out/profile_line.csv
+        fieldkit profile tests/data/tschamut2014/terrain.asc \
+          --from 30.602,235.28 --to 102.22,151.49 --step 1 \
+          -o out/profile_line.csv
 
     A section from a CSV of vertices x, z (here the one just written; a field
     CSV in feet takes --units ft), with its materials:

@@ -290,9 +290,15 @@ def read_dem(path: str | PathLike[str]) -> DemGrid:
 
     Examples
     --------
-    >>> grid = read_dem("tests/data/tschamut2014/terrain.asc")
-    >>> grid.shape, grid.cellsize_m, float(grid.x_m[0]), float(grid.y_m[-1])
-    ((46, 43), 5.0, -32.5, 87.5)
+    >>> import tempfile, pathlib
+    >>> f = pathlib.Path(tempfile.mkdtemp()) / "dem.asc"
+    >>> _ = f.write_text("ncols 3\\nnrows 2\\nxllcorner -35\\nyllcorner 85\\n"
+    ...                  "cellsize 5\\nNODATA_value -9999\\n1 2 3\\n4 -9999 6\\n")
+    >>> grid = read_dem(f)
+    >>> grid.shape, grid.cellsize_m, grid.x_m.tolist(), grid.y_m.tolist()
+    ((2, 3), 5.0, [-32.5, -27.5, -22.5], [92.5, 87.5])
+    >>> grid.values.tolist()
+    [[1.0, 2.0, 3.0], [4.0, nan, 6.0]]
     """
     file = check_readable(path)
     with file.open("rb") as handle:

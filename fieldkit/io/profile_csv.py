@@ -77,7 +77,7 @@ def read_profile_csv(
     >>> f = pathlib.Path(tempfile.mkdtemp()) / "profile.csv"
     >>> _ = f.write_text("x_ft,z_ft,material\\n0,100,rock\\n10,90,\\n")
     >>> p = read_profile_csv(f)
-    >>> p.x_m.tolist(), p.z_m.tolist(), p.material
+    >>> p.x_m.round(4).tolist(), p.z_m.round(4).tolist(), p.material
     ([0.0, 3.048], [30.48, 27.432], ('rock',))
     """
     table = read_csv_table(path)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import doctest
+
 import numpy as np
 import pytest
 
@@ -218,3 +220,10 @@ def test_plain_tiff_without_georeferencing_is_refused(tmp_path):
         dst.write(np.ones((4, 4), "float32"), 1)
     with pytest.raises(InputFileError, match="not georeferenced"):
         read_dem(path)
+
+
+def test_doctests():
+    import fieldkit.io.dem as module
+
+    result = doctest.testmod(module)
+    assert result.attempted > 0 and result.failed == 0

@@ -1,7 +1,8 @@
-"""Sections from a DEM: analytic surfaces, material ranges, the Tschamut 2014 terrain."""
+"""Sections from a DEM: analytic surfaces, material ranges, Tschamut 2014 terrain."""
 
 from __future__ import annotations
 
+import doctest
 import math
 
 import numpy as np
@@ -286,3 +287,10 @@ def test_tschamut_descent_falls_and_stays_in_the_grid(tschamut, run):
     print(f"{run}: descent {s.length_m:.1f} m, drop {s.drop_m:.1f} m, {s.ending}; "
           f"end {end:.1f} m from the deposit (observed runout "
           f"{deposit.at[run, 'observed_runout_m']:.1f} m)")  # fmt: skip
+
+
+def test_doctests():
+    import fieldkit.model.dem_profile as module
+
+    result = doctest.testmod(module)
+    assert result.attempted > 0 and result.failed == 0
