@@ -64,6 +64,13 @@ FLAGS: dict[str, str] = {
     "angle_out_deg": "--angle-out",
     "spin_out_radps": "--spin-out",
     "impulse_ns": "--impulse",
+    # DEM sections (fieldkit.model.dem_profile)
+    "start_xy": "--from",
+    "vertices_xy": "--from/--to",
+    "spacing_m": "--step",
+    "step_m": "--step",
+    "max_length_m": "--max-length",
+    "ranges": "--materials",
 }
 
 _QUOTED = re.compile(r"`(\w+)`")

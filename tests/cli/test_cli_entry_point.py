@@ -14,7 +14,7 @@ import pytest
 import fieldkit
 from fieldkit.cli import app
 
-COMMANDS = ["reduce", "impact", "fence", "track", "view"]
+COMMANDS = ["reduce", "impact", "fence", "track", "view", "profile"]
 REPO = Path(__file__).resolve().parents[2]
 
 

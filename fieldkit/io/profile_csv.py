@@ -1,0 +1,135 @@
+"""A slope profile from a CSV of section vertices: ``x, z[, material]``.
+
+One row per vertex, in order down the section::
+
+    x_m,z_m,material
+    0,100,rock
+    12,80,talus
+    40,62,
+
+``x`` (aliases: chainage, distance, station) is the horizontal distance along the
+section, strictly increasing; ``z`` (elevation, elev, height) the ground elevation.
+``material`` names the material of the segment that *starts* at the row's vertex, so
+the last row's cell names no segment (it may be empty; a name there is not used).
+Without a material column, :attr:`ProfileVertices.material` is None.
+
+Units as every reader here (:func:`fieldkit.io.csv_table.length_factor`): a unit in
+the column name (``x_m``, ``Elevation (ft)``) wins, else ``units`` (``"m"`` or
+``"ft"``); a length column with neither is an error. The plan coordinates
+``plan_x_m``, ``plan_y_m`` that ``fieldkit profile`` writes are read when both are
+filled in on every row; other columns are ignored.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from os import PathLike
+
+import numpy as np
+
+from fieldkit.errors import InputFileError
+from fieldkit.io.csv_table import length_factor, read_csv_table
+
+X_ALIASES = ("x", "chainage", "distance", "station")
+Z_ALIASES = ("z", "elevation", "elev", "height", "ground_z")
+MATERIAL_ALIASES = ("material", "materials", "surface")
+
+
+@dataclass(frozen=True)
+class ProfileVertices:
+    """Profile vertices read from a CSV, in metres.
+
+    Attributes
+    ----------
+    x_m, z_m
+        ``(n,)`` section vertices [m], x strictly increasing, n >= 2.
+    material
+        ``(n-1,)`` material of each segment, or None without a material column.
+    source
+        The file.
+    plan_x_m, plan_y_m
+        ``(n,)`` plan coordinates of the vertices [m], or None.
+    """
+
+    x_m: np.ndarray
+    z_m: np.ndarray
+    material: tuple[str, ...] | None
+    source: str
+    plan_x_m: np.ndarray | None = None
+    plan_y_m: np.ndarray | None = None
+
+
+def read_profile_csv(
+    path: str | PathLike[str], units: str | None = None
+) -> ProfileVertices:
+    """Read profile vertices (format in the module docstring).
+
+    Raises
+    ------
+    InputFileError
+        Missing x or z column, text or non-finite numbers, fewer than two vertices,
+        x not strictly increasing (names the row), a material cell left empty above
+        the last row.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> f = pathlib.Path(tempfile.mkdtemp()) / "profile.csv"
+    >>> _ = f.write_text("x_ft,z_ft,material\\n0,100,rock\\n10,90,\\n")
+    >>> p = read_profile_csv(f)
+    >>> p.x_m.round(4).tolist(), p.z_m.round(4).tolist(), p.material
+    ([0.0, 3.048], [30.48, 27.432], ('rock',))
+    """
+    table = read_csv_table(path)
+    source = table.source
+    columns = table.require(
+        {"x": X_ALIASES, "z": Z_ALIASES}, "a profile CSV needs columns x, z"
+    )
+    x_column, z_column = columns["x"], columns["z"]
+    x_factor = length_factor(table, x_column, units)
+    z_factor = length_factor(table, z_column, units)
+    material_column = table.find(MATERIAL_ALIASES, "the material")
+    rows = table.rows
+    if len(rows) < 2:
+        raise InputFileError(
+            f"a profile needs at least 2 vertices (got {len(rows)})",
+            source=source,
+            where=f"row {rows[0][0]}",
+        )
+    x = np.array([table.number(n, row, x_column) for n, row in rows]) * x_factor
+    z = np.array([table.number(n, row, z_column) for n, row in rows]) * z_factor
+    steps = np.diff(x)
+    if (steps <= 0).any():
+        i = int(np.flatnonzero(steps <= 0)[0])
+        header = x_column.header.strip()
+        raise InputFileError(
+            f"column '{header}' must increase down the section: "
+            f"{table.cell(rows[i + 1][1], x_column)} after "
+            f"{table.cell(rows[i][1], x_column)}",
+            source=source,
+            where=f"row {rows[i + 1][0]}",
+        )
+    material = None
+    if material_column is not None:
+        names = [table.cell(row, material_column) for _, row in rows[:-1]]
+        for (number, _), name in zip(rows[:-1], names, strict=True):
+            if not name:
+                raise InputFileError(
+                    f"column '{material_column.header.strip()}' is empty: every "
+                    "vertex but the last starts a segment, which needs a material",
+                    source=source,
+                    where=f"row {number}",
+                )
+        material = tuple(names)
+    plan = [table.find((name,)) for name in ("plan_x", "plan_y")]
+    plan_xy: list[np.ndarray | None] = [None, None]
+    if all(plan) and all(table.cell(row, c) for _, row in rows for c in plan):
+        plan_xy = [
+            np.array([table.number(n, row, c) for n, row in rows])
+            * length_factor(table, c, units)
+            for c in plan
+        ]
+    return ProfileVertices(
+        x_m=x, z_m=z, material=material, source=source, plan_x_m=plan_xy[0],
+        plan_y_m=plan_xy[1],
+    )  # fmt: skip
