@@ -5,3 +5,16 @@ flight and first contact, the impact in local N/T axes with the active laws, the
 sliding/rolling phase (eq. 7.3) and stopping; physical effects are small units in
 :mod:`fieldkit.model.effects`, switched on in the model file.
 """
+
+from fieldkit.model.model_file import Model, model_from_dict, read_model, write_model
+from fieldkit.model.results import SimulationResult
+from fieldkit.model.simulate import simulate
+
+__all__ = [
+    "Model",
+    "SimulationResult",
+    "model_from_dict",
+    "read_model",
+    "simulate",
+    "write_model",
+]
