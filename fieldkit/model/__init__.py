@@ -1,4 +1,4 @@
-"""The forward model: a fast 2-D lumped-mass Monte Carlo rockfall simulator (thesis ch. 7).
+"""The forward model: a fast 2-D lumped-mass Monte Carlo rock-fall simulator (ch. 7).
 
 A slope profile (a polyline with a material per segment), a seeder, exact ballistic
 flight and first contact, the impact in local N/T axes with the active laws, the

@@ -69,10 +69,22 @@ G = 9.81
 INF = math.inf
 #: Columns of a recorded impact row.
 RECORD_COLUMNS = (
-    "t_s", "x_m", "z_m", "slope_deg", "vi_x_mps", "vi_z_mps", "vf_x_mps", "vf_z_mps",
-    "mass_kg", "radius_m", "gyration_m", "omega_i_radps", "omega_f_radps",
-    "material_index", "tree_strike",
-)  # fmt: skip
+    "t_s",
+    "x_m",
+    "z_m",
+    "slope_deg",
+    "vi_x_mps",
+    "vi_z_mps",
+    "vf_x_mps",
+    "vf_z_mps",
+    "mass_kg",
+    "radius_m",
+    "gyration_m",
+    "omega_i_radps",
+    "omega_f_radps",
+    "material_index",
+    "tree_strike",
+)
 N_RECORD = len(RECORD_COLUMNS)
 #: Columns of an analysis-point record: crossed flag, speed, KE, RE, total, height.
 N_ANALYSIS = 6
@@ -108,7 +120,7 @@ M_EN, M_ET, M_PHI, M_EN_SD, M_ET_SD, M_PHI_SD, M_ROUGH, M_ROUGH_SD = range(8)
 
 @njit(cache=True)
 def descending_root(a, b, c):
-    """Smallest ``t >= 0`` with ``a t^2 + b t + c = 0`` and ``2 a t + b < 0``; inf if none."""
+    """Smallest ``t >= 0`` with ``a t^2 + b t + c = 0`` and ``2 a t + b < 0``, or inf."""
     if a == 0.0:
         if b < 0.0:
             t = -c / b
@@ -219,8 +231,29 @@ def _env_put(env, env0, envdx, xq, h, edge):
 
 
 @njit(cache=True)
-def _sweep_flight(x0, z0, vx, vz, ax, az, t1, px, pz, sl, m, r, kg, w,
-                  ana_x, ana, env0, envdx, env, trace, ntr):  # fmt: skip
+def _sweep_flight(
+    x0,
+    z0,
+    vx,
+    vz,
+    ax,
+    az,
+    t1,
+    px,
+    pz,
+    sl,
+    m,
+    r,
+    kg,
+    w,
+    ana_x,
+    ana,
+    env0,
+    envdx,
+    env,
+    trace,
+    ntr,
+):
     """Analysis-point crossings, envelope and trace of one flight piece ``[0, t1]``."""
     x1 = x0 + vx * t1 + 0.5 * ax * t1 * t1
     lo, hi = min(x0, x1), max(x0, x1)
@@ -288,8 +321,9 @@ def _sweep_flight(x0, z0, vx, vz, ax, az, t1, px, pz, sl, m, r, kg, w,
 
 
 @njit(cache=True)
-def _sweep_slide(xa, xb, sp, ad, cpsi, m, r, kg, px, pz, sl,
-                 ana_x, ana, env0, envdx, env, trace, ntr):  # fmt: skip
+def _sweep_slide(
+    xa, xb, sp, ad, cpsi, m, r, kg, px, pz, sl, ana_x, ana, env0, envdx, env, trace, ntr
+):
     """Analysis crossings, envelope (height 0) and trace of a slide from xa to xb."""
     lo, hi = min(xa, xb), max(xa, xb)
     for a in range(ana_x.size):
@@ -328,10 +362,40 @@ def _friction_tan(mat, mi, key, n, entry):
 
 
 @njit(cache=True)
-def run_rock(key, x, z, vx, vz, w, m, r, kg,
-             px, pz, sl, cpsi, spsi, psid, smat, mat, tx, td, th,
-             flags, par, core, ana_x, ana, env0, envdx, env,
-             rec, rec_start, rec_on, trace):  # fmt: skip
+def run_rock(
+    key,
+    x,
+    z,
+    vx,
+    vz,
+    w,
+    m,
+    r,
+    kg,
+    px,
+    pz,
+    sl,
+    cpsi,
+    spsi,
+    psid,
+    smat,
+    mat,
+    tx,
+    td,
+    th,
+    flags,
+    par,
+    core,
+    ana_x,
+    ana,
+    env0,
+    envdx,
+    env,
+    rec,
+    rec_start,
+    rec_on,
+    trace,
+):
     """Follow one rock; returns ``(impacts, state, runout_x_m, trace_points)``.
 
     Arrays: profile vertices ``px, pz``; per segment slope dz/dx ``sl``, ``cos psi``,
@@ -388,9 +452,29 @@ def run_rock(key, x, z, vx, vz, w, m, r, kg,
                                 break
                         ii += 1 if vx > 0.0 else -1
                     if struck >= 0:
-                        ntr = _sweep_flight(x, z, vx, vz, ax, az, tt, px, pz, sl, m, r,
-                                            kg, w, ana_x, ana, env0, envdx, env, trace,
-                                            ntr)  # fmt: skip
+                        ntr = _sweep_flight(
+                            x,
+                            z,
+                            vx,
+                            vz,
+                            ax,
+                            az,
+                            tt,
+                            px,
+                            pz,
+                            sl,
+                            m,
+                            r,
+                            kg,
+                            w,
+                            ana_x,
+                            ana,
+                            env0,
+                            envdx,
+                            env,
+                            trace,
+                            ntr,
+                        )
                         z = z + vz * tt + 0.5 * az * tt * tt
                         x = tx[struck]
                         vx = vx + ax * tt
@@ -406,8 +490,29 @@ def run_rock(key, x, z, vx, vz, w, m, r, kg,
                         tree_hit = 1.0
                         j = segment_at(px, x)
                         continue
-                ntr = _sweep_flight(x, z, vx, vz, ax, az, tc, px, pz, sl, m, r, kg, w,
-                                    ana_x, ana, env0, envdx, env, trace, ntr)  # fmt: skip
+                ntr = _sweep_flight(
+                    x,
+                    z,
+                    vx,
+                    vz,
+                    ax,
+                    az,
+                    tc,
+                    px,
+                    pz,
+                    sl,
+                    m,
+                    r,
+                    kg,
+                    w,
+                    ana_x,
+                    ana,
+                    env0,
+                    envdx,
+                    env,
+                    trace,
+                    ntr,
+                )
                 x = x + vx * tc + 0.5 * ax * tc * tc
                 z = z + vz * tc + 0.5 * az * tc * tc
                 vx = vx + ax * tc
@@ -477,9 +582,13 @@ def run_rock(key, x, z, vx, vz, w, m, r, kg,
                 if flags[F_ADR] == 1:
                     theta_i = math.degrees(math.atan2(-vin, abs(vit)))
                     e_n = angle_dependent_restitution.normal_restitution(
-                        e_n, mat[mi, M_EN], theta_i, par[P_ADR_B], par[P_ADR_REF],
+                        e_n,
+                        mat[mi, M_EN],
+                        theta_i,
+                        par[P_ADR_B],
+                        par[P_ADR_REF],
                         par[P_ADR_A],
-                    )  # fmt: skip
+                    )
                 vfn = -e_n * vin
                 if flags[F_VSR] == 1:
                     vfn *= velocity_scaled_restitution.normal_speed_factor(
@@ -548,16 +657,52 @@ def run_rock(key, x, z, vx, vz, w, m, r, kg,
                 if v2 <= 0.0:
                     dist = sp * sp / (-ad)
                     x_new = x + dirn * dist * c
-                    ntr = _sweep_slide(x, x_new, sp, ad, c, m, r, kg, px, pz, sl,
-                                       ana_x, ana, env0, envdx, env, trace, ntr)  # fmt: skip
+                    ntr = _sweep_slide(
+                        x,
+                        x_new,
+                        sp,
+                        ad,
+                        c,
+                        m,
+                        r,
+                        kg,
+                        px,
+                        pz,
+                        sl,
+                        ana_x,
+                        ana,
+                        env0,
+                        envdx,
+                        env,
+                        trace,
+                        ntr,
+                    )
                     t += sp / (-ad)
                     x = x_new
                     u = 0.0
                     continue
                 ve = math.sqrt(v2)
                 x_new = px[j + 1] if dirn > 0.0 else px[j]
-                ntr = _sweep_slide(x, x_new, sp, ad, c, m, r, kg, px, pz, sl,
-                                   ana_x, ana, env0, envdx, env, trace, ntr)  # fmt: skip
+                ntr = _sweep_slide(
+                    x,
+                    x_new,
+                    sp,
+                    ad,
+                    c,
+                    m,
+                    r,
+                    kg,
+                    px,
+                    pz,
+                    sl,
+                    ana_x,
+                    ana,
+                    env0,
+                    envdx,
+                    env,
+                    trace,
+                    ntr,
+                )
                 t += (ve - sp) / ad if ad != 0.0 else length / sp
                 x = x_new
                 jn = j + (1 if dirn > 0.0 else -1)
@@ -601,19 +746,79 @@ def run_rock(key, x, z, vx, vz, w, m, r, kg,
 
 
 @njit(cache=True, parallel=True)
-def run_rocks(keys, x, z, vx, vz, w, m, r, kg,
-              px, pz, sl, cpsi, spsi, psid, smat, mat, tx, td, th,
-              flags, par, core, ana_x, ana, env0, envdx, env,
-              rec, rec_offsets, rec_on, impacts, states, runout):  # fmt: skip
+def run_rocks(
+    keys,
+    x,
+    z,
+    vx,
+    vz,
+    w,
+    m,
+    r,
+    kg,
+    px,
+    pz,
+    sl,
+    cpsi,
+    spsi,
+    psid,
+    smat,
+    mat,
+    tx,
+    td,
+    th,
+    flags,
+    par,
+    core,
+    ana_x,
+    ana,
+    env0,
+    envdx,
+    env,
+    rec,
+    rec_offsets,
+    rec_on,
+    impacts,
+    states,
+    runout,
+):
     """:func:`run_rock` over all rocks in parallel; outputs written in place."""
     no_trace = np.zeros((0, 2))
     for i in prange(keys.size):
         n, st, ro, _ = run_rock(
-            keys[i], x[i], z[i], vx[i], vz[i], w[i], m[i], r[i], kg[i],
-            px, pz, sl, cpsi, spsi, psid, smat, mat, tx, td, th,
-            flags, par, core, ana_x, ana[i], env0, envdx, env[i],
-            rec, rec_offsets[i], rec_on, no_trace,
-        )  # fmt: skip
+            keys[i],
+            x[i],
+            z[i],
+            vx[i],
+            vz[i],
+            w[i],
+            m[i],
+            r[i],
+            kg[i],
+            px,
+            pz,
+            sl,
+            cpsi,
+            spsi,
+            psid,
+            smat,
+            mat,
+            tx,
+            td,
+            th,
+            flags,
+            par,
+            core,
+            ana_x,
+            ana[i],
+            env0,
+            envdx,
+            env[i],
+            rec,
+            rec_offsets[i],
+            rec_on,
+            no_trace,
+        )
         impacts[i] = n
         states[i] = st
         runout[i] = ro

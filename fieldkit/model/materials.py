@@ -1,4 +1,4 @@
-"""Slope materials: restitution, friction and roughness of one kind of ground (Table 7-1).
+"""Slope materials: restitution, friction and roughness of one ground (Table 7-1).
 
 A :class:`Material` holds what RocFall and CRSP users enter per slope material: the
 normal and tangential coefficients of restitution (eqs. 4.6, 4.7), the friction angle

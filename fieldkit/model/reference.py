@@ -67,12 +67,26 @@ def simulate_one_rock(
     max_impacts = int(inputs.core[2])
     rec = np.zeros((max_impacts, kernel.N_RECORD))
     n, state, runout, _ = kernel.run_rock.py_func(
-        np.uint64(key), float(x_m), float(z_m), float(vx_mps), float(vz_mps),
-        float(omega_radps), mass, float(radius[0]), float(gyration[0]),
-        *inputs.profile_args(), np.zeros(0), np.full((0, kernel.N_ANALYSIS), np.nan),
-        float(inputs.px[0]), 1.0, np.zeros(0, np.float32), rec, 0, True,
+        np.uint64(key),
+        float(x_m),
+        float(z_m),
+        float(vx_mps),
+        float(vz_mps),
+        float(omega_radps),
+        mass,
+        float(radius[0]),
+        float(gyration[0]),
+        *inputs.profile_args(),
+        np.zeros(0),
+        np.full((0, kernel.N_ANALYSIS), np.nan),
+        float(inputs.px[0]),
+        1.0,
+        np.zeros(0, np.float32),
+        rec,
+        0,
+        True,
         np.zeros((0, 2)),
-    )  # fmt: skip
+    )
     return OneRock(impacts=rec[:n].copy(), state=int(state), runout_x_m=float(runout))
 
 

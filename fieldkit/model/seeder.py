@@ -62,7 +62,8 @@ def draw_starts(
     Examples
     --------
     >>> p = Profile.from_arrays([0, 10], [10, 0], ["rock"])
-    >>> s = draw_starts(Seeder(x_m=1.0, z_m=12.0), p, 100.0, 3, np.random.default_rng(1))
+    >>> rng = np.random.default_rng(1)
+    >>> s = draw_starts(Seeder(x_m=1.0, z_m=12.0), p, 100.0, 3, rng)
     >>> s.z_m.tolist()
     [12.0, 12.0, 12.0]
     """

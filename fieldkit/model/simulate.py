@@ -61,9 +61,21 @@ class KernelInputs:
     def profile_args(self) -> tuple:
         """Positional arguments of :func:`kernel.run_rock` after the rock state."""
         return (
-            self.px, self.pz, self.sl, self.cpsi, self.spsi, self.psid, self.smat,
-            self.mat, self.tx, self.td, self.th, self.flags, self.par, self.core,
-        )  # fmt: skip
+            self.px,
+            self.pz,
+            self.sl,
+            self.cpsi,
+            self.spsi,
+            self.psid,
+            self.smat,
+            self.mat,
+            self.tx,
+            self.td,
+            self.th,
+            self.flags,
+            self.par,
+            self.core,
+        )
 
 
 def kernel_inputs(model: Model) -> KernelInputs:
@@ -76,29 +88,48 @@ def kernel_inputs(model: Model) -> KernelInputs:
     names = tuple(model.materials)
     mat = np.array(
         [
-            [m.e_n, m.e_t, m.friction_deg, m.e_n_sd, m.e_t_sd, m.friction_deg_sd,
-             m.roughness_m, m.roughness_deg_sd]
+            [
+                m.e_n,
+                m.e_t,
+                m.friction_deg,
+                m.e_n_sd,
+                m.e_t_sd,
+                m.friction_deg_sd,
+                m.roughness_m,
+                m.roughness_deg_sd,
+            ]
             for m in model.materials.values()
         ],
         float,
-    )  # fmt: skip
+    )
     smat = np.array([names.index(name) for name in prof.material], np.int64)
     flags, par = registry.kernel_arrays(model.effects)
     trees = model.trees
     empty = np.zeros(0)
     core = np.array(
-        [model.core[k] for k in ("slide_vn_mps", "stop_speed_mps", "max_impacts",
-                                  "drag_dt_s")],
+        [
+            model.core[k]
+            for k in ("slide_vn_mps", "stop_speed_mps", "max_impacts", "drag_dt_s")
+        ],
         float,
-    )  # fmt: skip
+    )
     return KernelInputs(
-        px=px, pz=pz, sl=sl, cpsi=np.cos(psi), spsi=np.sin(psi),
-        psid=np.degrees(psi), smat=smat, mat=mat, material_names=names,
+        px=px,
+        pz=pz,
+        sl=sl,
+        cpsi=np.cos(psi),
+        spsi=np.sin(psi),
+        psid=np.degrees(psi),
+        smat=smat,
+        mat=mat,
+        material_names=names,
         tx=empty if trees is None else np.ascontiguousarray(trees.x_m, float),
         td=empty if trees is None else np.ascontiguousarray(trees.diameter_m, float),
         th=empty if trees is None else np.ascontiguousarray(trees.height_m, float),
-        flags=flags, par=par, core=core,
-    )  # fmt: skip
+        flags=flags,
+        par=par,
+        core=core,
+    )
 
 
 def draw_rocks(
@@ -184,7 +215,7 @@ def simulate(
     >>> from fieldkit.model.model_file import model_from_dict
     >>> m = model_from_dict({"profile": {"x_m": [0, 50], "z_m": [30, 0],
     ...   "material": "rock"}, "materials": {"rock": {"e_n": 0.3, "e_t": 0.8,
-    ...   "friction_deg": 35}}, "body": {"mass_kg": 100, "radius_m": 0.2},
+    ...   "friction_deg": 25}}, "body": {"mass_kg": 100, "radius_m": 0.2},
     ...   "seeder": {"x_m": 1, "z_m": 31}})
     >>> simulate(m, 2, np.random.default_rng(0)).state.tolist()
     [1, 1]
@@ -230,12 +261,28 @@ def simulate(
 
         def run(rec, offsets, on, sel=sel):
             kernel.run_rocks(
-                keys[sel], starts.x_m[sel], starts.z_m[sel], starts.vx_mps[sel],
-                starts.vz_mps[sel], starts.omega_radps[sel], starts.mass_kg[sel],
-                radius[sel], gyration[sel], *inputs.profile_args(), ana_x, ana[sel],
-                float(x0), envdx, env[sel], rec, offsets, on, impacts[sel],
-                states[sel], runout[sel],
-            )  # fmt: skip
+                keys[sel],
+                starts.x_m[sel],
+                starts.z_m[sel],
+                starts.vx_mps[sel],
+                starts.vz_mps[sel],
+                starts.omega_radps[sel],
+                starts.mass_kg[sel],
+                radius[sel],
+                gyration[sel],
+                *inputs.profile_args(),
+                ana_x,
+                ana[sel],
+                float(x0),
+                envdx,
+                env[sel],
+                rec,
+                offsets,
+                on,
+                impacts[sel],
+                states[sel],
+                runout[sel],
+            )
 
         tic = time.perf_counter()
         run(no_rec, np.zeros(b - a, np.int64), False)
@@ -271,11 +318,26 @@ def simulate(
         trace = np.zeros((TRACE_POINTS, 2))
         scratch_ana = np.full((0, kernel.N_ANALYSIS), np.nan)
         *_, count = kernel.run_rock(
-            keys[i], starts.x_m[i], starts.z_m[i], starts.vx_mps[i], starts.vz_mps[i],
-            starts.omega_radps[i], starts.mass_kg[i], radius[i], gyration[i],
-            *inputs.profile_args(), np.zeros(0), scratch_ana, float(x0), 1.0,
-            np.zeros(0, np.float32), no_rec, 0, False, trace,
-        )  # fmt: skip
+            keys[i],
+            starts.x_m[i],
+            starts.z_m[i],
+            starts.vx_mps[i],
+            starts.vz_mps[i],
+            starts.omega_radps[i],
+            starts.mass_kg[i],
+            radius[i],
+            gyration[i],
+            *inputs.profile_args(),
+            np.zeros(0),
+            scratch_ana,
+            float(x0),
+            1.0,
+            np.zeros(0, np.float32),
+            no_rec,
+            0,
+            False,
+            trace,
+        )
         paths.append(trace[:count].copy())
     table = None
     if record_impacts and on_impact_chunk is None:

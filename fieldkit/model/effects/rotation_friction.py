@@ -27,8 +27,8 @@ SPEC = EffectSpec(
     stage="impact",
     summary="spin carried through flight; friction at the contact turns slip into "
     "rolling and spin into translation",
-    physics="J = (vit + r w)/(1 + r^2/k^2), |J| <= mu (1+e_n)|vin|; vft = e_t vit - c J; "
-    "w_f = (1-c)(-vft/r) + c (w - r J/k^2)",
+    physics="J = (vit + r w)/(1 + r^2/k^2), |J| <= mu (1+e_n)|vin|; "
+    "vft = e_t vit - c J; w_f = (1-c)(-vft/r) + c (w - r J/k^2)",
     parameters=(
         Parameter(
             "friction", 0.5, 0.0, 2.0, "-", "contact friction coefficient mu", None
