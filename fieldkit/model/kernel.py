@@ -120,7 +120,7 @@ M_EN, M_ET, M_PHI, M_EN_SD, M_ET_SD, M_PHI_SD, M_ROUGH, M_ROUGH_SD = range(8)
 
 @njit(cache=True)
 def descending_root(a, b, c):
-    """Smallest ``t >= 0`` with ``a t^2 + b t + c = 0`` and ``2 a t + b < 0``, or inf."""
+    """First ``t >= 0`` with ``a t^2 + b t + c = 0``, ``2 a t + b < 0``; else inf."""
     if a == 0.0:
         if b < 0.0:
             t = -c / b
