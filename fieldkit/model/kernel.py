@@ -354,6 +354,25 @@ def _sweep_slide(
 
 
 @njit(cache=True)
+def _tree_struck(tx, xa, xb, key, n, p):
+    """Index of the first tree strictly past ``xa`` up to ``xb`` that is struck, or -1.
+
+    Used for rocks sliding or rolling on the ground (always below the tree top).
+    """
+    lo, hi = min(xa, xb), max(xa, xb)
+    i0 = np.searchsorted(tx, lo, side="right")
+    i1 = np.searchsorted(tx, hi, side="right")
+    forward = xb > xa
+    for k in range(i1 - i0):
+        ii = i0 + k if forward else i1 - 1 - k
+        if tx[ii] == xa:
+            continue
+        if uniform(key, n, SLOT_TREE + ii) < p:
+            return ii
+    return -1
+
+
+@njit(cache=True)
 def _friction_tan(mat, mi, key, n, entry):
     phi = mat[mi, M_PHI]
     if mat[mi, M_PHI_SD] > 0.0:
@@ -654,6 +673,27 @@ def run_rock(
                     state = STOPPED  # at rest in a notch
                     break
                 v2 = sp * sp + 2.0 * ad * length
+                if trees:
+                    reach = length if v2 > 0.0 else sp * sp / (-ad)
+                    ii = _tree_struck(
+                        tx, x, x + dirn * reach * c, key, n, par[P_TREE_P]
+                    )
+                    if ii >= 0:
+                        d = abs(tx[ii] - x) / c
+                        vt2 = sp * sp + 2.0 * ad * d
+                        vt = math.sqrt(vt2) if vt2 > 0.0 else 0.0
+                        ntr = _sweep_slide(
+                            x, tx[ii], sp, ad, c, m, r, kg, px, pz, sl,
+                            ana_x, ana, env0, envdx, env, trace, ntr,
+                        )  # fmt: skip
+                        t += (vt - sp) / ad if ad != 0.0 else d / sp
+                        x = tx[ii]
+                        vt = tree_impacts.speed_after_strike(
+                            vt, m, td[ii], par[P_TREE_C], par[P_TREE_EXP]
+                        )
+                        u = dirn * vt
+                        tree_hit = 1.0
+                        continue
                 if v2 <= 0.0:
                     dist = sp * sp / (-ad)
                     x_new = x + dirn * dist * c

@@ -1,7 +1,8 @@
 """Energy taken by trees the rock strikes in flight (thesis §6.6, Fig. 6.8).
 
 Trees stand at given ``x`` with a trunk diameter (at chest height) and a height. A
-flight passing a tree with its centre below the tree top strikes it with probability
+flight passing a tree with its centre below the tree top, or a rock sliding or rolling
+past it, strikes it with probability
 ``hit_probability`` (the chance the trunk lies in the rock's lane; for a stand of
 density ``n`` per m^2 and lane width ``d + 2r`` it is about ``n (d + 2r)`` per metre).
 A strike dissipates the energy the trunk can take,
