@@ -674,7 +674,7 @@ def run_rock(
                     break
                 v2 = sp * sp + 2.0 * ad * length
                 if trees:
-                    reach = length if v2 > 0.0 else sp * sp / (-ad)
+                    reach = length if v2 > 0.0 else sp * sp / (-2.0 * ad)
                     ii = _tree_struck(
                         tx, x, x + dirn * reach * c, key, n, par[P_TREE_P]
                     )
@@ -695,7 +695,7 @@ def run_rock(
                         tree_hit = 1.0
                         continue
                 if v2 <= 0.0:
-                    dist = sp * sp / (-ad)
+                    dist = sp * sp / (-2.0 * ad)
                     x_new = x + dirn * dist * c
                     ntr = _sweep_slide(
                         x,
