@@ -1,0 +1,57 @@
+"""Quadratic air drag in flight: ``a = -k |v| v``, ``k = rho C_d pi r^2 / (2 m)``.
+
+Without drag the flight is the exact parabola. With drag the flight is integrated in
+substeps of the core setting ``drag_dt_s``; within each the acceleration is held at
+its value at the predicted mid-step velocity (second order), so each substep is a
+parabola and first contact inside it is still found exactly. ``cd = 0`` is the base
+model (the exact parabola is used, bit for bit). Drag matters for video tracks of
+small, fast blocks; for metre-size blocks it changes flights by millimetres.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from fieldkit.model.effects.spec import EffectSpec, Parameter
+
+SPEC = EffectSpec(
+    name="air_drag",
+    stage="flight",
+    summary="quadratic air drag shortens flights",
+    physics="a = g - k |v| v, k = rho C_d pi r^2 / (2 m)",
+    parameters=(
+        Parameter("cd", 0.5, 0.0, 3.0, "-", "drag coefficient of a rough block", 0.0),
+        Parameter(
+            "air_density_kg_m3",
+            1.225,
+            0.0,
+            2.0,
+            "kg/m^3",
+            "air density (sea level)",
+            None,
+        ),
+    ),
+    reference="none in the thesis (standard quadratic drag)",
+    reads=("vi_x_mps", "vi_z_mps", "radius_m", "mass_kg"),
+    writes=("vi_x_mps", "vi_z_mps"),
+)
+
+
+@njit(cache=True)
+def drag_factor(cd, air_density_kg_m3, radius_m, mass_kg):
+    """``k = rho C_d pi r^2 / (2 m)`` [1/m]."""
+    return air_density_kg_m3 * cd * math.pi * radius_m * radius_m / (2.0 * mass_kg)
+
+
+@njit(cache=True)
+def substep_acceleration(vx, vz, k, g, dt):
+    """Constant ``(ax, az)`` for a substep of ``dt``: drag at the mid-step velocity."""
+    speed = math.sqrt(vx * vx + vz * vz)
+    ax0 = -k * speed * vx
+    az0 = -g - k * speed * vz
+    mx = vx + 0.5 * dt * ax0
+    mz = vz + 0.5 * dt * az0
+    speed = math.sqrt(mx * mx + mz * mz)
+    return -k * speed * mx, -g - k * speed * mz

@@ -1,0 +1,42 @@
+"""Random local slope at each impact, rougher for small blocks (eq. 7.4, CRSP/RocFall).
+
+The dip used for the impact axes is ``psi + delta`` with ``delta ~ N(0, sd)``::
+
+    sd = scale * sqrt( atan(s / r)^2 + roughness_deg_sd^2 )
+
+``s`` is the material's ``roughness_m`` (CRSP: the height of the asperities within a
+block radius), ``r`` the block radius, so the same ground perturbs a small block more
+(§7.3.6); ``roughness_deg_sd`` is RocFall's direct SD of the segment dip (Table 7-1).
+If the perturbed surface faces away from the incoming rock (``vin >= 0``), the mirror
+draw ``-delta`` is used, and if that also fails, ``delta = 0``. ``scale = 0`` is the
+base model.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from fieldkit.model.effects.spec import EffectSpec, Parameter
+
+SPEC = EffectSpec(
+    name="slope_roughness",
+    stage="impact",
+    summary="random local slope at each impact; small blocks feel rougher ground",
+    physics="psi' = psi + N(0, scale * hypot(atan(s/r), sd_psi))",
+    parameters=(
+        Parameter("scale", 1.0, 0.0, 5.0, "-", "multiplier on the dip SD", 0.0),
+    ),
+    reference="thesis eq. 7.4, section 7.3.6; RocFall Table 7-1",
+    reads=("slope_deg", "radius_m"),
+    writes=("slope_deg",),
+)
+
+
+@njit(cache=True)
+def dip_sd_rad(roughness_m, roughness_deg_sd, radius_m, scale):
+    """SD of the local dip perturbation [rad] (see the module docstring)."""
+    crsp = math.atan(roughness_m / radius_m)
+    rocfall = math.radians(roughness_deg_sd)
+    return scale * math.sqrt(crsp * crsp + rocfall * rocfall)

@@ -1,0 +1,39 @@
+"""Normal restitution falling with impact speed (thesis eq. 7.1, RocFall/CRSP).
+
+``vfn = e_n |vin| / (1 + (vin/K)^2)``: half the constant-``e_n`` rebound at
+``|vin| = K``, unchanged for slow impacts. ``K = inf`` is the base model.
+"""
+
+from __future__ import annotations
+
+from numba import njit
+
+from fieldkit.model.effects.spec import EffectSpec, Parameter
+
+SPEC = EffectSpec(
+    name="velocity_scaled_restitution",
+    stage="impact",
+    summary="fast impacts rebound less (soil crushing), RocFall's e_n scaling",
+    physics="vfn = e_n |vin| / (1 + (vin/K)^2)",
+    parameters=(
+        Parameter(
+            "k_mps",
+            9.144,
+            0.1,
+            float("inf"),
+            "m/s",
+            "velocity scale K (RocFall default 9.144 m/s = 30 ft/s)",
+            float("inf"),
+        ),
+    ),
+    reference="thesis eq. 7.1",
+    reads=("vin_mps",),
+    writes=("vfn_mps",),
+)
+
+
+@njit(cache=True)
+def normal_speed_factor(v_in_mps, k_mps):
+    """Factor ``1 / (1 + (vin/K)^2)`` on the rebound normal speed (eq. 7.1)."""
+    q = v_in_mps / k_mps
+    return 1.0 / (1.0 + q * q)

@@ -1,0 +1,864 @@
+"""The compiled core: one rock's flight, impacts, sliding and stopping (numba).
+
+:func:`run_rock` follows one rock from its start until it stops, leaves the profile or
+reaches ``max_impacts``; :func:`run_rocks` runs many in parallel (``prange`` over
+rocks; every random number is a function of the rock's key, so results do not depend
+on threads). :mod:`fieldkit.model.reference` runs the same :func:`run_rock` source in
+the Python interpreter.
+
+Flight (exact, lumped mass): the centre follows ``x = x0 + vx t``,
+``z = z0 + vz t - g t^2 / 2``. The signed height above the line of segment j,
+``d(t) = A t^2 + B t + C``, is a quadratic; contact is its smallest root ``t >= 0``
+at which ``d`` is *decreasing* (the centre meets the line from above) and ``x(t)``
+lies on the segment. This excludes the root at ``t = 0`` after a rebound or a launch
+(where ``d`` grows) without any time epsilon. ``x`` is monotonic in ``t``, so
+segments are met in x order: the scan starts at the current segment and steps in the
+direction of travel; the first segment with a contact is the contact. Roots use the
+cancellation-free form ``q = -(B + sign(B) sqrt(B^2 - 4AC))/2``, ``t = q/A, C/q``.
+With ``air_drag`` the flight is a chain of parabolic substeps (constant acceleration
+each), handled by the same contact test.
+
+Impact in local axes of the segment dip psi (T down-slope, N outward; §2):
+``vin < 0``, ``vit``; ``vfn = -e_n vin``, ``vft = e_t vit`` with per-impact draws
+``N(mean, sd)`` clipped at 0, modified by the active effects. A rebound whose normal
+speed is below ``slide_vn_mps`` (or that points into the real segment) starts the
+sliding/rolling phase with the tangential velocity on the segment.
+
+Sliding (eq. 7.3): along segment j with dip psi and friction angle phi (drawn at
+each segment entry), acceleration ``g (sin psi - sign(u) cos psi tan phi)``, exact
+``v^2 = v0^2 + 2 a s``. A rock coming to rest stays if ``|tan psi| <= tan phi`` and
+restarts down-slope otherwise. At a convex break it launches into flight with its
+velocity; at a concave break it continues with the velocity projected on the new
+segment (the normal component is lost). Spin while sliding is rolling, ``-u/r``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from fieldkit.model.effects import (
+    air_drag,
+    angle_dependent_restitution,
+    mass_loss,
+    rotation_friction,
+    slope_roughness,
+    tree_impacts,
+    velocity_scaled_restitution,
+)
+from fieldkit.model.effects.registry import EFFECTS, LAYOUT
+from fieldkit.model.random_streams import (
+    SLOT_E_N,
+    SLOT_E_T,
+    SLOT_FRICTION,
+    SLOT_ROUGHNESS,
+    SLOT_TREE,
+    normal,
+    uniform,
+)
+from fieldkit.model.results import (
+    EXITED_DOWNSLOPE,
+    EXITED_UPSLOPE,
+    MAX_IMPACTS,
+    STOPPED,
+)
+
+G = 9.81
+INF = math.inf
+#: Columns of a recorded impact row.
+RECORD_COLUMNS = (
+    "t_s",
+    "x_m",
+    "z_m",
+    "slope_deg",
+    "vi_x_mps",
+    "vi_z_mps",
+    "vf_x_mps",
+    "vf_z_mps",
+    "mass_kg",
+    "radius_m",
+    "gyration_m",
+    "omega_i_radps",
+    "omega_f_radps",
+    "material_index",
+    "tree_strike",
+)
+N_RECORD = len(RECORD_COLUMNS)
+#: Columns of an analysis-point record: crossed flag, speed, KE, RE, total, height.
+N_ANALYSIS = 6
+#: Slide steps (segment passes) after which a rock is stopped as MAX_IMPACTS.
+MAX_SLIDE_STEPS = 100000
+
+# Flag indices (registry order) and parameter indices (registry layout).
+_NAMES = [spec.name for spec in EFFECTS]
+F_ADR = _NAMES.index("angle_dependent_restitution")
+F_VSR = _NAMES.index("velocity_scaled_restitution")
+F_ROT = _NAMES.index("rotation_friction")
+F_ROUGH = _NAMES.index("slope_roughness")
+F_MASS = _NAMES.index("mass_loss")
+F_TREE = _NAMES.index("tree_impacts")
+F_DRAG = _NAMES.index("air_drag")
+P_ADR_B = LAYOUT["angle_dependent_restitution.b"]
+P_ADR_REF = LAYOUT["angle_dependent_restitution.theta_ref_deg"]
+P_ADR_A = LAYOUT["angle_dependent_restitution.a"]
+P_VSR_K = LAYOUT["velocity_scaled_restitution.k_mps"]
+P_ROT_MU = LAYOUT["rotation_friction.friction"]
+P_ROT_C = LAYOUT["rotation_friction.coupling"]
+P_ROUGH = LAYOUT["slope_roughness.scale"]
+P_MASS_RATE = LAYOUT["mass_loss.rate_per_m"]
+P_MASS_EXP = LAYOUT["mass_loss.impact_exponent"]
+P_TREE_P = LAYOUT["tree_impacts.hit_probability"]
+P_TREE_C = LAYOUT["tree_impacts.energy_factor"]
+P_TREE_EXP = LAYOUT["tree_impacts.energy_exponent"]
+P_DRAG_CD = LAYOUT["air_drag.cd"]
+P_DRAG_RHO = LAYOUT["air_drag.air_density_kg_m3"]
+# Material table columns.
+M_EN, M_ET, M_PHI, M_EN_SD, M_ET_SD, M_PHI_SD, M_ROUGH, M_ROUGH_SD = range(8)
+
+
+@njit(cache=True)
+def descending_root(a, b, c):
+    """First ``t >= 0`` with ``a t^2 + b t + c = 0``, ``2 a t + b < 0``; else inf."""
+    if a == 0.0:
+        if b < 0.0:
+            t = -c / b
+            return t if t >= 0.0 else INF
+        return INF
+    disc = b * b - 4.0 * a * c
+    if disc < 0.0:
+        return INF
+    sq = math.sqrt(disc)
+    q = -0.5 * (b + sq) if b >= 0.0 else -0.5 * (b - sq)
+    best = INF
+    r1 = q / a
+    if r1 >= 0.0 and 2.0 * a * r1 + b < 0.0:
+        best = r1
+    if q != 0.0:
+        r2 = c / q
+        if r2 >= 0.0 and 2.0 * a * r2 + b < 0.0 and r2 < best:
+            best = r2
+    return best
+
+
+@njit(cache=True)
+def time_to_x(x0, vx, ax, xb):
+    """First ``t >= 0`` with ``x0 + vx t + ax t^2 / 2 = xb``; inf if never."""
+    if ax == 0.0:
+        if vx == 0.0:
+            return INF
+        t = (xb - x0) / vx
+        return t if t >= 0.0 else INF
+    a = 0.5 * ax
+    c = x0 - xb
+    disc = vx * vx - 4.0 * a * c
+    if disc < 0.0:
+        return INF
+    sq = math.sqrt(disc)
+    q = -0.5 * (vx + sq) if vx >= 0.0 else -0.5 * (vx - sq)
+    best = INF
+    r1 = q / a
+    if r1 >= 0.0:
+        best = r1
+    if q != 0.0:
+        r2 = c / q
+        if 0.0 <= r2 < best:
+            best = r2
+    return best
+
+
+@njit(cache=True)
+def segment_at(px, x):
+    """Segment index under ``x`` (clipped to the profile)."""
+    j = np.searchsorted(px, x, side="right") - 1
+    if j < 0:
+        return 0
+    if j > px.size - 2:
+        return px.size - 2
+    return j
+
+
+@njit(cache=True)
+def ground_z(px, pz, sl, x):
+    """Ground elevation at ``x``."""
+    j = segment_at(px, x)
+    return pz[j] + sl[j] * (x - px[j])
+
+
+@njit(cache=True)
+def piece_contact(px, pz, sl, j, x0, z0, vx, vz, ax, az, tmax):
+    """First contact of a constant-acceleration piece lasting at most ``tmax``.
+
+    Returns ``(segment, t)``: ``segment >= 0`` a contact; ``-1`` none within
+    ``tmax``; ``-2`` / ``-3`` the centre leaves the profile at its lower / upper end
+    at time ``t``.
+    """
+    nseg = px.size - 1
+    step = 1 if vx > 0.0 else (-1 if vx < 0.0 else 0)
+    jj = j
+    while True:
+        s = sl[jj]
+        t = descending_root(
+            0.5 * (az - s * ax), vz - s * vx, z0 - pz[jj] - s * (x0 - px[jj])
+        )
+        if t <= tmax:
+            xt = x0 + vx * t + 0.5 * ax * t * t
+            tol = 1e-9 * (1.0 + abs(xt))
+            if px[jj] - tol <= xt <= px[jj + 1] + tol:
+                return jj, t
+        if step == 0:
+            return -1, tmax
+        boundary = px[jj + 1] if step > 0 else px[jj]
+        tb = time_to_x(x0, vx, ax, boundary)
+        if tb > tmax:
+            return -1, tmax
+        jj += step
+        if jj >= nseg:
+            return -2, tb
+        if jj < 0:
+            return -3, tb
+
+
+@njit(cache=True)
+def _env_put(env, env0, envdx, xq, h, edge):
+    nb = env.size
+    b = int(math.floor((xq - env0) / envdx))
+    if 0 <= b < nb and not (env[b] >= h):
+        env[b] = h
+    if edge and 0 <= b - 1 < nb and not (env[b - 1] >= h):
+        env[b - 1] = h
+
+
+@njit(cache=True)
+def _sweep_flight(
+    x0,
+    z0,
+    vx,
+    vz,
+    ax,
+    az,
+    t1,
+    px,
+    pz,
+    sl,
+    m,
+    r,
+    kg,
+    w,
+    ana_x,
+    ana,
+    env0,
+    envdx,
+    env,
+    trace,
+    ntr,
+):
+    """Analysis-point crossings, envelope and trace of one flight piece ``[0, t1]``."""
+    x1 = x0 + vx * t1 + 0.5 * ax * t1 * t1
+    lo, hi = min(x0, x1), max(x0, x1)
+    for a in range(ana_x.size):
+        xa = ana_x[a]
+        if ana[a, 0] == 1.0 or xa < lo or xa > hi or vx == 0.0:
+            continue
+        ta = time_to_x(x0, vx, ax, xa)
+        if ta > t1:
+            continue
+        za = z0 + vz * ta + 0.5 * az * ta * ta
+        vxa = vx + ax * ta
+        vza = vz + az * ta
+        v2 = vxa * vxa + vza * vza
+        ke = 0.5 * m * v2
+        re = 0.5 * m * kg * kg * w * w
+        ana[a, 0] = 1.0
+        ana[a, 1] = math.sqrt(v2)
+        ana[a, 2] = ke
+        ana[a, 3] = re
+        ana[a, 4] = ke + re
+        ana[a, 5] = za - ground_z(px, pz, sl, xa)
+    if env.size > 0 and vx != 0.0:
+        # h(x) = z(x) - ground(x) is concave on each segment: its maximum over a bin
+        # is at a bin edge, a vertex, a piece end or the stationary point.
+        for xq in (x0, x1):
+            tq = time_to_x(x0, vx, ax, xq) if xq != x0 else 0.0
+            if tq == INF:
+                tq = t1
+            zq = z0 + vz * tq + 0.5 * az * tq * tq
+            _env_put(env, env0, envdx, xq, zq - ground_z(px, pz, sl, xq), False)
+        b0 = int(math.ceil((lo - env0) / envdx))
+        b1 = int(math.floor((hi - env0) / envdx))
+        for b in range(max(b0, 0), min(b1, env.size) + 1):
+            xq = env0 + b * envdx
+            tq = time_to_x(x0, vx, ax, xq)
+            if tq <= t1:
+                zq = z0 + vz * tq + 0.5 * az * tq * tq
+                _env_put(env, env0, envdx, xq, zq - ground_z(px, pz, sl, xq), True)
+        ja = segment_at(px, lo)
+        jb = segment_at(px, hi)
+        for jj in range(ja, jb + 1):
+            if jj > ja:
+                xq = px[jj]
+                tq = time_to_x(x0, vx, ax, xq)
+                if tq <= t1:
+                    zq = z0 + vz * tq + 0.5 * az * tq * tq
+                    _env_put(env, env0, envdx, xq, zq - pz[jj], False)
+            if ax == 0.0:
+                xs = x0 + (vz - sl[jj] * vx) * vx / (-az)
+                if lo <= xs <= hi and px[jj] <= xs <= px[jj + 1]:
+                    ts = (xs - x0) / vx
+                    zq = z0 + vz * ts + 0.5 * az * ts * ts
+                    _env_put(env, env0, envdx, xs, zq - ground_z(px, pz, sl, xs), False)
+    cap = trace.shape[0]
+    if cap > 0:
+        samples = 8 if ax == 0.0 else 1
+        for i in range(samples):
+            if ntr < cap:
+                tq = t1 * i / samples
+                trace[ntr, 0] = x0 + vx * tq + 0.5 * ax * tq * tq
+                trace[ntr, 1] = z0 + vz * tq + 0.5 * az * tq * tq
+                ntr += 1
+    return ntr
+
+
+@njit(cache=True)
+def _sweep_slide(
+    xa, xb, sp, ad, cpsi, m, r, kg, px, pz, sl, ana_x, ana, env0, envdx, env, trace, ntr
+):
+    """Analysis crossings, envelope (height 0) and trace of a slide from xa to xb."""
+    lo, hi = min(xa, xb), max(xa, xb)
+    for a in range(ana_x.size):
+        xq = ana_x[a]
+        if ana[a, 0] == 1.0 or xq < lo or xq > hi:
+            continue
+        v2 = sp * sp + 2.0 * ad * abs(xq - xa) / cpsi
+        v = math.sqrt(v2) if v2 > 0.0 else 0.0
+        ke = 0.5 * m * v * v
+        re = 0.5 * m * kg * kg * (v / r) ** 2
+        ana[a, 0] = 1.0
+        ana[a, 1] = v
+        ana[a, 2] = ke
+        ana[a, 3] = re
+        ana[a, 4] = ke + re
+        ana[a, 5] = 0.0
+    if env.size > 0:
+        b0 = int(math.floor((lo - env0) / envdx))
+        b1 = int(math.floor((hi - env0) / envdx))
+        for b in range(max(b0, 0), min(b1, env.size - 1) + 1):
+            if not (env[b] >= 0.0):
+                env[b] = 0.0
+    if trace.shape[0] > ntr:
+        trace[ntr, 0] = xa
+        trace[ntr, 1] = ground_z(px, pz, sl, xa)
+        ntr += 1
+    return ntr
+
+
+@njit(cache=True)
+def _tree_struck(tx, xa, xb, key, n, p):
+    """Index of the first tree strictly past ``xa`` up to ``xb`` that is struck, or -1.
+
+    Used for rocks sliding or rolling on the ground (always below the tree top).
+    """
+    lo, hi = min(xa, xb), max(xa, xb)
+    i0 = np.searchsorted(tx, lo, side="right")
+    i1 = np.searchsorted(tx, hi, side="right")
+    forward = xb > xa
+    for k in range(i1 - i0):
+        ii = i0 + k if forward else i1 - 1 - k
+        if tx[ii] == xa:
+            continue
+        if uniform(key, n, SLOT_TREE + ii) < p:
+            return ii
+    return -1
+
+
+@njit(cache=True)
+def _friction_tan(mat, mi, key, n, entry):
+    phi = mat[mi, M_PHI]
+    if mat[mi, M_PHI_SD] > 0.0:
+        phi = max(0.0, phi + mat[mi, M_PHI_SD] * normal(key, n, SLOT_FRICTION + entry))
+    return math.tan(math.radians(min(phi, 89.9)))
+
+
+@njit(cache=True)
+def run_rock(
+    key,
+    x,
+    z,
+    vx,
+    vz,
+    w,
+    m,
+    r,
+    kg,
+    px,
+    pz,
+    sl,
+    cpsi,
+    spsi,
+    psid,
+    smat,
+    mat,
+    tx,
+    td,
+    th,
+    flags,
+    par,
+    core,
+    ana_x,
+    ana,
+    env0,
+    envdx,
+    env,
+    rec,
+    rec_start,
+    rec_on,
+    trace,
+):
+    """Follow one rock; returns ``(impacts, state, runout_x_m, trace_points)``.
+
+    Arrays: profile vertices ``px, pz``; per segment slope dz/dx ``sl``, ``cos psi``,
+    ``sin psi``, ``psi`` [deg], material index; material table ``mat`` (columns
+    ``M_*``); trees ``tx, td, th``; effect ``flags`` and ``par`` (registry layout);
+    ``core`` = (slide_vn, stop_speed, max_impacts, drag_dt). Outputs written in place:
+    ``ana`` (analysis points x N_ANALYSIS, NaN-filled on entry), ``env`` (envelope
+    bins, NaN-filled), ``rec[rec_start + i]`` (impact rows when ``rec_on``) and
+    ``trace`` (x, z points; zero rows for none).
+    """
+    nseg = px.size - 1
+    slide_vn = core[0]
+    stop_v = core[1]
+    max_imp = int(core[2])
+    drag_dt = core[3]
+    m0, r0, k0, x_release = m, r, kg, x
+    drag = flags[F_DRAG] == 1 and par[P_DRAG_CD] > 0.0
+    trees = flags[F_TREE] == 1 and tx.size > 0 and par[P_TREE_P] > 0.0
+    n = 0
+    t = 0.0
+    ntr = 0
+    tree_hit = 0.0
+    state = -1
+    runout = x
+    j = segment_at(px, x)
+    flying = True
+    u = 0.0
+    while state < 0:
+        if flying:
+            while True:
+                if drag:
+                    k = air_drag.drag_factor(par[P_DRAG_CD], par[P_DRAG_RHO], r, m)
+                    ax, az = air_drag.substep_acceleration(vx, vz, k, G, drag_dt)
+                    tmax = drag_dt
+                else:
+                    ax, az, tmax = 0.0, -G, INF
+                jc, tc = piece_contact(px, pz, sl, j, x, z, vx, vz, ax, az, tmax)
+                if trees and vx != 0.0:
+                    x_end = x + vx * tc + 0.5 * ax * tc * tc
+                    lo, hi = min(x, x_end), max(x, x_end)
+                    i0 = np.searchsorted(tx, lo, side="right")
+                    i1 = np.searchsorted(tx, hi, side="right")
+                    struck = -1
+                    tt = 0.0
+                    ii = i0 if vx > 0.0 else i1 - 1
+                    for _ in range(i1 - i0):
+                        tt = time_to_x(x, vx, ax, tx[ii])
+                        if tt <= tc:
+                            zt = z + vz * tt + 0.5 * az * tt * tt
+                            if zt - ground_z(px, pz, sl, tx[ii]) < th[ii] and (
+                                uniform(key, n, SLOT_TREE + ii) < par[P_TREE_P]
+                            ):
+                                struck = ii
+                                break
+                        ii += 1 if vx > 0.0 else -1
+                    if struck >= 0:
+                        ntr = _sweep_flight(
+                            x,
+                            z,
+                            vx,
+                            vz,
+                            ax,
+                            az,
+                            tt,
+                            px,
+                            pz,
+                            sl,
+                            m,
+                            r,
+                            kg,
+                            w,
+                            ana_x,
+                            ana,
+                            env0,
+                            envdx,
+                            env,
+                            trace,
+                            ntr,
+                        )
+                        z = z + vz * tt + 0.5 * az * tt * tt
+                        x = tx[struck]
+                        vx = vx + ax * tt
+                        vz = vz + az * tt
+                        t += tt
+                        v = math.sqrt(vx * vx + vz * vz)
+                        v_new = tree_impacts.speed_after_strike(
+                            v, m, td[struck], par[P_TREE_C], par[P_TREE_EXP]
+                        )
+                        scale = v_new / v if v > 0.0 else 0.0
+                        vx *= scale
+                        vz *= scale
+                        tree_hit = 1.0
+                        j = segment_at(px, x)
+                        continue
+                ntr = _sweep_flight(
+                    x,
+                    z,
+                    vx,
+                    vz,
+                    ax,
+                    az,
+                    tc,
+                    px,
+                    pz,
+                    sl,
+                    m,
+                    r,
+                    kg,
+                    w,
+                    ana_x,
+                    ana,
+                    env0,
+                    envdx,
+                    env,
+                    trace,
+                    ntr,
+                )
+                x = x + vx * tc + 0.5 * ax * tc * tc
+                z = z + vz * tc + 0.5 * az * tc * tc
+                vx = vx + ax * tc
+                vz = vz + az * tc
+                t += tc
+                if jc >= 0:
+                    j = jc
+                    z = pz[j] + sl[j] * (x - px[j])  # exactly on the line
+                    break
+                if jc == -2:
+                    state = EXITED_DOWNSLOPE
+                    runout = px[nseg]
+                    break
+                if jc == -3:
+                    state = EXITED_UPSLOPE
+                    runout = px[0]
+                    break
+                j = segment_at(px, x)
+            if state >= 0:
+                break
+            if n >= max_imp:
+                state = MAX_IMPACTS
+                runout = x
+                break
+            n += 1
+            # ---- impact on segment j ----
+            mi = smat[j]
+            e_n = mat[mi, M_EN]
+            if mat[mi, M_EN_SD] > 0.0:
+                e_n = max(0.0, e_n + mat[mi, M_EN_SD] * normal(key, n, SLOT_E_N))
+            e_t = mat[mi, M_ET]
+            if mat[mi, M_ET_SD] > 0.0:
+                e_t = max(0.0, e_t + mat[mi, M_ET_SD] * normal(key, n, SLOT_E_T))
+            if flags[F_MASS] == 1:
+                ratio = mass_loss.volume_ratio(
+                    x - x_release, n, par[P_MASS_RATE], par[P_MASS_EXP]
+                )
+                cube = ratio ** (1.0 / 3.0)
+                m, r, kg = m0 * ratio, r0 * cube, k0 * cube
+            c = cpsi[j]
+            s = spsi[j]
+            psi = psid[j]
+            vit = vx * c - vz * s
+            vin = vx * s + vz * c
+            if flags[F_ROUGH] == 1:
+                sd = slope_roughness.dip_sd_rad(
+                    mat[mi, M_ROUGH], mat[mi, M_ROUGH_SD], r, par[P_ROUGH]
+                )
+                if sd > 0.0:
+                    delta = sd * normal(key, n, SLOT_ROUGHNESS)
+                    for trial in range(3):
+                        d = delta if trial == 0 else (-delta if trial == 1 else 0.0)
+                        rad = math.radians(psid[j]) + d
+                        c2 = math.cos(rad)
+                        s2 = math.sin(rad)
+                        if vx * s2 + vz * c2 < 0.0 or trial == 2:
+                            c, s, psi = c2, s2, math.degrees(rad)
+                            break
+                    vit = vx * c - vz * s
+                    vin = vx * s + vz * c
+            w_i = w
+            if vin >= 0.0:
+                vfn = 0.0
+                vft = vit
+                w = -vft / r
+            else:
+                if flags[F_ADR] == 1:
+                    theta_i = math.degrees(math.atan2(-vin, abs(vit)))
+                    e_n = angle_dependent_restitution.normal_restitution(
+                        e_n,
+                        mat[mi, M_EN],
+                        theta_i,
+                        par[P_ADR_B],
+                        par[P_ADR_REF],
+                        par[P_ADR_A],
+                    )
+                vfn = -e_n * vin
+                if flags[F_VSR] == 1:
+                    vfn *= velocity_scaled_restitution.normal_speed_factor(
+                        vin, par[P_VSR_K]
+                    )
+                if flags[F_ROT] == 1:
+                    vft, w = rotation_friction.impact(
+                        vit, vin, e_t, e_n, w, r, kg, par[P_ROT_MU], par[P_ROT_C]
+                    )
+                else:
+                    vft = e_t * vit
+                    w = -vft / r
+            vfx = vft * c + vfn * s
+            vfz = -vft * s + vfn * c
+            if rec_on:
+                row = rec_start + n - 1
+                rec[row, 0] = t
+                rec[row, 1] = x
+                rec[row, 2] = z
+                rec[row, 3] = psi
+                rec[row, 4] = vx
+                rec[row, 5] = vz
+                rec[row, 6] = vfx
+                rec[row, 7] = vfz
+                rec[row, 8] = m
+                rec[row, 9] = r
+                rec[row, 10] = kg
+                rec[row, 11] = w_i
+                rec[row, 12] = w
+                rec[row, 13] = mi
+                rec[row, 14] = tree_hit
+            tree_hit = 0.0
+            if trace.shape[0] > ntr:
+                trace[ntr, 0] = x
+                trace[ntr, 1] = z
+                ntr += 1
+            vn_real = vfx * spsi[j] + vfz * cpsi[j]
+            if vfn < slide_vn or vn_real <= 0.0:
+                flying = False
+                u = vfx * cpsi[j] - vfz * spsi[j]
+                entry = 0
+                tanphi = _friction_tan(mat, mi, key, n, entry)
+            else:
+                vx, vz = vfx, vfz
+        else:
+            # ---- sliding / rolling on segment j (eq. 7.3) ----
+            for _ in range(MAX_SLIDE_STEPS):
+                c = cpsi[j]
+                s = spsi[j]
+                if u > 0.0:
+                    dirn = 1.0
+                elif u < 0.0:
+                    dirn = -1.0
+                else:
+                    if abs(s) <= c * tanphi:
+                        state = STOPPED
+                        break
+                    dirn = 1.0 if s > 0.0 else -1.0
+                sp = abs(u)
+                ad = dirn * G * s - G * c * tanphi  # acceleration along travel
+                length = ((px[j + 1] - x) if dirn > 0.0 else (x - px[j])) / c
+                if sp == 0.0 and length <= 1e-12:
+                    state = STOPPED  # at rest in a notch
+                    break
+                v2 = sp * sp + 2.0 * ad * length
+                if trees:
+                    reach = length if v2 > 0.0 else sp * sp / (-2.0 * ad)
+                    ii = _tree_struck(
+                        tx, x, x + dirn * reach * c, key, n, par[P_TREE_P]
+                    )
+                    if ii >= 0:
+                        d = abs(tx[ii] - x) / c
+                        vt2 = sp * sp + 2.0 * ad * d
+                        vt = math.sqrt(vt2) if vt2 > 0.0 else 0.0
+                        ntr = _sweep_slide(
+                            x, tx[ii], sp, ad, c, m, r, kg, px, pz, sl,
+                            ana_x, ana, env0, envdx, env, trace, ntr,
+                        )  # fmt: skip
+                        t += (vt - sp) / ad if ad != 0.0 else d / sp
+                        x = tx[ii]
+                        vt = tree_impacts.speed_after_strike(
+                            vt, m, td[ii], par[P_TREE_C], par[P_TREE_EXP]
+                        )
+                        u = dirn * vt
+                        tree_hit = 1.0
+                        continue
+                if v2 <= 0.0:
+                    dist = sp * sp / (-2.0 * ad)
+                    x_new = x + dirn * dist * c
+                    ntr = _sweep_slide(
+                        x,
+                        x_new,
+                        sp,
+                        ad,
+                        c,
+                        m,
+                        r,
+                        kg,
+                        px,
+                        pz,
+                        sl,
+                        ana_x,
+                        ana,
+                        env0,
+                        envdx,
+                        env,
+                        trace,
+                        ntr,
+                    )
+                    t += sp / (-ad)
+                    x = x_new
+                    u = 0.0
+                    continue
+                ve = math.sqrt(v2)
+                x_new = px[j + 1] if dirn > 0.0 else px[j]
+                ntr = _sweep_slide(
+                    x,
+                    x_new,
+                    sp,
+                    ad,
+                    c,
+                    m,
+                    r,
+                    kg,
+                    px,
+                    pz,
+                    sl,
+                    ana_x,
+                    ana,
+                    env0,
+                    envdx,
+                    env,
+                    trace,
+                    ntr,
+                )
+                t += (ve - sp) / ad if ad != 0.0 else length / sp
+                x = x_new
+                jn = j + (1 if dirn > 0.0 else -1)
+                if jn >= nseg:
+                    state = EXITED_DOWNSLOPE
+                    break
+                if jn < 0:
+                    state = EXITED_UPSLOPE
+                    break
+                u_end = dirn * ve
+                convex = psid[jn] > psid[j] if dirn > 0.0 else psid[jn] < psid[j]
+                if convex:
+                    vx = u_end * c
+                    vz = -u_end * s
+                    w = -u_end / r
+                    j = jn
+                    z = pz[j] + sl[j] * (x - px[j])
+                    flying = True
+                    break
+                u = u_end * (c * cpsi[jn] + s * spsi[jn])  # projection on segment jn
+                if abs(u) < stop_v:
+                    u = 0.0
+                j = jn
+                entry += 1
+                tanphi = _friction_tan(mat, smat[j], key, n, entry)
+            else:
+                state = MAX_IMPACTS
+            if state >= 0:
+                runout = x
+                if trace.shape[0] > ntr:
+                    trace[ntr, 0] = x
+                    trace[ntr, 1] = ground_z(px, pz, sl, x)
+                    ntr += 1
+            else:
+                w = -u / r if u != 0.0 else w
+    if state != STOPPED and trace.shape[0] > ntr:
+        trace[ntr, 0] = x if state == MAX_IMPACTS else runout
+        trace[ntr, 1] = z
+        ntr += 1
+    return n, state, runout, ntr
+
+
+@njit(cache=True, parallel=True)
+def run_rocks(
+    keys,
+    x,
+    z,
+    vx,
+    vz,
+    w,
+    m,
+    r,
+    kg,
+    px,
+    pz,
+    sl,
+    cpsi,
+    spsi,
+    psid,
+    smat,
+    mat,
+    tx,
+    td,
+    th,
+    flags,
+    par,
+    core,
+    ana_x,
+    ana,
+    env0,
+    envdx,
+    env,
+    rec,
+    rec_offsets,
+    rec_on,
+    impacts,
+    states,
+    runout,
+):
+    """:func:`run_rock` over all rocks in parallel; outputs written in place."""
+    no_trace = np.zeros((0, 2))
+    for i in prange(keys.size):
+        n, st, ro, _ = run_rock(
+            keys[i],
+            x[i],
+            z[i],
+            vx[i],
+            vz[i],
+            w[i],
+            m[i],
+            r[i],
+            kg[i],
+            px,
+            pz,
+            sl,
+            cpsi,
+            spsi,
+            psid,
+            smat,
+            mat,
+            tx,
+            td,
+            th,
+            flags,
+            par,
+            core,
+            ana_x,
+            ana[i],
+            env0,
+            envdx,
+            env[i],
+            rec,
+            rec_offsets[i],
+            rec_on,
+            no_trace,
+        )
+        impacts[i] = n
+        states[i] = st
+        runout[i] = ro

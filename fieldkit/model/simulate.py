@@ -1,0 +1,361 @@
+"""Run a model for many rocks: draws, chunks, the compiled kernel, streamed impacts.
+
+:func:`simulate` draws every rock's start from the seeder and one 64-bit key per rock
+with the caller's Generator (fixed order, vectorised), then runs
+:func:`fieldkit.model.kernel.run_rocks` in chunks. Inside the kernel each random
+number is a function of (key, impact number, slot)
+(:mod:`fieldkit.model.random_streams`), so a seed reproduces a run exactly whatever
+the thread count or chunk size.
+
+Recording impacts (``record_impacts=True``) runs each chunk twice: once to count each
+rock's impacts, once to write them into an array of exactly that size, which is
+turned into an :class:`~fieldkit.impact_table.ImpactTable` and handed to
+``on_impact_chunk`` (or kept, when no callback is given). Memory is bounded by one
+chunk's impacts; without recording it does not depend on the number of impacts.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from fieldkit.errors import ArgumentError
+from fieldkit.impact_table import ImpactTable
+from fieldkit.model import kernel
+from fieldkit.model.effects import registry
+from fieldkit.model.model_file import Model
+from fieldkit.model.results import AnalysisPoint, SimulationResult
+from fieldkit.model.seeder import Starts, draw_starts
+
+#: Rocks per kernel call when impacts are not recorded (progress granularity).
+CHUNK_ROCKS = 100_000
+#: Trace points kept per sampled trajectory.
+TRACE_POINTS = 20_000
+
+
+@dataclass(frozen=True)
+class KernelInputs:
+    """The model as the kernel's flat arrays (shared by simulate and reference)."""
+
+    px: np.ndarray
+    pz: np.ndarray
+    sl: np.ndarray
+    cpsi: np.ndarray
+    spsi: np.ndarray
+    psid: np.ndarray
+    smat: np.ndarray
+    mat: np.ndarray
+    material_names: tuple[str, ...]
+    tx: np.ndarray
+    td: np.ndarray
+    th: np.ndarray
+    flags: np.ndarray
+    par: np.ndarray
+    core: np.ndarray
+
+    def profile_args(self) -> tuple:
+        """Positional arguments of :func:`kernel.run_rock` after the rock state."""
+        return (
+            self.px,
+            self.pz,
+            self.sl,
+            self.cpsi,
+            self.spsi,
+            self.psid,
+            self.smat,
+            self.mat,
+            self.tx,
+            self.td,
+            self.th,
+            self.flags,
+            self.par,
+            self.core,
+        )
+
+
+def kernel_inputs(model: Model) -> KernelInputs:
+    """Flatten ``model`` into :class:`KernelInputs`."""
+    prof = model.profile
+    px = np.ascontiguousarray(prof.x_m, float)
+    pz = np.ascontiguousarray(prof.z_m, float)
+    sl = np.diff(pz) / np.diff(px)
+    psi = -np.arctan(sl)
+    names = tuple(model.materials)
+    mat = np.array(
+        [
+            [
+                m.e_n,
+                m.e_t,
+                m.friction_deg,
+                m.e_n_sd,
+                m.e_t_sd,
+                m.friction_deg_sd,
+                m.roughness_m,
+                m.roughness_deg_sd,
+            ]
+            for m in model.materials.values()
+        ],
+        float,
+    )
+    smat = np.array([names.index(name) for name in prof.material], np.int64)
+    flags, par = registry.kernel_arrays(model.effects)
+    trees = model.trees
+    empty = np.zeros(0)
+    core = np.array(
+        [
+            model.core[k]
+            for k in ("slide_vn_mps", "stop_speed_mps", "max_impacts", "drag_dt_s")
+        ],
+        float,
+    )
+    return KernelInputs(
+        px=px,
+        pz=pz,
+        sl=sl,
+        cpsi=np.cos(psi),
+        spsi=np.sin(psi),
+        psid=np.degrees(psi),
+        smat=smat,
+        mat=mat,
+        material_names=names,
+        tx=empty if trees is None else np.ascontiguousarray(trees.x_m, float),
+        td=empty if trees is None else np.ascontiguousarray(trees.diameter_m, float),
+        th=empty if trees is None else np.ascontiguousarray(trees.height_m, float),
+        flags=flags,
+        par=par,
+        core=core,
+    )
+
+
+def draw_rocks(
+    model: Model, rocks: int, rng: np.random.Generator
+) -> tuple[Starts, np.ndarray]:
+    """Start states and per-rock keys, drawn in the one fixed order of a run."""
+    starts = draw_starts(model.seeder, model.profile, model.body.mass_kg, rocks, rng)
+    keys = rng.integers(0, 2**63, size=rocks, dtype=np.uint64)
+    return starts, keys
+
+
+def body_of(model: Model, mass_kg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Radius and gyration of rocks of ``mass_kg`` (shape kept: ∝ mass^(1/3))."""
+    cube = (np.asarray(mass_kg, float) / model.body.mass_kg) ** (1.0 / 3.0)
+    return model.body.radius_m * cube, model.body.gyration_m * cube
+
+
+def impact_frame(
+    rec: np.ndarray, impacts: np.ndarray, first_rock: int, names: tuple[str, ...]
+) -> ImpactTable:
+    """ImpactTable (derived) from kernel impact rows of consecutive rocks."""
+    cols = dict(zip(kernel.RECORD_COLUMNS, rec.T, strict=True))
+    rock = np.repeat(np.arange(first_rock, first_rock + impacts.size), impacts)
+    starts = np.repeat(np.cumsum(impacts) - impacts, impacts)
+    number = np.arange(rec.shape[0]) - starts + 1
+    frame = pd.DataFrame(
+        {
+            "path_id": rock.astype(str),
+            "point": number.astype(str),
+            "t_s": cols["t_s"],
+            "x_m": cols["x_m"],
+            "z_m": cols["z_m"],
+            "slope_deg": cols["slope_deg"],
+            "material": np.asarray(names, dtype=object)[
+                cols["material_index"].astype(np.int64)
+            ],
+            "mass_kg": cols["mass_kg"],
+            "radius_m": cols["radius_m"],
+            "gyration_m": cols["gyration_m"],
+            "vi_x_mps": cols["vi_x_mps"],
+            "vi_z_mps": cols["vi_z_mps"],
+            "vf_x_mps": cols["vf_x_mps"],
+            "vf_z_mps": cols["vf_z_mps"],
+            "omega_i_radps": cols["omega_i_radps"],
+            "omega_f_radps": cols["omega_f_radps"],
+            "tree_strike": cols["tree_strike"] > 0.5,
+        }
+    )
+    return ImpactTable(frame, source="simulation").derive()
+
+
+def simulate(
+    model: Model,
+    rocks: int,
+    rng: np.random.Generator,
+    *,
+    analysis_x_m: Sequence[float] = (),
+    trajectories: int = 0,
+    record_impacts: bool = False,
+    impact_chunk_rocks: int = 20000,
+    on_impact_chunk: Callable[[ImpactTable], None] | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    envelope_dx_m: float | None = None,
+) -> SimulationResult:
+    """Simulate ``rocks`` rocks of ``model`` with the random numbers of ``rng``.
+
+    Parameters
+    ----------
+    analysis_x_m
+        x of vertical analysis lines (speeds, energies, heights of crossing rocks).
+    trajectories
+        Sample (x, z) paths of the first this-many rocks.
+    record_impacts, impact_chunk_rocks, on_impact_chunk
+        Build the ImpactTable of simulated impacts, ``impact_chunk_rocks`` rocks at a
+        time, handing each chunk to ``on_impact_chunk`` (else kept in the result).
+    progress
+        Called with (rocks done, rocks) after each chunk.
+    envelope_dx_m
+        Bin width of the bounce-height envelope; None = no envelope.
+
+    Examples
+    --------
+    >>> from fieldkit.model.model_file import model_from_dict
+    >>> m = model_from_dict({"profile": {"x_m": [0, 50], "z_m": [30, 0],
+    ...   "material": "rock"}, "materials": {"rock": {"e_n": 0.3, "e_t": 0.8,
+    ...   "friction_deg": 25}}, "body": {"mass_kg": 100, "radius_m": 0.2},
+    ...   "seeder": {"x_m": 1, "z_m": 31}})
+    >>> simulate(m, 2, np.random.default_rng(0)).state.tolist()
+    [1, 1]
+    """
+    if not (isinstance(rocks, int | np.integer) and rocks >= 1):
+        raise ArgumentError(
+            f"rocks must be an integer >= 1 (got {rocks})", source="rocks"
+        )
+    if envelope_dx_m is not None and not envelope_dx_m > 0:
+        raise ArgumentError(
+            f"envelope_dx_m must be > 0 (got {envelope_dx_m})", source="envelope_dx_m"
+        )
+    if impact_chunk_rocks < 1:
+        raise ArgumentError(
+            f"impact_chunk_rocks must be >= 1 (got {impact_chunk_rocks})",
+            source="impact_chunk_rocks",
+        )
+    inputs = kernel_inputs(model)
+    starts, keys = draw_rocks(model, rocks, rng)
+    radius, gyration = body_of(model, starts.mass_kg)
+    ana_x = np.asarray(analysis_x_m, float).reshape(-1)
+    ana = np.full((rocks, ana_x.size, kernel.N_ANALYSIS), np.nan)
+    x0, x1 = inputs.px[0], inputs.px[-1]
+    if envelope_dx_m is not None:
+        bins = max(1, math.ceil((x1 - x0) / envelope_dx_m))
+        edges = x0 + envelope_dx_m * np.arange(bins + 1)
+        env = np.full((rocks, bins), np.nan, np.float32)
+        envdx = float(envelope_dx_m)
+    else:
+        edges = np.zeros(0)
+        env = np.zeros((rocks, 0), np.float32)
+        envdx = 1.0
+    impacts = np.zeros(rocks, np.int64)
+    states = np.zeros(rocks, np.int64)
+    runout = np.zeros(rocks, float)
+    chunk = impact_chunk_rocks if record_impacts else CHUNK_ROCKS
+    tables: list[ImpactTable] = []
+    wall = 0.0
+    no_rec = np.zeros((0, kernel.N_RECORD))
+    for a in range(0, rocks, chunk):
+        b = min(rocks, a + chunk)
+        sel = slice(a, b)
+
+        def run(rec, offsets, on, sel=sel):
+            kernel.run_rocks(
+                keys[sel],
+                starts.x_m[sel],
+                starts.z_m[sel],
+                starts.vx_mps[sel],
+                starts.vz_mps[sel],
+                starts.omega_radps[sel],
+                starts.mass_kg[sel],
+                radius[sel],
+                gyration[sel],
+                *inputs.profile_args(),
+                ana_x,
+                ana[sel],
+                float(x0),
+                envdx,
+                env[sel],
+                rec,
+                offsets,
+                on,
+                impacts[sel],
+                states[sel],
+                runout[sel],
+            )
+
+        tic = time.perf_counter()
+        run(no_rec, np.zeros(b - a, np.int64), False)
+        wall += time.perf_counter() - tic
+        if record_impacts:
+            counts = impacts[sel]
+            offsets = np.cumsum(counts) - counts
+            rec = np.empty((int(counts.sum()), kernel.N_RECORD))
+            tic = time.perf_counter()
+            run(rec, offsets, True)
+            wall += time.perf_counter() - tic
+            table = impact_frame(rec, counts, a, inputs.material_names)
+            if on_impact_chunk is not None:
+                on_impact_chunk(table)
+            else:
+                tables.append(table)
+        if progress is not None:
+            progress(b, rocks)
+    analysis = [
+        AnalysisPoint(
+            x_m=float(xa),
+            crossed=ana[:, i, 0] == 1.0,
+            speed_mps=ana[:, i, 1],
+            ke_j=ana[:, i, 2],
+            re_j=ana[:, i, 3],
+            total_j=ana[:, i, 4],
+            height_m=ana[:, i, 5],
+        )
+        for i, xa in enumerate(ana_x)
+    ]
+    paths = []
+    for i in range(min(trajectories, rocks)):
+        trace = np.zeros((TRACE_POINTS, 2))
+        scratch_ana = np.full((0, kernel.N_ANALYSIS), np.nan)
+        *_, count = kernel.run_rock(
+            keys[i],
+            starts.x_m[i],
+            starts.z_m[i],
+            starts.vx_mps[i],
+            starts.vz_mps[i],
+            starts.omega_radps[i],
+            starts.mass_kg[i],
+            radius[i],
+            gyration[i],
+            *inputs.profile_args(),
+            np.zeros(0),
+            scratch_ana,
+            float(x0),
+            1.0,
+            np.zeros(0, np.float32),
+            no_rec,
+            0,
+            False,
+            trace,
+        )
+        paths.append(trace[:count].copy())
+    table = None
+    if record_impacts and on_impact_chunk is None:
+        table = ImpactTable(
+            pd.concat([t.frame for t in tables], ignore_index=True), source="simulation"
+        )
+    return SimulationResult(
+        model=model,
+        rocks=rocks,
+        seed=None,
+        wall_s=wall,
+        impacts=int(impacts.sum()),
+        runout_x_m=runout,
+        state=states,
+        impacts_per_rock=impacts,
+        analysis=analysis,
+        envelope_x_m=edges,
+        envelope_height_m=env,
+        trajectories=paths,
+        impact_table=table,
+    )

@@ -1,0 +1,93 @@
+"""One contract over the registry: every effect obeys the same rules."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from conftest import build, same_result
+
+from fieldkit.errors import ArgumentError, InputFileError
+from fieldkit.model import simulate
+from fieldkit.model.effects.registry import EFFECTS, BY_NAME, describe, effect
+
+NAMES = [spec.name for spec in EFFECTS]
+CONTRACT = {
+    "angle_dependent_restitution", "velocity_scaled_restitution", "rotation_friction",
+    "slope_roughness", "mass_loss", "tree_impacts", "air_drag",
+}  # fmt: skip
+
+
+def test_registry_is_the_architecture_vocabulary():
+    assert set(NAMES) == CONTRACT and len(NAMES) == len(CONTRACT)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_metadata_is_complete_and_defaults_in_bounds(name):
+    spec = effect(name)
+    assert spec.stage in ("impact", "flight", "slide")
+    assert spec.summary and spec.physics and spec.reference
+    assert spec.parameters
+    for p in spec.parameters:
+        assert p.lower <= p.default <= p.upper, p.name
+        assert p.units and p.description
+        if p.neutral is not None:
+            assert p.lower <= p.neutral <= p.upper
+    assert any(p.neutral is not None for p in spec.parameters)
+    text = describe(name)
+    for p in spec.parameters:
+        assert f"{name}.{p.name}" in text
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_neutral_parameters_reproduce_the_base_model_exactly(name):
+    rng_args = dict(record_impacts=True, analysis_x_m=[50.0])
+    base = simulate(build(sd=True), 300, np.random.default_rng(11), **rng_args)
+    neutral = build({name: effect(name).neutral()}, sd=True)
+    other = simulate(neutral, 300, np.random.default_rng(11), **rng_args)
+    assert same_result(base, other)
+    assert np.array_equal(
+        base.analysis[0].speed_mps, other.analysis[0].speed_mps, equal_nan=True
+    )
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_default_parameters_change_the_result(name):
+    base = simulate(build(sd=True), 300, np.random.default_rng(11), record_impacts=True)
+    on = simulate(
+        build({name: {}}, sd=True), 300, np.random.default_rng(11), record_impacts=True
+    )
+    assert not same_result(base, on)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_same_generator_same_result(name):
+    model = build({name: {}}, sd=True)
+    a = simulate(model, 200, np.random.default_rng(5), record_impacts=True)
+    b = simulate(model, 200, np.random.default_rng(5), record_impacts=True)
+    c = simulate(model, 200, np.random.default_rng(6), record_impacts=True)
+    assert same_result(a, b)
+    assert not same_result(a, c)
+
+
+def test_unknown_effect_lists_the_known_ones():
+    with pytest.raises(ArgumentError) as err:
+        effect("air_dragg")
+    for name in NAMES:
+        assert name in str(err.value)
+    with pytest.raises(InputFileError) as err:
+        build({"gravity_off": {}})
+    assert str(err.value).startswith("test.json: effects.gravity_off: unknown effect")
+    assert "rotation_friction" in str(err.value)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_parameter_outside_bounds_is_one_line_naming_file_and_parameter(name):
+    p = BY_NAME[name].parameters[0]
+    bad = p.upper * 2 + 1 if math.isfinite(p.upper) else p.lower - 1
+    with pytest.raises(InputFileError) as err:
+        build({name: {p.name: bad}})
+    text = str(err.value)
+    assert text.startswith(f"test.json: effects.{name}.{p.name}: must be in [")
+    assert "\n" not in text
