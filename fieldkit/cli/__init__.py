@@ -13,7 +13,7 @@ from typing import Annotated
 import typer
 
 from fieldkit._version import __version__
-from fieldkit.cli import fence, impact, reduce, track, view
+from fieldkit.cli import effects, fence, impact, reduce, simulate, track, view
 
 app = typer.Typer(
     name="fieldkit",
@@ -50,6 +50,8 @@ app.command("impact")(impact.impact)
 app.command("fence")(fence.fence)
 app.command("track")(track.track)
 app.command("view")(view.view)
+app.command("simulate")(simulate.simulate)
+app.command("effects")(effects.effects)
 
 # typer bundles its own click; reach its base exception through a public class.
 _USAGE_ERRORS = next(
