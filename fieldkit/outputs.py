@@ -27,6 +27,15 @@ What "together" guarantees
   during the renames (a few milliseconds at the end); then some files are new, some
   old, and backups ``.fk-XXXXXXXX.bak`` may remain beside them.
 
+Files written during the computation (streamed)
+-----------------------------------------------
+An output too large to hold in memory (a simulation's impacts) is written while it
+is computed: :meth:`OutputSet.stream` plans the path and returns a temporary file
+beside it, which the caller fills progressively; :meth:`OutputSet.commit` renames it
+into place with the others. If the command fails before the commit, :meth:`abort`
+(or leaving ``with OutputSet(...) as outputs:`` by an exception) removes it and the
+folders made for it, so nothing partial remains.
+
 Targets that are not regular files
 ----------------------------------
 A FIFO or a character device (``/dev/null``, a terminal) is *written through*: opened
@@ -87,6 +96,8 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
+
+import numpy as np
 
 from fieldkit.errors import OutputFileError
 
@@ -178,6 +189,7 @@ class _Output:
     backup: Path | None = None
     through: bool = False  # written in place (FIFO, character device)
     placed: bool = False  # renamed into place
+    streamed: bool = False  # tmp filled by the caller before commit (stream)
 
 
 class OutputSet:
@@ -200,6 +212,14 @@ class OutputSet:
         self._inputs = [(Path(p), _identity(p)) for p in inputs if p is not None]
         self._outputs: list[_Output] = []
         self._committed = False
+        self._created: list[Path] = []  # folders made before commit (stream)
+
+    def __enter__(self) -> OutputSet:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if exc_type is not None:
+            self.abort()
 
     @property
     def paths(self) -> list[Path]:
@@ -272,6 +292,77 @@ class OutputSet:
         self._outputs[-1].write = write
         return target
 
+    def stream(self, path: PathArg, *, argument: str | None = None) -> Path:
+        """Plan ``path`` and return a temporary file to write it into now.
+
+        For an output written while it is computed (chunk by chunk): the caller
+        opens the returned file, appends to it, closes it before :meth:`commit`,
+        which renames it over ``path`` with the other outputs (or copies it into a
+        FIFO or device). Nothing else writes it. On failure before the commit call
+        :meth:`abort` (or use the set as a context manager), which removes it.
+
+        Returns
+        -------
+        Path
+            The temporary file (empty, in the target's folder, which is created
+            now if missing; in the system's temporary folder for a FIFO or device).
+
+        Raises
+        ------
+        OutputFileError
+            As :meth:`plan`, or the temporary file cannot be made.
+
+        Examples
+        --------
+        >>> import tempfile
+        >>> folder = Path(tempfile.mkdtemp())
+        >>> with OutputSet() as outputs:
+        ...     tmp = outputs.stream(folder / "big.csv")
+        ...     with open(tmp, "w") as f:
+        ...         for chunk in ("a\\n", "b\\n"):
+        ...             _ = f.write(chunk)
+        ...     _ = outputs.commit()
+        >>> (folder / "big.csv").read_text()
+        'a\\nb\\n'
+        """
+        if self._committed:
+            raise RuntimeError("an OutputSet commits once")
+        target = self.plan(path, argument=argument)
+        out = self._outputs[-1]
+        try:
+            if out.through:
+                fd, tmp = tempfile.mkstemp(
+                    prefix="fieldkit-", suffix=_temp_suffix(out.real)
+                )
+            else:
+                _make_folders(out.real.parent, self._created)
+                fd, tmp = tempfile.mkstemp(
+                    prefix=_TEMP_PREFIX,
+                    suffix=_temp_suffix(out.real),
+                    dir=out.real.parent,
+                )
+        except OSError as exc:
+            self._outputs.pop()
+            raise OutputFileError(describe_os_error(exc), source=target) from None
+        os.close(fd)
+        out.tmp, out.streamed = Path(tmp), True
+        out.write = _streamed
+        return out.tmp
+
+    def abort(self) -> None:
+        """Give up before :meth:`commit`: remove streamed temporary files and the
+        folders made for them. Nothing else has been written. Harmless after a
+        commit (then it does nothing)."""
+        if self._committed:
+            return
+        self._committed = True
+        for out in self._outputs:
+            _remove(out.tmp)
+            out.tmp = None
+        for folder in reversed(self._created):
+            with contextlib.suppress(OSError):
+                folder.rmdir()
+
     def commit(self) -> list[Path]:
         """Write every file: all into temporary files, then all renamed into place.
 
@@ -293,7 +384,7 @@ class OutputSet:
         if unwritten:
             raise ValueError(f"planned outputs without a writer: {unwritten}")
         self._committed = True
-        created: list[Path] = []
+        created: list[Path] = self._created
         current: _Output | None = None
         try:
             mode = 0o666 & ~_umask()
@@ -411,8 +502,16 @@ def _make_folders(folder: Path, created: list[Path]) -> None:
         created.append(new)
 
 
+def _streamed(tmp: Path) -> None:
+    """The writer of a streamed output: its file is already written."""
+
+
 def _stage(out: _Output, created: list[Path], mode: int) -> None:
     """Run the writer into a temporary file (beside the target when renamed)."""
+    if out.streamed:  # filled by the caller already
+        if not out.through:
+            os.chmod(out.tmp, mode)
+        return
     st = _stat(out.real)
     if st is not None and stat.S_ISDIR(st.st_mode):
         raise IsADirectoryError(errno.EISDIR, "Is a directory", str(out.path))
@@ -566,9 +665,17 @@ def escape_formulas(frame: pd.DataFrame) -> pd.DataFrame:
     """
     out = frame.copy()
     for col in _text_columns(out):
-        out[col] = out[col].map(
-            lambda v: escape_formula(v) if isinstance(v, str) else v
-        )
+        # only the cells escape_formula changes go through it (a column of digits,
+        # such as a simulation's rock numbers, costs one vectorised test)
+        column = out[col]
+        text = column.astype("string")
+        starts = text.str.lstrip("'").str[:1].isin(FORMULA_STARTS)
+        rows = np.flatnonzero(starts.fillna(False).to_numpy(bool))
+        rows = [i for i in rows if isinstance(column.iloc[i], str)]
+        if rows:
+            column = column.copy()
+            column.iloc[rows] = [escape_formula(column.iloc[i]) for i in rows]
+            out[col] = column
     return out
 
 

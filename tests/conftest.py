@@ -140,3 +140,83 @@ def shell_commands():
 def run_shell():
     """:func:`_run_shell`: run one example command line in a folder."""
     return _run_shell
+
+
+@pytest.fixture()
+def synthetic_simulation():
+    """A SimulationResult built from numpy arrays with known distributions.
+
+    ``make(rocks, seed)`` -> result on a 3-vertex profile (x 0, 50, 100 m; materials
+    rock, talus) whose runout is U(60, 100) m, with one analysis point at x = 70 m
+    crossed by the rocks whose runout exceeds 70 m (speed ~ N(10, 2) m/s, height ~
+    N(1, 0.2) m), an envelope of 10 bins and 3 straight-line trajectories. The model
+    is a stand-in with the attributes the summary and figures read.
+    """
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from fieldkit.model.results import AnalysisPoint, SimulationResult
+
+    def make(rocks: int = 1000, seed: int = 1) -> SimulationResult:
+        rng = np.random.default_rng(seed)
+        profile = SimpleNamespace(
+            x_m=np.array([0.0, 50.0, 100.0]),
+            z_m=np.array([60.0, 20.0, 10.0]),
+            material=("rock", "talus"),
+            source="synthetic",
+        )
+        profile.ground_z = lambda x: np.interp(x, profile.x_m, profile.z_m)
+        model = SimpleNamespace(
+            profile=profile,
+            materials={},
+            effects={"air_drag": {"cd": 0.5}},
+            core={"slide_vn_mps": 0.5},
+            source="synthetic.json",
+            provenance={},
+        )
+        runout = rng.uniform(60.0, 100.0, rocks)
+        crossed = runout > 70.0
+        speed = np.where(crossed, rng.normal(10.0, 2.0, rocks), np.nan)
+        mass, k, omega = 1000.0, 0.4, speed / 0.5
+        ke = 0.5 * mass * speed**2
+        re = 0.5 * mass * k**2 * omega**2
+        point = AnalysisPoint(
+            x_m=70.0,
+            crossed=crossed,
+            speed_mps=speed,
+            ke_j=ke,
+            re_j=re,
+            total_j=ke + re,
+            height_m=np.where(crossed, rng.normal(1.0, 0.2, rocks), np.nan),
+        )
+        edges = np.linspace(0.0, 100.0, 11)
+        centres = (edges[:-1] + edges[1:]) / 2
+        env = rng.exponential(1.0, (rocks, 10)).astype(np.float32)
+        env[centres[None, :] > runout[:, None]] = np.nan
+        trajectories = [
+            np.column_stack(
+                [
+                    np.linspace(0, r, 20),
+                    np.interp(np.linspace(0, r, 20), profile.x_m, profile.z_m) + 1.0,
+                ]
+            )
+            for r in runout[:3]
+        ]
+        state = np.where(runout < 100.0, 0, 1)
+        return SimulationResult(
+            model=model,
+            rocks=rocks,
+            seed=seed,
+            wall_s=0.5,
+            impacts=rocks * 7,
+            runout_x_m=runout,
+            state=state,
+            impacts_per_rock=np.full(rocks, 7),
+            analysis=[point],
+            envelope_x_m=edges,
+            envelope_height_m=env,
+            trajectories=trajectories,
+        )
+
+    return make

@@ -13,7 +13,7 @@ from typing import Annotated
 import typer
 
 from fieldkit._version import __version__
-from fieldkit.cli import fence, impact, profile, reduce, track, view
+from fieldkit.cli import effects, fence, impact, profile, reduce, simulate, track, view
 
 app = typer.Typer(
     name="fieldkit",
@@ -51,6 +51,8 @@ app.command("fence")(fence.fence)
 app.command("track")(track.track)
 app.command("view")(view.view)
 app.command("profile")(profile.profile)
+app.command("simulate")(simulate.simulate)
+app.command("effects")(effects.effects)
 
 # typer bundles its own click; reach its base exception through a public class.
 _USAGE_ERRORS = next(

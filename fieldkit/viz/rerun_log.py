@@ -20,9 +20,13 @@ Entity layout
 ``plots/speed/{measured,fitted}``, ``plots/spin``, ``plots/residual_mm``  time series
 ``contacts/<i>/speed``           speed through each net contact
 ``section/<path>/...``           an ImpactTable: impacts, velocity arrows, slope ticks
+``simulation/profile``           a simulated slope profile (line strip, x, 0, z)
+``simulation/trajectories/<i>``  the sampled trajectory of rock i
+``simulation/impacts``           impacts of those rocks, coloured by impact speed
 
 Timelines: ``frame`` (video frame index), ``t`` (seconds); ImpactTables use
-``impact`` (row order).
+``impact`` (row order); a simulation uses ``rock`` (rock index: the trajectories
+appear one by one) and ``t`` (time of each impact since the rock's release).
 """
 
 from __future__ import annotations
@@ -37,6 +41,7 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from fieldkit.impact_table import ImpactTable
+from fieldkit.model.results import SimulationResult
 from fieldkit.outputs import OutputSet, write_file
 from fieldkit.physics.local_axes import to_section
 from fieldkit.tracking.flights.pipeline import TrackAnalysis
@@ -140,6 +145,73 @@ def write_impact_recording(
             rec.disconnect()
 
     return write_file(path, record, outputs)
+
+
+def write_simulation_recording(
+    path: str | os.PathLike[str],
+    result: SimulationResult,
+    impacts: ImpactTable | None = None,
+    *,
+    outputs: OutputSet | None = None,
+) -> Path:
+    """Write a rerun recording of a simulation: profile, trajectories, impacts.
+
+    The profile as a line strip, each sampled trajectory (``result.trajectories``)
+    as a line strip on the ``rock`` timeline, and ``impacts`` (those of the same
+    rocks, when given) as points coloured by impact speed (blue slow -> red fast)
+    on the ``t`` timeline. Into ``outputs`` when given, else at once.
+    """
+    profile = result.model.profile
+
+    def record(tmp: Path) -> None:
+        rec = _open(tmp, "simulation")
+        try:
+            rec.log("simulation", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+            rec.log(
+                "simulation/profile",
+                rr.LineStrips3D(
+                    [_xyz(profile.x_m, profile.z_m)], colors=[(90, 90, 90)]
+                ),
+                static=True,
+            )
+            for i, samples in enumerate(result.trajectories):
+                rec.set_time("rock", sequence=i)
+                rec.log(
+                    f"simulation/trajectories/{i}",
+                    rr.LineStrips3D(
+                        [_xyz(samples[:, 0], samples[:, 1])], colors=[_FLIGHT_COLOUR]
+                    ),
+                )
+            if impacts is not None and len(impacts):
+                rec.reset_time()
+                f = impacts.frame
+                speed = impacts.column("vi_mps")
+                colours = _speed_colours(speed)
+                t = impacts.column("t_s")
+                order = np.argsort(np.where(np.isfinite(t), t, 0.0), kind="stable")
+                for j in order:
+                    rec.set_time("t", duration=float(t[j]) if np.isfinite(t[j]) else 0)
+                    rec.log(
+                        f"simulation/impacts/{f['path_id'].iloc[j]}",
+                        rr.Points3D(
+                            _xyz(f["x_m"].iloc[j : j + 1], f["z_m"].iloc[j : j + 1]),
+                            colors=colours[j : j + 1],
+                            radii=0.2,
+                            labels=[f"{speed[j]:.1f} m/s"],
+                        ),
+                    )
+        finally:
+            rec.disconnect()
+
+    return write_file(path, record, outputs)
+
+
+def _speed_colours(speed: np.ndarray) -> np.ndarray:
+    """RGB from blue (slowest) to red (fastest) of the finite speeds."""
+    v = np.where(np.isfinite(speed), speed, 0.0)
+    span = np.ptp(v) if v.size else 0.0
+    u = (v - v.min()) / span if span > 0 else np.zeros_like(v)
+    return np.column_stack([40 + 200 * u, 80 * (1 - u), 220 * (1 - u)]).astype(np.uint8)
 
 
 # ---------------------------------------------------------------- track pieces

@@ -1,0 +1,127 @@
+"""Monte Carlo statistics: estimates and standard errors against known truths."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from fieldkit.model.statistics import (
+    distribution,
+    envelope_percentiles,
+    fraction_se,
+    max_se,
+    mean_se,
+    percentile_se,
+)
+
+
+def test_percentiles_of_a_small_array_by_hand():
+    x = np.array([4.0, 1.0, 3.0, 2.0, 5.0, np.nan])  # NaN ignored
+    # type-7 positions (n-1) p on the sorted 1..5: p90 -> 3.6 -> 4.6
+    assert percentile_se(x, 50)[0] == 3.0
+    assert percentile_se(x, 90)[0] == pytest.approx(4.6)
+    assert percentile_se(x, 100)[0] == 5.0
+    # SE: quantiles at 0.9 -/+ sqrt(0.09/5) = 0.9 -/+ 0.1342 -> clipped at 1.0
+    lo = 1 + 4 * (0.9 - math.sqrt(0.09 / 5))
+    assert percentile_se(x, 90)[1] == pytest.approx((5.0 - lo) / 2)
+
+
+def test_median_se_of_normal_samples_is_1_2533_over_root_n():
+    n, reps = 2000, 400
+    rng = np.random.default_rng(7)
+    samples = rng.standard_normal((reps, n))
+    medians = np.median(samples, axis=1)
+    reported = np.array([percentile_se(s, 50)[1] for s in samples])
+    theory = math.sqrt(math.pi / 2) / math.sqrt(n)
+    assert np.mean(reported) == pytest.approx(theory, rel=0.05)
+    # what a user cares about: the reported SE matches the spread over reruns
+    assert np.mean(reported) == pytest.approx(np.std(medians, ddof=1), rel=0.15)
+
+
+def test_p95_se_matches_the_spread_over_reruns():
+    n, reps = 2000, 400
+    rng = np.random.default_rng(8)
+    samples = rng.exponential(1.0, (reps, n))
+    p95 = np.percentile(samples, 95, axis=1)
+    reported = np.mean([percentile_se(s, 95)[1] for s in samples])
+    # asymptotic: sqrt(p(1-p)/n) / f(q), f(q) = 1 - p for Exp(1)
+    assert reported == pytest.approx(math.sqrt(0.95 * 0.05 / n) / 0.05, rel=0.1)
+    assert reported == pytest.approx(np.std(p95, ddof=1), rel=0.15)
+
+
+def test_mean_se_is_sigma_over_root_n():
+    x = np.random.default_rng(3).normal(5.0, 2.0, 10000)
+    m, se = mean_se(x)
+    assert se == pytest.approx(x.std(ddof=1) / 100.0)
+    assert se == pytest.approx(0.02, rel=0.03)
+    assert m == pytest.approx(5.0, abs=4 * se)
+
+
+def test_max_se_is_the_exact_bootstrap():
+    x = np.array([1.0, 2.0, 3.0])
+    # resample max = x_(k) with prob (k/3)^3 - ((k-1)/3)^3: 1/27, 7/27, 19/27
+    w = np.array([1, 7, 19]) / 27
+    mean = np.dot(w, x)
+    assert max_se(x) == (3.0, pytest.approx(math.sqrt(np.dot(w, (x - mean) ** 2))))
+    # agrees with resampling (a Monte Carlo bootstrap) on a larger sample
+    rng = np.random.default_rng(5)
+    y = rng.exponential(1.0, 300)
+    boot = y[rng.integers(0, y.size, (20000, y.size))].max(axis=1)
+    assert max_se(y)[1] == pytest.approx(boot.std(), rel=0.05)
+
+
+def test_fraction_se_is_binomial():
+    assert fraction_se(30, 120) == (0.25, pytest.approx(math.sqrt(0.25 * 0.75 / 120)))
+    assert fraction_se(0, 10) == (0.0, 0.0)
+    assert all(math.isnan(v) for v in fraction_se(0, 0))
+
+
+def test_distribution_without_samples_is_json_null():
+    d = distribution(np.array([np.nan]))
+    assert d["n"] == 0 and d["p50"] is None and d["se"]["max"] is None
+    json.dumps(d)
+
+
+def test_envelope_percentiles_per_bin_over_rocks_that_reached_it():
+    h = np.array([[1.0, 2.0, np.nan], [3.0, np.nan, np.nan], [5.0, 4.0, np.nan]])
+    e = envelope_percentiles(h)
+    assert e["reached"].tolist() == [3, 2, 0]
+    assert e["p50"][:2].tolist() == [3.0, 3.0]
+    assert e["p95"][0] == pytest.approx(4.8)
+    assert e["max"][:2].tolist() == [5.0, 4.0]
+    assert np.isnan(e["max"][2])
+
+
+def test_summary_contract(synthetic_simulation):
+    result = synthetic_simulation(rocks=4000, seed=2)
+    s = result.summary()
+    json.dumps(s)  # plain JSON
+    assert s["rocks"] == 4000 and s["impacts"] == 28000 and s["seed"] == 2
+    assert s["wall_s"] == 0.5
+    runout = s["runout_x_m"]
+    # U(60, 100): p50 = 80, p90 = 96, mean 80
+    assert runout["p50"] == pytest.approx(80.0, abs=3 * runout["se"]["p50"] + 0.1)
+    assert runout["p90"] == pytest.approx(96.0, abs=3 * runout["se"]["p90"] + 0.1)
+    assert runout["se"]["mean"] == pytest.approx(40 / math.sqrt(12) / 63.25, rel=0.05)
+    for key in ("mean", "p50", "p90", "p95", "p99", "max"):
+        assert key in runout and key in runout["se"]
+    assert s["stopped_fraction"] == pytest.approx(1.0)
+    (point,) = s["analysis_points"]
+    p = 0.75  # P(U(60, 100) > 70)
+    assert point["passing_fraction"] == pytest.approx(
+        p, abs=3 * point["passing_fraction_se"]
+    )
+    assert point["passing_fraction_se"] == pytest.approx(
+        math.sqrt(p * (1 - p) / 4000), rel=0.05
+    )
+    speed = point["speed_mps"]
+    assert speed["n"] == point["passing"]
+    # N(10, 2): p90 = 10 + 1.2816 * 2
+    assert speed["p90"] == pytest.approx(12.563, abs=3 * speed["se"]["p90"])
+    for key in ("ke_j", "re_j", "total_j", "bounce_height_m"):
+        assert point[key]["n"] == point["passing"]
+    assert s["model"]["effects"] == {"air_drag": {"cd": 0.5}}
+    assert len(s["envelope"]["x_m"]) == 10

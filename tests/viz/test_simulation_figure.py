@@ -1,0 +1,86 @@
+"""Simulation figures: what is drawn, with units, at the right values."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from matplotlib.collections import PolyCollection
+
+from fieldkit.viz.simulation_figure import (
+    Measured,
+    envelope_figure,
+    point_histograms_figure,
+    runout_figure,
+    simulation_figure_names,
+    trajectories_figure,
+    write_simulation_figures,
+)
+
+
+def _vlines(ax) -> dict[str, float]:
+    return {
+        line.get_label(): float(line.get_xdata()[0])
+        for line in ax.get_lines()
+        if len(set(np.atleast_1d(line.get_xdata()))) == 1
+    }
+
+
+def test_trajectories_over_the_section(synthetic_simulation):
+    result = synthetic_simulation(rocks=200)
+    ax = trajectories_figure(result).axes[0]
+    fills = [c for c in ax.collections if isinstance(c, PolyCollection)]
+    labels = [c.get_label() for c in fills]
+    assert labels == ["material: rock", "material: talus"]
+    assert fills[0].get_facecolor().tolist() != fills[1].get_facecolor().tolist()
+    paths = [ln for ln in ax.get_lines() if ln.get_color() == "tab:red"]
+    assert len(paths) == 3
+    assert _vlines(ax)["analysis points"] == 70.0
+    assert "(m)" in ax.get_xlabel() and "(m)" in ax.get_ylabel()
+
+
+def test_histograms_mark_percentiles_and_the_measured_value(synthetic_simulation):
+    result = synthetic_simulation(rocks=500)
+    point = result.analysis[0]
+    fig = point_histograms_figure(
+        result, 0, measured=Measured(x_m=70.0, speed_mps=18.0, ke_j=600e3)
+    )
+    speed_ax, energy_ax = fig.axes
+    speeds = point.speed_mps[point.crossed]
+    lines = {
+        ln.get_label().split(" =")[0]: ln.get_xdata()[0] for ln in speed_ax.get_lines()
+    }
+    for q in (50, 90, 95, 99):
+        assert lines[f"p{q}"] == pytest.approx(np.percentile(speeds, q))
+    assert lines["measured speed"] == 18.0
+    e_lines = {
+        ln.get_label().split(" =")[0]: ln.get_xdata()[0] for ln in energy_ax.get_lines()
+    }
+    assert e_lines["measured KE"] == pytest.approx(600.0)  # kJ
+    assert e_lines["p50"] == pytest.approx(
+        np.percentile(point.total_j[point.crossed], 50) / 1e3
+    )
+    assert "(m/s)" in speed_ax.get_xlabel() and "(kJ)" in energy_ax.get_xlabel()
+    heights = sum(p.get_height() for p in speed_ax.patches)
+    assert heights == point.crossed.sum()
+
+
+def test_envelope_lines_are_the_per_bin_statistics(synthetic_simulation):
+    result = synthetic_simulation(rocks=300)
+    ax = envelope_figure(result, measured=[Measured(x_m=70, height_m=1.5)]).axes[0]
+    by = {ln.get_label(): ln for ln in ax.get_lines()}
+    env = result.envelope()
+    np.testing.assert_allclose(by["max"].get_ydata(), env["max"])
+    np.testing.assert_allclose(by["95th percentile"].get_xdata(), env["x_m"])
+    assert list(by["measured mean height"].get_ydata()) == [1.5]
+    assert "(m)" in ax.get_ylabel()
+
+
+def test_runout_histogram_and_files(synthetic_simulation, tmp_path):
+    result = synthetic_simulation(rocks=300)
+    ax = runout_figure(result).axes[0]
+    assert _vlines(ax)[f"p50 = {np.percentile(result.runout_x_m, 50):.4g} m"] == (
+        pytest.approx(np.percentile(result.runout_x_m, 50))
+    )
+    paths = write_simulation_figures(tmp_path, result)
+    assert [p.name for p in paths] == simulation_figure_names(result)
+    assert all(p.read_bytes()[:4] == b"\x89PNG" for p in paths)
