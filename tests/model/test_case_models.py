@@ -10,10 +10,12 @@ from __future__ import annotations
 import csv
 import importlib.util
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import REPO
+
+REPO = Path(__file__).resolve().parents[2]
 
 SITES = ("mt_stephen", "kreuger_quarry", "ehime", "tornado_mountain", "asphalt")
 FILES = {s: REPO / "surveys" / s / "model_rocfall_table_7_1.json" for s in SITES}
