@@ -20,7 +20,8 @@ def incline(effects, e_n=0.45, e_t=0.85, radius_m=0.3, mass_kg=300.0, **material
         {
             "profile": {"x_m": [0, 300], "z_m": [200, 200 - 300 * math.tan(0.6)],
                         "material": "m"},
-            "materials": {"m": {"e_n": e_n, "e_t": e_t, "friction_deg": 30, **material}},
+            "materials": {"m": {"e_n": e_n, "e_t": e_t, "friction_deg": 30,
+                                **material}},
             "body": {"mass_kg": mass_kg, "radius_m": radius_m, "gyration_m": 0.2},
             "seeder": {"x_m": 1, "z_m": 202},
             "effects": effects,

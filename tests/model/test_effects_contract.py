@@ -10,7 +10,7 @@ from conftest import build, same_result
 
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.model import simulate
-from fieldkit.model.effects.registry import EFFECTS, BY_NAME, describe, effect
+from fieldkit.model.effects.registry import BY_NAME, EFFECTS, describe, effect
 
 NAMES = [spec.name for spec in EFFECTS]
 CONTRACT = {
