@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import build
+from model_builders import build
 from scipy.integrate import solve_ivp
 
 from fieldkit.model import model_from_dict, simulate

@@ -7,7 +7,7 @@ import json
 
 import numpy as np
 import pytest
-from conftest import BASE
+from model_builders import BASE
 
 from fieldkit.errors import InputFileError
 from fieldkit.model import read_model, simulate, write_model
@@ -98,6 +98,6 @@ def test_model_round_trips_and_with_parameters(tmp_path):
 
 
 def test_smoke_model_for_other_stages_reads(repo):
-    model = read_model(repo / "tests/data/models/smoke.json")
+    model = read_model(repo / "tests/model/data/smoke.json")
     res = simulate(model, 20, np.random.default_rng(0))
     assert res.impacts > 0 and res.rocks == 20
