@@ -199,9 +199,11 @@ def piece_contact(px, pz, sl, j, x0, z0, vx, vz, ax, az, tmax):
     jj = j
     while True:
         s = sl[jj]
-        t = descending_root(
-            0.5 * (az - s * ax), vz - s * vx, z0 - pz[jj] - s * (x0 - px[jj])
-        )
+        b = vz - s * vx
+        c = z0 - pz[jj] - s * (x0 - px[jj])
+        if jj == j and c <= 0.0 and b <= 0.0:
+            return jj, 0.0  # on (or by rounding below) the line, moving into it
+        t = descending_root(0.5 * (az - s * ax), b, c)
         if t <= tmax:
             xt = x0 + vx * t + 0.5 * ax * t * t
             tol = 1e-9 * (1.0 + abs(xt))
@@ -447,8 +449,8 @@ def run_rock(
             while True:
                 if drag:
                     k = air_drag.drag_factor(par[P_DRAG_CD], par[P_DRAG_RHO], r, m)
-                    ax, az = air_drag.substep_acceleration(vx, vz, k, G, drag_dt)
-                    tmax = drag_dt
+                    tmax = air_drag.substep_s(vx, vz, k, drag_dt)
+                    ax, az = air_drag.substep_acceleration(vx, vz, k, G, tmax)
                 else:
                     ax, az, tmax = 0.0, -G, INF
                 jc, tc = piece_contact(px, pz, sl, j, x, z, vx, vz, ax, az, tmax)
@@ -462,9 +464,10 @@ def run_rock(
                     ii = i0 if vx > 0.0 else i1 - 1
                     for _ in range(i1 - i0):
                         tt = time_to_x(x, vx, ax, tx[ii])
-                        if tt <= tc:
+                        if tt < tc:
                             zt = z + vz * tt + 0.5 * az * tt * tt
-                            if zt - ground_z(px, pz, sl, tx[ii]) < th[ii] and (
+                            above = zt - ground_z(px, pz, sl, tx[ii])
+                            if 0.0 < above < th[ii] and (
                                 uniform(key, n, SLOT_TREE + ii) < par[P_TREE_P]
                             ):
                                 struck = ii

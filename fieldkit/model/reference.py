@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fieldkit.model import kernel
+import fieldkit.model.kernel as kernel
 from fieldkit.model.model_file import Model
 from fieldkit.model.simulate import body_of, draw_rocks, kernel_inputs
 

@@ -24,9 +24,9 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+import fieldkit.model.kernel as kernel
 from fieldkit.errors import ArgumentError
 from fieldkit.impact_table import ImpactTable
-from fieldkit.model import kernel
 from fieldkit.model.effects import registry
 from fieldkit.model.model_file import Model
 from fieldkit.model.results import AnalysisPoint, SimulationResult

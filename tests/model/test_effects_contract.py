@@ -5,8 +5,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
-from conftest import build, same_result
+from model_builders import build, same_result
 
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.model import simulate
@@ -91,3 +92,33 @@ def test_parameter_outside_bounds_is_one_line_naming_file_and_parameter(name):
     text = str(err.value)
     assert text.startswith(f"test.json: effects.{name}.{p.name}: must be in [")
     assert "\n" not in text
+
+
+def test_result_does_not_depend_on_threads_or_chunks():
+    import numba
+    from model_builders import ALL_EFFECTS
+
+    model = build(ALL_EFFECTS, sd=True)
+    a = simulate(model, 300, np.random.default_rng(2), record_impacts=True)
+    chunks = []
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        b = simulate(
+            model,
+            300,
+            np.random.default_rng(2),
+            record_impacts=True,
+            impact_chunk_rocks=70,
+            on_impact_chunk=chunks.append,
+        )
+    finally:
+        numba.set_num_threads(threads)
+    assert len(chunks) == 5 and b.impact_table is None
+    assert sum(len(c) for c in chunks) == a.impacts == b.impacts
+    assert np.array_equal(a.runout_x_m, b.runout_x_m)
+    assert np.array_equal(a.state, b.state)
+    streamed = pd.concat([c.frame for c in chunks], ignore_index=True)
+    cols = ["path_id", "point", "x_m", "vf_x_mps", "omega_f_radps", "mass_kg"]
+    pd.testing.assert_frame_equal(streamed[cols], a.impact_table.frame[cols])
+    assert chunks[1].frame["path_id"].iloc[0] == "70"

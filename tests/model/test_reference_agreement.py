@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import ALL_EFFECTS, build
+from model_builders import ALL_EFFECTS, build
 from scipy.optimize import brentq
 
 from fieldkit.model import model_from_dict, simulate

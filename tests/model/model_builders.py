@@ -5,7 +5,6 @@ from __future__ import annotations
 import copy
 
 import numpy as np
-import pytest
 
 from fieldkit.model.model_file import model_from_dict
 from fieldkit.model.results import SimulationResult
@@ -52,12 +51,6 @@ def build(effects=None, sd=False, **changes) -> object:
     for key, value in changes.items():
         data[key] = value
     return model_from_dict(data, source="test.json")
-
-
-@pytest.fixture
-def make_model():
-    """The :func:`build` factory."""
-    return build
 
 
 def same_result(a: SimulationResult, b: SimulationResult) -> bool:
