@@ -141,10 +141,12 @@ def simulate(
     bounce height -- each with its Monte Carlo standard error, so you can see
     whether --rocks was enough.
 
-    Example (from the repository root):
+    Example (from the repository root; thesis §7.5.4, Tornado Mountain with
+    the RocFall inputs of Table 7-1):
 
-        fieldkit simulate tests/data/models/smoke.json --rocks 200 --seed 1 \\
-          --at 40 --summary out/summary.json --figures out/sim
+        fieldkit simulate surveys/tornado_mountain/model_rocfall_table_7_1.json \\
+          --rocks 2000 --seed 1 --at 610 --measured x=610,speed=18,ke=600e3 \\
+          --summary out/summary.json --figures out/sim
     """
     from fieldkit.io.impact_stream import (
         ImpactStreamWriter,

@@ -64,7 +64,6 @@ def _draw_section(ax, profile) -> None:
             label=f"material: {name}" if new else None,
         )
     ax.plot(x, z, color="0.2", lw=1.2)
-    ax.set_ylim(bottom=bottom)
 
 
 def trajectories_figure(

@@ -14,7 +14,7 @@ import pytest
 from fieldkit.cli.simulate import parse_measured
 from fieldkit.errors import ArgumentError
 
-MODEL = Path(__file__).resolve().parents[1] / "data" / "models" / "smoke.json"
+MODEL = Path(__file__).resolve().parents[1] / "model" / "data" / "smoke.json"
 
 
 def test_measured_values_parse_and_refuse_bad_keys():
