@@ -183,63 +183,56 @@ def run_case(case: str, rocks: int, impacts: str) -> dict:
     }
 
 
-def reference_function():
-    """The one-rock-at-a-time simulator in fieldkit.model.reference, and its name."""
-    module = importlib.import_module("fieldkit.model.reference")
-    for name in ("simulate_reference", "reference_simulate", "simulate"):
-        function = getattr(module, name, None)
-        if callable(function):
-            return name, function
-    raise AttributeError(
-        "fieldkit.model.reference has no simulate_reference / simulate function"
-    )
-
-
-def max_difference(a, b) -> float:
-    """Largest |a - b| over the per-rock outcomes both simulators report."""
-    pairs = [
-        (a.runout_x_m, b.runout_x_m),
-        (a.state, b.state),
-        (a.impacts_per_rock, b.impacts_per_rock),
-    ]
-    for pa, pb in zip(a.analysis, b.analysis, strict=True):
-        pairs += [(pa.speed_mps, pb.speed_mps), (pa.height_m, pb.height_m)]
-    worst = 0.0
-    for x, y in pairs:
-        x, y = np.asarray(x, float), np.asarray(y, float)
-        if x.shape != y.shape or not np.array_equal(np.isnan(x), np.isnan(y)):
-            return float("inf")
-        both = ~np.isnan(x)
-        if both.any():
-            worst = max(worst, float(np.max(np.abs(x[both] - y[both]))))
-    return worst
-
-
 def run_reference(case: str) -> dict:
-    """Reference vs kernel on the same REFERENCE_ROCKS rocks and seed."""
+    """Reference vs kernel on the same REFERENCE_ROCKS rocks and seed.
+
+    :func:`fieldkit.model.reference.simulate_reference` follows one rock at a time
+    through the kernel's own per-rock code run by the Python interpreter, drawing the
+    same random numbers; every impact row and every rock's outcome must agree.
+    """
     from fieldkit.model import simulate
+    from fieldkit.model.kernel import RECORD_COLUMNS
+    from fieldkit.model.reference import simulate_reference
 
     set_threads()
-    name, reference = reference_function()
     model = build_model(case)
     simulate(model, 50, np.random.default_rng(0))  # warm-up
-    at = (450.0,)
     kernel = simulate(
-        model, REFERENCE_ROCKS, np.random.default_rng(SEED), analysis_x_m=at
+        model, REFERENCE_ROCKS, np.random.default_rng(SEED), record_impacts=True
     )
     start = time.perf_counter()
-    ref = reference(
-        model, REFERENCE_ROCKS, np.random.default_rng(SEED), analysis_x_m=at
-    )
+    ref = simulate_reference(model, REFERENCE_ROCKS, np.random.default_rng(SEED))
     wall = time.perf_counter() - start
+    impacts = sum(len(r.impacts) for r in ref)
+    frame = kernel.impact_table.frame
+    worst = float(np.max(np.abs(kernel.runout_x_m - [r.runout_x_m for r in ref])))
+    same_states = bool(np.array_equal(kernel.state, [r.state for r in ref]))
+    for rock, r in enumerate(ref):
+        rows = frame[frame["path_id"] == str(rock)]
+        if len(rows) != len(r.impacts):
+            return {
+                "case": case,
+                "rocks": REFERENCE_ROCKS,
+                "impacts": impacts,
+                "wall_s": wall,
+                "max_abs_difference": float("inf"),
+                "impacts_equal": False,
+                "states_equal": same_states,
+            }
+        for name in ("x_m", "z_m", "vi_x_mps", "vi_z_mps", "vf_x_mps", "vf_z_mps"):
+            got = rows[name].to_numpy(float)
+            want = r.impacts[:, RECORD_COLUMNS.index(name)]
+            if len(got):
+                worst = max(worst, float(np.max(np.abs(got - want))))
     return {
         "case": case,
-        "function": f"fieldkit.model.reference.{name}",
+        "function": "fieldkit.model.reference.simulate_reference",
         "rocks": REFERENCE_ROCKS,
-        "impacts": int(ref.impacts),
+        "impacts": impacts,
         "wall_s": wall,
-        "max_abs_difference": max_difference(kernel, ref),
-        "impacts_equal": int(ref.impacts) == int(kernel.impacts),
+        "max_abs_difference": worst,
+        "impacts_equal": impacts == int(kernel.impacts),
+        "states_equal": same_states,
     }
 
 

@@ -25,6 +25,13 @@ from pathlib import Path
 import numpy as np
 
 from fieldkit.errors import FieldkitError, InputFileError
+from fieldkit.io.dem import read_dem
+from fieldkit.io.profile_csv import read_profile_csv
+from fieldkit.model.dem_profile import (
+    profile_along_polyline,
+    section_from_vertices,
+    steepest_descent_line,
+)
 from fieldkit.model.effects import registry
 from fieldkit.model.materials import Material, check_number
 from fieldkit.model.profile import Profile
@@ -131,8 +138,14 @@ def _unknown(data: dict, known: set[str], where: str, source: str) -> None:
             )
 
 
-def model_from_dict(data: dict, *, source: str = "") -> Model:
-    """Validate a parsed model file; one-line errors naming ``source`` and the field."""
+def model_from_dict(
+    data: dict, *, source: str = "", base_dir: str | os.PathLike[str] | None = None
+) -> Model:
+    """Validate a parsed model file; one-line errors naming ``source`` and the field.
+
+    ``base_dir`` is where relative file names in the model file (a profile CSV or
+    DEM) are looked up: the model file's folder (None: the working directory).
+    """
     data = _object(data, "model", source)
     _unknown(
         data,
@@ -152,13 +165,8 @@ def model_from_dict(data: dict, *, source: str = "") -> Model:
     for key in ("profile", "materials", "body", "seeder"):
         if key not in data:
             raise InputFileError("missing", source=source, where=key)
-    prof = _object(data["profile"], "profile", source)
-    _unknown(prof, {"x_m", "z_m", "material"}, "profile", source)
-    for key in ("x_m", "z_m", "material"):
-        if key not in prof:
-            raise InputFileError("missing", source=source, where=f"profile.{key}")
-    profile = Profile.from_arrays(
-        prof["x_m"], prof["z_m"], prof["material"], source=source
+    profile = _profile(
+        _object(data["profile"], "profile", source), source, base_dir=base_dir
     )
     mats = _object(data["materials"], "materials", source)
     materials = {
@@ -235,6 +243,69 @@ def model_from_dict(data: dict, *, source: str = "") -> Model:
         trees=trees,
         source=source,
         provenance=dict(provenance) if isinstance(provenance, dict) else {},
+    )
+
+
+def _profile(prof: dict, source: str, *, base_dir) -> Profile:
+    """The slope profile from where a user has it (docs/architecture.md §5).
+
+    * vertex lists: ``{"x_m": [...], "z_m": [...], "material": [...]}``;
+    * a CSV of vertices: ``{"csv": "profile.csv", "units": "ft"}`` (units as in
+      :func:`fieldkit.io.profile_csv.read_profile_csv`);
+    * a section cut from a DEM (ESRI ASCII grid or GeoTIFF): ``{"dem":
+      "terrain.asc", "from": [x, y]}`` follows the steepest descent from a release
+      point, ``{"dem": ..., "line": [[x, y], ...]}`` a polyline; optional
+      ``"step_m"`` (default half a cell) and ``"max_length_m"``.
+
+    A CSV or DEM profile takes its segment materials from ``"materials":
+    "0-40:rock,40-:talus"`` (chainage ranges), else from the CSV's material column.
+    """
+    base = Path(base_dir) if base_dir is not None else Path()
+    if "csv" in prof or "dem" in prof:
+        kind = "csv" if "csv" in prof else "dem"
+        allowed = (
+            {"csv", "units", "materials"}
+            if kind == "csv"
+            else {"dem", "from", "line", "step_m", "max_length_m", "materials"}
+        )
+        _unknown(prof, allowed, "profile", source)
+        path = base / str(prof[kind])
+        if kind == "csv":
+            vertices = read_profile_csv(path, units=prof.get("units"))
+            section = section_from_vertices(
+                vertices.x_m, vertices.z_m, vertices.material, source=str(path)
+            )
+        else:
+            section = _dem_section(prof, path, source)
+        if "materials" in prof:
+            section = section.with_materials(str(prof["materials"]))
+        return Profile.from_arrays(
+            section.chainage_m, section.z_m, section.material, source=source
+        )
+    _unknown(prof, {"x_m", "z_m", "material"}, "profile", source)
+    for key in ("x_m", "z_m", "material"):
+        if key not in prof:
+            raise InputFileError("missing", source=source, where=f"profile.{key}")
+    return Profile.from_arrays(
+        prof["x_m"], prof["z_m"], prof["material"], source=source
+    )
+
+
+def _dem_section(prof: dict, path: Path, source: str):
+    """The section of a ``"dem"`` profile entry (steepest descent or polyline)."""
+    grid = read_dem(path)
+    step = prof.get("step_m")
+    step = 0.5 * grid.cellsize_m if step is None else float(step)
+    if ("from" in prof) == ("line" in prof):
+        raise InputFileError(
+            "give either `from` [x, y] (steepest descent) or `line` [[x, y], ...]",
+            source=source,
+            where="profile.dem",
+        )
+    if "line" in prof:
+        return profile_along_polyline(grid, prof["line"], step)
+    return steepest_descent_line(
+        grid, prof["from"], step, max_length_m=prof.get("max_length_m")
     )
 
 
@@ -332,7 +403,7 @@ def read_model(path: str | os.PathLike[str]) -> Model:
         raise InputFileError(
             f"not valid JSON ({exc.msg})", source=path, where=f"line {exc.lineno}"
         ) from None
-    return model_from_dict(data, source=str(path))
+    return model_from_dict(data, source=str(path), base_dir=path.parent)
 
 
 def model_to_dict(model: Model) -> dict:
