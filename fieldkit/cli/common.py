@@ -169,6 +169,30 @@ def note(message: str) -> None:
     typer.echo(f"note: {' '.join(with_flags(message).split())}", err=True)
 
 
+def body_from_options(
+    mass: float | None,
+    radius: float | None,
+    gyration: float | None,
+    shape: str | None,
+    dimensions: str | None,
+    unit_weight: float | None,
+    inertia: float | None = None,
+) -> ResolvedBody:
+    """The body the shared body options describe (one mapping of options to the
+    arguments of :func:`fieldkit.physics.bodies.resolve_body` for every command)."""
+    from fieldkit.physics.bodies import resolve_body
+
+    return resolve_body(
+        mass_kg=mass,
+        radius_m=radius,
+        gyration_m=gyration,
+        inertia_kgm2=inertia,
+        shape=shape,
+        dimensions_m=dimensions,
+        unit_weight_kn_m3=unit_weight,
+    )
+
+
 def print_body_notes(body: ResolvedBody) -> None:
     """Print what the body's values say must be stated (overrides, measurements)."""
     for text in body.notes:

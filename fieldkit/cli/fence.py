@@ -21,6 +21,7 @@ from fieldkit.cli.common import (
     RadiusOpt,
     ShapeOpt,
     UnitWeightOpt,
+    body_from_options,
     one_line_errors,
     print_body_notes,
 )
@@ -155,17 +156,10 @@ def fence(
           --speed-in 22 --angle-in 50 --spin-in 18
     """
     from fieldkit.outputs import OutputSet, write_text
-    from fieldkit.physics.bodies import resolve_body
     from fieldkit.physics.fence_impact import fence_impact
 
-    rock = resolve_body(
-        mass_kg=mass,
-        radius_m=radius,
-        gyration_m=gyration,
-        inertia_kgm2=inertia,
-        shape=shape,
-        dimensions_m=dimensions,
-        unit_weight_kn_m3=unit_weight,
+    rock = body_from_options(
+        mass, radius, gyration, shape, dimensions, unit_weight, inertia
     ).require(*BODY_NEEDS, source="fieldkit fence")
     if speed_in is None:
         raise ArgumentError("the impact speed is required", source="--speed-in")

@@ -17,13 +17,14 @@ from fieldkit.cli.common import (
     RadiusOpt,
     ShapeOpt,
     UnitWeightOpt,
+    body_from_options,
     one_line_errors,
     print_body_notes,
     warn,
 )
 from fieldkit.errors import ArgumentError
 from fieldkit.outputs import OutputSet, write_text
-from fieldkit.physics.bodies import ResolvedBody, resolve_body
+from fieldkit.physics.bodies import ResolvedBody
 from fieldkit.physics.impact_mechanics import (
     ImpactResult,
     minimum_friction_to_stop_slip,
@@ -307,13 +308,8 @@ def impact(
     v_it, v_in = _impact_velocity(speed, angle, vt, vn)
     if not math.isfinite(spin):
         raise ArgumentError(f"--spin must be finite (got {spin:g})")
-    body = resolve_body(
-        mass_kg=mass,
-        radius_m=radius,
-        gyration_m=gyration,
-        shape=shape,
-        dimensions_m=dimensions,
-        unit_weight_kn_m3=unit_weight,
+    body = body_from_options(
+        mass, radius, gyration, shape, dimensions, unit_weight
     ).require(*BODY_NEEDS, source="fieldkit impact")
     outputs = OutputSet()
     for path, flag in ((figure, "--figure"), (json_out, "--json")):

@@ -15,6 +15,7 @@ from fieldkit.cli.common import (
     RadiusOpt,
     ShapeOpt,
     UnitWeightOpt,
+    body_from_options,
     note,
     one_line_errors,
     print_body_notes,
@@ -172,7 +173,6 @@ def reduce(
           --mass 3750 --radius 0.725 --gyration 0.46 \\
           -o out/boulder_a.csv --figures out/figures
     """
-    from fieldkit.physics.bodies import resolve_body
     from fieldkit.reduce.pipeline import ReduceOptions, reduce_path
     from fieldkit.reduce.summary import format_summary, summarize
     from fieldkit.survey import Survey
@@ -204,13 +204,8 @@ def reduce(
         raise ArgumentError(
             f"must be between 0 and 180 degrees (got {theta0:g})", source="--theta0"
         )
-    body = resolve_body(
-        mass_kg=mass,
-        radius_m=radius,
-        gyration_m=gyration,
-        shape=shape,
-        dimensions_m=dimensions,
-        unit_weight_kn_m3=unit_weight,
+    body = body_from_options(
+        mass, radius, gyration, shape, dimensions, unit_weight
     ).require(*BODY_NEEDS, source="fieldkit reduce")
     if out is None and figures is None:
         note("no -o/--out or --figures given; printing the summary only")

@@ -17,6 +17,7 @@ from fieldkit.cli.common import (
     RadiusOpt,
     ShapeOpt,
     UnitWeightOpt,
+    body_from_options,
     note,
     one_line_errors,
     print_body_notes,
@@ -140,7 +141,6 @@ def track(
           -o out/bounce_track.csv --impacts out/bounce_impacts.csv \\
           --figures out/bounce
     """
-    from fieldkit.physics.bodies import resolve_body
     from fieldkit.tracking.flights.pipeline import analyse_track
     from fieldkit.tracking.video.calibration import (
         parse_scale_points,
@@ -160,14 +160,7 @@ def track(
         raise ArgumentError(
             f"must be a positive frame rate, got {fps:g}", source="--fps"
         )
-    body = resolve_body(
-        mass_kg=mass,
-        radius_m=radius,
-        gyration_m=gyration,
-        shape=shape,
-        dimensions_m=dimensions,
-        unit_weight_kn_m3=unit_weight,
-    )
+    body = body_from_options(mass, radius, gyration, shape, dimensions, unit_weight)
     if surface_angle is not None and not (
         math.isfinite(surface_angle) and -90 < surface_angle < 90
     ):

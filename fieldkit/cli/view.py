@@ -15,6 +15,7 @@ from fieldkit.cli.common import (
     RadiusOpt,
     ShapeOpt,
     UnitWeightOpt,
+    body_from_options,
     note,
     one_line_errors,
     print_body_notes,
@@ -24,7 +25,6 @@ from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.impact_table import ImpactTable
 from fieldkit.io.track_files import detect_format, read_track
 from fieldkit.outputs import OutputSet
-from fieldkit.physics.bodies import resolve_body
 
 #: Body values `view` needs to analyse a track (an ImpactTable carries its own).
 TRACK_BODY_NEEDS = ("radius_m",)
@@ -136,14 +136,7 @@ def view(
         raise ArgumentError(
             f"output must be a .rrd file, got {out.name!r}", source="-o"
         )
-    body = resolve_body(
-        mass_kg=mass,
-        radius_m=radius,
-        gyration_m=gyration,
-        shape=shape,
-        dimensions_m=dimensions,
-        unit_weight_kn_m3=unit_weight,
-    )
+    body = body_from_options(mass, radius, gyration, shape, dimensions, unit_weight)
     fmt = input_format.value
     if fmt == "auto":
         fmt = detect_format(input_file)
