@@ -19,8 +19,13 @@ DPI = 150
 
 
 def new_figure(width_in: float = 8.0, height_in: float = 5.0) -> tuple[Figure, object]:
-    """A figure with one axes, grid on, in the house style."""
-    fig, ax = plt.subplots(figsize=(width_in, height_in), layout="constrained")
+    """A figure with one axes, grid on, in the house style.
+
+    A plain :class:`~matplotlib.figure.Figure`, not a pyplot one: nothing keeps it
+    alive after the caller drops it (no pyplot registry to leak into).
+    """
+    fig = Figure(figsize=(width_in, height_in), layout="constrained")
+    ax = fig.add_subplot()
     ax.grid(True, alpha=0.3)
     return fig, ax
 
