@@ -49,10 +49,12 @@ def fit(
 
     Example (from the repository root):
 
-        fieldkit synth tests/model/data/smoke.json --paths 30 --seed 1 \\
+        fieldkit synth surveys/tornado_mountain/model_rocfall_table_7_1.json \\
+          --paths 20 --seed 1 \\
           --effects angle_dependent_restitution=b=1.2 -o out/synth.csv
 
-        fieldkit fit out/synth.csv --model tests/model/data/smoke.json \\
+        fieldkit fit out/synth.csv \\
+          --model surveys/tornado_mountain/model_rocfall_table_7_1.json \\
           -o out/calibrated.json --report out/fit
     """
     from fieldkit.fit.impact_fit import fit_impacts

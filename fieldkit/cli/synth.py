@@ -87,7 +87,8 @@ def synth(
 
     Example (from the repository root):
 
-        fieldkit synth tests/model/data/smoke.json --paths 30 --seed 1 \\
+        fieldkit synth surveys/tornado_mountain/model_rocfall_table_7_1.json \\
+          --paths 20 --seed 1 \\
           --effects angle_dependent_restitution=b=1.2 --noise 0.05 \\
           -o out/synth.csv
     """
