@@ -13,7 +13,18 @@ from typing import Annotated
 import typer
 
 from fieldkit._version import __version__
-from fieldkit.cli import effects, fence, impact, profile, reduce, simulate, track, view
+from fieldkit.cli import (
+    effects,
+    fence,
+    fit,
+    impact,
+    profile,
+    reduce,
+    simulate,
+    synth,
+    track,
+    view,
+)
 
 app = typer.Typer(
     name="fieldkit",
@@ -53,6 +64,8 @@ app.command("view")(view.view)
 app.command("profile")(profile.profile)
 app.command("simulate")(simulate.simulate)
 app.command("effects")(effects.effects)
+app.command("synth")(synth.synth)
+app.command("fit")(fit.fit)
 
 # typer bundles its own click; reach its base exception through a public class.
 _USAGE_ERRORS = next(

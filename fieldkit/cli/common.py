@@ -71,6 +71,10 @@ FLAGS: dict[str, str] = {
     "step_m": "--step",
     "max_length_m": "--max-length",
     "ranges": "--materials",
+    # synthetic tables and fits (fieldkit.fit)
+    "noise_fraction": "--noise",
+    "paths": "--paths",
+    "report_dir": "--report",
 }
 
 _QUOTED = re.compile(r"`(\w+)`")

@@ -383,6 +383,38 @@ def _friction_tan(mat, mi, key, n, entry):
 
 
 @njit(cache=True)
+def restitution(vin, vit, e_n, e_n_mean, e_t, omega_i, r, kg, flags, par):
+    """``(vfn, vft, omega_f)`` of one impact in local axes: the impact stage's laws.
+
+    ``vfn = -e_n vin``, ``vft = e_t vit`` (eqs. 4.6, 4.7; spin after impact rolling,
+    ``-vft/r``, eq. 7.5), modified by the active impact-stage effects in ``flags`` /
+    ``par``: angle-dependent ``e_n`` (eq. 5.4), velocity-scaled ``vfn`` (eq. 7.1),
+    rotation friction (eqs. 4.20-4.22). ``e_n``, ``e_t`` are this impact's draws,
+    ``e_n_mean`` the material mean. ``vin >= 0`` (moving away from the ground) keeps
+    the tangential velocity and stops the normal one. :func:`run_rock` and
+    :mod:`fieldkit.fit.impact_model` both call this one function.
+    """
+    if vin >= 0.0:
+        return 0.0, vit, -vit / r
+    if flags[F_ADR] == 1:
+        theta_i = math.degrees(math.atan2(-vin, abs(vit)))
+        e_n = angle_dependent_restitution.normal_restitution(
+            e_n, e_n_mean, theta_i, par[P_ADR_B], par[P_ADR_REF], par[P_ADR_A]
+        )
+    vfn = -e_n * vin
+    if flags[F_VSR] == 1:
+        vfn *= velocity_scaled_restitution.normal_speed_factor(vin, par[P_VSR_K])
+    if flags[F_ROT] == 1:
+        vft, w = rotation_friction.impact(
+            vit, vin, e_t, e_n, omega_i, r, kg, par[P_ROT_MU], par[P_ROT_C]
+        )
+    else:
+        vft = e_t * vit
+        w = -vft / r
+    return vfn, vft, w
+
+
+@njit(cache=True)
 def run_rock(
     key,
     x,
@@ -596,33 +628,9 @@ def run_rock(
                     vit = vx * c - vz * s
                     vin = vx * s + vz * c
             w_i = w
-            if vin >= 0.0:
-                vfn = 0.0
-                vft = vit
-                w = -vft / r
-            else:
-                if flags[F_ADR] == 1:
-                    theta_i = math.degrees(math.atan2(-vin, abs(vit)))
-                    e_n = angle_dependent_restitution.normal_restitution(
-                        e_n,
-                        mat[mi, M_EN],
-                        theta_i,
-                        par[P_ADR_B],
-                        par[P_ADR_REF],
-                        par[P_ADR_A],
-                    )
-                vfn = -e_n * vin
-                if flags[F_VSR] == 1:
-                    vfn *= velocity_scaled_restitution.normal_speed_factor(
-                        vin, par[P_VSR_K]
-                    )
-                if flags[F_ROT] == 1:
-                    vft, w = rotation_friction.impact(
-                        vit, vin, e_t, e_n, w, r, kg, par[P_ROT_MU], par[P_ROT_C]
-                    )
-                else:
-                    vft = e_t * vit
-                    w = -vft / r
+            vfn, vft, w = restitution(
+                vin, vit, e_n, mat[mi, M_EN], e_t, w, r, kg, flags, par
+            )
             vfx = vft * c + vfn * s
             vfz = -vft * s + vfn * c
             if rec_on:

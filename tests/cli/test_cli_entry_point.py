@@ -23,6 +23,8 @@ COMMANDS = [
     "profile",
     "simulate",
     "effects",
+    "synth",
+    "fit",
 ]
 REPO = Path(__file__).resolve().parents[2]
 
@@ -42,7 +44,7 @@ def test_every_registered_command_is_listed():
 
 
 #: Commands whose examples need the simulator core.
-NEEDS_CORE = {"simulate", "effects"}
+NEEDS_CORE = {"simulate", "effects", "synth", "fit"}
 
 #: Commands whose examples render and track a video clip (about 15 s).
 SLOW_EXAMPLES = {"track"}

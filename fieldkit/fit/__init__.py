@@ -1,0 +1,1 @@
+"""Fitting model parameters to measured impacts (docs/architecture.md §4)."""

@@ -1,0 +1,289 @@
+"""Weighted least squares of a model's impact laws on an ImpactTable.
+
+The data are each impact's measured rebound in local axes, ``vfn_mps`` and
+``vft_mps``, and ``omega_f_radps`` where it is measured (finite and
+``omega_source`` not ``estimated``/``none``); the prediction is
+:func:`fieldkit.fit.impact_model.predict_arrays` (the simulator's impact stage with
+material means). Residuals ``(observed - predicted) / sd`` are minimised by
+``scipy.optimize.least_squares`` (``trf``, bounds, 3-point Jacobian).
+
+Weights (the first that the table allows, stated in the result):
+
+1. ``vfn_sd_mps``, ``vft_sd_mps`` (and ``omega_f_sd_radps`` for spins): the SDs of
+   the rebound components themselves (written by ``fieldkit synth``);
+2. ``e_n_sd``, ``e_t_sd``: ``sd(vfn) = e_n_sd |vin|``, ``sd(vft) = e_t_sd |vit|``
+   (the table's restitution uncertainty carried to the rebound speed with the
+   impact velocity as exact; ``vi_sd_mps`` is already inside ``e_n_sd`` and is not
+   used again). Spins then need ``omega_f_sd_radps``, else they are left out;
+3. unit weights: residuals in m/s, spins as the surface speed ``r omega`` in m/s.
+
+Free parameters: ``materials.<m>.e_n`` and ``materials.<m>.e_t`` of every material
+the table's impacts touch, and every parameter of the active impact-stage effects
+except those an impact table cannot determine (:data:`HELD`, stated in the notes):
+flight and slide effects leave no mark on a single impact, and ``slope_roughness``
+acts through the slope the table already records. Bounds come from the material
+validation (:data:`fieldkit.model.materials.MATERIAL_FIELDS`) and the effect
+registry.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from fieldkit.errors import InputFileError
+from fieldkit.fit.fit_result import FitResult
+from fieldkit.fit.impact_model import ImpactInputs, impact_inputs, predict_arrays
+from fieldkit.impact_table import ImpactTable
+from fieldkit.model.effects import registry
+from fieldkit.model.materials import MATERIAL_FIELDS
+from fieldkit.model.model_file import Model
+
+#: Effect parameters held at the model's value, with the reason (stated in notes).
+HELD: dict[str, str] = {
+    "angle_dependent_restitution.theta_ref_deg": "trades exactly with the material "
+    "e_n (e_n theta_ref^b is one number)",
+    "angle_dependent_restitution.a": "a = 0 or a > 0 selects the form of eq. 5.4; "
+    "with a > 0 it trades exactly with the material e_n",
+    "slope_roughness.scale": "acts through the slope the table records",
+}
+#: Primary columns every fitted row needs finite.
+FINITE_COLUMNS = ("vi_x_mps", "vi_z_mps", "vf_x_mps", "vf_z_mps", "slope_deg")
+_NOT_MEASURED_SPIN = ("estimated", "none")
+
+
+def _rows(mask: np.ndarray) -> str:
+    rows = np.flatnonzero(mask) + 1
+    shown = ", ".join(str(r) for r in rows[:5])
+    return (
+        f"row {shown}"
+        if rows.size == 1
+        else f"rows {shown}" + (f" and {rows.size - 5} more" if rows.size > 5 else "")
+    )
+
+
+def check_table(table: ImpactTable, model: Model) -> None:
+    """Columns present and finite for a fit; one-line InputFileError otherwise."""
+    frame = table.frame
+    needed = ["material", "radius_m"]
+    if "rotation_friction" in model.effects:
+        needed.append("gyration_m")
+    missing = [c for c in needed if c not in frame or frame[c].isna().all()]
+    if missing:
+        raise InputFileError(
+            f"missing column(s) {', '.join(missing)} (needed to fit impacts)",
+            source=table.source,
+        )
+    for name in (*FINITE_COLUMNS, *needed[1:]):
+        bad = ~np.isfinite(table.column(name))
+        if bad.any():
+            raise InputFileError(
+                f"{name} is not a finite number", source=table.source, where=_rows(bad)
+            )
+    empty = frame["material"].isna().to_numpy()
+    if empty.any():
+        raise InputFileError(
+            "material is empty", source=table.source, where=_rows(empty)
+        )
+
+
+def free_parameters(model: Model, materials: list[str]) -> tuple[list[str], list[str]]:
+    """``(free parameter names, notes)`` for a table touching ``materials``."""
+    names = []
+    for m in materials:
+        names += [f"materials.{m}.e_n", f"materials.{m}.e_t"]
+    notes = []
+    for effect, values in model.effects.items():
+        spec = registry.effect(effect)
+        for key in values:
+            name = f"{effect}.{key}"
+            if spec.stage != "impact":
+                notes.append(
+                    f"{name} held: a {spec.stage}-stage effect leaves no "
+                    "mark on a single impact"
+                )
+            elif name in HELD:
+                notes.append(f"{name} held: {HELD[name]}")
+            else:
+                names.append(name)
+    unused = [m for m in model.materials if m not in materials]
+    if unused:
+        notes.append(f"material(s) {', '.join(unused)} not in the table: unchanged")
+    return names, notes
+
+
+def _bounds(model: Model, name: str) -> tuple[float, float]:
+    parts = name.split(".")
+    if parts[0] == "materials":
+        lower, upper, _, _ = MATERIAL_FIELDS[parts[2]]
+        return lower, upper
+    p = registry.effect(parts[0]).parameter(parts[1])
+    return p.lower, p.upper
+
+
+def _weights(table: ImpactTable, inputs: ImpactInputs) -> tuple[np.ndarray, str]:
+    """``(sd array (n, 3), description)``; NaN sd = datum left out."""
+    frame = table.frame
+    n = len(frame)
+    sd = np.full((n, 3), np.nan)
+    spin = table.column("omega_f_radps")
+    if "omega_source" in frame:
+        src = frame["omega_source"].astype("string").fillna("")
+        spin = np.where(src.isin(_NOT_MEASURED_SPIN).to_numpy(), np.nan, spin)
+    has_spin = np.isfinite(spin)
+    if "vfn_sd_mps" in frame and "vft_sd_mps" in frame:
+        sd[:, 0] = table.column("vfn_sd_mps")
+        sd[:, 1] = table.column("vft_sd_mps")
+        text = "1/sd from the table's vfn_sd_mps, vft_sd_mps"
+        spin_sd = "omega_f_sd_radps" in frame
+    elif "e_n_sd" in frame and "e_t_sd" in frame and frame["e_n_sd"].notna().all():
+        sd[:, 0] = table.column("e_n_sd") * np.abs(inputs.vin_mps)
+        sd[:, 1] = table.column("e_t_sd") * np.abs(inputs.vit_mps)
+        text = (
+            "1/sd with sd(vfn) = e_n_sd |vin|, sd(vft) = e_t_sd |vit| from the "
+            "table's e_n_sd, e_t_sd"
+        )
+        spin_sd = "omega_f_sd_radps" in frame
+    else:
+        sd[:, 0] = 1.0
+        sd[:, 1] = 1.0
+        sd[has_spin, 2] = 1.0 / inputs.radius_m[has_spin]
+        return sd, (
+            "unit weights (the table has no *_sd columns): residuals in m/s, spins "
+            "as r omega_f in m/s"
+        )
+    if spin_sd:
+        sd[has_spin, 2] = table.column("omega_f_sd_radps")[has_spin]
+        text += ", omega_f_sd_radps"
+    elif has_spin.any():
+        text += "; measured spins left out (no omega_f_sd_radps)"
+    bad = ~((sd[:, 0] > 0) & (sd[:, 1] > 0) & np.isfinite(sd[:, :2]).all(axis=1))
+    if bad.any():
+        raise InputFileError(
+            "standard uncertainty is not a positive number",
+            source=table.source,
+            where=_rows(bad),
+        )
+    return sd, text
+
+
+def fit_impacts(table: ImpactTable, model: Model) -> tuple[FitResult, Model]:
+    """Fit ``model``'s impact laws to ``table``; ``(result, calibrated model)``.
+
+    The calibrated model is ``model`` with the fitted values in place (its
+    ``provenance`` is left to the caller, who knows the table's file name).
+
+    Raises
+    ------
+    InputFileError
+        Required columns missing, non-finite values (rows named), materials of the
+        table not in the model (named), or fewer data than parameters.
+    """
+    check_table(table, model)
+    table = table.derive()
+    inputs = impact_inputs(table, model)
+    used = [m for m in inputs.material_names if m in set(table.frame["material"])]
+    names, notes = free_parameters(model, used)
+    sd, weighting = _weights(table, inputs)
+    observed = np.column_stack(
+        [
+            table.column("vfn_mps"),
+            table.column("vft_mps"),
+            table.column("omega_f_radps"),
+        ]
+    )
+    use = np.isfinite(sd) & np.isfinite(observed)
+    ndata, p = int(use.sum()), len(names)
+    if ndata <= p:
+        per = max(1, int(use.sum(axis=1).max())) if len(table) else 2
+        need = p // per + 1
+        raise InputFileError(
+            f"too few impacts to fit: {len(table)} impact(s) give {ndata} data for "
+            f"{p} parameters ({', '.join(names)}); need more data than parameters, "
+            f"at least {need} impacts",
+            source=table.source,
+        )
+    start = np.array([model.parameters()[n] for n in names], float)
+    bounds = np.array([_bounds(model, n) for n in names], float)
+    for i, name in enumerate(names):
+        if not math.isfinite(start[i]):
+            default = registry.effect(name.split(".")[0]).parameter(name.split(".")[1])
+            start[i] = default.default
+            notes.append(
+                f"{name} starts at its default {default.default:g} "
+                "(the model's value is not finite)"
+            )
+    start = np.clip(start, bounds[:, 0], bounds[:, 1])
+    mat_index = {m: i for i, m in enumerate(inputs.material_names)}
+    e_n0 = np.array([model.materials[m].e_n for m in inputs.material_names])
+    e_t0 = np.array([model.materials[m].e_t for m in inputs.material_names])
+
+    def unpack(theta: np.ndarray):
+        e_n, e_t = e_n0.copy(), e_t0.copy()
+        effects = {k: dict(v) for k, v in model.effects.items()}
+        for name, value in zip(names, theta, strict=True):
+            parts = name.split(".")
+            if parts[0] == "materials":
+                target = e_n if parts[2] == "e_n" else e_t
+                target[mat_index[parts[1]]] = value
+            else:
+                effects[parts[0]][parts[1]] = float(value)
+        return e_n, e_t, effects
+
+    def residuals(theta: np.ndarray) -> np.ndarray:
+        pred = predict_arrays(inputs, *unpack(theta))
+        return ((observed - pred) / sd)[use]
+
+    fit = least_squares(
+        residuals,
+        start,
+        bounds=(bounds[:, 0], bounds[:, 1]),
+        method="trf",
+        jac="3-point",
+        x_scale="jac",
+    )
+    r = fit.fun
+    chi2 = float(r @ r)
+    dof = ndata - p
+    redchi = chi2 / dof
+    jac = fit.jac
+    with np.errstate(divide="ignore", invalid="ignore"):
+        try:
+            cov = np.linalg.inv(jac.T @ jac) * redchi
+        except np.linalg.LinAlgError:
+            cov = np.full((p, p), np.inf)
+        se = np.sqrt(np.where(np.diag(cov) >= 0, np.diag(cov), np.nan))
+        corr = cov / np.outer(se, se)
+    corr[~np.isfinite(corr)] = np.nan
+    np.fill_diagonal(corr, 1.0)
+    ln = ndata * math.log(chi2 / ndata) if chi2 > 0 else -math.inf
+    rows = np.broadcast_to(np.arange(len(table))[:, None], use.shape)[use]
+    kind = np.broadcast_to(np.array(["vfn", "vft", "omega_f"]), use.shape)[use]
+    result = FitResult(
+        names=names,
+        values=np.asarray(fit.x, float),
+        stderr=se,
+        start=start,
+        lower=bounds[:, 0],
+        upper=bounds[:, 1],
+        correlation=corr,
+        chi2=chi2,
+        redchi=redchi,
+        aic=ln + 2 * p,
+        bic=ln + math.log(ndata) * p,
+        ndata=ndata,
+        nparams=p,
+        n_impacts=len(table),
+        success=bool(fit.success),
+        message=str(fit.message),
+        weighting=weighting,
+        notes=notes,
+        residuals=r,
+        residual_kind=kind,
+        residual_row=rows,
+    )
+    calibrated = model.with_parameters(dict(zip(names, map(float, fit.x), strict=True)))
+    return result, replace(calibrated, provenance=dict(model.provenance))
