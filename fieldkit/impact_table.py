@@ -133,6 +133,14 @@ EXTENSION_COLUMNS: tuple[Column, ...] = (
     Column("e_n_sd", "float", False, "standard uncertainty of e_n [-]"),
     Column("e_t_sd", "float", False, "standard uncertainty of e_t [-]"),
     Column("vi_sd_mps", "float", False, "standard uncertainty of vi_mps [m/s]"),
+    Column("vf_sd_mps", "float", False, "standard uncertainty of vf_mps [m/s]"),
+    Column("vin_sd_mps", "float", False, "standard uncertainty of vin_mps [m/s]"),
+    Column("vit_sd_mps", "float", False, "standard uncertainty of vit_mps [m/s]"),
+    Column("vfn_sd_mps", "float", False, "standard uncertainty of vfn_mps [m/s]"),
+    Column("vft_sd_mps", "float", False, "standard uncertainty of vft_mps [m/s]"),
+    Column(
+        "theta_i_sd_deg", "float", False, "standard uncertainty of theta_i_deg [deg]"
+    ),
 )
 
 COLUMNS_BY_NAME: dict[str, Column] = {
