@@ -244,8 +244,7 @@ def reduce(
     )
     if height_sigma is not None and trees is None:
         raise ArgumentError(
-            "--height-sigma goes with --trees (it is the error of tree-strike "
-            "heights)",
+            "--height-sigma goes with --trees (it is the error of tree-strike heights)",
             source="--height-sigma",
         )
     body = resolve_body(
