@@ -143,6 +143,21 @@ EXTENSION_COLUMNS: tuple[Column, ...] = (
     ),
 )
 
+#: Value column -> its standard-uncertainty column (docs/architecture.md §3
+#: ``<column>_sd``, the unit suffix kept last), for every value a reduction or a
+#: track analysis propagates its measurement error to.
+SD_COLUMNS: dict[str, str] = {
+    "e_n": "e_n_sd",
+    "e_t": "e_t_sd",
+    "vi_mps": "vi_sd_mps",
+    "vf_mps": "vf_sd_mps",
+    "vin_mps": "vin_sd_mps",
+    "vit_mps": "vit_sd_mps",
+    "vfn_mps": "vfn_sd_mps",
+    "vft_mps": "vft_sd_mps",
+    "theta_i_deg": "theta_i_sd_deg",
+}
+
 COLUMNS_BY_NAME: dict[str, Column] = {
     c.name: c for c in CONTRACT_COLUMNS + EXTENSION_COLUMNS
 }

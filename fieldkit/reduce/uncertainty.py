@@ -67,6 +67,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fieldkit.errors import ArgumentError, FieldkitError
+from fieldkit.impact_table import SD_COLUMNS
 
 __all__ = [
     "DEFAULT_DRAWS",
@@ -94,17 +95,7 @@ DEFAULT_SEED = 2004
 
 #: Reduced values whose standard uncertainty a reduction reports (``sd_column`` of
 #: each is its column).
-OUTPUTS = (
-    "e_n",
-    "e_t",
-    "vi_mps",
-    "vf_mps",
-    "vin_mps",
-    "vit_mps",
-    "vfn_mps",
-    "vft_mps",
-    "theta_i_deg",
-)
+OUTPUTS = tuple(SD_COLUMNS)
 
 #: Unit suffixes kept last in a column name: ``vi_mps`` -> ``vi_sd_mps``.
 _UNITS = ("_mps", "_m", "_deg", "_j", "_s", "_radps", "_kg")
