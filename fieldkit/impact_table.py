@@ -133,7 +133,30 @@ EXTENSION_COLUMNS: tuple[Column, ...] = (
     Column("e_n_sd", "float", False, "standard uncertainty of e_n [-]"),
     Column("e_t_sd", "float", False, "standard uncertainty of e_t [-]"),
     Column("vi_sd_mps", "float", False, "standard uncertainty of vi_mps [m/s]"),
+    Column("vf_sd_mps", "float", False, "standard uncertainty of vf_mps [m/s]"),
+    Column("vin_sd_mps", "float", False, "standard uncertainty of vin_mps [m/s]"),
+    Column("vit_sd_mps", "float", False, "standard uncertainty of vit_mps [m/s]"),
+    Column("vfn_sd_mps", "float", False, "standard uncertainty of vfn_mps [m/s]"),
+    Column("vft_sd_mps", "float", False, "standard uncertainty of vft_mps [m/s]"),
+    Column(
+        "theta_i_sd_deg", "float", False, "standard uncertainty of theta_i_deg [deg]"
+    ),
 )
+
+#: Value column -> its standard-uncertainty column (docs/architecture.md §3
+#: ``<column>_sd``, the unit suffix kept last), for every value a reduction or a
+#: track analysis propagates its measurement error to.
+SD_COLUMNS: dict[str, str] = {
+    "e_n": "e_n_sd",
+    "e_t": "e_t_sd",
+    "vi_mps": "vi_sd_mps",
+    "vf_mps": "vf_sd_mps",
+    "vin_mps": "vin_sd_mps",
+    "vit_mps": "vit_sd_mps",
+    "vfn_mps": "vfn_sd_mps",
+    "vft_mps": "vft_sd_mps",
+    "theta_i_deg": "theta_i_sd_deg",
+}
 
 COLUMNS_BY_NAME: dict[str, Column] = {
     c.name: c for c in CONTRACT_COLUMNS + EXTENSION_COLUMNS

@@ -39,6 +39,9 @@ FLAGS: dict[str, str] = {
     "gpx_track": "--gpx-track",
     "declination_deg": "--declination",
     "friction": "--friction",
+    "position_sigma_m": "--position-sigma",
+    "elevation_sigma_m": "--position-sigma",
+    "strike_height_sigma_m": "--height-sigma",
     # video tracking and track exports
     "fps": "--fps",
     "scale_points": "--scale-points",

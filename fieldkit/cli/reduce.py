@@ -142,6 +142,24 @@ def reduce(
             "azimuth_reference column says the azimuths are true.",
         ),
     ] = None,
+    position_sigma: Annotated[
+        float | None,
+        typer.Option(
+            "--position-sigma",
+            help="Standard uncertainty (m) of each surveyed point (GPS or "
+            "rangefinder), in plan and in height, relative to its neighbours "
+            "(default 0.5: averaged handheld GNSS under open sky or a rangefinder; "
+            "2-5 under forest canopy).",
+        ),
+    ] = None,
+    height_sigma: Annotated[
+        float | None,
+        typer.Option(
+            "--height-sigma",
+            help="Standard uncertainty (m) of each tree-strike height (default "
+            "0.25: where on the scar the rock's centre passed).",
+        ),
+    ] = None,
     out: Annotated[
         Path | None,
         typer.Option("-o", "--out", help="Output table: .csv, .parquet or .xlsx."),
@@ -162,8 +180,10 @@ def reduce(
     Velocities, N/T components on the chord slope, e_N, e_T, energies (KE, RE
     with omega = v/r, energy head) and flight heights go to one row per impact,
     with quality flags (qa_flags) and standard uncertainties (e_n_sd, e_t_sd,
-    vi_sd_mps) propagated from a position error of 0.5 m in plan and in height
-    (stated in the summary).
+    vi_sd_mps, vf_sd_mps, vin/vit/vfn/vft_sd_mps, theta_i_sd_deg) propagated by
+    Monte Carlo from --position-sigma (default 0.5 m in plan and in height per
+    point) and --height-sigma (default 0.25 m per tree strike); the summary
+    states the model and how many e_n are known to better than 0.1.
 
     Example (thesis Table 2-4, Tornado Mountain boulder A; from the
     repository root):
@@ -203,6 +223,29 @@ def reduce(
     if theta0 is not None and not (math.isfinite(theta0) and 0.0 < theta0 < 180.0):
         raise ArgumentError(
             f"must be between 0 and 180 degrees (got {theta0:g})", source="--theta0"
+        )
+    from fieldkit.reduce.uncertainty import (
+        DEFAULT_ELEVATION_SIGMA_M,
+        DEFAULT_POSITION_SIGMA_M,
+        DEFAULT_STRIKE_HEIGHT_SIGMA_M,
+        PositionError,
+    )
+
+    error_model = PositionError(
+        position_sigma_m=(
+            DEFAULT_POSITION_SIGMA_M if position_sigma is None else position_sigma
+        ),
+        elevation_sigma_m=(
+            DEFAULT_ELEVATION_SIGMA_M if position_sigma is None else position_sigma
+        ),
+        strike_height_sigma_m=(
+            DEFAULT_STRIKE_HEIGHT_SIGMA_M if height_sigma is None else height_sigma
+        ),
+    )
+    if height_sigma is not None and trees is None:
+        raise ArgumentError(
+            "--height-sigma goes with --trees (it is the error of tree-strike heights)",
+            source="--height-sigma",
         )
     body = body_from_options(
         mass, radius, gyration, shape, dimensions, unit_weight
@@ -249,7 +292,11 @@ def reduce(
 
         tree_set = read_trees(trees, points, units=units)
     options = ReduceOptions(
-        path_id=path_id or name, theta0_deg=theta0, body=body, friction=friction
+        path_id=path_id or name,
+        theta0_deg=theta0,
+        body=body,
+        friction=friction,
+        position_error=error_model,
     )
     survey = Survey(points, tree_set)
     reduction = reduce_path(survey, options)

@@ -13,8 +13,9 @@
    slope, where the slope is the default chord from the previous one
    (``e_n_next_chord``): how much ``e_n`` hangs on that choice;
 6. :func:`~fieldkit.reduce.uncertainty.propagate` -- ``e_n_sd``, ``e_t_sd``,
-   ``vi_sd_mps`` from the position error, by repeating steps 1-4 on perturbed points
-   (:func:`point_kinematics`);
+   ``vi_sd_mps`` and the other ``*_sd`` columns of
+   :data:`~fieldkit.reduce.uncertainty.OUTPUTS` from the position error, by repeating
+   steps 1-4 on perturbed points and tree-strike heights (:func:`point_kinematics`);
 7. :meth:`ImpactTable.derive` -- N/T components, angles, e_n, e_t, energies, heads and
    the quality flags (``qa_flags``);
 8. :func:`add_flight_energy` -- KE gained in each flight (``flight_dke_j``).
@@ -39,7 +40,7 @@ from fieldkit.physics.bodies import ResolvedBody
 from fieldkit.physics.energy import kinetic_energy
 from fieldkit.reduce.flights import SolvedFlight, solve_flights
 from fieldkit.reduce.impact_theory import DEFAULT_FRICTION, add_theory_columns
-from fieldkit.reduce.uncertainty import PositionError, Propagated, propagate
+from fieldkit.reduce.uncertainty import OUTPUTS, PositionError, Propagated, propagate
 from fieldkit.survey import Survey
 
 
@@ -62,9 +63,10 @@ class ReduceOptions:
         Contact friction coefficient mu [-] for the impact-mechanics energy beside
         the measured one (:func:`fieldkit.reduce.impact_theory.add_theory_columns`).
     position_error
-        The survey's position error, propagated to ``e_n_sd``, ``e_t_sd`` and
-        ``vi_sd_mps`` (:mod:`fieldkit.reduce.uncertainty`; default 0.5 m in plan and
-        in height); None leaves those columns out.
+        The survey's position error, propagated to ``e_n_sd``, ``e_t_sd``,
+        ``vi_sd_mps`` and the other ``*_sd`` columns
+        (:mod:`fieldkit.reduce.uncertainty`; default 0.5 m in plan and in height per
+        point, 0.25 m per tree-strike height); None leaves those columns out.
     """
 
     path_id: str
@@ -251,19 +253,28 @@ def _solve(
 
 
 def point_kinematics(
-    survey: Survey, options: ReduceOptions, x_m: np.ndarray, z_m: np.ndarray
+    survey: Survey,
+    options: ReduceOptions,
+    x_m: np.ndarray,
+    z_m: np.ndarray,
+    strike_heights_m: np.ndarray | None = None,
 ) -> dict[str, np.ndarray]:
-    """``e_n``, ``e_t`` and ``vi_mps`` of every point with the points moved to
-    ``(x_m, z_m)``: steps 1-4 of :func:`reduce_survey` without building a table (what
-    :func:`~fieldkit.reduce.uncertainty.propagate` repeats). Tree strikes keep their
-    distance and height from the (moved) launch point.
+    """The :data:`~fieldkit.reduce.uncertainty.OUTPUTS` of every point with the points
+    moved to ``(x_m, z_m)`` and the tree strikes to ``strike_heights_m`` (in the rows'
+    order; None: as surveyed): steps 1-4 of :func:`reduce_survey` without building a
+    table (what :func:`~fieldkit.reduce.uncertainty.propagate` repeats). Tree strikes
+    keep their distance from the (moved) launch point.
     """
     frame = survey.points.frame.reset_index(drop=True).copy()
     frame["x_m"], frame["z_m"] = x_m, z_m
     moved = replace(survey, points=replace(survey.points, frame=frame))
+    if strike_heights_m is not None and survey.trees is not None:
+        trees = survey.trees.frame.copy()
+        trees["strike_height_m"] = np.asarray(strike_heights_m, float)
+        moved = replace(moved, trees=replace(survey.trees, frame=trees))
     slope, _, flights = _solve(moved, options, np.asarray(x_m), np.asarray(z_m))
     values = restitution(*flight_velocities(flights, len(frame)), slope)
-    return {name: values[name] for name in ("e_n", "e_t", "vi_mps")}
+    return {name: values[name] for name in OUTPUTS}
 
 
 def add_flight_energy(table: ImpactTable) -> ImpactTable:
@@ -339,11 +350,15 @@ def reduce_path(survey: Survey, options: ReduceOptions | None = None) -> Reducti
     )
     spread = None
     if options.position_error is not None:
+        heights = None
+        if survey.trees is not None:
+            heights = survey.trees.frame["strike_height_m"].to_numpy(float)
         spread = propagate(
-            lambda xs, zs: point_kinematics(survey, options, xs, zs),
+            lambda xs, zs, hs=None: point_kinematics(survey, options, xs, zs, hs),
             x,
             z,
             options.position_error,
+            strike_heights_m=heights,
         )
         for name, values in spread.sd.items():
             rows[name] = values

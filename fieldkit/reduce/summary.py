@@ -4,7 +4,8 @@ Restitution coefficients by slope material (mean, standard deviation, count; the
 thesis Table 2-7 and Figs. 5.7-5.8 report them), how each flight was fixed (tree,
 given, assumed), the energy budget (kinetic energy lost on impacts against energy
 gained in flights, and the potential energy released), how many rows carry each
-quality flag (``qa_flags``), the position error the ``*_sd`` columns come from, and a
+quality flag (``qa_flags``), the position error the ``*_sd`` columns come from and how
+many impacts have an ``e_n`` known to better than :data:`E_N_SD_MEANINGFUL`, and a
 warning when the default chord slope moves ``e_n`` by more than that error does.
 
 The impact-mechanics share of the measured loss (thesis §6.3) is a median over the
@@ -34,6 +35,10 @@ THEORY_MAX_GAINED_SHARE = 0.25
 #: theory predicts a gain, e.g. e_n > 1, or more than the whole loss): beyond it the
 #: velocities do not support the comparison and the median of the rest is cherry-picked.
 THEORY_MAX_OUTSIDE_SHARE = 0.25
+#: ``e_n_sd`` below which an impact's ``e_n`` is counted as meaningful: e_n spans
+#: about 0.1-0.9 on natural slopes (thesis Table 2-7), so a value known to better
+#: than 0.1 places the impact in that range; one known to 0.3 does not.
+E_N_SD_MEANINGFUL = 0.1
 
 
 @dataclass(frozen=True)
@@ -78,6 +83,10 @@ class ReductionSummary:
     slope_sensitive: int = 0
     slope_shift_median: float = float("nan")
     e_n_sd_median: float = float("nan")
+    #: Impacts with a finite ``e_n_sd``, and of those how many are below
+    #: :data:`E_N_SD_MEANINGFUL`.
+    e_n_sd_count: int = 0
+    e_n_meaningful: int = 0
     #: How the ``*_sd`` columns were obtained (None: not propagated).
     uncertainty: str | None = None
 
@@ -193,9 +202,12 @@ def summarize(
     if "e_n_next_chord" in impacts:
         shift = np.abs(impacts["e_n_next_chord"] - impacts["e_n"]).to_numpy(float)
         shift = shift[chord & np.isfinite(shift)]
+    all_sd = np.array([], dtype=float)
     if "e_n_sd" in impacts:
         sd = impacts["e_n_sd"].to_numpy(float)[chord]
         sd = sd[np.isfinite(sd)]
+        all_sd = impacts["e_n_sd"].to_numpy(float)
+        all_sd = all_sd[np.isfinite(all_sd) & np.isfinite(impacts["e_n"])]
     return ReductionSummary(
         path_ids=tuple(str(p) for p in table.paths()),
         n_points=len(f),
@@ -226,6 +238,8 @@ def summarize(
         ),
         slope_shift_median=float(np.median(shift)) if len(shift) else np.nan,
         e_n_sd_median=float(np.median(sd)) if len(sd) else np.nan,
+        e_n_sd_count=len(all_sd),
+        e_n_meaningful=int(np.sum(all_sd < E_N_SD_MEANINGFUL)),
         uncertainty=None if uncertainty is None else uncertainty.describe(),
     )
 
@@ -294,6 +308,12 @@ def format_summary(summary: ReductionSummary) -> str:
             else ""
         )
         lines.append(f"uncertainty: {summary.uncertainty}{median}")
+        if summary.e_n_sd_count:
+            lines.append(
+                f"  e_n is known to better than {E_N_SD_MEANINGFUL:g} (e_n_sd) at "
+                f"{summary.e_n_meaningful} of {summary.e_n_sd_count} impacts; "
+                "weigh the others by their e_n_sd"
+            )
     if summary.flag_counts:
         lines.append(
             "quality flags (qa_flags; meanings in fieldkit.impact_table.QA_FLAGS): "

@@ -1,22 +1,27 @@
 """Standard uncertainties of reduced values, from the survey's position error.
 
 The ``<column>_sd`` columns of an ImpactTable (docs/architecture.md §3: ``e_n_sd``,
-``e_t_sd``, ``vi_sd_mps``) come from :func:`propagate`: a Monte Carlo that perturbs
-every surveyed point, runs the *same* reduction again (passed in as a callable) and
-takes the standard deviation of each output over the draws. Nothing is linearised, so
+``e_t_sd``, ``vi_sd_mps``, ``vf_sd_mps``, ``vin_sd_mps``, ``vit_sd_mps``,
+``vfn_sd_mps``, ``vft_sd_mps``, ``theta_i_sd_deg``; :data:`OUTPUTS`) come from
+:func:`propagate`: a Monte Carlo that perturbs every surveyed point and tree-strike
+height, runs the *same* reduction again (passed in as a callable) and takes the
+standard deviation of each output over the draws. Nothing is linearised, so
 the non-linear three-point and eq. 3.5 solutions, the chord slopes and the N/T
 decomposition all carry the error the way they carry the data.
 
 Error model (:class:`PositionError`)
     Each point's section coordinates get independent normal errors: ``x_m`` with
-    standard deviation ``position_sigma_m`` and ``z_m`` with ``height_sigma_m``.
+    standard deviation ``position_sigma_m`` and ``z_m`` with ``elevation_sigma_m``;
+    each tree strike's height above the ground gets ``strike_height_sigma_m``.
     ``position_sigma_m`` is the standard uncertainty of a point's plan position along
     any horizontal direction. For points placed in plan (GPS, rangefinder) the section
     ``x`` is the cumulative plan distance, so a point's along-path error moves its own
     ``x`` by the same amount to first order (an across-path error changes plan
     distances only to second order); the common offset of the first point cancels.
-    Tree strikes (tape distance and height from the impact) and surveyed slopes are
-    taken as exact here; only the positions vary.
+    A tree strike's height fixes a three-point parabola (eq. 3.5) and so moves with
+    its own error; its tape distance from the launch point and surveyed slopes are
+    taken as exact (a taped distance is good to centimetres, far below the plan error
+    of the points it is measured from).
 
 Defaults, and why
     What the reduction feels is the error of one impact *relative to the next*,
@@ -26,11 +31,20 @@ Defaults, and why
     0.5 m in plan suits a handheld receiver held on each scar under open sky, or a
     laser rangefinder (TruPulse 360: about ±0.3 m in distance at these ranges) with a
     scar half a metre across, as at Tornado Mountain (thesis §2.2.2: "a GPS unit and a
-    laser rangefinder"). :data:`DEFAULT_HEIGHT_SIGMA_M` = 0.5 m in height: GNSS heights
-    are 1.5-2 times worse than plan positions, a rangefinder's inclination is better;
-    0.5 m covers the handheld case without overstating the rangefinder. A survey with
-    a total station (centimetres) or a handheld GNSS under forest canopy (metres)
-    needs its own values; the reduction states the values it used.
+    laser rangefinder"). A consumer handheld GNSS is good to only 3-5 m *absolute* in
+    the open, but most of that is the shared part that cancels between neighbouring
+    fixes; averaging a fix over a minute on each scar brings the point-to-point part
+    to about half a metre, which is what the default assumes. Under forest canopy the
+    point-to-point error itself reaches metres: give ``position_sigma_m`` of 2-5 m
+    there. :data:`DEFAULT_ELEVATION_SIGMA_M` = 0.5 m in height: GNSS heights are
+    1.5-2 times worse than plan positions, a rangefinder's inclination is better;
+    0.5 m covers the handheld case without overstating the rangefinder. The command
+    line sets both from one number (a point's plan and height error). A survey with a
+    total station (centimetres) needs its own values; the reduction states the values
+    it used. :data:`DEFAULT_STRIKE_HEIGHT_SIGMA_M` = 0.25 m for a tree strike: the
+    scar on the trunk is taped to centimetres, but where on a scar of a rock a metre
+    across its centre passed (and where "the ground" at the tree's foot is on a
+    slope) is uncertain by a quarter of a metre.
 
 Sampling
     :data:`DEFAULT_DRAWS` = 100 draws from ``numpy.random.default_rng(seed)`` with the
@@ -53,12 +67,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from fieldkit.errors import ArgumentError, FieldkitError
+from fieldkit.impact_table import SD_COLUMNS
 
 __all__ = [
     "DEFAULT_DRAWS",
-    "DEFAULT_HEIGHT_SIGMA_M",
+    "DEFAULT_ELEVATION_SIGMA_M",
     "DEFAULT_POSITION_SIGMA_M",
     "DEFAULT_SEED",
+    "DEFAULT_STRIKE_HEIGHT_SIGMA_M",
+    "OUTPUTS",
     "PositionError",
     "Propagated",
     "propagate",
@@ -68,11 +85,17 @@ __all__ = [
 #: Standard uncertainty of a point's plan position, relative to its neighbours [m].
 DEFAULT_POSITION_SIGMA_M = 0.5
 #: Standard uncertainty of a point's elevation, relative to its neighbours [m].
-DEFAULT_HEIGHT_SIGMA_M = 0.5
+DEFAULT_ELEVATION_SIGMA_M = 0.5
+#: Standard uncertainty of a tree strike's height above the ground at the tree [m].
+DEFAULT_STRIKE_HEIGHT_SIGMA_M = 0.25
 #: Monte Carlo draws.
 DEFAULT_DRAWS = 100
 #: Seed of ``numpy.random.default_rng`` (fixed: the same survey gives the same sd).
 DEFAULT_SEED = 2004
+
+#: Reduced values whose standard uncertainty a reduction reports (``sd_column`` of
+#: each is its column).
+OUTPUTS = tuple(SD_COLUMNS)
 
 #: Unit suffixes kept last in a column name: ``vi_mps`` -> ``vi_sd_mps``.
 _UNITS = ("_mps", "_m", "_deg", "_j", "_s", "_radps", "_kg")
@@ -100,8 +123,10 @@ class PositionError:
     ----------
     position_sigma_m
         Standard uncertainty of each point's plan position [m] (module docstring).
-    height_sigma_m
+    elevation_sigma_m
         Standard uncertainty of each point's elevation [m].
+    strike_height_sigma_m
+        Standard uncertainty of each tree strike's height above the ground [m].
     draws
         Monte Carlo draws (>= 10).
     seed
@@ -109,14 +134,19 @@ class PositionError:
     """
 
     position_sigma_m: float = DEFAULT_POSITION_SIGMA_M
-    height_sigma_m: float = DEFAULT_HEIGHT_SIGMA_M
+    elevation_sigma_m: float = DEFAULT_ELEVATION_SIGMA_M
+    strike_height_sigma_m: float = DEFAULT_STRIKE_HEIGHT_SIGMA_M
     draws: int = DEFAULT_DRAWS
     seed: int = DEFAULT_SEED
 
     def __post_init__(self) -> None:
-        for name in ("position_sigma_m", "height_sigma_m"):
+        for name in ("position_sigma_m", "elevation_sigma_m", "strike_height_sigma_m"):
             value = getattr(self, name)
-            if not (isinstance(value, int | float) and math.isfinite(value)):
+            if not (
+                isinstance(value, int | float)
+                and not isinstance(value, bool)
+                and math.isfinite(value)
+            ):
                 raise ArgumentError(f"{name} must be a finite number", source=name)
             if value < 0:
                 raise ArgumentError(f"{name} must be >= 0 (got {value:g})", source=name)
@@ -128,14 +158,17 @@ class PositionError:
 
     def describe(self) -> str:
         """One line: the model, whether it is the default, the sampling."""
-        default = (self.position_sigma_m, self.height_sigma_m) == (
+        points = (self.position_sigma_m, self.elevation_sigma_m) == (
             DEFAULT_POSITION_SIGMA_M,
-            DEFAULT_HEIGHT_SIGMA_M,
+            DEFAULT_ELEVATION_SIGMA_M,
         )
-        where = "the default" if default else "given"
+        strikes = self.strike_height_sigma_m == DEFAULT_STRIKE_HEIGHT_SIGMA_M
         return (
             f"position error {self.position_sigma_m:g} m in plan and "
-            f"{self.height_sigma_m:g} m in height per point ({where}), "
+            f"{self.elevation_sigma_m:g} m in height per point "
+            f"({'the default' if points else 'given'}), "
+            f"{self.strike_height_sigma_m:g} m per tree-strike height "
+            f"({'the default' if strikes else 'given'}), "
             f"{self.draws} Monte Carlo draws, seed {self.seed}"
         )
 
@@ -163,12 +196,13 @@ class Propagated:
 
 
 def propagate(
-    reduction: Callable[[np.ndarray, np.ndarray], Mapping[str, np.ndarray]],
+    reduction: Callable[..., Mapping[str, np.ndarray]],
     x_m: Sequence[float] | np.ndarray,
     z_m: Sequence[float] | np.ndarray,
     model: PositionError | None = None,
     *,
-    outputs: Sequence[str] = ("e_n", "e_t", "vi_mps"),
+    outputs: Sequence[str] = OUTPUTS,
+    strike_heights_m: Sequence[float] | np.ndarray | None = None,
 ) -> Propagated:
     """Standard uncertainty of a reduction's outputs from the position error.
 
@@ -185,6 +219,10 @@ def propagate(
         Position error and sampling (default :class:`PositionError`).
     outputs
         Names to propagate; the result is keyed by :func:`sd_column` of each.
+    strike_heights_m
+        Tree-strike heights [m], if the survey has any: then ``reduction`` is called
+        as ``reduction(x_m, z_m, strike_heights_m)`` with the heights perturbed by
+        ``model.strike_height_sigma_m`` too.
 
     Returns
     -------
@@ -207,14 +245,21 @@ def propagate(
     model = model or PositionError()
     x = np.asarray(x_m, dtype=float)
     z = np.asarray(z_m, dtype=float)
+    heights = None
+    if strike_heights_m is not None and len(strike_heights_m):
+        heights = np.asarray(strike_heights_m, dtype=float)
     rng = np.random.default_rng(model.seed)
     samples: dict[str, list[np.ndarray]] = {name: [] for name in outputs}
     failed, first = 0, None
     for _ in range(model.draws):
         dx = rng.normal(0.0, model.position_sigma_m, x.shape)
-        dz = rng.normal(0.0, model.height_sigma_m, z.shape)
+        dz = rng.normal(0.0, model.elevation_sigma_m, z.shape)
         try:
-            values = reduction(x + dx, z + dz)
+            if heights is None:
+                values = reduction(x + dx, z + dz)
+            else:
+                dh = rng.normal(0.0, model.strike_height_sigma_m, heights.shape)
+                values = reduction(x + dx, z + dz, heights + dh)
         except FieldkitError as error:
             failed += 1
             first = first or str(error)

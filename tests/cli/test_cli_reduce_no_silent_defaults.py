@@ -558,8 +558,9 @@ def test_tornado_summary_states_the_error_model_and_the_slope_warning(tornado):
     stdout, table = tornado
     assert (
         "uncertainty: position error 0.5 m in plan and 0.5 m in height per point "
-        "(the default), 100 Monte Carlo draws, seed 2004 -> e_n_sd, e_t_sd, vi_sd_mps"
-        in stdout
+        "(the default), 0.25 m per tree-strike height (the default), 100 Monte Carlo "
+        "draws, seed 2004 -> e_n_sd, e_t_sd, vi_sd_mps, vf_sd_mps, vin_sd_mps, "
+        "vit_sd_mps, vfn_sd_mps, vft_sd_mps, theta_i_sd_deg" in stdout
     )
     for column in ("e_n_sd", "e_t_sd", "vi_sd_mps", "e_n_next_chord"):
         assert table[column].notna().sum() >= 47, column

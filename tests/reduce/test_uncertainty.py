@@ -160,7 +160,9 @@ def test_propagate_on_a_known_linear_case():
     ("kwargs", "name"),
     [
         ({"position_sigma_m": -0.1}, "position_sigma_m"),
-        ({"height_sigma_m": float("nan")}, "height_sigma_m"),
+        ({"elevation_sigma_m": float("nan")}, "elevation_sigma_m"),
+        ({"strike_height_sigma_m": float("inf")}, "strike_height_sigma_m"),
+        ({"strike_height_sigma_m": -1.0}, "strike_height_sigma_m"),
         ({"draws": 3}, "draws"),
     ],
 )

@@ -202,6 +202,11 @@ class FlightFit:
         Root-mean-square distance of the samples from the free-g parabola [m].
     residual_m
         Distance of each sample from the fixed-g parabola [m].
+    covariance
+        Covariance of ``(position, velocity)`` at ``t_ref_s`` of either component,
+        ``x`` or ``z`` (the two are independent and share the design) [m^2, m^2/s,
+        m^2/s^2]: ``sigma^2 (A'A)^-1`` of the fixed-g fit, with the noise variance
+        ``sigma^2`` estimated from its residuals (``2n - 4`` degrees of freedom).
     """
 
     index: int
@@ -221,6 +226,9 @@ class FlightFit:
     rms_m: float
     rms_free_m: float
     residual_m: np.ndarray = field(repr=False)
+    covariance: np.ndarray = field(
+        default_factory=lambda: np.full((2, 2), np.nan), repr=False
+    )
 
     @property
     def n_samples(self) -> int:
@@ -321,7 +329,8 @@ def fit_flight(
     sigma2_free = free.sse_m2 / max(2 * n - 5, 1)
     g_var = sigma2_free * free.unit_covariance()[2, 2]
     sigma2 = fixed.sse_m2 / max(2 * n - 4, 1)
-    v_se = float(np.sqrt(max(sigma2 * fixed.unit_covariance()[1, 1], 0.0)))
+    covariance = sigma2 * fixed.unit_covariance()
+    v_se = float(np.sqrt(max(covariance[1, 1], 0.0)))
 
     fit = FlightFit(
         index=index,
@@ -341,6 +350,7 @@ def fit_flight(
         rms_m=0.0,
         rms_free_m=float(np.sqrt(free.sse_m2 / n)),
         residual_m=np.empty(0),
+        covariance=covariance,
     )
     px, pz = fit.position(t)
     fit.residual_m = np.hypot(x - px, z - pz)

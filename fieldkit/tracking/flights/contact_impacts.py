@@ -21,6 +21,9 @@ For each contact between two fitted flights
 * **Spin** before and after: slope of a straight line through the unwrapped marker
   angle over the whole adjacent flight (spin is constant in free flight), else the
   median of the track's ``omega_radps`` there, else NaN.
+* **Uncertainty.** ``e_n_sd``, ``e_t_sd``, ``vi_sd_mps`` and the other ``*_sd``
+  columns: the fits' covariance propagated to first order
+  (:mod:`fieldkit.tracking.flights.impact_uncertainty`).
 
 Travel toward -x: the table is built in the mirrored frame (``x -> -x``,
 ``vx -> -vx``, ``omega -> -omega``) so that x increases along travel as the
@@ -39,6 +42,7 @@ from fieldkit.physics.constants import G
 from fieldkit.track import Track
 from fieldkit.tracking.flights.ballistic_fit import FlightFit
 from fieldkit.tracking.flights.contact_surface import surface_angles
+from fieldkit.tracking.flights.impact_uncertainty import contact_sds
 from fieldkit.tracking.flights.net_contacts import contact_onset
 from fieldkit.tracking.flights.segmentation import EXTENDED_CONTACT_SAMPLES, ContactSpan
 
@@ -250,6 +254,17 @@ def build_impact_table(
     has_spin = np.isfinite(f["omega_i_radps"]) & np.isfinite(f["omega_f_radps"])
     f["omega_source"] = np.where(has_spin, "measured", "none")
     _flight_geometry(f)
+    pairs = [
+        (
+            flights[ev.before],
+            flights[ev.after],
+            (ev.t_impact_s, ev.t_restitution_s),
+            not ev.extended,
+        )
+        for ev in events
+    ]
+    for column, values in contact_sds(pairs, slope, sx).items():
+        f[column] = values
     f = f.drop(columns=["x_end_m", "z_end_m", "extended", "sag_rms_m"])
     table = ImpactTable(f, source=path_id).derive()
     table.frame["theta0_deg"] = table.frame["theta_f_deg"]
