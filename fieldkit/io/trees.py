@@ -35,6 +35,7 @@ the row.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from os import PathLike
 
 import numpy as np
@@ -309,61 +310,67 @@ def _place_geographic(
     impacts: PointSet, after: str, lat: float, lon: float, source: str, where: str
 ) -> tuple[str, float, float, str]:
     """(after_impact, along-line distance, offset, note) of a lat/lon tree."""
-    frame = impacts.frame
-    names = impacts.names
-    lats = frame["lat_deg"].to_numpy(float)
-    lons = frame["lon_deg"].to_numpy(float)
-    candidates = [names.index(after)] if after else range(len(names) - 1)
-    best = None
-    for i in candidates:
+    lats = impacts.frame["lat_deg"].to_numpy(float)
+    lons = impacts.frame["lon_deg"].to_numpy(float)
+
+    def project(i: int) -> tuple[float, float, float]:
         along, across, length = geodesy.along_and_across(
             lats[i], lons[i], lats[i + 1], lons[i + 1], [lat], [lon]
         )
-        along_m, across_m = float(along[0]), float(across[0])
-        if after or 0.0 < along_m < length:
-            if best is None or abs(across_m) < abs(best[2]):
-                best = (i, along_m, across_m)
-    if best is None:
-        raise InputFileError(
-            f"tree at {lat:.7f}, {lon:.7f} is not between any two successive impacts "
-            "in plan; give after_impact",
-            source=source,
-            where=where,
-        )
-    i, along_m, across_m = best
-    note = ""
-    if not after:
-        note = (
-            f"{where}: no after_impact given; tree placed on the flight "
-            f"'{names[i]}' → '{names[i + 1]}' ({abs(across_m):.1f} m from its plan "
-            "line)"
-        )
-    return names[i], along_m, across_m, note
+        return float(along[0]), float(across[0]), float(length)
+
+    return _nearest_flight(
+        impacts, after, project, f"{lat:.7f}, {lon:.7f}", source, where
+    )
 
 
 def _place_on_grid(
     impacts: PointSet, after: str, x: float, y: float, source: str, where: str
 ) -> tuple[str, float, float, str]:
     """(after_impact, along-line distance, offset, note) of a tree on the local grid."""
-    frame = impacts.frame
-    names = impacts.names
-    gx = frame["easting_m"].to_numpy(float)
-    gy = frame["northing_m"].to_numpy(float)
-    candidates = [names.index(after)] if after else range(len(names) - 1)
-    best = None
-    for i in candidates:
+    gx = impacts.frame["easting_m"].to_numpy(float)
+    gy = impacts.frame["northing_m"].to_numpy(float)
+
+    def project(i: int) -> tuple[float, float, float] | None:
         dx, dy = gx[i + 1] - gx[i], gy[i + 1] - gy[i]
         length = math.hypot(dx, dy)
         if length == 0.0:
-            continue
+            return None
         along = ((x - gx[i]) * dx + (y - gy[i]) * dy) / length
         across = ((x - gx[i]) * dy - (y - gy[i]) * dx) / length  # right of the line
+        return along, across, length
+
+    return _nearest_flight(
+        impacts, after, project, f"x = {x:g}, y = {y:g}", source, where
+    )
+
+
+def _nearest_flight(
+    impacts: PointSet,
+    after: str,
+    project: Callable[[int], tuple[float, float, float] | None],
+    position: str,
+    source: str,
+    where: str,
+) -> tuple[str, float, float, str]:
+    """The flight a tree stands on, in plan: ``after`` if given, else the flight whose
+    plan line passes nearest among those the tree lies between. ``project(i)`` gives
+    the tree's ``(along, across, length)`` on the plan line of flight ``i`` (None for a
+    line of zero length)."""
+    names = impacts.names
+    candidates = [names.index(after)] if after else range(len(names) - 1)
+    best = None
+    for i in candidates:
+        placed = project(i)
+        if placed is None:
+            continue
+        along, across, length = placed
         if after or 0.0 < along < length:
             if best is None or abs(across) < abs(best[2]):
                 best = (i, along, across)
     if best is None:
         raise InputFileError(
-            f"tree at x = {x:g}, y = {y:g} is not between any two successive impacts "
+            f"tree at {position} is not between any two successive impacts "
             "in plan; give after_impact",
             source=source,
             where=where,
