@@ -193,9 +193,7 @@ def simulate(
             tmp = outputs.stream(impacts, argument="--impacts")
             writer = ImpactStreamWriter(tmp, stream_format(impacts))
 
-        def on_chunk(table) -> None:
-            if table.frame["vi_mps"].isna().all():
-                table = table.derive()
+        def on_chunk(table) -> None:  # chunks arrive derived (model.simulate)
             writer.write(table)
             if rrd is not None and trajectories:
                 ids = table.frame["path_id"].astype(int)
