@@ -29,7 +29,7 @@ registry.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -170,23 +170,151 @@ def _weights(table: ImpactTable, inputs: ImpactInputs) -> tuple[np.ndarray, str]
     return sd, text
 
 
-def fit_impacts(table: ImpactTable, model: Model) -> tuple[FitResult, Model]:
-    """Fit ``model``'s impact laws to ``table``; ``(result, calibrated model)``.
+@dataclass
+class ImpactProblem:
+    """A table's impact data against a model, ready to fit on any subset of rows.
 
-    The calibrated model is ``model`` with the fitted values in place (its
-    ``provenance`` is left to the caller, who knows the table's file name).
+    Built once by :func:`impact_problem`; :meth:`solve` fits chosen parameters on
+    chosen rows (what cross-validation needs) and :meth:`predict` evaluates the
+    laws anywhere. ``observed``, ``sd`` and ``use`` are ``(n, 3)`` arrays over the
+    data kinds ``vfn``, ``vft``, ``omega_f`` (NaN sd = datum left out).
+    """
+
+    table: ImpactTable
+    model: Model
+    inputs: ImpactInputs
+    observed: np.ndarray
+    sd: np.ndarray
+    use: np.ndarray
+    weighting: str
+    materials: list[str]
+
+    def unpack(
+        self, model: Model, names: list[str], theta: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, dict[str, dict[str, float]]]:
+        """``(e_n, e_t, effects)`` of ``model`` with ``names`` set to ``theta``."""
+        index = {m: i for i, m in enumerate(self.inputs.material_names)}
+        e_n = np.array([model.materials[m].e_n for m in self.inputs.material_names])
+        e_t = np.array([model.materials[m].e_t for m in self.inputs.material_names])
+        effects = {k: dict(v) for k, v in model.effects.items()}
+        for name, value in zip(names, theta, strict=True):
+            parts = name.split(".")
+            if parts[0] == "materials":
+                target = e_n if parts[2] == "e_n" else e_t
+                target[index[parts[1]]] = value
+            else:
+                effects[parts[0]][parts[1]] = float(value)
+        return e_n, e_t, effects
+
+    def predict(
+        self,
+        model: Model,
+        names: list[str] | None = None,
+        theta: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """``(n, 3)`` predicted ``vfn, vft, omega_f`` of every row."""
+        names = names or []
+        theta = np.zeros(0) if theta is None else theta
+        return predict_arrays(self.inputs, *self.unpack(model, names, theta))
+
+    def start(self, model: Model, names: list[str]) -> tuple[np.ndarray, list[str]]:
+        """Starting values (clipped into bounds) and notes on substituted ones."""
+        notes = []
+        start = np.array([model.parameters()[n] for n in names], float)
+        bounds = self.bounds(model, names)
+        for i, name in enumerate(names):
+            if not math.isfinite(start[i]):
+                effect, key = name.split(".")[:2]
+                default = registry.effect(effect).parameter(key).default
+                start[i] = default
+                notes.append(
+                    f"{name} starts at its default {default:g} "
+                    "(the model's value is not finite)"
+                )
+        return np.clip(start, bounds[:, 0], bounds[:, 1]), notes
+
+    @staticmethod
+    def bounds(model: Model, names: list[str]) -> np.ndarray:
+        """``(p, 2)`` lower and upper bounds of ``names``."""
+        return np.array([_bounds(model, n) for n in names], float).reshape(-1, 2)
+
+    def solve(
+        self,
+        model: Model,
+        names: list[str],
+        rows: np.ndarray | None = None,
+        start: np.ndarray | None = None,
+    ):
+        """``scipy.optimize.least_squares`` result of ``names`` fitted on ``rows``.
+
+        ``rows`` is a boolean mask or index array (all rows when None); the
+        residuals are ``(observed - predicted) / sd`` of the used data.
+        """
+        rows = np.ones(len(self.observed), bool) if rows is None else rows
+        mask = np.zeros(len(self.observed), bool)
+        mask[rows] = True
+        use = self.use & mask[:, None]
+        inputs = self.inputs
+        sub = ImpactInputs(
+            *(getattr(inputs, f)[mask] for f in _ARRAY_FIELDS),
+            material_names=inputs.material_names,
+        )
+        observed, sd = self.observed[mask], self.sd[mask]
+        keep = use[mask]
+        if start is None:
+            start, _ = self.start(model, names)
+        bounds = self.bounds(model, names)
+
+        def residuals(theta: np.ndarray) -> np.ndarray:
+            pred = predict_arrays(sub, *self.unpack(model, names, theta))
+            return ((observed - pred) / sd)[keep]
+
+        if not names:
+            return _NoFit(residuals(np.zeros(0)))
+        return least_squares(
+            residuals,
+            start,
+            bounds=(bounds[:, 0], bounds[:, 1]),
+            method="trf",
+            jac="3-point",
+            x_scale="jac",
+        )
+
+
+_ARRAY_FIELDS = (
+    "vin_mps",
+    "vit_mps",
+    "omega_i_radps",
+    "radius_m",
+    "gyration_m",
+    "material_index",
+)
+
+
+@dataclass
+class _NoFit:
+    """``least_squares``-like result when nothing is free."""
+
+    fun: np.ndarray
+    x: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    jac: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    success: bool = True
+    message: str = "no free parameters"
+
+
+def impact_problem(table: ImpactTable, model: Model) -> ImpactProblem:
+    """Check ``table`` against ``model`` and gather the arrays of a fit.
 
     Raises
     ------
     InputFileError
         Required columns missing, non-finite values (rows named), materials of the
-        table not in the model (named), or fewer data than parameters.
+        table not in the model (named), non-positive uncertainties.
     """
     check_table(table, model)
     table = table.derive()
     inputs = impact_inputs(table, model)
     used = [m for m in inputs.material_names if m in set(table.frame["material"])]
-    names, notes = free_parameters(model, used)
     sd, weighting = _weights(table, inputs)
     observed = np.column_stack(
         [
@@ -195,60 +323,40 @@ def fit_impacts(table: ImpactTable, model: Model) -> tuple[FitResult, Model]:
             table.column("omega_f_radps"),
         ]
     )
-    use = np.isfinite(sd) & np.isfinite(observed)
-    ndata, p = int(use.sum()), len(names)
-    if ndata <= p:
-        per = max(1, int(use.sum(axis=1).max())) if len(table) else 2
-        need = p // per + 1
-        raise InputFileError(
-            f"too few impacts to fit: {len(table)} impact(s) give {ndata} data for "
-            f"{p} parameters ({', '.join(names)}); need more data than parameters, "
-            f"at least {need} impacts",
-            source=table.source,
-        )
-    start = np.array([model.parameters()[n] for n in names], float)
-    bounds = np.array([_bounds(model, n) for n in names], float)
-    for i, name in enumerate(names):
-        if not math.isfinite(start[i]):
-            default = registry.effect(name.split(".")[0]).parameter(name.split(".")[1])
-            start[i] = default.default
-            notes.append(
-                f"{name} starts at its default {default.default:g} "
-                "(the model's value is not finite)"
-            )
-    start = np.clip(start, bounds[:, 0], bounds[:, 1])
-    mat_index = {m: i for i, m in enumerate(inputs.material_names)}
-    e_n0 = np.array([model.materials[m].e_n for m in inputs.material_names])
-    e_t0 = np.array([model.materials[m].e_t for m in inputs.material_names])
-
-    def unpack(theta: np.ndarray):
-        e_n, e_t = e_n0.copy(), e_t0.copy()
-        effects = {k: dict(v) for k, v in model.effects.items()}
-        for name, value in zip(names, theta, strict=True):
-            parts = name.split(".")
-            if parts[0] == "materials":
-                target = e_n if parts[2] == "e_n" else e_t
-                target[mat_index[parts[1]]] = value
-            else:
-                effects[parts[0]][parts[1]] = float(value)
-        return e_n, e_t, effects
-
-    def residuals(theta: np.ndarray) -> np.ndarray:
-        pred = predict_arrays(inputs, *unpack(theta))
-        return ((observed - pred) / sd)[use]
-
-    fit = least_squares(
-        residuals,
-        start,
-        bounds=(bounds[:, 0], bounds[:, 1]),
-        method="trf",
-        jac="3-point",
-        x_scale="jac",
+    return ImpactProblem(
+        table=table,
+        model=model,
+        inputs=inputs,
+        observed=observed,
+        sd=sd,
+        use=np.isfinite(sd) & np.isfinite(observed),
+        weighting=weighting,
+        materials=used,
     )
+
+
+def too_few(problem: ImpactProblem, names: list[str], rows=None) -> str | None:
+    """Why ``rows`` of ``problem`` cannot fit ``names`` (None when they can)."""
+    use = problem.use if rows is None else problem.use[rows]
+    ndata, p = int(use.sum()), len(names)
+    if ndata > p:
+        return None
+    n = len(use)
+    per = max(1, int(use.sum(axis=1).max())) if n else 2
+    need = p // per + 1
+    return (
+        f"too few impacts to fit: {n} impact(s) give {ndata} data for "
+        f"{p} parameters ({', '.join(names)}); need more data than parameters, "
+        f"at least {need} impacts"
+    )
+
+
+def fit_result(problem: ImpactProblem, names, start, fit, notes) -> FitResult:
+    """The :class:`FitResult` of a :meth:`ImpactProblem.solve` on all rows."""
     r = fit.fun
+    ndata, p = r.size, len(names)
     chi2 = float(r @ r)
-    dof = ndata - p
-    redchi = chi2 / dof
+    redchi = chi2 / (ndata - p)
     jac = fit.jac
     with np.errstate(divide="ignore", invalid="ignore"):
         try:
@@ -260,10 +368,12 @@ def fit_impacts(table: ImpactTable, model: Model) -> tuple[FitResult, Model]:
     corr[~np.isfinite(corr)] = np.nan
     np.fill_diagonal(corr, 1.0)
     ln = ndata * math.log(chi2 / ndata) if chi2 > 0 else -math.inf
-    rows = np.broadcast_to(np.arange(len(table))[:, None], use.shape)[use]
+    use = problem.use
+    rows = np.broadcast_to(np.arange(len(use))[:, None], use.shape)[use]
     kind = np.broadcast_to(np.array(["vfn", "vft", "omega_f"]), use.shape)[use]
-    result = FitResult(
-        names=names,
+    bounds = problem.bounds(problem.model, names)
+    return FitResult(
+        names=list(names),
         values=np.asarray(fit.x, float),
         stderr=se,
         start=start,
@@ -276,14 +386,36 @@ def fit_impacts(table: ImpactTable, model: Model) -> tuple[FitResult, Model]:
         bic=ln + math.log(ndata) * p,
         ndata=ndata,
         nparams=p,
-        n_impacts=len(table),
+        n_impacts=len(use),
         success=bool(fit.success),
         message=str(fit.message),
-        weighting=weighting,
-        notes=notes,
+        weighting=problem.weighting,
+        notes=list(notes),
         residuals=r,
         residual_kind=kind,
         residual_row=rows,
     )
+
+
+def fit_impacts(table: ImpactTable, model: Model) -> tuple[FitResult, Model]:
+    """Fit ``model``'s impact laws to ``table``; ``(result, calibrated model)``.
+
+    The calibrated model is ``model`` with the fitted values in place (its
+    ``provenance`` is left to the caller, who knows the table's file name).
+
+    Raises
+    ------
+    InputFileError
+        Required columns missing, non-finite values (rows named), materials of the
+        table not in the model (named), or fewer data than parameters.
+    """
+    problem = impact_problem(table, model)
+    names, notes = free_parameters(model, problem.materials)
+    why = too_few(problem, names)
+    if why:
+        raise InputFileError(why, source=table.source)
+    start, start_notes = problem.start(model, names)
+    fit = problem.solve(model, names, start=start)
+    result = fit_result(problem, names, start, fit, notes + start_notes)
     calibrated = model.with_parameters(dict(zip(names, map(float, fit.x), strict=True)))
     return result, replace(calibrated, provenance=dict(model.provenance))

@@ -1,0 +1,1 @@
+"""Diagnose: compare model and measurement, find where it fails and what is missing."""
