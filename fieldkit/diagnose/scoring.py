@@ -113,6 +113,11 @@ def _jackknife_se(left_out: np.ndarray) -> float:
     return float(math.sqrt((n - 1) / n * ((left_out - left_out.mean()) ** 2).sum()))
 
 
-def meaningful(gain: float, se: float, *, z: float) -> bool:
+#: A gain is meaningful when it exceeds this many standard errors (calibrated by
+#: ``benchmarks/bench_diagnose_power.py`` against the false-finding rate).
+DEFAULT_Z = 1.0
+
+
+def meaningful(gain: float, se: float, *, z: float = DEFAULT_Z) -> bool:
     """Whether a held-out gain exceeds ``z`` standard errors (and is positive)."""
     return gain > 0.0 and math.isfinite(se) and gain > z * se
