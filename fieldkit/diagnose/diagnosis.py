@@ -129,6 +129,9 @@ class Diagnosis:
     notes: list[str] = field(default_factory=list)
     n_data: int = 0
     n_rows: int = 0
+    #: Arrays for figures and recordings (not in the JSON): ``features``,
+    #: ``baseline``/``after``/``steps`` held-out residuals, ``weight``, ``path_id``.
+    arrays: dict = field(default_factory=dict, repr=False)
 
     def to_json(self) -> dict:
         """The ``diagnose --json`` document (contract keys first)."""

@@ -56,9 +56,7 @@ def held_out(
     r = np.asarray(residual, float)
     w = np.broadcast_to(np.asarray(weight, float), r.shape)
     ok = np.isfinite(r) & np.isfinite(w)
-    g = np.broadcast_to(
-        np.asarray(group).reshape((-1,) + (1,) * (r.ndim - 1)), r.shape
-    )
+    g = np.broadcast_to(np.asarray(group).reshape((-1,) + (1,) * (r.ndim - 1)), r.shape)
     sse = np.bincount(g[ok], weights=(w * r * r)[ok], minlength=n_groups)
     weight_sum = np.bincount(g[ok], weights=w[ok], minlength=n_groups)
     return HeldOut(sse=sse, weight=weight_sum)
@@ -116,6 +114,9 @@ def _jackknife_se(left_out: np.ndarray) -> float:
 #: A gain is meaningful when it exceeds this many standard errors (calibrated by
 #: ``benchmarks/bench_diagnose_power.py`` against the false-finding rate).
 DEFAULT_Z = 1.0
+#: Two meaningful candidates whose gains differ by less than this many paired
+#: standard errors cannot be told apart (confounded).
+CONFOUND_Z = 2.0
 
 
 def meaningful(gain: float, se: float, *, z: float = DEFAULT_Z) -> bool:
