@@ -14,6 +14,7 @@ import typer
 
 from fieldkit._version import __version__
 from fieldkit.cli import (
+    diagnose,
     effects,
     fence,
     fit,
@@ -66,6 +67,7 @@ app.command("simulate")(simulate.simulate)
 app.command("effects")(effects.effects)
 app.command("synth")(synth.synth)
 app.command("fit")(fit.fit)
+app.command("diagnose")(diagnose.diagnose)
 
 # typer bundles its own click; reach its base exception through a public class.
 _USAGE_ERRORS = next(

@@ -55,7 +55,7 @@ def impact_candidates(
     for spec in registry.EFFECTS:
         name = spec.name
         if name in model.effects:
-            skipped[name] = "already in the model (its parameters are refitted)"
+            skipped[name] = "already in the model"
         elif name in NOT_FROM_IMPACTS:
             skipped[name] = NOT_FROM_IMPACTS[name]
         elif (

@@ -130,7 +130,8 @@ class Diagnosis:
     n_data: int = 0
     n_rows: int = 0
     #: Arrays for figures and recordings (not in the JSON): ``features``,
-    #: ``baseline``/``after``/``steps`` held-out residuals, ``weight``, ``path_id``.
+    #: ``baseline``/``after``/``steps`` held-out residuals, ``weight``, ``path_id``,
+    #: ``dependence`` (tests of the baseline and of each step), ``after_model``.
     arrays: dict = field(default_factory=dict, repr=False)
 
     def to_json(self) -> dict:

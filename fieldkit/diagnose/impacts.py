@@ -248,7 +248,7 @@ def diagnose_impacts(
     scorer = _Scorer(problem, groups)
     say = progress or (lambda _msg: None)
     say("baseline")
-    baseline = scorer.score(model, [])
+    baseline = scorer.score(model, list(model.effects))
     current = baseline
     steps: list[Step] = []
     first: list[Candidate] | None = None
@@ -296,10 +296,12 @@ def diagnose_impacts(
     features = residual_tests.impact_features(
         problem.table.frame, cands.measured_spin(problem)
     )
-    std_base = baseline.residual / np.sqrt(1.0 / scorer.weight)
-    std_after = current.residual / np.sqrt(1.0 / scorer.weight)
-    before_tests = residual_tests.dependence_tests(std_base, features)
-    after_tests = residual_tests.dependence_tests(std_after, features)
+    sd = np.sqrt(1.0 / scorer.weight)
+    stage_tests = [
+        residual_tests.dependence_tests(r / sd, features)
+        for r in [baseline.residual] + [s.residual for s in accepted]
+    ]
+    before_tests, after_tests = stage_tests[0], stage_tests[-1]
     if len(set(path_id)) < len(path_id) / 2:
         notes.append(
             "dependence tests treat impacts as independent; impacts of one rock "
@@ -339,6 +341,8 @@ def diagnose_impacts(
             "steps": [s.residual for s in accepted],
             "weight": scorer.weight,
             "path_id": path_id,
+            "after_model": current.model,
+            "dependence": stage_tests,
         },
     )
 

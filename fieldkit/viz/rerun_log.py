@@ -61,7 +61,7 @@ _TRACK_COLOUR = (230, 230, 230)
 _IMPACT_COLOUR = (220, 60, 40)
 
 
-def _open(path: Path, name: str) -> rr.RecordingStream:
+def open_recording(path: Path, name: str) -> rr.RecordingStream:
     rec = rr.RecordingStream(
         "fieldkit", recording_id=f"fieldkit-{name}", send_properties=False
     )
@@ -105,7 +105,7 @@ def write_recording(
     """
 
     def record(tmp: Path) -> None:
-        rec = _open(tmp, "track")
+        rec = open_recording(tmp, "track")
         try:
             rec.send_blueprint(_track_blueprint(frames is not None))
             _log_world(rec, analysis)
@@ -134,7 +134,7 @@ def write_impact_recording(
     """
 
     def record(tmp: Path) -> None:
-        rec = _open(tmp, "impacts")
+        rec = open_recording(tmp, "impacts")
         try:
             rec.log("section", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
             for path_id in table.paths():
@@ -164,7 +164,7 @@ def write_simulation_recording(
     profile = result.model.profile
 
     def record(tmp: Path) -> None:
-        rec = _open(tmp, "simulation")
+        rec = open_recording(tmp, "simulation")
         try:
             rec.log("simulation", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
             rec.log(
