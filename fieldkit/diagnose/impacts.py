@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fieldkit.diagnose import candidates as cands
-from fieldkit.diagnose import residual_tests
+from fieldkit.diagnose import null_calibration, residual_tests
 from fieldkit.diagnose.diagnosis import Candidate, Diagnosis, ModelScore, Step
 from fieldkit.diagnose.groups import DEFAULT_FOLDS, Groups, make_groups
 from fieldkit.diagnose.scoring import (
@@ -137,7 +137,12 @@ class _Scorer:
         w = np.where(problem.use, 1.0 / sd**2, np.nan)
         self.weight = w / np.nanmean(w)
 
-    def score(self, model: Model, effects: list[str]) -> Scored:
+    def held_out(self, model: Model) -> HeldOut:
+        """Only the cross-validated score of ``model`` (no full-data fit)."""
+        residual = self._cv_residual(model)
+        return held_out(residual, self.weight, self.groups.group, self.groups.n_groups)
+
+    def _cv_residual(self, model: Model) -> np.ndarray:
         p = self.problem
         names, _ = free_parameters(model, p.materials)
         residual = np.full_like(p.observed, np.nan)
@@ -155,6 +160,13 @@ class _Scorer:
             pred = p.predict(model, free, fit.x)
             residual[test] = (p.observed[test] - pred[test]) * self.scale[test]
         residual[~p.use] = np.nan
+        return residual
+
+    def score(self, model: Model, effects: list[str]) -> Scored:
+        """Cross-validated residuals and the full-data fit of ``model``."""
+        p = self.problem
+        names, _ = free_parameters(model, p.materials)
+        residual = self._cv_residual(model)
         start, _ = p.start(model, names)
         full = p.solve(model, names, start=start)
         result = fit_result(p, names, start, full, [])
@@ -207,13 +219,16 @@ def diagnose_impacts(
     folds: int = DEFAULT_FOLDS,
     z: float = DEFAULT_Z,
     z_confound: float = CONFOUND_Z,
+    null_draws: int = null_calibration.DEFAULT_DRAWS,
     candidates: list[str] | None = None,
     progress: Callable[[str], None] | None = None,
 ) -> Diagnosis:
     """Diagnose ``table`` against ``model`` (None: constant e_n, e_t per material).
 
     ``z`` is the recommendation rule (gain > z SE), ``z_confound`` the
-    confounding rule (gains within z_confound paired SEs).
+    confounding rule (gains within z_confound paired SEs); ``null_draws`` null
+    tables test each such gain when the impact velocities carry error
+    (:mod:`~fieldkit.diagnose.null_calibration`; 0 = off).
     ``rng`` deals the groups to folds (a seed reproduces the diagnosis exactly);
     ``candidates`` restricts the candidate effects (default: every one the table
     can inform). See the module docstring for the method.
@@ -231,11 +246,12 @@ def diagnose_impacts(
             "baseline: constant e_n, e_t per material (no --model given), fitted"
         )
     problem = impact_problem(table, model)
+    notes += problem.notes
     notes.append(f"weights: {problem.weighting}")
     path_id = (
-        table.frame["path_id"].astype("string").fillna("").to_numpy(str)
-        if "path_id" in table.frame
-        else np.array(["path"] * len(table))
+        problem.table.frame["path_id"].astype("string").fillna("").to_numpy(str)
+        if "path_id" in problem.table.frame
+        else np.array(["path"] * len(problem.table))
     )
     groups = make_groups(path_id, rng, folds=folds)
     pool, skipped = cands.impact_candidates(problem, model)
@@ -246,6 +262,18 @@ def diagnose_impacts(
         pool = [c for c in pool if c in candidates]
     _check(problem, groups, model, pool)
     scorer = _Scorer(problem, groups)
+    errors = null_calibration.input_errors(problem)
+    if errors is not None and null_draws > 0:
+        notes.append(
+            "impact velocities carry error (vin_sd_mps, vit_sd_mps): each gain that "
+            f"passes the SE rule is also tested against {null_draws} null tables "
+            "(errors in the impact velocities can pass for a speed or angle law)"
+        )
+    elif errors is not None:
+        notes.append(
+            "impact velocities carry error but the null-table test is off: a gain "
+            "may come from errors in the impact velocities"
+        )
     say = progress or (lambda _msg: None)
     say("baseline")
     baseline = scorer.score(model, list(model.effects))
@@ -264,6 +292,9 @@ def diagnose_impacts(
             variant = with_effects(current.model, {name: {}})
             scored[name] = scorer.score(variant, [*current.effects, name])
         ranked = _rank(current, scored, z)
+        if errors is not None and null_draws > 0:
+            say(f"step {len(steps) + 1}: {null_draws} null tables")
+            _null_test(scorer, current, ranked, errors, null_draws, rng)
         if first is None:
             first = ranked
         best = ranked[0]
@@ -319,8 +350,14 @@ def diagnose_impacts(
             f"a candidate is recommended when its held-out gain exceeds {z:g} "
             "jackknife standard error(s) over the groups; two meaningful candidates "
             f"whose gains differ by less than {z_confound:g} paired standard error(s) "
-            "are "
-            "confounded and neither is added"
+            "are confounded and neither is added"
+            + (
+                f"; with errors in the impact velocities a gain must also beat "
+                f"the gains of {null_draws} null tables (Monte Carlo p <= "
+                f"{null_calibration.ALPHA:g})"
+                if errors is not None and null_draws > 0
+                else ""
+            )
         ),
         groups=groups.description,
         stopped=stopped,
@@ -361,6 +398,35 @@ def _rank(current: Scored, scored: dict[str, Scored], z: float) -> list[Candidat
     return sorted(out, key=lambda c: c.cv_rmse)
 
 
+def _null_test(
+    scorer: _Scorer,
+    current: Scored,
+    ranked: list[Candidate],
+    errors: tuple[np.ndarray, np.ndarray],
+    draws: int,
+    rng: np.random.Generator,
+) -> None:
+    """Set ``null_p`` (and demote ``meaningful``) of the candidates passing the SE
+    rule, against ``draws`` null tables from ``current``."""
+    tested = [c for c in ranked if c.meaningful]
+    if not tested:
+        return
+    problem = scorer.problem
+    truth = problem.predict(current.model)
+    variants = {c.effect: with_effects(current.model, {c.effect: {}}) for c in tested}
+    gains = {c.effect: np.empty(draws) for c in tested}
+    for d in range(draws):
+        null = _Scorer(
+            null_calibration.null_problem(problem, truth, errors, rng), scorer.groups
+        )
+        reference = null.held_out(current.model)
+        for name, variant in variants.items():
+            gains[name][d] = improvement(reference, null.held_out(variant))[0]
+    for c in tested:
+        c.null_p = null_calibration.monte_carlo_p(c.improvement, gains[c.effect])
+        c.meaningful = c.null_p <= null_calibration.ALPHA
+
+
 def _alike(
     current: Scored, scored: dict[str, Scored], ranked: list[Candidate], z: float
 ) -> list[str]:
@@ -388,7 +454,7 @@ def _worst(problem: ImpactProblem, residual: np.ndarray, weight: np.ndarray) -> 
         j = int(np.nanargmax(np.where(np.isfinite(z[i]), z[i], -1.0)))
         out.append(
             {
-                "row": int(i) + 1,
+                "row": int(problem.rows[i]) + 1,
                 "path_id": str(frame["path_id"].iloc[i]) if "path_id" in frame else "",
                 "point": str(frame["point"].iloc[i]) if "point" in frame else "",
                 "material": str(frame["material"].iloc[i]),

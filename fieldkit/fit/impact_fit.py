@@ -66,25 +66,48 @@ def _rows(mask: np.ndarray) -> str:
     )
 
 
-def check_table(table: ImpactTable, model: Model) -> None:
-    """Columns present and finite for a fit; one-line InputFileError otherwise."""
+def no_flight_rows(table: ImpactTable) -> np.ndarray:
+    """Rows with no arriving or no leaving flight (both components of ``vi`` or of
+    ``vf`` empty): a reduced path's release and stop points, not impacts."""
     frame = table.frame
+
+    def empty(a: str, b: str) -> np.ndarray:
+        if a not in frame or b not in frame:
+            return np.zeros(len(frame), bool)
+        return (frame[a].isna() & frame[b].isna()).to_numpy()
+
+    return empty("vi_x_mps", "vi_z_mps") | empty("vf_x_mps", "vf_z_mps")
+
+
+def check_table(
+    table: ImpactTable, model: Model, skip: np.ndarray | None = None
+) -> None:
+    """Columns present and finite for a fit; one-line InputFileError otherwise.
+
+    ``skip`` marks rows left out of the fit (not checked).
+    """
+    frame = table.frame
+    keep = np.ones(len(frame), bool) if skip is None else ~skip
     needed = ["material", "radius_m"]
     if "rotation_friction" in model.effects:
         needed.append("gyration_m")
-    missing = [c for c in needed if c not in frame or frame[c].isna().all()]
+    missing = [
+        c
+        for c in (*needed, *FINITE_COLUMNS)
+        if c not in frame or frame[c].isna().all()
+    ]
     if missing:
         raise InputFileError(
             f"missing column(s) {', '.join(missing)} (needed to fit impacts)",
             source=table.source,
         )
     for name in (*FINITE_COLUMNS, *needed[1:]):
-        bad = ~np.isfinite(table.column(name))
+        bad = ~np.isfinite(table.column(name)) & keep
         if bad.any():
             raise InputFileError(
                 f"{name} is not a finite number", source=table.source, where=_rows(bad)
             )
-    empty = frame["material"].isna().to_numpy()
+    empty = frame["material"].isna().to_numpy() & keep
     if empty.any():
         raise InputFileError(
             "material is empty", source=table.source, where=_rows(empty)
@@ -189,6 +212,8 @@ class ImpactProblem:
     use: np.ndarray
     weighting: str
     materials: list[str]
+    rows: np.ndarray  # the table row (0-based) of each problem row
+    notes: list[str] = field(default_factory=list)
 
     def unpack(
         self, model: Model, names: list[str], theta: np.ndarray
@@ -315,7 +340,17 @@ def impact_problem(table: ImpactTable, model: Model) -> ImpactProblem:
         Required columns missing, non-finite values (rows named), materials of the
         table not in the model (named), non-positive uncertainties.
     """
-    check_table(table, model)
+    skip = no_flight_rows(table)
+    check_table(table, model, skip)
+    notes = []
+    if skip.any():
+        notes.append(
+            f"{_rows(skip)} left out: no arriving or leaving flight (a release or "
+            "stop point, not an impact)"
+        )
+        table = ImpactTable(
+            table.frame.loc[~skip].reset_index(drop=True), source=table.source
+        )
     table = table.derive()
     inputs = impact_inputs(table, model)
     used = [m for m in inputs.material_names if m in set(table.frame["material"])]
@@ -336,6 +371,8 @@ def impact_problem(table: ImpactTable, model: Model) -> ImpactProblem:
         use=np.isfinite(sd) & np.isfinite(observed),
         weighting=weighting,
         materials=used,
+        rows=np.flatnonzero(~skip),
+        notes=notes,
     )
 
 
@@ -420,6 +457,6 @@ def fit_impacts(table: ImpactTable, model: Model) -> tuple[FitResult, Model]:
         raise InputFileError(why, source=table.source)
     start, start_notes = problem.start(model, names)
     fit = problem.solve(model, names, start=start)
-    result = fit_result(problem, names, start, fit, notes + start_notes)
+    result = fit_result(problem, names, start, fit, problem.notes + notes + start_notes)
     calibrated = model.with_parameters(dict(zip(names, map(float, fit.x), strict=True)))
     return result, replace(calibrated, provenance=dict(model.provenance))
