@@ -335,7 +335,9 @@ def diagnose_flights(
         Fewer than three flights, or a flight with too few samples.
     """
     if not (math.isfinite(radius_m) and radius_m > 0):
-        raise ArgumentError(f"radius_m must be > 0 (got {radius_m:g})", source="radius_m")
+        raise ArgumentError(
+            f"radius_m must be > 0 (got {radius_m:g})", source="radius_m"
+        )
     if mass_kg is not None and not (math.isfinite(mass_kg) and mass_kg > 0):
         raise ArgumentError(f"mass_kg must be > 0 (got {mass_kg:g})", source="mass_kg")
     data = _collect(flights, source)
@@ -435,7 +437,8 @@ def diagnose_flights(
         dependence_before=before,
         dependence_after=after_dep,
         unexplained=[
-            f"{d.component} residual vs {d.feature} ({d.statistic}, p = {d.p_value:.2g})"
+            f"{d.component} residual vs {d.feature} "
+            f"({d.statistic}, p = {d.p_value:.2g})"
             for d in after_dep
             if d.significant
         ],

@@ -1,7 +1,8 @@
 """An accurate flight with quadratic air drag, and its sensitivities, for fitting.
 
 The physics is :mod:`fieldkit.model.effects.air_drag`'s (``a = g - k |v| v`` with
-``k = rho C_d pi r^2 / (2 m)`` from :func:`~fieldkit.model.effects.air_drag.drag_factor`),
+``k = rho C_d pi r^2 / (2 m)`` from
+:func:`~fieldkit.model.effects.air_drag.drag_factor`),
 but integrated by classical fourth-order Runge-Kutta with steps of at most
 ``max_step_s`` (the kernel's second-order substeps are built for finding contacts, not
 for matching millimetre-accurate video positions). With ``k = 0`` every RK4 step is
