@@ -1,4 +1,4 @@
-"""Flight-level diagnosis (`air_drag` from a track's flights): power, false findings, time.
+"""Flight-level diagnosis (`air_drag` from flights): power, false findings, time.
 
 Synthetic tracks (:func:`fieldkit.fit.synthetic_track.synthetic_track`): a rock of
 radius 0.2 m (sphere, 2650 kg/m^3, 88.8 kg) bouncing down a 35 deg plane, 8 flights
