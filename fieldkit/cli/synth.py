@@ -1,4 +1,4 @@
-"""`fieldkit synth`: a synthetic ImpactTable (simulator, hidden effects, noise)."""
+"""`fieldkit synth`: a synthetic ImpactTable or video track (hidden effects, noise)."""
 
 from __future__ import annotations
 
@@ -13,7 +13,15 @@ from fieldkit.cli.common import note, one_line_errors
 from fieldkit.errors import ArgumentError
 from fieldkit.outputs import OutputSet
 
-FLAGS = {"effects": "--effects", "output": "-o"}
+FLAGS = {
+    "effects": "--effects",
+    "output": "-o",
+    "fps": "--fps",
+    "noise_m": "--noise-m",
+    "flights": "--flights",
+    "launch_speed_mps": "--launch-speed",
+    "launch_angle_deg": "--launch-angle",
+}
 
 
 def parse_effect(text: str) -> tuple[str, dict[str, float]]:
@@ -49,7 +57,12 @@ def synth(
         Path, typer.Argument(metavar="MODEL.json", help="The model file (§5).")
     ],
     output: Annotated[
-        Path, typer.Option("-o", help="The ImpactTable to write (.csv, .parquet).")
+        Path,
+        typer.Option(
+            "-o",
+            help="The ImpactTable to write (.csv, .parquet); with --track the "
+            "track (.csv).",
+        ),
     ],
     effects: Annotated[
         list[str] | None,
@@ -75,8 +88,43 @@ def synth(
         int | None,
         typer.Option("--seed", help="Random seed (drawn and printed when omitted)."),
     ] = None,
+    track: Annotated[
+        bool,
+        typer.Option(
+            "--track",
+            help="Write a video track (CSV) of the model's body bouncing down a plane "
+            "instead of an ImpactTable; only the body and air_drag act.",
+        ),
+    ] = False,
+    fps: Annotated[
+        float, typer.Option("--fps", help="--track: capture rate, frames/s.")
+    ] = 200.0,
+    noise_m: Annotated[
+        float,
+        typer.Option("--noise-m", help="--track: SD of the noise on x and z, metres."),
+    ] = 0.005,
+    flights: Annotated[
+        int, typer.Option("--flights", help="--track: number of flights.")
+    ] = 8,
+    launch_speed: Annotated[
+        float,
+        typer.Option(
+            "--launch-speed",
+            help="--track: mean launch speed of a flight, m/s (each drawn within "
+            "+-20 %).",
+        ),
+    ] = 15.0,
+    launch_angle: Annotated[
+        float,
+        typer.Option(
+            "--launch-angle",
+            help="--track: mean launch angle above the plane, deg (each drawn "
+            "within +-5 deg).",
+        ),
+    ] = 15.0,
 ) -> None:
-    """Make an ImpactTable with the simulator: hidden effects plus measurement noise.
+    """Make an ImpactTable (or, with --track, a video track) with hidden effects
+    and noise.
 
     The model's rocks are simulated with the hidden effects switched on (added to
     the model's own, or overriding their parameters), every impact recorded, and
@@ -91,11 +139,34 @@ def synth(
           --paths 20 --seed 1 \\
           --effects angle_dependent_restitution=b=1.2 --noise 0.05 \\
           -o out/synth.csv
+
+    With --track: a track CSV (t_s, x_m, z_m; clean positions in x_m_true,
+    z_m_true, the flight of each sample in flight_true) of the model's body
+    bouncing down a plane of the profile's mean dip, each flight launched from the
+    previous landing; quadratic air drag when air_drag is on (cd > 0), else exact
+    parabolas; Gaussian noise --noise-m on x and z. For `fieldkit diagnose`:
+
+        fieldkit synth surveys/tornado_mountain/model_rocfall_table_7_1.json \\
+          --track --fps 200 --noise-m 0.005 --flights 8 --seed 1 \\
+          --effects air_drag=cd=0.8 -o out/track.csv
     """
     from fieldkit.fit.synthetic import synthetic_table
     from fieldkit.model.model_file import read_model
 
     hidden = dict(parse_effect(text) for text in (effects or []))
+    if track:
+        _synth_track(
+            model_file,
+            output,
+            hidden,
+            seed,
+            fps=fps,
+            noise_m=noise_m,
+            flights=flights,
+            speed=launch_speed,
+            angle=launch_angle,
+        )
+        return
     with OutputSet(inputs=[model_file]) as outputs:
         outputs.plan(output, argument="-o")
         model = read_model(model_file)
@@ -115,4 +186,65 @@ def synth(
     typer.echo(
         f"{len(table)} impacts of {paths} rocks (seed {seed}), noise F = {noise:g} "
         f"on vf; effects: {', '.join(active) or 'none (base model)'} -> {output}"
+    )
+
+
+def _synth_track(
+    model_file: Path,
+    output: Path,
+    hidden: dict[str, dict[str, float]],
+    seed: int | None,
+    *,
+    fps: float,
+    noise_m: float,
+    flights: int,
+    speed: float,
+    angle: float,
+) -> None:
+    """`synth --track`: the model's body bouncing down a plane (see :func:`synth`)."""
+    from fieldkit.fit.synthetic import with_effects
+    from fieldkit.fit.synthetic_track import synthetic_track
+    from fieldkit.model.model_file import read_model
+
+    if flights < 1:
+        raise ArgumentError(f"flights must be >= 1 (got {flights})", source="flights")
+    if not (speed > 0 and 0 < angle < 90):
+        raise ArgumentError(
+            f"launch_speed_mps must be > 0 and launch_angle_deg in (0, 90) "
+            f"(got {speed:g}, {angle:g})",
+            source="launch_speed_mps",
+        )
+    if not (fps > 0 and noise_m >= 0):
+        raise ArgumentError(
+            f"fps must be > 0 and noise_m >= 0 (got {fps:g}, {noise_m:g})",
+            source="fps",
+        )
+    with OutputSet(inputs=[model_file]) as outputs:
+        outputs.plan(output, argument="-o")
+        model = with_effects(read_model(model_file), hidden)
+        if seed is None:
+            seed = secrets.randbits(32)
+            note(f"`seed` not given: used {seed}; pass --seed {seed} to reproduce")
+        rng = np.random.default_rng(seed)
+        drag = model.effects.get("air_drag", {"cd": 0.0, "air_density_kg_m3": 1.225})
+        px, pz = model.profile.x_m, model.profile.z_m
+        dip = float(np.degrees(np.arctan2(pz[0] - pz[-1], px[-1] - px[0])))
+        result = synthetic_track(
+            radius_m=model.body.radius_m,
+            mass_kg=model.body.mass_kg,
+            cd=float(drag["cd"]),
+            air_density_kg_m3=float(drag["air_density_kg_m3"]),
+            launch_speed_mps=speed * rng.uniform(0.8, 1.2, flights),
+            launch_angle_deg=angle + rng.uniform(-5.0, 5.0, flights),
+            surface_angle_deg=dip,
+            fps=fps,
+            noise_m=noise_m,
+            rng=rng,
+        )
+        result.write(output, outputs=outputs)
+        outputs.commit()
+    typer.echo(
+        f"track of {flights} flights, {len(result)} samples at {fps:g} frames/s "
+        f"(seed {seed}), plane dip {dip:.1f} deg, noise {noise_m:g} m, "
+        f"air_drag cd = {float(drag['cd']):g} -> {output}"
     )

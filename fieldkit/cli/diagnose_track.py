@@ -1,0 +1,98 @@
+"""Glue for `fieldkit diagnose` on a video track: read, find flights, diagnose.
+
+:mod:`fieldkit.diagnose` may not import the tracking stage, so the command line joins
+them: the flights come from the track's ``flight`` column when it has one (a track
+written by `fieldkit track`), else from
+:func:`fieldkit.tracking.flights.pipeline.analyse_track`; their samples go to
+:func:`fieldkit.diagnose.flights.diagnose_flights`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from fieldkit.diagnose.diagnosis import Diagnosis
+from fieldkit.diagnose.flights import FlightSamples, diagnose_flights
+from fieldkit.track import Track
+from fieldkit.tracking.flights.pipeline import analyse_track
+
+
+def _rows_text(rows: np.ndarray) -> str:
+    """File rows (header = row 1) of track positions ``rows``."""
+    return f"rows {int(rows.min()) + 2}-{int(rows.max()) + 2}"
+
+
+def track_flights(track: Track, *, radius_m: float) -> list[FlightSamples]:
+    """The flights of a track as :class:`FlightSamples`, labelled with file rows.
+
+    Uses the track's ``flight`` column (flight index, -1 outside flights) when
+    present, else segments the track (:func:`analyse_track`).
+    """
+    frame = track.frame
+    if "flight" in frame and (frame["flight"].fillna(-1) >= 0).any():
+        label = frame["flight"].fillna(-1).to_numpy(int)
+        rows_of = [np.flatnonzero(label == f) for f in np.unique(label[label >= 0])]
+        origin = "the track's flight column"
+    else:
+        analysis = analyse_track(track, radius_m=radius_m)
+        # analyse_track sorts by time; map back to the file's rows
+        order = np.argsort(frame["t_s"].to_numpy(float), kind="stable")
+        rows_of = [order[f.rows] for f in analysis.flights]
+        origin = "segmentation"
+    t, x, z = track.t, track.x, track.z
+    flights = []
+    for i, rows in enumerate(rows_of):
+        rows = rows[np.argsort(t[rows], kind="stable")]
+        flights.append(
+            FlightSamples(
+                t[rows], x[rows], z[rows], label=f"flight {i} ({_rows_text(rows)})"
+            )
+        )
+    track.meta["flights_from"] = origin
+    return flights
+
+
+def diagnose_track_file(
+    path: Path,
+    *,
+    radius_m: float,
+    mass_kg: float | None,
+    rng: np.random.Generator,
+    folds: int,
+) -> Diagnosis:
+    """Diagnose the flights of the track file ``path`` (is ``air_drag`` missing?).
+
+    Parameters
+    ----------
+    path
+        A fieldkit track CSV (``t_s``, ``x_m``, ``z_m``; ``flight`` used if present).
+    radius_m, mass_kg
+        The body; without a mass, a sphere of rock (stated in the notes).
+    rng
+        Random generator for the cross-validation folds.
+    folds
+        Folds (whole flights held out).
+
+    Raises
+    ------
+    InputFileError
+        Unreadable track, fewer than three flights, a flight with too few samples
+        (naming the file and the flight's rows).
+    """
+    track = Track.read(path)
+    track.source = str(path)
+    flights = track_flights(track, radius_m=radius_m)
+    diagnosis = diagnose_flights(
+        flights,
+        radius_m=radius_m,
+        mass_kg=mass_kg,
+        rng=rng,
+        folds=folds,
+        source=str(path),
+    )
+    diagnosis.notes.insert(
+        0, f"{len(flights)} flights from {track.meta['flights_from']}"
+    )
+    return diagnosis

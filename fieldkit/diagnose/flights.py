@@ -1,0 +1,449 @@
+"""Flight-level diagnosis of a video track: is ``air_drag`` missing from the flights?
+
+The data are the centre positions of the samples in each ballistic flight of a track
+(the flights found by :mod:`fieldkit.tracking.flights`; this module takes them as
+plain :class:`FlightSamples`). Two models are compared by their held-out error:
+
+* **baseline** -- the parabola with ``g = 9.81 m/s^2`` fixed; each flight's initial
+  position and velocity are nuisance parameters (closed-form least squares);
+* **air_drag** -- quadratic drag ``a = g - k |v| v`` with ``k = rho C_d pi r^2 /
+  (2 m)`` exactly as in the simulator (:mod:`fieldkit.model.effects.air_drag`), one
+  **global** ``air_drag.cd`` (air density held at the registry default), the same
+  four nuisance parameters per flight (:mod:`fieldkit.model.drag_flight`).
+
+Cross-validation holds out whole flights (the groups of
+:func:`~fieldkit.diagnose.groups.make_groups`): ``cd`` is fitted on the training
+flights (Newton on the sum of squares profiled over the flights' own parameters),
+then each held-out flight's initial state is refitted with ``cd`` fixed. The
+baseline has no global parameter, so its held-out residuals are its per-flight fits;
+both models thus get the same freedom per held-out flight, and the gain is the
+improvement of the held-out RMS of the position residuals (``cv_rmse_m``, per
+coordinate), with its jackknife standard error over flights
+(:mod:`fieldkit.diagnose.scoring`). ``air_drag`` is recommended when the gain
+exceeds :data:`~fieldkit.diagnose.scoring.DEFAULT_Z` standard errors, the rule of the
+impact-level diagnosis.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import stats
+
+from fieldkit.diagnose.diagnosis import (
+    Candidate,
+    Dependence,
+    Diagnosis,
+    ModelScore,
+    Step,
+)
+from fieldkit.diagnose.groups import make_groups
+from fieldkit.diagnose.scoring import DEFAULT_Z, held_out, improvement, meaningful
+from fieldkit.errors import ArgumentError, InputFileError
+from fieldkit.model import drag_flight
+from fieldkit.model.effects import air_drag, registry
+from fieldkit.physics.constants import G
+
+#: Fewest flights for a held-out comparison (and a jackknife SE) over flights.
+MIN_FLIGHTS = 3
+#: Fewest samples per flight (four nuisance parameters per flight, plus residuals).
+MIN_FLIGHT_SAMPLES = 6
+#: Rock density assumed when no mass is given [kg/m^3] (sphere of the radius).
+ROCK_DENSITY_KG_M3 = 2650.0
+#: Family-wise level of the residual dependence tests (Holm correction).
+DEPENDENCE_ALPHA = 0.05
+#: Newton iterations on ``cd`` and Gauss-Newton iterations per flight.
+_OUTER, _INNER = 30, 8
+
+_SPEC = air_drag.SPEC
+_RHO = next(p.default for p in _SPEC.parameters if p.name == "air_density_kg_m3")
+_CD_MAX = next(p.upper for p in _SPEC.parameters if p.name == "cd")
+
+
+@dataclass(frozen=True)
+class FlightSamples:
+    """The samples of one flight: times [s] and centre positions [m] (x along the
+    travel, z up). ``label`` names it in messages (e.g. ``"flight 3 (rows 120-180)"``).
+    """
+
+    t_s: np.ndarray
+    x_m: np.ndarray
+    z_m: np.ndarray
+    label: str = ""
+
+
+@dataclass
+class _Data:
+    """All flights concatenated (time order within each flight)."""
+
+    t: np.ndarray
+    x: np.ndarray
+    z: np.ndarray
+    start: np.ndarray  # flight f is start[f]:start[f+1]
+    flight: np.ndarray  # flight index of each sample
+    labels: list[str]
+
+    @property
+    def n_flights(self) -> int:
+        return self.start.size - 1
+
+    def subset(self, which: np.ndarray) -> _Data:
+        """The flights ``which`` (indices, increasing)."""
+        parts = [np.arange(self.start[f], self.start[f + 1]) for f in which]
+        rows = np.concatenate(parts)
+        sizes = np.array([p.size for p in parts])
+        return _Data(
+            self.t[rows],
+            self.x[rows],
+            self.z[rows],
+            np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64),
+            np.repeat(np.arange(len(parts)), sizes),
+            [self.labels[f] for f in which],
+        )
+
+
+@dataclass
+class _Fit:
+    """A model fitted to flights: drag factor, per-flight states, residuals."""
+
+    k: float
+    params: np.ndarray  # (n_flights, 4): x0, z0, vx0, vz0 at each flight's start
+    sse: float
+    info: float  # sum |j_k perp|^2: the profiled curvature of sse/2 in k
+    residual: np.ndarray  # (n, 2)
+    speed: np.ndarray  # (n,) model speed
+
+
+def sphere_mass_kg(radius_m: float) -> float:
+    """Mass of a rock sphere of ``radius_m`` at :data:`ROCK_DENSITY_KG_M3`.
+
+    Examples
+    --------
+    >>> round(sphere_mass_kg(0.2), 2)
+    88.8
+    """
+    return ROCK_DENSITY_KG_M3 * 4.0 / 3.0 * math.pi * radius_m**3
+
+
+def _collect(flights: list[FlightSamples], source: str | None) -> _Data:
+    """Check the flights (count, samples, times) and concatenate them."""
+    if len(flights) < MIN_FLIGHTS:
+        raise InputFileError(
+            f"{len(flights)} flight(s) found; at least {MIN_FLIGHTS} are needed "
+            "to diagnose flight-level effects (whole flights are held out)",
+            source=source,
+        )
+    ts, xs, zs, labels = [], [], [], []
+    for i, f in enumerate(flights):
+        label = f.label or f"flight {i}"
+        t, x, z = (np.asarray(a, float) for a in (f.t_s, f.x_m, f.z_m))
+        ok = np.isfinite(t) & np.isfinite(x) & np.isfinite(z)
+        if ok.sum() < MIN_FLIGHT_SAMPLES:
+            raise InputFileError(
+                f"{int(ok.sum())} usable samples in the flight; at least "
+                f"{MIN_FLIGHT_SAMPLES} are needed",
+                source=source,
+                where=label,
+            )
+        t, x, z = t[ok], x[ok], z[ok]
+        if np.any(np.diff(t) <= 0):
+            raise InputFileError(
+                "sample times must increase within a flight", source=source, where=label
+            )
+        ts.append(t)
+        xs.append(x)
+        zs.append(z)
+        labels.append(label)
+    sizes = np.array([t.size for t in ts])
+    return _Data(
+        np.concatenate(ts),
+        np.concatenate(xs),
+        np.concatenate(zs),
+        np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64),
+        np.repeat(np.arange(len(ts)), sizes),
+        labels,
+    )
+
+
+def _fit_at(data: _Data, k: float, params: np.ndarray) -> tuple[float, float, float]:
+    """Per-flight fits at drag factor ``k``: ``(sse, r.j_k, |j_k perp|^2)`` totals."""
+    sse, grad, info = drag_flight.fit_flights(
+        data.t, data.x, data.z, data.start, k, G, drag_flight.MAX_STEP_S, params, _INNER
+    )
+    return float(sse.sum()), float(grad.sum()), float(info.sum())
+
+
+def _fit(data: _Data, k_max: float, k: float | None = None) -> _Fit:
+    """Fit the flights with ``k`` fixed (given) or ``k`` in ``[0, k_max]`` fitted.
+
+    ``k`` is found by projected Newton on ``sse/2`` profiled over the flights'
+    states (the model is nearly linear in ``k``: two or three steps), halving a step
+    that does not lower the sum of squares.
+    """
+    params = np.full((data.n_flights, 4), np.nan)
+    k_now = 0.0 if k is None else k
+    sse, grad, info = _fit_at(data, k_now, params)
+    if k is None:
+        for _ in range(_OUTER):
+            step = grad / info if info > 0 else 0.0
+            trial_k = min(max(k_now + step, 0.0), k_max)
+            if trial_k == k_now:
+                break
+            trial_p = params.copy()
+            trial = _fit_at(data, trial_k, trial_p)
+            while trial[0] > sse and abs(trial_k - k_now) > 1e-9 * (k_max + k_now):
+                trial_k = 0.5 * (trial_k + k_now)
+                trial_p = params.copy()
+                trial = _fit_at(data, trial_k, trial_p)
+            if trial[0] > sse:
+                break
+            done = abs(trial_k - k_now) <= 1e-7 * max(trial_k, 1e-12)
+            k_now, params = trial_k, trial_p
+            sse, grad, info = trial
+            if done:
+                break
+    residual, speed = drag_flight.residuals(
+        data.t, data.x, data.z, data.start, k_now, G, drag_flight.MAX_STEP_S, params
+    )
+    return _Fit(k_now, params, sse, info, residual, speed)
+
+
+def _held_out_drag(data: _Data, fold: np.ndarray, k_max: float) -> np.ndarray:
+    """Held-out residuals ``(n, 2)`` of the drag model: ``k`` from the other folds,
+    each held-out flight's state refitted with that ``k``."""
+    out = np.empty((data.t.size, 2))
+    fold_of_flight = fold[data.start[:-1]]
+    for f in np.unique(fold_of_flight):
+        test = np.flatnonzero(fold_of_flight == f)
+        train = np.flatnonzero(fold_of_flight != f)
+        k = _fit(data.subset(train), k_max).k
+        rows = np.isin(data.flight, test)
+        out[rows] = _fit(data.subset(test), k_max, k=k).residual
+    return out
+
+
+def _dependence(
+    data: _Data, fit: _Fit, *, alpha: float = DEPENDENCE_ALPHA
+) -> list[Dependence]:
+    """Spearman tests of the x and z residuals against the time from mid-flight and
+    the model speed, Holm-corrected over the four tests."""
+    t_mid = np.empty(data.t.size)
+    for f in range(data.n_flights):
+        a, b = data.start[f], data.start[f + 1]
+        half = 0.5 * (data.t[b - 1] - data.t[a])
+        t_mid[a:b] = np.abs(data.t[a:b] - 0.5 * (data.t[a] + data.t[b - 1])) / half
+    features = {"time_from_mid_flight": t_mid, "speed_mps": fit.speed}
+    tests = []
+    for feature, values in features.items():
+        for c, component in enumerate(("x", "z")):
+            rho, p = stats.spearmanr(values, fit.residual[:, c])
+            rho = 0.0 if not np.isfinite(rho) else float(rho)
+            p = 1.0 if not np.isfinite(p) else float(p)
+            tests.append((feature, component, rho, p))
+    order = np.argsort([t[3] for t in tests])
+    significant = np.zeros(len(tests), bool)
+    for rank, i in enumerate(order):  # Holm step-down
+        if tests[i][3] > alpha / (len(tests) - rank):
+            break
+        significant[i] = True
+    return [
+        Dependence(
+            feature=feature,
+            component=f"position_{component}",
+            statistic=f"spearman rho = {rho:+.3f} (n = {data.t.size})",
+            p_value=p,
+            significant=bool(significant[i]),
+        )
+        for i, (feature, component, rho, p) in enumerate(tests)
+    ]
+
+
+def _free_g_note(data: _Data) -> str:
+    """The g of a free-g parabola per flight, against 9.81."""
+    values = []
+    for f in range(data.n_flights):
+        a, b = data.start[f], data.start[f + 1]
+        tau = data.t[a:b] - data.t[a]
+        design = np.column_stack([np.ones_like(tau), tau, tau * tau])
+        coef = np.linalg.lstsq(design, data.z[a:b], rcond=None)[0]
+        values.append(-2.0 * coef[2])
+    shown = ", ".join(f"{g:.3f}" for g in values)
+    return (
+        f"free-g parabola per flight: g = {shown} m/s^2 (the models use {G:g}); "
+        "quadratic drag lowers the apparent g of falling flights, raises it on "
+        "rising ones, and slows x (which a parabola keeps linear)"
+    )
+
+
+def _skipped() -> dict[str, str]:
+    """Every registered effect but air_drag, with why flight positions cannot
+    inform it."""
+    out = {}
+    for spec in registry.EFFECTS:
+        if spec.name == "air_drag":
+            continue
+        if spec.name == "tree_impacts":
+            out[spec.name] = "no tree strikes in a video flight"
+        elif spec.stage == "impact":
+            out[spec.name] = (
+                "acts at contact (impact stage): flight positions do not inform it; "
+                "diagnose the track's ImpactTable instead"
+            )
+        else:
+            out[spec.name] = f"{spec.stage}-stage effect not modelled in flights"
+    return out
+
+
+def diagnose_flights(
+    flights: list[FlightSamples],
+    *,
+    radius_m: float,
+    mass_kg: float | None = None,
+    rng: np.random.Generator,
+    folds: int = 5,
+    z: float = DEFAULT_Z,
+    source: str | None = None,
+) -> Diagnosis:
+    """Whether ``air_drag`` improves the held-out fit of a track's flights.
+
+    Parameters
+    ----------
+    flights
+        The flights (at least :data:`MIN_FLIGHTS`, each with at least
+        :data:`MIN_FLIGHT_SAMPLES` samples).
+    radius_m, mass_kg
+        The body; without a mass, a sphere of rock (:data:`ROCK_DENSITY_KG_M3`).
+    rng
+        Random generator for the folds.
+    folds
+        Folds of the cross-validation (whole flights held out).
+    z
+        Standard errors a gain must exceed to be meaningful.
+    source
+        The track file, for messages.
+
+    Returns
+    -------
+    Diagnosis
+        Metric ``cv_rmse_m``: held-out RMS of the x and z position residuals [m].
+
+    Raises
+    ------
+    InputFileError
+        Fewer than three flights, or a flight with too few samples.
+    """
+    if not (math.isfinite(radius_m) and radius_m > 0):
+        raise ArgumentError(
+            f"radius_m must be > 0 (got {radius_m:g})", source="radius_m"
+        )
+    if mass_kg is not None and not (math.isfinite(mass_kg) and mass_kg > 0):
+        raise ArgumentError(f"mass_kg must be > 0 (got {mass_kg:g})", source="mass_kg")
+    data = _collect(flights, source)
+    notes = [f"air density held at {_RHO:g} kg/m^3 (registry default)"]
+    if mass_kg is None:
+        mass_kg = sphere_mass_kg(radius_m)
+        notes.append(
+            f"mass not given: a sphere of rock ({ROCK_DENSITY_KG_M3:g} kg/m^3) of "
+            f"radius {radius_m:g} m, {mass_kg:.4g} kg; the fitted cd scales with "
+            "the assumed mass / radius^2"
+        )
+    per_cd = float(air_drag.drag_factor(1.0, _RHO, radius_m, mass_kg))
+    k_max = _CD_MAX * per_cd
+
+    groups = make_groups(data.flight, rng, folds=folds, min_paths=MIN_FLIGHTS)
+    n_groups = groups.n_groups
+    base = _fit(data, k_max, k=0.0)
+    base_ho = held_out(base.residual, 1.0, groups.group, n_groups)
+    drag_ho = held_out(
+        _held_out_drag(data, groups.fold, k_max), 1.0, groups.group, n_groups
+    )
+    gain, se = improvement(base_ho, drag_ho)
+    ok = meaningful(gain, se, z=z)
+
+    full = _fit(data, k_max)
+    n_obs = 2 * data.t.size
+    dof = max(1, n_obs - 4 * data.n_flights - 1)
+    sigma2 = full.sse / dof
+    cd = full.k / per_cd
+    cd_sd = math.sqrt(sigma2 / full.info) / per_cd if full.info > 0 else math.inf
+    drag_params = {"air_drag.cd": cd, "air_drag.air_density_kg_m3": _RHO}
+    candidate = Candidate(
+        effect="air_drag",
+        cv_rmse=drag_ho.rmse,
+        improvement=gain,
+        improvement_se=se,
+        meaningful=ok,
+        params={"air_drag.cd": cd},
+        params_sd={"air_drag.cd": cd_sd},
+    )
+    baseline = ModelScore(
+        effects=[],
+        cv_rmse=base_ho.rmse,
+        params={"gravity_mps2": G},
+        fit_rmse=math.sqrt(base.sse / n_obs),
+    )
+    if ok:
+        after = ModelScore(
+            effects=["air_drag"],
+            cv_rmse=drag_ho.rmse,
+            params=drag_params,
+            params_sd={"air_drag.cd": cd_sd},
+            fit_rmse=math.sqrt(full.sse / n_obs),
+        )
+        steps = [Step("air_drag", base_ho.rmse, drag_ho.rmse, [candidate])]
+        stopped = "no flight-level candidate left (air_drag is the only one)"
+        final = full
+    else:
+        after, steps, final = baseline, [], base
+        stopped = (
+            f"air_drag does not improve the held-out error meaningfully "
+            f"(gain {gain:.4f} +- {se:.4f}, needs > {z:g} SE)"
+        )
+    before = _dependence(data, base)
+    after_dep = _dependence(data, final)
+    notes.append(_free_g_note(data))
+    per_flight = [
+        math.sqrt(
+            float((base.residual[data.flight == f] ** 2).sum())
+            / (2 * (data.start[f + 1] - data.start[f]))
+        )
+        for f in range(data.n_flights)
+    ]
+    worst = [
+        {"flight": data.labels[f], "baseline_rmse_m": per_flight[f]}
+        for f in np.argsort(per_flight)[::-1][:3]
+    ]
+    return Diagnosis(
+        metric="cv_rmse_m",
+        baseline=baseline,
+        candidates=[candidate],
+        recommended="air_drag" if ok else None,
+        steps=steps,
+        confounded=[],
+        after=after,
+        rule=(
+            f"an effect is recommended when its held-out gain exceeds {z:g} "
+            "jackknife standard error(s) over flights (gain > 0 and gain > z SE)"
+        ),
+        groups=(
+            f"{data.n_flights} flights (whole flights held out); "
+            f"{groups.n_folds}-fold cross-validation; each held-out flight's "
+            "initial position and velocity refitted for both models"
+        ),
+        stopped=stopped,
+        skipped=_skipped(),
+        dependence_before=before,
+        dependence_after=after_dep,
+        unexplained=[
+            f"{d.component} residual vs {d.feature} "
+            f"({d.statistic}, p = {d.p_value:.2g})"
+            for d in after_dep
+            if d.significant
+        ],
+        worst=worst,
+        notes=notes,
+        n_data=n_obs,
+        n_rows=int(data.t.size),
+    )
