@@ -333,6 +333,15 @@ def diagnose_impacts(
         for r in [baseline.residual] + [s.residual for s in accepted]
     ]
     before_tests, after_tests = stage_tests[0], stage_tests[-1]
+    if groups.unit == "block":
+        notes.append(
+            "held out: blocks of one path, not independent rocks. An impact's "
+            "arrival and rebound come from the same surveyed points, so survey error "
+            "is shared across blocks and between vin and vfn; on error-only "
+            "simulations of the thesis surveys the rule still found an effect in up "
+            "to 9 of 20 tables (docs/real-data-diagnosis.md). Treat a recommendation "
+            "on a single surveyed path as a hypothesis to test on more paths"
+        )
     if len(set(path_id)) < len(path_id) / 2:
         notes.append(
             "dependence tests treat impacts as independent; impacts of one rock "
