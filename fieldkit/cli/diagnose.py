@@ -36,13 +36,13 @@ def _is_track(path: Path) -> bool:
 
 
 def _summary(diagnosis) -> list[str]:
+    from fieldkit.diagnose.report import baseline_label
+
     d = diagnosis
     unit = "m/s" if d.metric.endswith("_mps") else "m"
-    extra = "".join(" + " + e for e in d.baseline.effects)
     lines = [
         f"held out: {d.groups}",
-        f"baseline (constant e_n, e_t{extra}): "
-        f"{d.metric} {d.baseline.cv_rmse:.4g} {unit}",
+        f"baseline ({baseline_label(d)}): {d.metric} {d.baseline.cv_rmse:.4g} {unit}",
     ]
     for c in d.candidates:
         mark = "*" if c.meaningful else " "
@@ -82,7 +82,8 @@ def _write_report(report_dir: Path, diagnosis, inputs, outputs: OutputSet) -> st
         [("baseline", arrays["baseline"], flags[0])],
         components=components,
         unit=unit,
-        title=f"baseline: held-out residuals ({d.metric} {d.baseline.cv_rmse:.4g})",
+        title=f"baseline: {arrays.get('residual_kind', 'held-out')} residuals "
+        f"({d.metric} {d.baseline.cv_rmse:.4g})",
         outputs=outputs,
     )
     before = arrays["baseline"]

@@ -224,17 +224,22 @@ def _held_out_drag(data: _Data, fold: np.ndarray, k_max: float) -> np.ndarray:
     return out
 
 
-def _dependence(
-    data: _Data, fit: _Fit, *, alpha: float = DEPENDENCE_ALPHA
-) -> list[Dependence]:
-    """Spearman tests of the x and z residuals against the time from mid-flight and
-    the model speed, Holm-corrected over the four tests."""
+def _features(data: _Data, fit: _Fit) -> dict[str, np.ndarray]:
+    """Per-sample features: |time from mid-flight| / half the flight, model speed."""
     t_mid = np.empty(data.t.size)
     for f in range(data.n_flights):
         a, b = data.start[f], data.start[f + 1]
         half = 0.5 * (data.t[b - 1] - data.t[a])
         t_mid[a:b] = np.abs(data.t[a:b] - 0.5 * (data.t[a] + data.t[b - 1])) / half
-    features = {"time_from_mid_flight": t_mid, "speed_mps": fit.speed}
+    return {"time_from_mid_flight": t_mid, "speed_mps": fit.speed}
+
+
+def _dependence(
+    data: _Data, fit: _Fit, *, alpha: float = DEPENDENCE_ALPHA
+) -> list[Dependence]:
+    """Spearman tests of the x and z residuals against the time from mid-flight and
+    the model speed, Holm-corrected over the four tests."""
+    features = _features(data, fit)
     tests = []
     for feature, values in features.items():
         for c, component in enumerate(("x", "z")):
@@ -446,4 +451,13 @@ def diagnose_flights(
         notes=notes,
         n_data=n_obs,
         n_rows=int(data.t.size),
+        arrays={
+            "features": _features(data, base),
+            "baseline": base.residual,
+            "steps": [full.residual] if ok else [],
+            "after": final.residual,
+            "components": ("x", "z"),
+            "dependence": [before] + ([after_dep] if ok else []),
+            "residual_kind": "in-sample (each flight's own fit)",
+        },
     )

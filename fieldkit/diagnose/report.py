@@ -48,6 +48,27 @@ def _candidate_rows(candidates: list[Candidate], unit: str) -> list[str]:
     return rows
 
 
+def _worst_line(w: dict, unit: str) -> str:
+    if "row" not in w:  # flights: label and numbers as given
+        return "* " + ", ".join(
+            f"{k} {_fmt(v) if isinstance(v, float) else v}" for k, v in w.items()
+        )
+    return (
+        f"* row {w['row']} (path {w['path_id']}, point {w['point']}, "
+        f"{w['material']}): {w['component']} residual "
+        f"{w['residual_mps']:+.3g} {unit} ({w['z']:.1f} sd)"
+    )
+
+
+def baseline_label(d: Diagnosis) -> str:
+    """What the baseline is, in words."""
+    if d.metric == "cv_rmse_m":
+        base = "ballistic flights (g = 9.81 m/s^2)"
+    else:
+        base = "constant e_n, e_t per material"
+    return base + "".join(f" + {e}" for e in d.baseline.effects)
+
+
 def markdown(diagnosis: Diagnosis, *, title: str, inputs: list[str]) -> str:
     """The full report for ``diagnosis`` (``inputs``: the files it read)."""
     d = diagnosis
@@ -92,7 +113,7 @@ def markdown(diagnosis: Diagnosis, *, title: str, inputs: list[str]) -> str:
     out += [
         "## Baseline: where it fails",
         "",
-        f"Effects: {', '.join(d.baseline.effects) or 'none (constant e_n, e_t)'}; "
+        f"Model: {baseline_label(d)}; "
         f"held-out RMSE {_fmt(d.baseline.cv_rmse)} {unit} "
         f"(in-sample {_fmt(d.baseline.fit_rmse)}).",
         "",
@@ -115,12 +136,7 @@ def markdown(diagnosis: Diagnosis, *, title: str, inputs: list[str]) -> str:
         out.append("")
     if d.worst:
         out += ["Worst impacts (held-out, baseline):", ""]
-        out += [
-            f"* row {w['row']} (path {w['path_id']}, point {w['point']}, "
-            f"{w['material']}): {w['component']} residual "
-            f"{w['residual_mps']:+.3g} {unit} ({w['z']:.1f} sd)"
-            for w in d.worst
-        ]
+        out += [_worst_line(w, unit) for w in d.worst]
         out.append("")
     hits = [x for x in d.dependence_before if x.significant]
     out.append("Residuals depend on:" if hits else "Residuals depend on no feature.")
@@ -130,7 +146,8 @@ def markdown(diagnosis: Diagnosis, *, title: str, inputs: list[str]) -> str:
     ]
     tested = sorted({x.feature for x in d.dependence_before})
     out += ["", f"Features tested: {', '.join(tested) or 'none'}.", ""]
-    out += [f"![baseline residuals]({figs[0]})", ""]
+    kind = d.arrays.get("residual_kind", "held-out")
+    out += [f"![baseline residuals ({kind})]({figs[0]})", ""]
     out += ["## Which effect is missing", ""]
     out += _candidate_rows(d.candidates, unit) if d.candidates else ["No candidates."]
     out.append("")

@@ -56,7 +56,7 @@ def _panel(ax, values, residual, components, unit) -> None:
                     med.append(np.median(r[sel]))
             ax.plot(mid, med, c=_COLOURS[j % 3], lw=2)
     ax.axhline(0.0, color="k", lw=0.8)
-    ax.set_ylabel(f"held-out residual ({unit})")
+    ax.set_ylabel(f"residual ({unit})")
     ax.grid(True, alpha=0.3)
 
 
