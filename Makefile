@@ -4,7 +4,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test test-all bench lint video clean
+.PHONY: demo test test-all bench bench-diagnose lint video clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -28,9 +28,15 @@ test: $(STAMP)
 test-all: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q -m ''
 
-## Speed and memory figures (printed, not asserted).
+## Speed and memory figures (printed, not asserted); bench_diagnose_power runs its
+## short setting here (a few tables per condition, ~3 min on 2 cores).
 bench: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python benchmarks/run_all.py
+
+## The measured run of diagnose's power and false-finding rates (>= 100 tables per
+## target condition; long: about an hour on 2 idle cores).
+bench-diagnose: $(STAMP)
+	MPLBACKEND=Agg $(BIN)/python benchmarks/bench_diagnose_power.py --full
 
 ## Re-render the synthetic high-speed clips in video/ (deterministic).
 video: $(STAMP)
