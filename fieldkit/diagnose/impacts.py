@@ -42,10 +42,9 @@ from fieldkit.diagnose import null_calibration, residual_tests
 from fieldkit.diagnose.diagnosis import Candidate, Diagnosis, ModelScore, Step
 from fieldkit.diagnose.groups import DEFAULT_FOLDS, Groups, make_groups
 from fieldkit.diagnose.scoring import (
-    CONFOUND_Z,
     DEFAULT_Z,
+    MIN_GAIN,
     HeldOut,
-    difference,
     held_out,
     improvement,
     meaningful,
@@ -218,15 +217,16 @@ def diagnose_impacts(
     rng: np.random.Generator,
     folds: int = DEFAULT_FOLDS,
     z: float = DEFAULT_Z,
-    z_confound: float = CONFOUND_Z,
+    z_confound: float | None = None,
     null_draws: int = null_calibration.DEFAULT_DRAWS,
     candidates: list[str] | None = None,
     progress: Callable[[str], None] | None = None,
 ) -> Diagnosis:
     """Diagnose ``table`` against ``model`` (None: constant e_n, e_t per material).
 
-    ``z`` is the recommendation rule (gain > z SE), ``z_confound`` the
-    confounding rule (gains within z_confound paired SEs); ``null_draws`` null
+    ``z`` is the recommendation rule (gain > z SE and > ``MIN_GAIN``);
+    ``z_confound`` (default ``z``) the rule of the conditional gains that decide
+    confounding (see :func:`_alike`); ``null_draws`` null
     tables test each such gain when the impact velocities carry error
     (:mod:`~fieldkit.diagnose.null_calibration`; 0 = off).
     ``rng`` deals the groups to folds (a seed reproduces the diagnosis exactly);
@@ -305,15 +305,15 @@ def diagnose_impacts(
                 f"{best.improvement:+.3f} ± {best.improvement_se:.3f})"
             )
             break
-        alike = _alike(current, scored, ranked, z_confound)
+        alike = _alike(scorer, scored, ranked, z if z_confound is None else z_confound)
         if alike:
             for other in alike:
                 confounded.append([best.effect, other])
                 advice.append(cands.separating_measurement(best.effect, other, problem))
             stopped = (
                 f"{best.effect} cannot be told apart from {', '.join(alike)} "
-                "(held-out gains equal within the paired standard error): "
-                "neither is added"
+                "(neither adds a meaningful held-out gain to the other): neither "
+                "is added"
             )
             break
         after = scored[best.effect]
@@ -357,9 +357,9 @@ def diagnose_impacts(
         after=current.score(),
         rule=(
             f"a candidate is recommended when its held-out gain exceeds {z:g} "
-            "jackknife standard error(s) over the groups; two meaningful candidates "
-            f"whose gains differ by less than {z_confound:g} paired standard error(s) "
-            "are confounded and neither is added"
+            f"jackknife standard error(s) over the groups and {MIN_GAIN:.0%} of the "
+            "held-out error; the best and a meaningful runner-up are confounded "
+            "(neither added) when neither adds such a gain to the other"
             + (
                 f"; with errors in the impact velocities a gain must also beat "
                 f"the gains of {null_draws} null tables (Monte Carlo p <= "
@@ -437,19 +437,31 @@ def _null_test(
 
 
 def _alike(
-    current: Scored, scored: dict[str, Scored], ranked: list[Candidate], z: float
+    scorer: _Scorer,
+    scored: dict[str, Scored],
+    ranked: list[Candidate],
+    z: float,
 ) -> list[str]:
-    """Meaningful runners-up whose gain is within ``z`` paired SEs of the best."""
-    best = ranked[0]
+    """Meaningful runners-up that explain the same thing as the best candidate.
+
+    For the best ``A`` and each meaningful runner-up ``B`` the model with both is
+    scored: when neither adds a meaningful held-out gain to the other (``B`` given
+    ``A`` and ``A`` given ``B``), the data cannot tell them apart. When ``B`` adds
+    to ``A`` both are real (``B`` is ranked again at the next step); when only
+    ``A`` adds to ``B``, ``A`` is the better explanation.
+    """
+    best = ranked[0].effect
     out = []
     for other in ranked[1:]:
         if not other.meaningful:
             continue
-        gap, se = difference(
-            current.held, scored[best.effect].held, scored[other.effect].held
-        )
-        if gap <= z * se:
-            out.append(other.effect)
+        both = with_effects(scored[best].model, {other.effect: {}})
+        held = scorer.held_out(both)
+        if meaningful(*improvement(scored[best].held, held), z=z):
+            continue
+        if meaningful(*improvement(scored[other.effect].held, held), z=z):
+            continue
+        out.append(other.effect)
     return out
 
 

@@ -37,7 +37,12 @@ from threadpoolctl import threadpool_limits
 
 from fieldkit.errors import InputFileError
 from fieldkit.fit.fit_result import FitResult
-from fieldkit.fit.impact_model import ImpactInputs, impact_inputs, predict_arrays
+from fieldkit.fit.impact_model import (
+    ImpactInputs,
+    predict_rows,
+    impact_inputs,
+    predict_arrays,
+)
 from fieldkit.impact_table import ImpactTable
 from fieldkit.model.effects import registry
 from fieldkit.model.materials import MATERIAL_FIELDS
@@ -291,9 +296,7 @@ class ImpactProblem:
             start, _ = self.start(model, names)
         bounds = self.bounds(model, names)
 
-        def residuals(theta: np.ndarray) -> np.ndarray:
-            pred = predict_arrays(sub, *self.unpack(model, names, theta))
-            return ((observed - pred) / sd)[keep]
+        residuals = _Residuals(self, model, names, sub, observed, sd, keep)
 
         if not names:
             return _NoFit(residuals(np.zeros(0)))
@@ -308,6 +311,42 @@ class ImpactProblem:
                 jac="3-point",
                 x_scale="jac",
             )
+
+
+class _Residuals:
+    """``theta -> (observed - predicted) / sd`` with the parameter plumbing done once.
+
+    Each name maps to one slot: a material's ``e_n`` or ``e_t`` or an entry of the
+    kernel's flat effect-parameter array (the registry layout), so a call only
+    writes ``theta`` into copies of three arrays and runs the compiled predictor.
+    """
+
+    def __init__(self, problem, model, names, inputs, observed, sd, keep) -> None:
+        e_n, e_t, effects = problem.unpack(model, [], np.zeros(0))
+        self.flags, self.par = registry.kernel_arrays(effects)
+        self.e_n, self.e_t = e_n, e_t
+        index = {m: i for i, m in enumerate(problem.inputs.material_names)}
+        self.slots = []
+        for name in names:
+            parts = name.split(".")
+            if parts[0] == "materials":
+                self.slots.append((parts[2], index[parts[1]]))
+            else:
+                self.slots.append(("par", registry.LAYOUT[name]))
+        self.inputs = inputs
+        self.observed, self.sd, self.keep = observed, sd, keep
+
+    def __call__(self, theta: np.ndarray) -> np.ndarray:
+        e_n, e_t, par = self.e_n.copy(), self.e_t.copy(), self.par.copy()
+        target = {"e_n": e_n, "e_t": e_t, "par": par}
+        for (kind, i), value in zip(self.slots, theta, strict=True):
+            target[kind][i] = value
+        i = self.inputs
+        pred = predict_rows(
+            i.vin_mps, i.vit_mps, i.omega_i_radps, i.radius_m, i.gyration_m,
+            i.material_index, e_n, e_t, self.flags, par,
+        )  # fmt: skip
+        return ((self.observed - pred) / self.sd)[self.keep]
 
 
 _ARRAY_FIELDS = (

@@ -85,7 +85,9 @@ def impact_inputs(table: ImpactTable, model: Model) -> ImpactInputs:
 
 
 @njit(cache=True)
-def _predict(vin, vit, omega, r, kg, mi, e_n, e_t, flags, par):
+def predict_rows(vin, vit, omega, r, kg, mi, e_n, e_t, flags, par):
+    """``(n, 3)`` ``vfn, vft, omega_f`` of each row (compiled loop over
+    :func:`fieldkit.model.kernel.restitution`; ``mi`` indexes ``e_n``, ``e_t``)."""
     n = vin.size
     out = np.empty((n, 3))
     for i in range(n):
@@ -108,7 +110,7 @@ def predict_arrays(
     active effect -> parameter values (as in a model file).
     """
     flags, par = registry.kernel_arrays(effects)
-    return _predict(
+    return predict_rows(
         inputs.vin_mps,
         inputs.vit_mps,
         inputs.omega_i_radps,
