@@ -39,9 +39,9 @@ from fieldkit.errors import InputFileError
 from fieldkit.fit.fit_result import FitResult
 from fieldkit.fit.impact_model import (
     ImpactInputs,
-    predict_rows,
     impact_inputs,
     predict_arrays,
+    predict_rows,
 )
 from fieldkit.impact_table import ImpactTable
 from fieldkit.model.effects import registry
