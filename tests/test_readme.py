@@ -42,15 +42,19 @@ def run_blocks(selected, repo_copy, shell_commands, run_shell, monkeypatch) -> i
 def test_shell_blocks_run(repo_copy, shell_commands, run_shell, monkeypatch):
     selected = [b for b in blocks("") if not renders_video(b)]
     ran = run_blocks(selected, repo_copy, shell_commands, run_shell, monkeypatch)
-    # --version, reduce, impact, fence, view (2), effects, simulate and profile; the
-    # video block runs when slow
-    assert ran == 9
+    # --version, reduce, impact, fence, view (2), effects, simulate, profile, synth,
+    # fit, diagnose, synth --track, diagnose (track); the video block runs when slow
+    assert ran == 14
     assert (repo_copy / "boulder_a.csv").is_file()
     assert (repo_copy / "boulder_a.rrd").is_file()
     assert {p.name for p in (repo_copy / "figs").iterdir()} >= {"section.png"}
     assert (repo_copy / "sim" / "summary.json").is_file()
     assert (repo_copy / "sim" / "impacts.parquet").is_file()
     assert (repo_copy / "tschamut_profile.csv").is_file()
+    out = repo_copy / "out"
+    assert (out / "calibrated.json").is_file() and (out / "after.json").is_file()
+    assert (out / "diagnosis" / "report.md").is_file()
+    assert (out / "track_diagnosis" / "report.md").is_file()
 
 
 @pytest.mark.slow
