@@ -10,6 +10,7 @@ import pytest
 from diagnose_cases import ANGLE, ROTATION, VELOCITY
 
 from fieldkit.diagnose.impacts import diagnose_impacts
+from fieldkit.diagnose.scoring import DEFAULT_Z, MIN_GAIN
 from fieldkit.model.effects import registry
 
 CONTRACT_KEYS = [
@@ -44,7 +45,10 @@ def _check_ranking(candidates: list, reference_cv: float) -> None:
         assert c["improvement"] == pytest.approx(
             1.0 - c["cv_rmse_mps"] / reference_cv, abs=1e-12
         )
-        assert c["meaningful"] == (0.0 < c["improvement"] > c["improvement_se"])
+        # the rule of scoring.meaningful: gain > z SE and > the minimum gain
+        assert c["meaningful"] == (
+            c["improvement"] > max(MIN_GAIN, DEFAULT_Z * c["improvement_se"])
+        )
         _check_params(c["params"])
         assert c["params"] and all(k.startswith(c["effect"] + ".") for k in c["params"])
 

@@ -11,14 +11,16 @@ from __future__ import annotations
 import importlib.util
 import sys
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import REPO
 
 from fieldkit.diagnose.impacts import diagnose_impacts
 from fieldkit.errors import InputFileError
 from fieldkit.reduce.uncertainty import PositionError
+
+REPO = Path(__file__).resolve().parents[2]
 
 spec = importlib.util.spec_from_file_location(
     "diagnose_real_data", REPO / "examples" / "diagnose_real_data.py"
