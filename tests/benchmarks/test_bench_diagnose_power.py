@@ -51,15 +51,20 @@ def pool():
 @pytest.mark.parametrize(
     ("hidden", "narrow"),
     [
-        ({"velocity_scaled_restitution": 1.0}, False),
-        ({"angle_dependent_restitution": 0.5, "rotation_friction": 0.25}, False),
-        ({"angle_dependent_restitution": 0.5}, True),
+        ({"velocity_scaled_restitution": 1.0}, None),
+        ({"angle_dependent_restitution": 0.5, "rotation_friction": 0.25}, None),
+        ({"angle_dependent_restitution": 0.5}, 0),  # index into NARROW_CASES
     ],
 )
 def test_realised_effect_size_matches_target(bench, pool, hidden, narrow):
     sigma = 0.25
     table, effects, _ = bench.build_table(
-        pool, 60, hidden, sigma, np.random.default_rng(7), narrow=narrow
+        pool,
+        60,
+        hidden,
+        sigma,
+        np.random.default_rng(7),
+        narrow=None if narrow is None else bench.NARROW_CASES[narrow],
     )
     assert len(table) == 60
     assert table.frame["path_id"].nunique() >= bench.MIN_PATHS
@@ -92,6 +97,10 @@ def test_unabsorbed_is_zero_without_effect(bench, pool):
 
 
 def test_narrow_tables_have_narrow_speeds(bench, pool):
-    states = bench.sample_states(pool, 60, np.random.default_rng(2), narrow=True)
-    speed = np.hypot(states["vi_x_mps"], states["vi_z_mps"])
-    assert np.all(np.abs(speed / bench.NARROW_SPEED - 1) <= bench.NARROW_SPREAD)
+    for spread, window in bench.NARROW_CASES:
+        states = bench.sample_states(
+            pool, 30, np.random.default_rng(2), narrow=(spread, window)
+        )
+        assert len(states) == 30
+        speed = np.hypot(states["vi_x_mps"], states["vi_z_mps"])
+        assert np.all(np.abs(speed / bench.NARROW_SPEED - 1) <= spread)
