@@ -60,7 +60,7 @@ from scipy.optimize import brentq
 
 from fieldkit.diagnose import impacts
 from fieldkit.diagnose.impacts import diagnose_impacts
-from fieldkit.diagnose.scoring import DEFAULT_Z
+from fieldkit.diagnose.scoring import CONFOUND_Z, DEFAULT_Z
 from fieldkit.fit.impact_model import ImpactInputs, predict_arrays
 from fieldkit.impact_table import ImpactTable
 from fieldkit.model.model_file import Model, model_from_dict
@@ -448,8 +448,8 @@ def main(argv: list[str] | None = None) -> int:
         args.speed_runs = 1
     sigma = args.sigma
     # z_confound: the z of the conditional gains that decide confounding (None = z).
-    default_rule = (DEFAULT_Z, None)
-    z_rules = [(z, None) for z in (1.0, 1.5, 2.0)] + [(1.5, 1.0), (2.0, 1.0)]
+    default_rule = (DEFAULT_Z, CONFOUND_Z)
+    z_rules = [(z, z) for z in (1.0, 1.5, 2.0)] + [(1.5, 1.0), (2.0, 1.0)]
     if default_rule not in z_rules:
         z_rules.append(default_rule)
 
@@ -462,7 +462,7 @@ def main(argv: list[str] | None = None) -> int:
     print(
         f"{tables} tables per grid cell, {target_tables} per target condition "
         f"(a-d); default rule z = {DEFAULT_Z:g}, "
-        "z_confound = z (conditional gains); rates ± binomial SE"
+        f"z_confound = {CONFOUND_Z:g} (conditional gains); rates ± binomial SE"
     )
     t_start = time.perf_counter()
     pool = impact_pool(args.pool_paths, seed=1)
@@ -665,7 +665,7 @@ def main(argv: list[str] | None = None) -> int:
             rs = runs(("confound", conf_n, k), rule)
             cells.append(_rate(sum(bool(r["confounded"]) for r in rs), len(rs)))
             cells.append(_rate(sum(r["recommended"] in two for r in rs), len(rs)))
-        zc = "z" if rule[1] is None else f"{rule[1]:g}"
+        zc = f"{rule[1]:g}"
         print(f"{rule[0]:4g} {zc:>6s} " + " ".join(f"{c:>12s}" for c in cells))
 
     return _speed(pool, sigma, args.speed_runs, t_start)

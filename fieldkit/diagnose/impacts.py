@@ -43,6 +43,7 @@ from fieldkit.diagnose import null_calibration, residual_tests
 from fieldkit.diagnose.diagnosis import Candidate, Diagnosis, ModelScore, Step
 from fieldkit.diagnose.groups import DEFAULT_FOLDS, Groups, make_groups
 from fieldkit.diagnose.scoring import (
+    CONFOUND_Z,
     DEFAULT_Z,
     MIN_GAIN,
     HeldOut,
@@ -224,7 +225,7 @@ def diagnose_impacts(
     rng: np.random.Generator,
     folds: int = DEFAULT_FOLDS,
     z: float = DEFAULT_Z,
-    z_confound: float | None = None,
+    z_confound: float = CONFOUND_Z,
     null_draws: int = null_calibration.DEFAULT_DRAWS,
     candidates: list[str] | None = None,
     progress: Callable[[str], None] | None = None,
@@ -232,7 +233,7 @@ def diagnose_impacts(
     """Diagnose ``table`` against ``model`` (None: constant e_n, e_t per material).
 
     ``z`` is the recommendation rule (gain > z SE and > ``MIN_GAIN``);
-    ``z_confound`` (default ``z``) the rule of the conditional gains that decide
+    ``z_confound`` the rule of the conditional gains that decide
     confounding (see :func:`_alike`); ``null_draws`` null
     tables test each such gain when the impact velocities carry error
     (:mod:`~fieldkit.diagnose.null_calibration`; 0 = off).
@@ -312,7 +313,7 @@ def diagnose_impacts(
                 f"{best.improvement:+.3f} ± {best.improvement_se:.3f})"
             )
             break
-        alike = _alike(scorer, scored, ranked, z if z_confound is None else z_confound)
+        alike = _alike(scorer, scored, ranked, z_confound)
         if alike:
             for other in alike:
                 confounded.append([best.effect, other])
@@ -366,7 +367,8 @@ def diagnose_impacts(
             f"a candidate is recommended when its held-out gain exceeds {z:g} "
             f"jackknife standard error(s) over the groups and {MIN_GAIN:.0%} of the "
             "held-out error; the best and a meaningful runner-up are confounded "
-            "(neither added) when neither adds such a gain to the other"
+            "(neither added) when neither adds to the other a gain above "
+            f"{z_confound:g} standard error(s) and {MIN_GAIN:.0%}"
             + (
                 f"; with errors in the impact velocities a gain must also beat "
                 f"the gains of {null_draws} null tables (Monte Carlo p <= "
