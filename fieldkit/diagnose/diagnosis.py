@@ -50,17 +50,15 @@ class Candidate:
     meaningful: bool
     params: dict[str, float] = field(default_factory=dict)
     params_sd: dict[str, float] = field(default_factory=dict)
-    null_p: float = math.nan  # Monte Carlo p against null tables (NaN: not run)
 
     def to_json(self, metric: str) -> dict:
-        """The contract's candidate entry (+ meaningful, params_sd, null_p)."""
+        """The contract's candidate entry (+ ``meaningful``, ``params_sd``)."""
         return {
             "effect": self.effect,
             metric: _num(self.cv_rmse),
             "improvement": _num(self.improvement),
             "improvement_se": _num(self.improvement_se),
             "meaningful": bool(self.meaningful),
-            "null_p": _num(self.null_p),
             "params": {k: _num(v) for k, v in self.params.items()},
             "params_sd": {k: _num(v) for k, v in self.params_sd.items()},
         }

@@ -39,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fieldkit.diagnose import candidates as cands
-from fieldkit.diagnose import null_calibration, residual_tests
+from fieldkit.diagnose import residual_tests
 from fieldkit.diagnose.diagnosis import Candidate, Diagnosis, ModelScore, Step
 from fieldkit.diagnose.groups import DEFAULT_FOLDS, Groups, make_groups
 from fieldkit.diagnose.scoring import (
@@ -226,7 +226,6 @@ def diagnose_impacts(
     folds: int = DEFAULT_FOLDS,
     z: float = DEFAULT_Z,
     z_confound: float = CONFOUND_Z,
-    null_draws: int = null_calibration.DEFAULT_DRAWS,
     candidates: list[str] | None = None,
     progress: Callable[[str], None] | None = None,
 ) -> Diagnosis:
@@ -234,9 +233,7 @@ def diagnose_impacts(
 
     ``z`` is the recommendation rule (gain > z SE and > ``MIN_GAIN``);
     ``z_confound`` the rule of the conditional gains that decide
-    confounding (see :func:`_alike`); ``null_draws`` null
-    tables test each such gain when the impact velocities carry error
-    (:mod:`~fieldkit.diagnose.null_calibration`; 0 = off).
+    confounding (see :func:`_alike`).
     ``rng`` deals the groups to folds (a seed reproduces the diagnosis exactly);
     ``candidates`` restricts the candidate effects (default: every one the table
     can inform). See the module docstring for the method.
@@ -270,17 +267,11 @@ def diagnose_impacts(
         pool = [c for c in pool if c in candidates]
     _check(problem, groups, model, pool)
     scorer = _Scorer(problem, groups)
-    errors = null_calibration.input_errors(problem)
-    if errors is not None and null_draws > 0:
+    if {"vin_sd_mps", "vit_sd_mps"} <= set(problem.table.frame):
         notes.append(
-            "impact velocities carry error (vin_sd_mps, vit_sd_mps): each gain that "
-            f"passes the SE rule is also tested against {null_draws} null tables "
-            "(errors in the impact velocities can pass for a speed or angle law)"
-        )
-    elif errors is not None:
-        notes.append(
-            "impact velocities carry error but the null-table test is off: a gain "
-            "may come from errors in the impact velocities"
+            "the impact velocities carry error (vin_sd_mps, vit_sd_mps) but are "
+            "taken as exact inputs: errors in them can pass for a speed or angle "
+            "law (docs/real-data-diagnosis.md)"
         )
     say = progress or (lambda _msg: None)
     say("baseline")
@@ -300,9 +291,6 @@ def diagnose_impacts(
             variant = with_effects(current.model, {name: {}})
             scored[name] = scorer.score(variant, [*current.effects, name])
         ranked = _rank(current, scored, z)
-        if errors is not None and null_draws > 0:
-            say(f"step {len(steps) + 1}: {null_draws} null tables")
-            _null_test(scorer, current, ranked, errors, null_draws, rng)
         if first is None:
             first = ranked
         best = ranked[0]
@@ -369,13 +357,6 @@ def diagnose_impacts(
             "held-out error; the best and a meaningful runner-up are confounded "
             "(neither added) when neither adds to the other a gain above "
             f"{z_confound:g} standard error(s) and {MIN_GAIN:.0%}"
-            + (
-                f"; with errors in the impact velocities a gain must also beat "
-                f"the gains of {null_draws} null tables (Monte Carlo p <= "
-                f"{null_calibration.ALPHA:g})"
-                if errors is not None and null_draws > 0
-                else ""
-            )
         ),
         groups=groups.description,
         stopped=stopped,
@@ -414,35 +395,6 @@ def _rank(current: Scored, scored: dict[str, Scored], z: float) -> list[Candidat
             )
         )
     return sorted(out, key=lambda c: c.cv_rmse)
-
-
-def _null_test(
-    scorer: _Scorer,
-    current: Scored,
-    ranked: list[Candidate],
-    errors: tuple[np.ndarray, np.ndarray],
-    draws: int,
-    rng: np.random.Generator,
-) -> None:
-    """Set ``null_p`` (and demote ``meaningful``) of the candidates passing the SE
-    rule, against ``draws`` null tables from ``current``."""
-    tested = [c for c in ranked if c.meaningful]
-    if not tested:
-        return
-    problem = scorer.problem
-    truth = problem.predict(current.model)
-    variants = {c.effect: with_effects(current.model, {c.effect: {}}) for c in tested}
-    gains = {c.effect: np.empty(draws) for c in tested}
-    for d in range(draws):
-        null = _Scorer(
-            null_calibration.null_problem(problem, truth, errors, rng), scorer.groups
-        )
-        reference = null.held_out(current.model)
-        for name, variant in variants.items():
-            gains[name][d] = improvement(reference, null.held_out(variant))[0]
-    for c in tested:
-        c.null_p = null_calibration.monte_carlo_p(c.improvement, gains[c.effect])
-        c.meaningful = c.null_p <= null_calibration.ALPHA
 
 
 def _alike(
