@@ -123,20 +123,20 @@ def test_tornado_diagnosis_prefers_speed_law_and_rejects_angle_law(tornado):
 
 
 @pytest.mark.slow
-def test_tornado_speed_law_is_also_recommended_on_null_tables(tornado):
-    # The speed-law recommendation is not evidence: on tables with no effect at all
-    # (constant e_n + the survey's error) the diagnosis recommends it about half the
-    # time (9 of 20 in docs/real-data-diagnosis.md): errors in the measured vin.
-    deltas = real.error_draws(tornado, 8, np.random.default_rng(real.SEED))
+def test_null_tables_rarely_recommend_anything(tornado):
+    # Tables with no effect at all (constant e_n + the survey's own error,
+    # re-propagated from the points) must not look like a speed law: with the
+    # 1-SE rule they did in 9 of 20; with the 2-SE rule and the 1 % minimum gain in
+    # 1 of 20 (docs/real-data-diagnosis.md). At most 1 of 8 here.
+    deltas = real.error_draws(tornado, 10, np.random.default_rng(real.SEED))
     recs = [
         diagnose_impacts(
             real.null_table(tornado.table, deltas[k]),
             rng=np.random.default_rng(real.SEED + k),
         ).recommended
-        for k in range(6)
+        for k in range(8)
     ]
-    assert recs.count("velocity_scaled_restitution") >= 1
-    assert "angle_dependent_restitution" not in recs
+    assert sum(r is not None for r in recs) <= 1, recs
 
 
 @pytest.mark.slow
