@@ -170,8 +170,9 @@ def diagnose(
 
     Example (from the repository root):
 
-        fieldkit synth tests/model/data/smoke.json --paths 60 --seed 3 \\
-          --effects angle_dependent_restitution=b=0.8 -o out/hidden.csv
+        fieldkit synth surveys/tornado_mountain/model_rocfall_table_7_1.json \\
+          --paths 25 --seed 7 --effects angle_dependent_restitution=b=1.03 \\
+          -o out/hidden.csv
 
         fieldkit diagnose out/hidden.csv --seed 1 --json out/diagnosis.json \\
           --report out/diagnosis --rrd out/diagnosis.rrd
