@@ -5,8 +5,8 @@ Layers, lowest first (a module may import its own layer's package and any lower 
 0. ``errors`` -- the one error type; ``_version`` -- the version string;
 1. ``physics`` (pure thesis equations: imports nothing of ours but ``errors``) and
    ``outputs`` (safe file writing: all or nothing, never over an input);
-2. the three data types ``survey``, ``track``, ``impact_table`` (the ImpactTable's
-   derived columns are thesis equations, so it imports ``physics``);
+2. the data types ``survey``, ``track``, ``impact_table``, ``path_observations`` (the
+   ImpactTable's derived columns are thesis equations, so it imports ``physics``);
 3. ``io`` -- field formats in, data types out;
 4. the stages ``reduce``, ``tracking``, ``model``, ``fit``, ``diagnose``, ``export``;
    a stage imports another stage only along :data:`STAGE_EDGES`;
@@ -35,6 +35,7 @@ LAYERS: dict[str, int] = {
     "survey": 2,
     "track": 2,
     "impact_table": 2,
+    "path_observations": 2,
     "io": 3,
     "reduce": 4,
     "tracking": 4,
@@ -155,7 +156,14 @@ def test_io_and_physics_depend_on_nothing_above_them():
         for importer, imported in EDGES
         if unit(importer) == "io" and unit(imported) != "io"
     }
-    assert io <= {"errors", "outputs", "survey", "track", "impact_table"}
+    assert io <= {
+        "errors",
+        "outputs",
+        "survey",
+        "track",
+        "impact_table",
+        "path_observations",
+    }
 
 
 def _cycle(graph: dict[str, set[str]]) -> list[str] | None:
