@@ -5,7 +5,9 @@ base model moved onto the run's own 2-D section (profile from the DEM, seeder at
 release point, the run's block as body) and what was observed along it. The
 simulated runout of a rock is the horizontal distance along the section from the
 release to where it stopped (the section's chainage; ``runout_x_m`` of the
-simulator minus the release chainage, which is 0 on a section that starts there).
+simulator minus the release chainage ``model.seeder.x_m``: 0 on the sections of
+:func:`fieldkit.fit.path_sections.path_runs`, whose profiles start upslope of the
+release at negative chainage).
 
 Common random numbers: :func:`simulated_runouts` draws every rock of a run from
 ``numpy.random.default_rng([seed, index])``, and the kernel's random streams are
@@ -60,6 +62,8 @@ def simulated_runouts(
     run: PathRun, model: Model, rocks: int, seed: int, index: int
 ) -> np.ndarray:
     """Runouts [m] of ``rocks`` rocks of ``model`` (``run``'s section) with common
-    random numbers ``default_rng([seed, index])``."""
+    random numbers ``default_rng([seed, index])``: the chainage of the stop less
+    that of the release (``model.seeder.x_m``; the profile may start upslope of it,
+    at negative chainage)."""
     result = simulate(model, rocks, np.random.default_rng([seed, index]))
-    return np.asarray(result.runout_x_m, float) - float(model.profile.x_m[0])
+    return np.asarray(result.runout_x_m, float) - float(model.seeder.x_m)
