@@ -301,7 +301,9 @@ def path_sections(
                 where=path_id,
             )
         if section == "descent":
-            out[path_id] = steepest_descent_line(grid, (x, y), step)
+            out[path_id] = _extend_to_edge(
+                grid, steepest_descent_line(grid, (x, y), step), step
+            )
         else:
             out[path_id] = _release_deposit_line(grid, row, step, source, path_id)
     return out
@@ -326,6 +328,13 @@ def _release_deposit_line(grid, row, step, source, path_id) -> Section:
             where=path_id,
         )
     ux, uy = (x1 - x0) / length, (y1 - y0) / length
+    t = _reach_edge(grid, x0, y0, ux, uy)
+    cut = profile_along_polyline(grid, [(x0, y0), (x0 + t * ux, y0 + t * uy)], step)
+    return replace(cut, ending="grid edge")
+
+
+def _reach_edge(grid, x0: float, y0: float, ux: float, uy: float) -> float:
+    """Plan distance from (x0, y0) along the unit vector (ux, uy) to the grid edge."""
     lo_x, hi_x = float(grid.x_m[0]), float(grid.x_m[-1])
     lo_y, hi_y = float(grid.y_m[-1]), float(grid.y_m[0])
     reach = []
@@ -334,9 +343,32 @@ def _release_deposit_line(grid, row, step, source, path_id) -> Section:
             reach.append((hi - p) / u)
         elif u < 0:
             reach.append((lo - p) / u)
-    t = min(reach) * (1 - 1e-9)
-    cut = profile_along_polyline(grid, [(x0, y0), (x0 + t * ux, y0 + t * uy)], step)
-    return replace(cut, ending="grid edge")
+    return min(reach) * (1 - 1e-9)
+
+
+def _extend_to_edge(grid, section: Section, step: float) -> Section:
+    """A descent line that ended in a pit or a flat, continued straight along its
+    last plan direction to the grid's edge.
+
+    The line of steepest descent stops where the ground stops falling (a local
+    minimum or flat of the DEM); a rock arriving there with speed runs on and up the
+    far slope. Without the extension the simulator would let it leave the section
+    there and cut its runout at the section's length.
+    """
+    if section.ending not in ("local minimum", "flat area"):
+        return section
+    px, py = section.plan_x_m, section.plan_y_m
+    dx, dy = px[-1] - px[-2], py[-1] - py[-2]
+    norm = math.hypot(dx, dy)
+    t = _reach_edge(grid, float(px[-1]), float(py[-1]), dx / norm, dy / norm)
+    if t <= step:
+        return section
+    vertices = np.column_stack([px, py]).tolist()
+    vertices.append([px[-1] + t * dx / norm, py[-1] + t * dy / norm])
+    cut = profile_along_polyline(grid, vertices, step)
+    return replace(
+        cut, ending=f"{section.ending}, then straight on to the grid edge"
+    )
 
 
 def nearest_on_section(section: Section, x: float, y: float) -> tuple[float, float]:
