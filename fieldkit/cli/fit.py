@@ -9,31 +9,129 @@ from typing import Annotated
 import typer
 
 from fieldkit.cli.common import one_line_errors
+from fieldkit.errors import ArgumentError
 from fieldkit.outputs import OutputSet, write_text
 
-FLAGS = {"output": "-o", "model": "--model", "report_dir": "--report"}
+FLAGS = {
+    "output": "-o",
+    "model": "--model",
+    "report_dir": "--report",
+    "releases": "--paths",
+    "deposits": "--deposits",
+    "dem": "--dem",
+    "json_file": "--json",
+    "holdout_releases": "--holdout-paths",
+    "holdout_deposits": "--holdout-deposits",
+}
+
+
+def _paths(options: dict) -> None:
+    from fieldkit.cli.fit_paths import fit_paths_command
+
+    for name in ("releases", "deposits", "dem"):
+        if options[name] is None:
+            raise ArgumentError(
+                "a path fit needs --paths, --deposits and --dem", source=name
+            )
+    if (options["holdout_releases"] is None) != (options["holdout_deposits"] is None):
+        raise ArgumentError(
+            "--holdout-paths and --holdout-deposits go together",
+            source="holdout_releases",
+        )
+    if options["table_file"] is not None:
+        raise ArgumentError(
+            "give either an ImpactTable or --paths, not both", source="table_file"
+        )
+    fit_paths_command(
+        releases=options["releases"],
+        deposits=options["deposits"],
+        dem=options["dem"],
+        model_file=options["model_file"],
+        output=options["output"],
+        json_file=options["json_file"],
+        report=options["report"],
+        holdout_releases=options["holdout_releases"],
+        holdout_deposits=options["holdout_deposits"],
+        free=options["free"],
+        rocks=options["rocks"],
+        seed=options["seed"],
+        bootstrap=options["bootstrap"],
+        section=options["section"],
+    )
 
 
 @one_line_errors(flags=FLAGS)
 def fit(
-    table_file: Annotated[
-        Path,
-        typer.Argument(
-            metavar="TABLE", help="The ImpactTable (.csv, .parquet, .xlsx)."
-        ),
-    ],
     model_file: Annotated[
         Path, typer.Option("--model", help="The base model file (§5).")
     ],
     output: Annotated[
         Path, typer.Option("-o", help="The calibrated model file to write.")
     ],
+    table_file: Annotated[
+        Path | None,
+        typer.Argument(
+            metavar="[TABLE]",
+            help="The ImpactTable (.csv, .parquet, .xlsx); omit with --paths.",
+        ),
+    ] = None,
     report: Annotated[
         Path | None,
         typer.Option(
-            "--report", help="Write report.md and residuals.png into this folder."
+            "--report",
+            help="Write report.md and residuals.png (impacts) or holdout.png (paths) "
+            "into this folder.",
         ),
     ] = None,
+    releases: Annotated[
+        Path | None,
+        typer.Option("--paths", help="Path fit: release points CSV (one run a row)."),
+    ] = None,
+    deposits: Annotated[
+        Path | None,
+        typer.Option("--deposits", help="Path fit: deposit points CSV (same ids)."),
+    ] = None,
+    dem: Annotated[
+        Path | None,
+        typer.Option("--dem", help="Path fit: the DEM (ESRI ASCII grid, GeoTIFF)."),
+    ] = None,
+    json_file: Annotated[
+        Path | None,
+        typer.Option("--json", help="Path fit: write the fit and hold-out scores."),
+    ] = None,
+    holdout_releases: Annotated[
+        Path | None,
+        typer.Option("--holdout-paths", help="Path fit: held-out release points."),
+    ] = None,
+    holdout_deposits: Annotated[
+        Path | None,
+        typer.Option("--holdout-deposits", help="Path fit: held-out deposits."),
+    ] = None,
+    free: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--free",
+            help="Path fit: a parameter to fit (repeatable; default e_n, e_t and "
+            "friction_deg of every material).",
+        ),
+    ] = None,
+    rocks: Annotated[
+        int, typer.Option("--rocks", help="Path fit: rocks per run and evaluation.")
+    ] = 200,
+    seed: Annotated[
+        int, typer.Option("--seed", help="Path fit: seed of the common random numbers.")
+    ] = 0,
+    bootstrap: Annotated[
+        int, typer.Option("--bootstrap", help="Path fit: bootstrap resamples of runs.")
+    ] = 20,
+    section: Annotated[
+        str,
+        typer.Option(
+            "--section",
+            help="Path fit: 'descent' (steepest descent from each release) or "
+            "'release-deposit' (honest for calibration only).",
+        ),
+    ] = "descent",
 ) -> None:
     """Fit restitution and effect parameters to measured impacts (weighted LSQ).
 
@@ -56,7 +154,29 @@ def fit(
         fieldkit fit out/synth.csv \\
           --model surveys/tornado_mountain/model_rocfall_table_7_1.json \\
           -o out/calibrated.json --report out/fit
+
+    With --paths, --deposits and --dem it calibrates the simulator on observed
+    runs instead: each run's section is the steepest descent from its release on
+    the DEM; the free parameters are fitted to the observed runouts by the mean
+    CRPS of simulated ensembles (common random numbers), with bootstrap
+    uncertainty over runs; held-out runs, when given, are scored for the
+    calibrated model, the starting model and the climatology (the calibration
+    runs' observed runouts). Example:
+
+        fieldkit fit --model examples/tschamut/model_base.json \\
+          --paths tests/data/tschamut2014/calibration_split/calibration_release_points.csv \\
+          --deposits tests/data/tschamut2014/calibration_split/calibration_observed_deposition.csv \\
+          --dem tests/data/tschamut2014/terrain.asc --rocks 60 --bootstrap 4 \\
+          -o out/tschamut_calibrated.json --json out/tschamut_fit.json
     """
+    if releases is not None or deposits is not None or dem is not None:
+        _paths(locals())
+        return
+    if table_file is None:
+        raise ArgumentError(
+            "give an ImpactTable, or --paths, --deposits and --dem for a path fit",
+            source="table_file",
+        )
     from fieldkit.fit.impact_fit import fit_impacts
     from fieldkit.impact_table import ImpactTable
     from fieldkit.model.model_file import read_model, write_model

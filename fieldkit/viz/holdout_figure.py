@@ -1,0 +1,55 @@
+"""Predicted runout intervals against observed runouts, one row per held-out run."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from fieldkit.outputs import OutputSet
+from fieldkit.viz.figure_files import save_png
+
+_STYLE = {"calibrated": ("C0", 0.12), "uncalibrated": ("C7", -0.12)}
+
+
+def holdout_figure(validation: dict) -> Figure:
+    """50 % (thick) and 90 % (thin) central intervals and median of the calibrated
+    and uncalibrated forecasts per held-out run; observed runout as a black dot;
+    the climatology's 5-95 % band shaded."""
+    ids = validation["path_ids"]
+    observed = validation["observed"]
+    n = len(ids)
+    fig = Figure(figsize=(8.0, 0.35 * n + 1.8), layout="constrained")
+    ax = fig.add_subplot()
+    clim = validation["ensembles"]["climatology"][0]
+    lo, hi = np.percentile(clim, [5, 95])
+    ax.axvspan(lo, hi, color="0.9", label="climatology 5-95 %")
+    y = np.arange(n)
+    for name, (colour, dy) in _STYLE.items():
+        for i, e in enumerate(validation["ensembles"][name]):
+            q = np.percentile(e, [5, 25, 50, 75, 95])
+            ax.plot([q[0], q[4]], [y[i] + dy] * 2, c=colour, lw=1)
+            ax.plot([q[1], q[3]], [y[i] + dy] * 2, c=colour, lw=4,
+                    label=name if i == 0 else None)  # fmt: skip
+            ax.plot(q[2], y[i] + dy, "|", c="k", ms=8)
+    ax.plot(observed, y, "o", c="k", ms=5, label="observed")
+    ax.set_yticks(y, ids)
+    ax.invert_yaxis()
+    ax.set_xlabel("runout along the section (m)")
+    s = validation["forecasts"]
+    ax.set_title(
+        "held-out runs: mean CRPS "
+        + ", ".join(f"{k} {s[k]['mean_crps']:.1f} m" for k in s)
+    )
+    ax.grid(True, axis="x", alpha=0.3)
+    ax.legend(loc="lower right", fontsize=8)
+    return fig
+
+
+def write_holdout_figure(
+    path: str | os.PathLike[str], validation: dict, *, outputs: OutputSet | None = None
+) -> Path:
+    """Write :func:`holdout_figure` as PNG (through ``outputs`` when given)."""
+    return save_png(holdout_figure(validation), path, outputs=outputs)
