@@ -26,9 +26,14 @@ resampled with replacement ``bootstrap`` times (equivalently, integer weights on
 per-run CRPS) and the fit is repeated from the optimum with a short budget. The
 standard error of a parameter is the SD of its bootstrap values; the 90 % interval is
 ``value ± 1.645 SE`` clipped to the bounds; the correlation matrix is that of the
-bootstrap values. A parameter is reported as *not pinned down* when its interval
-spans more than :data:`WIDE_FRACTION` of its bound range, or when its bootstrap
-correlation with another parameter exceeds :data:`CORRELATION_LIMIT` in size.
+bootstrap values. A flat direction gives no bootstrap spread (each refit stays where
+it starts), so the objective is also sliced across each parameter's bound range (the
+others at the optimum, ``slice_points`` points): a point whose paired mean CRPS
+excess over the runs is below 1.645 times its standard error is compatible with the
+data, and the interval is widened to include every compatible point. A parameter is
+reported as *not pinned down* when its interval spans more than
+:data:`WIDE_FRACTION` of its bound range, or when its bootstrap correlation with
+another parameter exceeds :data:`CORRELATION_LIMIT` in size.
 
 References
 ----------
@@ -187,6 +192,7 @@ class PathFitResult:
     lower: np.ndarray
     upper: np.ndarray
     correlation: np.ndarray
+    compatible: np.ndarray  # (p, 2) slice range the runs cannot tell apart
     pinned: list[bool]
     objective_start: float
     objective_optimum: float
@@ -240,6 +246,7 @@ class PathFitResult:
                 )
             ],
             "correlation": self.correlation.tolist(),
+            "slice_compatible": self.compatible.tolist(),
             "objective": "mean CRPS of observed runouts [m]",
             "objective_start": self.objective_start,
             "objective_optimum": self.objective_optimum,
@@ -298,6 +305,7 @@ def fit_paths(
     start: dict[str, float] | None = None,
     max_evaluations: int | None = None,
     bootstrap_evaluations: int | None = None,
+    slice_points: int = 9,
 ) -> PathFitResult:
     """Fit the ``free`` parameters to the observed runouts of ``runs``.
 
@@ -327,6 +335,9 @@ def fit_paths(
     max_evaluations, bootstrap_evaluations
         Objective evaluations of the main search (default ``max(150, 60 p)``) and
         of each bootstrap refit (default ``20 p + 10``).
+    slice_points
+        Points of the objective's slice across each parameter's bound range (module
+        docstring).
 
     Returns
     -------
@@ -410,12 +421,37 @@ def fit_paths(
         stderr = np.full(p, np.nan)
         corr = np.full((p, p), np.nan)
         notes.append("no bootstrap: no standard errors or intervals")
+    # Slice of the objective across each bound range (others at the optimum): the
+    # points the runs cannot tell from the optimum (paired mean CRPS difference
+    # below Z90 times its SE over runs). A flat direction has no bootstrap spread
+    # (every refit stays where it starts), so this is what reveals it.
+    compatible = np.empty((p, 2))
+    for j in range(p):
+        grid = np.linspace(lower[j], upper[j], slice_points)
+        ok = [x_best[j]]
+        for value in grid:
+            x = x_best.copy()
+            x[j] = value
+            diff = objective.per_run(x) - run_crps
+            se = diff.std(ddof=1) / math.sqrt(n_runs) if n_runs > 1 else 0.0
+            if diff.mean() <= Z90 * se:
+                ok.append(value)
+        compatible[j] = min(ok), max(ok)
+    say(f"slices done after {objective.evaluations} evaluations")
     interval = np.column_stack(
         [
             np.clip(x_best - Z90 * stderr, lower, upper),
             np.clip(x_best + Z90 * stderr, lower, upper),
         ]
     )
+    for j, n in enumerate(names):
+        lo, hi = compatible[j]
+        if lo < interval[j, 0] or hi > interval[j, 1]:
+            notes.append(
+                f"{n}: the objective's slice cannot tell [{lo:g}, {hi:g}] from the "
+                f"optimum; its 90 % interval is widened to include it"
+            )
+            interval[j] = min(lo, interval[j, 0]), max(hi, interval[j, 1])
     pinned = []
     for j, n in enumerate(names):
         width = (interval[j, 1] - interval[j, 0]) / span[j]
@@ -446,6 +482,7 @@ def fit_paths(
         lower=lower,
         upper=upper,
         correlation=corr,
+        compatible=compatible,
         pinned=pinned,
         objective_start=f0,
         objective_optimum=float(np.mean(run_crps)),
