@@ -1,0 +1,58 @@
+"""`fieldkit fit --paths`: the path-level fit from the command line, bad input."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+DATA = Path(__file__).parents[1] / "data" / "tschamut2014"
+SPLIT = DATA / "calibration_split"
+BASE = Path(__file__).parents[2] / "examples" / "tschamut" / "model_base.json"
+
+
+@pytest.mark.slow
+def test_tschamut_fit_writes_model_json_and_holdout_scores(cli, tmp_path):
+    r = cli(
+        "fit", "--model", BASE,
+        "--paths", SPLIT / "calibration_release_points.csv",
+        "--deposits", SPLIT / "calibration_observed_deposition.csv",
+        "--dem", DATA / "terrain.asc",
+        "--holdout-paths", SPLIT / "holdout_release_points.csv",
+        "--holdout-deposits", SPLIT / "holdout_observed_deposition.csv",
+        "--rocks", "40", "--bootstrap", "2", "--seed", "1",
+        "-o", tmp_path / "cal.json", "--json", tmp_path / "fit.json",
+        "--report", tmp_path / "rep",
+    )  # fmt: skip
+    assert r.exit_code == 0, r.output
+    fit = json.loads((tmp_path / "fit.json").read_text())
+    assert fit["n_runs"] == 18
+    assert fit["objective_optimum"] <= fit["objective_start"]
+    h = fit["holdout"]
+    assert set(h) == {"calibrated", "uncalibrated", "climatology"}
+    assert all(v["n_runs"] == 18 for v in h.values())
+    model = json.loads((tmp_path / "cal.json").read_text())
+    assert model["provenance"]["fit_paths"]["n_runs"] == 18
+    assert (tmp_path / "rep" / "holdout.png").stat().st_size > 20_000
+
+
+def test_path_fit_needs_all_three_inputs(cli, tmp_path):
+    r = cli("fit", "--model", BASE, "--paths", SPLIT / "calibration_release_points.csv",
+            "-o", tmp_path / "m.json")  # fmt: skip
+    assert r.exit_code == 1
+    assert "needs --paths, --deposits and --dem" in r.output
+    assert not (tmp_path / "m.json").exists()
+
+
+def test_mismatched_ids_one_line_nothing_written(cli, tmp_path):
+    r = cli(
+        "fit", "--model", BASE,
+        "--paths", SPLIT / "calibration_release_points.csv",
+        "--deposits", SPLIT / "holdout_observed_deposition.csv",
+        "--dem", DATA / "terrain.asc", "-o", tmp_path / "m.json",
+    )  # fmt: skip
+    assert r.exit_code == 1
+    errors = [x for x in r.output.splitlines() if x.startswith("error:")]
+    assert len(errors) == 1 and "v020" in errors[0]
+    assert not (tmp_path / "m.json").exists()
