@@ -161,13 +161,7 @@ def fit(
     CRPS of simulated ensembles (common random numbers), with bootstrap
     uncertainty over runs; held-out runs, when given, are scored for the
     calibrated model, the starting model and the climatology (the calibration
-    runs' observed runouts). Example:
-
-        fieldkit fit --model examples/tschamut/model_base.json \\
-          --paths tests/data/tschamut2014/calibration_split/calibration_release_points.csv \\
-          --deposits tests/data/tschamut2014/calibration_split/calibration_observed_deposition.csv \\
-          --dem tests/data/tschamut2014/terrain.asc --rocks 60 --bootstrap 4 \\
-          -o out/tschamut_calibrated.json --json out/tschamut_fit.json
+    runs' observed runouts). The README shows it on the Tschamut 2014 runs.
     """
     if releases is not None or deposits is not None or dem is not None:
         _paths(locals())
