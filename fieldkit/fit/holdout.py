@@ -84,8 +84,8 @@ def central_interval(samples: np.ndarray, level: float) -> tuple[float, float]:
 
     Examples
     --------
-    >>> central_interval(np.arange(101.0), 0.9)
-    (5.0, 95.0)
+    >>> central_interval(np.arange(101.0), 0.5)
+    (25.0, 75.0)
     """
     if not 0.0 < level < 1.0:
         raise ValueError(f"level must be in (0, 1) (got {level})")
