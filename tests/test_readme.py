@@ -28,11 +28,6 @@ def renders_video(block: str) -> bool:
     return "video/render.py" in block
 
 
-def fits_paths(block: str) -> bool:
-    """The path-level fit block (about 100 s: run with the slow tests)."""
-    return "fit --model" in block and "--paths" in block
-
-
 def run_blocks(selected, repo_copy, shell_commands, run_shell, monkeypatch) -> int:
     monkeypatch.setenv("MPLBACKEND", "Agg")
     count = 0
@@ -45,12 +40,12 @@ def run_blocks(selected, repo_copy, shell_commands, run_shell, monkeypatch) -> i
 
 
 def test_shell_blocks_run(repo_copy, shell_commands, run_shell, monkeypatch):
-    selected = [b for b in blocks("") if not renders_video(b) and not fits_paths(b)]
+    selected = [b for b in blocks("") if not renders_video(b)]
     ran = run_blocks(selected, repo_copy, shell_commands, run_shell, monkeypatch)
     # --version, reduce, impact, fence, view (2), effects, simulate, profile, synth,
-    # fit, diagnose, synth --track, diagnose (track); the video block and the path
-    # fit run when slow
-    assert ran == 14
+    # fit, fit --paths, diagnose, synth --track, diagnose (track); the video block
+    # runs when slow
+    assert ran == 15
     assert (repo_copy / "boulder_a.csv").is_file()
     assert (repo_copy / "boulder_a.rrd").is_file()
     assert {p.name for p in (repo_copy / "figs").iterdir()} >= {"section.png"}
@@ -59,16 +54,9 @@ def test_shell_blocks_run(repo_copy, shell_commands, run_shell, monkeypatch):
     assert (repo_copy / "tschamut_profile.csv").is_file()
     out = repo_copy / "out"
     assert (out / "calibrated.json").is_file() and (out / "after.json").is_file()
+    assert (out / "tschamut_calibrated.json").is_file()
     assert (out / "diagnosis" / "report.md").is_file()
     assert (out / "track_diagnosis" / "report.md").is_file()
-
-
-@pytest.mark.slow
-def test_path_fit_block_runs(repo_copy, shell_commands, run_shell, monkeypatch):
-    selected = [b for b in blocks("") if fits_paths(b)]
-    assert len(selected) == 1
-    assert run_blocks(selected, repo_copy, shell_commands, run_shell, monkeypatch) == 1
-    assert (repo_copy / "out" / "tschamut_calibrated.json").is_file()
 
 
 @pytest.mark.slow

@@ -97,9 +97,7 @@ def check_table(
     if "rotation_friction" in model.effects:
         needed.append("gyration_m")
     missing = [
-        c
-        for c in (*needed, *FINITE_COLUMNS)
-        if c not in frame or frame[c].isna().all()
+        c for c in (*needed, *FINITE_COLUMNS) if c not in frame or frame[c].isna().all()
     ]
     if missing:
         raise InputFileError(

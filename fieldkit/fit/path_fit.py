@@ -54,7 +54,7 @@ from scipy.optimize import minimize
 
 from fieldkit.errors import ArgumentError
 from fieldkit.fit.holdout import crps_ensemble
-from fieldkit.fit.path_runs import PathRun, simulated_runouts
+from fieldkit.fit.path_runs import PathRun, one_kernel_thread, simulated_runouts
 from fieldkit.model.effects import registry
 from fieldkit.model.materials import MATERIAL_FIELDS
 from fieldkit.model.model_file import CORE_DEFAULTS, Model
@@ -158,10 +158,11 @@ class PathObjective:
     def ensembles(self, values: dict[str, float]) -> list[np.ndarray]:
         """Simulated runouts of every (observed) run with ``values`` set."""
         out = []
-        for run, i, keys in zip(self.runs, self.index, self._keys, strict=True):
-            mine = {k: v for k, v in values.items() if k in keys}
-            model = run.model.with_parameters(mine) if mine else run.model
-            out.append(simulated_runouts(run, model, self.rocks, self.seed, i))
+        with one_kernel_thread():
+            for run, i, keys in zip(self.runs, self.index, self._keys, strict=True):
+                mine = {k: v for k, v in values.items() if k in keys}
+                model = run.model.with_parameters(mine) if mine else run.model
+                out.append(simulated_runouts(run, model, self.rocks, self.seed, i))
         return out
 
     def per_run(self, x: np.ndarray) -> np.ndarray:

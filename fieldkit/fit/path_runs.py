@@ -19,8 +19,11 @@ changes smoothly with them.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
+import numba
 import numpy as np
 
 from fieldkit.model.model_file import Model
@@ -67,3 +70,20 @@ def simulated_runouts(
     at negative chainage)."""
     result = simulate(model, rocks, np.random.default_rng([seed, index]))
     return np.asarray(result.runout_x_m, float) - float(model.seeder.x_m)
+
+
+@contextmanager
+def one_kernel_thread() -> Iterator[None]:
+    """Run the simulator's kernel on one thread inside the block.
+
+    A path fit makes thousands of small simulations (tens to hundreds of rocks):
+    on a shared 2-core machine the kernel's parallel loop then waits on busy cores
+    (the Tschamut fit took 101 s beside a test run, 6-8 s alone), while one thread
+    costs 25 % when the machine is idle (7.9 s against 6.3 s, measured).
+    """
+    before = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(before)
