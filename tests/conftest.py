@@ -69,7 +69,7 @@ def digest():
 
 
 #: What a fresh clone ships for examples to read, copied into a scratch repository root.
-BUNDLED = ("surveys", "video", "tests/data", "tests/io/data")
+BUNDLED = ("surveys", "video", "tests/data", "tests/io/data", "examples/tschamut")
 
 
 @pytest.fixture()

@@ -60,11 +60,12 @@ from fieldkit.model.materials import MATERIAL_FIELDS
 from fieldkit.model.model_file import CORE_DEFAULTS, Model
 
 #: Finite search bounds of material fields (MATERIAL_FIELDS allows [0, inf) for
-#: most): restitution coefficients from well below to just under the physical
-#: range of natural slopes (thesis Table 7-1 spans e_n 0.1-0.5, e_t 0.5-0.95), SDs up
-#: to what RocFall users enter at most, friction 5-60 deg, CRSP roughness up to 1 m.
+#: most): restitution coefficients over the range thesis Table 7-1 uses and a
+#: margin (e_n up to 1.0 on Tornado Mountain's colluvium, with RocFall's velocity
+#: scaling; e_t 0.5-0.95), SDs up to what RocFall users enter at most, friction
+#: 5-60 deg, CRSP roughness up to 1 m.
 PRACTICAL_BOUNDS: dict[str, tuple[float, float]] = {
-    "e_n": (0.02, 0.95),
+    "e_n": (0.02, 1.2),
     "e_t": (0.1, 1.0),
     "friction_deg": (5.0, 60.0),
     "e_n_sd": (0.0, 0.2),
