@@ -25,7 +25,6 @@ Run:  python examples/calibrate_tornado_mountain.py [OUT_DIR]
 from __future__ import annotations
 
 import importlib.util
-import sys
 from dataclasses import replace
 from pathlib import Path
 
