@@ -408,10 +408,15 @@ def fit_paths(
     for b in range(bootstrap):
         weights = np.bincount(rng.integers(0, n_runs, n_runs), minlength=n_runs)
         weights = weights.astype(float)
+        # Each resample also draws new simulated rocks: the fitted values carry
+        # the Monte Carlo error of a finite ensemble, which a bootstrap over runs
+        # with the optimum's own rocks would leave out.
+        objective.seed = seed + 1 + b
         ub, _, _ = _minimise(f, u_best, 0.05, short)
         boot[b] = to_x(ub)
         if (b + 1) % 10 == 0:
             say(f"bootstrap {b + 1}/{bootstrap}")
+    objective.seed = seed
     weights = np.ones(n_runs)
     if bootstrap >= 2:
         stderr = boot.std(axis=0, ddof=1)
