@@ -72,7 +72,6 @@ class Step:
     cv_rmse_before: float
     cv_rmse: float
     candidates: list[Candidate]
-    confounded: list[list[str]] = field(default_factory=list)
 
     def to_json(self, metric: str) -> dict:
         """The contract's step entry (+ the error before the step)."""

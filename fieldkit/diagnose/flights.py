@@ -40,6 +40,7 @@ from fieldkit.diagnose.diagnosis import (
     Step,
 )
 from fieldkit.diagnose.groups import make_groups
+from fieldkit.diagnose.residual_tests import holm
 from fieldkit.diagnose.scoring import DEFAULT_Z, held_out, improvement, meaningful
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.model import drag_flight
@@ -247,12 +248,7 @@ def _dependence(
             rho = 0.0 if not np.isfinite(rho) else float(rho)
             p = 1.0 if not np.isfinite(p) else float(p)
             tests.append((feature, component, rho, p))
-    order = np.argsort([t[3] for t in tests])
-    significant = np.zeros(len(tests), bool)
-    for rank, i in enumerate(order):  # Holm step-down
-        if tests[i][3] > alpha / (len(tests) - rank):
-            break
-        significant[i] = True
+    significant = holm([t[3] for t in tests], alpha)
     return [
         Dependence(
             feature=feature,

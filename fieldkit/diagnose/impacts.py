@@ -31,7 +31,6 @@ weighted RMSE in m/s (plain RMSE with unit weights).
 
 from __future__ import annotations
 
-import math
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -50,6 +49,7 @@ from fieldkit.diagnose.scoring import (
     held_out,
     improvement,
     meaningful,
+    weighted_rmse,
 )
 from fieldkit.errors import InputFileError
 from fieldkit.fit.impact_fit import (
@@ -179,10 +179,7 @@ class _Scorer:
         result = fit_result(p, names, start, full, [])
         pred = p.predict(model, names, full.x)
         r_all = np.where(p.use, (p.observed - pred) * self.scale, np.nan)
-        ok = np.isfinite(r_all)
-        fit_rmse = math.sqrt(
-            float(np.sum(self.weight[ok] * r_all[ok] ** 2) / np.sum(self.weight[ok]))
-        )
+        fit_rmse = weighted_rmse(r_all, self.weight)
         held = held_out(residual, self.weight, self.groups.group, self.groups.n_groups)
         return Scored(
             model=model.with_parameters(
@@ -313,7 +310,7 @@ def diagnose_impacts(
             )
             break
         after = scored[best.effect]
-        steps.append(Step(best.effect, current.cv_rmse, after.cv_rmse, ranked, []))
+        steps.append(Step(best.effect, current.cv_rmse, after.cv_rmse, ranked))
         current = after
         accepted.append(after)
         remaining.remove(best.effect)
@@ -457,12 +454,8 @@ def _per_material(
         rows = labels == m
         entry = {"impacts": float(rows.sum())}
         for label, s in (("baseline", baseline), ("after", after)):
-            r, w = s.residual[rows], weight[rows]
-            ok = np.isfinite(r)
-            entry[f"{label}_cv_rmse_mps"] = (
-                math.sqrt(float(np.sum(w[ok] * r[ok] ** 2) / np.sum(w[ok])))
-                if ok.any()
-                else math.nan
+            entry[f"{label}_cv_rmse_mps"] = weighted_rmse(
+                s.residual[rows], weight[rows]
             )
             entry[f"{label}_bias_vfn_mps"] = float(np.nanmean(s.residual[rows, 0]))
             entry[f"{label}_bias_vft_mps"] = float(np.nanmean(s.residual[rows, 1]))

@@ -123,15 +123,30 @@ def _test(r: np.ndarray, values: np.ndarray) -> tuple[str, float] | None:
     return f"Spearman rho = {rho:+.2f}; binned Kruskal-Wallis p = {p_kw:.2g}", p
 
 
+def holm(p_values, alpha: float = ALPHA) -> np.ndarray:
+    """Holm's step-down: which of ``p_values`` are significant at family-wise
+    ``alpha`` (the k-th smallest needs ``p <= alpha / (m - k)``, and every smaller
+    one before it).
+
+    Examples
+    --------
+    >>> holm([0.001, 0.04, 0.02], alpha=0.05).tolist()
+    [True, True, True]
+    >>> holm([0.001, 0.04, 0.03], alpha=0.05).tolist()
+    [True, False, False]
+    """
+    p = np.asarray(p_values, float)
+    order = np.argsort(p, kind="stable")
+    passed = p[order] <= alpha / (p.size - np.arange(p.size))
+    out = np.zeros(p.size, bool)
+    out[order] = np.logical_and.accumulate(passed)
+    return out
+
+
 def _holm(results: list[Dependence]) -> list[Dependence]:
     """Mark significance by Holm's step-down at :data:`ALPHA`."""
-    order = np.argsort([d.p_value for d in results], kind="stable")
-    m = len(results)
-    still = True
-    for rank, i in enumerate(order):
-        d = results[i]
-        still = still and d.p_value <= ALPHA / (m - rank)
-        d.significant = bool(still)
+    for d, flag in zip(results, holm([d.p_value for d in results]), strict=True):
+        d.significant = bool(flag)
     return results
 
 

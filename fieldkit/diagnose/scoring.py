@@ -77,25 +77,19 @@ def improvement(reference: HeldOut, candidate: HeldOut) -> tuple[float, float]:
     return gain, _jackknife_se(left_out)
 
 
-def difference(
-    reference: HeldOut, first: HeldOut, second: HeldOut
-) -> tuple[float, float]:
-    """Paired ``improvement(first) - improvement(second)`` and its jackknife SE.
+def weighted_rmse(residual: np.ndarray, weight: np.ndarray) -> float:
+    """``sqrt(sum w r^2 / sum w)`` over the finite residuals (NaN when none).
 
     Examples
     --------
-    >>> ref = HeldOut(np.array([4.0, 4.0, 4.0]), np.ones(3))
-    >>> a = HeldOut(np.array([1.0, 1.0, 1.0]), np.ones(3))
-    >>> [round(v, 6) for v in difference(ref, a, ref)]
-    [0.5, 0.0]
+    >>> weighted_rmse(np.array([1.0, np.nan, 3.0]), np.array([1.0, 1.0, 3.0]))
+    2.6457513110645907
     """
-    base = reference.sse.sum()
-    gap = math.sqrt(second.sse.sum() / base) - math.sqrt(first.sse.sum() / base)
-    base_k = _without(reference.sse)
-    left_out = np.sqrt(_without(second.sse) / base_k) - np.sqrt(
-        _without(first.sse) / base_k
-    )
-    return gap, _jackknife_se(left_out)
+    ok = np.isfinite(residual)
+    if not ok.any():
+        return math.nan
+    w = np.broadcast_to(weight, residual.shape)[ok]
+    return math.sqrt(float(np.sum(w * residual[ok] ** 2) / np.sum(w)))
 
 
 def _without(per_group: np.ndarray) -> np.ndarray:
