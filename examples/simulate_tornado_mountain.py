@@ -28,11 +28,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from fieldkit.fit.path_along import flights
 from fieldkit.impact_table import ImpactTable
 from fieldkit.model import read_model, simulate
-from fieldkit.physics.constants import G
 from fieldkit.physics.flight import flight_between
-from fieldkit.physics.flight_heights import max_normal_height
 
 SURVEY = Path(__file__).resolve().parents[1] / "surveys" / "tornado_mountain"
 ROCKS, SEED = 5000, 2004
@@ -62,29 +61,11 @@ def measured_mean_flight_height_m() -> tuple[float, int]:
 
 
 def chunk_flight_heights(table: ImpactTable) -> np.ndarray:
-    """Normal heights [m] of the uninterrupted flights between consecutive impacts.
-
-    Uses ``hmax_normal_m`` when the simulator fills it; otherwise computes it from the
-    launch velocity and the chord to the next impact of the same rock (eq. 3.12),
-    keeping only flights whose parabola really lands on that impact (1 cm), i.e. no
-    sliding or other event in between.
-    """
-    f = table.frame
-    x, z = f["x_m"].to_numpy(float), f["z_m"].to_numpy(float)
-    launch = (x >= FLIGHTS_X_M[0]) & (x <= FLIGHTS_X_M[1])
-    if "hmax_normal_m" in f and f["hmax_normal_m"].notna().any():
-        h = f["hmax_normal_m"].to_numpy(float)
-        return h[launch & np.isfinite(h)]
-    same_rock = f["path_id"].to_numpy()[:-1] == f["path_id"].to_numpy()[1:]
-    vx, vz = f["vf_x_mps"].to_numpy(float)[:-1], f["vf_z_mps"].to_numpy(float)[:-1]
-    dx, dz = np.diff(x), np.diff(z)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = dx / vx
-        landed = np.abs(vz * t - 0.5 * G * t**2 - dz) < 0.01
-    ok = same_rock & launch[:-1] & landed & (dx > 0) & (vx > 0)
-    psi = np.degrees(np.arctan2(-dz[ok], dx[ok]))  # chord dip, + descending
-    theta0 = np.degrees(np.arctan2(vz[ok], vx[ok])) + psi  # eq. 3.6
-    return max_normal_height(np.hypot(vx[ok], vz[ok]), theta0, psi)
+    """Normal heights [m] of the uninterrupted flights between consecutive impacts
+    launched at x in :data:`FLIGHTS_X_M` (eq. 3.12 on the chord; no sliding, rolling
+    or other event in between: :func:`fieldkit.fit.path_along.flights`)."""
+    launch_x, _, height = flights(table)
+    return height[(launch_x >= FLIGHTS_X_M[0]) & (launch_x <= FLIGHTS_X_M[1])]
 
 
 def percentile_of(values: np.ndarray, measured: float) -> float:

@@ -39,14 +39,20 @@ EXPECTED = {
         r"fitted b = 1\.\d+ ± 0\.\d+ \(hidden truth 1\.03; [0-2]\.\d SE away\)",
         r"held-out error \d+\.\d+ -> \d+\.\d+ m/s \((?:[3-9]\d)% lower\)",
     ],
-    # Issue 11 item 5: Table 7-1 and the impact-calibrated model on the same
-    # simulator, beside boulder A's measured 18 m/s, 600 kJ and 1.68 m (Table 2-4)
+    # Issue 11 item 5: Table 7-1, the impact- and the path-calibrated model on the
+    # same simulator, beside boulder A's measured 18 m/s, 600 kJ and 1.68 m
     "calibrate_tornado_mountain.py": [
         r"boulder A: 48 impacts",
         r"measured: 18 m/s and 600 kJ at x = 610 m .* mean normal flight height "
         r"1\.68 m over 44 flights",
         r"Table 7-1 \(thesis, by hand\)\s+\d",
         r"calibrated on boulder A's impacts\s+\d",
+        # the path-level fit scores all four kinds of observation of the path
+        r"calibrated on boulder A's path \(\d+ evaluations",
+        r"runout_m\s+\d+\.\d+ ->\s+\d+\.\d+ \(1 observed\)",
+        r"flight_height_m\s+\d+\.\d+ ->\s+\d+\.\d+ \(48 observed\)",
+        r"speed_mps\s+\d+\.\d+ ->\s+\d+\.\d+ \(49 observed\)",
+        r"calibrated on boulder A's path\s+\d",
     ],
     # docs/real-data-diagnosis.md: Tornado Mountain boulder A's 48 impacts, naive
     # eq. 5.4 slope 0.71 (thesis pooled 1.03); the one-impact surveys are refused

@@ -45,7 +45,7 @@ def test_shell_blocks_run(repo_copy, shell_commands, run_shell, monkeypatch):
     # --version, reduce, impact, fence, view (2), effects, simulate, profile, synth,
     # fit, fit --paths, diagnose, synth --track, diagnose (track); the video block
     # runs when slow
-    assert ran == 15
+    assert ran == 16
     assert (repo_copy / "boulder_a.csv").is_file()
     assert (repo_copy / "boulder_a.rrd").is_file()
     assert {p.name for p in (repo_copy / "figs").iterdir()} >= {"section.png"}
@@ -55,6 +55,7 @@ def test_shell_blocks_run(repo_copy, shell_commands, run_shell, monkeypatch):
     out = repo_copy / "out"
     assert (out / "calibrated.json").is_file() and (out / "after.json").is_file()
     assert (out / "tschamut_calibrated.json").is_file()
+    assert (out / "boulder_a_path.json").is_file()
     assert (out / "diagnosis" / "report.md").is_file()
     assert (out / "track_diagnosis" / "report.md").is_file()
 

@@ -22,17 +22,26 @@ FLAGS = {
     "json_file": "--json",
     "holdout_releases": "--holdout-paths",
     "holdout_deposits": "--holdout-deposits",
+    "bound": "--bound",
+    "screen": "--screen",
 }
 
 
 def _paths(options: dict) -> None:
     from fieldkit.cli.fit_paths import fit_paths_command
 
-    for name in ("releases", "deposits", "dem"):
+    on_dem = options["deposits"] is not None or options["dem"] is not None
+    for name in ("releases", "deposits", "dem") if on_dem else ("releases",):
         if options[name] is None:
             raise ArgumentError(
-                "a path fit needs --paths, --deposits and --dem", source=name
+                "a path fit on a DEM needs --paths, --deposits and --dem", source=name
             )
+    if not on_dem and options["holdout_releases"] is not None:
+        raise ArgumentError(
+            "held-out runs need a DEM (--deposits and --dem): a surveyed path "
+            "is fitted on the model's own profile",
+            source="holdout_releases",
+        )
     if (options["holdout_releases"] is None) != (options["holdout_deposits"] is None):
         raise ArgumentError(
             "--holdout-paths and --holdout-deposits go together",
@@ -57,6 +66,8 @@ def _paths(options: dict) -> None:
         seed=options["seed"],
         bootstrap=options["bootstrap"],
         section=options["section"],
+        screen=options["screen"],
+        bounds=options["bound"],
     )
 
 
@@ -124,6 +135,20 @@ def fit(
     bootstrap: Annotated[
         int, typer.Option("--bootstrap", help="Path fit: bootstrap resamples of runs.")
     ] = 20,
+    screen: Annotated[
+        int,
+        typer.Option(
+            "--screen",
+            help="Path fit: Sobol points screened for a better start (0: none).",
+        ),
+    ] = 16,
+    bound: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--bound",
+            help="Path fit: search bounds NAME=LO,HI of a free parameter (repeatable).",
+        ),
+    ] = None,
     section: Annotated[
         str,
         typer.Option(
@@ -162,6 +187,9 @@ def fit(
     uncertainty over runs; held-out runs, when given, are scored for the
     calibrated model, the starting model and the climatology (the calibration
     runs' observed runouts). The README shows it on the Tschamut 2014 runs.
+    With --paths alone, the file is an ImpactTable from reduce and each path is
+    fitted on the model's own profile: its runout, flight heights, impact spacing
+    and speeds at the impacts.
     """
     if releases is not None or deposits is not None or dem is not None:
         _paths(locals())

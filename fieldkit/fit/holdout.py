@@ -78,6 +78,52 @@ def crps_ensemble(samples: np.ndarray, observed: float) -> float:
     return float(np.mean(np.abs(x - y)) - spread)
 
 
+def crps_ensemble_many(
+    samples: np.ndarray, observed: np.ndarray, weights: np.ndarray | None = None
+) -> np.ndarray:
+    """CRPS of the empirical distribution of ``samples`` at each of ``observed``.
+
+    The same number as :func:`crps_ensemble` for every observation, with one sort;
+    with ``weights`` (>= 0, any sum), the CRPS of the weighted step CDF. With the
+    members sorted, normalised weights :math:`w_i` and cumulative weights
+    :math:`C_i`,
+
+    .. math::
+        \\mathrm{CRPS}(y) = \\sum_i w_i |x_i - y|
+        - \\sum_i w_i x_i (2 C_i - w_i - 1),
+
+    the first sum being :math:`y (2 W_y - 1) - 2 S_y + S` (:math:`W_y`, :math:`S_y`:
+    weight and weighted sum of the members at most ``y``), the second
+    :math:`\\tfrac12 E|X - X'|`.
+
+    Examples
+    --------
+    >>> crps_ensemble_many(np.array([0.0, 1.0]), np.array([0.5, 5.0])).tolist()
+    [0.25, 4.25]
+    >>> crps_ensemble_many(np.array([0.0, 1.0]), np.array([0.5]), np.array([1, 3.0]))
+    array([0.3125])
+    """
+    x = np.asarray(samples, float).ravel()
+    w = np.ones(x.size) if weights is None else np.asarray(weights, float).ravel()
+    keep = np.isfinite(x) & (w > 0)
+    x, w = x[keep], w[keep]
+    order = np.argsort(x, kind="stable")
+    x, w = x[order], w[order]
+    y = np.asarray(observed, float).ravel()
+    if x.size == 0:
+        return np.full(y.shape, np.nan)
+    w = w / w.sum()
+    cw = np.cumsum(w)
+    cwx = np.concatenate([[0.0], np.cumsum(w * x)])
+    k = np.searchsorted(x, y, side="right")
+    below = np.concatenate([[0.0], cw])[k]
+    absolute = y * (2.0 * below - 1.0) - 2.0 * cwx[k] + cwx[-1]
+    spread = float(np.dot(w * x, 2.0 * cw - w - 1.0))
+    out = absolute - spread
+    out[~np.isfinite(y)] = np.nan
+    return out
+
+
 def central_interval(samples: np.ndarray, level: float) -> tuple[float, float]:
     """The central ``level`` interval of ``samples``: its (1 - level)/2 and
     (1 + level)/2 quantiles (numpy's default linear interpolation).

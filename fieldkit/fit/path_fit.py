@@ -1,4 +1,4 @@
-"""Path-level fit: simulator parameters that make observed runouts likely.
+"""Path-level fit: simulator parameters that make observed paths likely.
 
 Each observed run (:class:`~fieldkit.fit.path_runs.PathRun`) is simulated on its own
 section with ``rocks`` rocks; the objective is the mean over runs of the CRPS of the
@@ -8,6 +8,12 @@ parameters for location *and* spread, Gneiting & Raftery 2007),
 
 .. math:: S(\\theta) = \\frac1N \\sum_{r=1}^N \\mathrm{CRPS}(F_{r,\\theta}, y_r).
 
+Where the runs carry observations along their paths (flight heights, impact
+spacing, speeds at the impacts: :mod:`fieldkit.fit.path_along`), each observed value
+is scored the same way and every kind weighs alike (:class:`PathObjective`): a
+single surveyed path such as Tornado Mountain's boulder A is fitted on its 45
+flights and impacts, not on its one runout.
+
 Common random numbers: run ``r`` is always simulated with
 ``default_rng([seed, r])`` (:func:`~fieldkit.fit.path_runs.simulated_runouts`), so
 :math:`S` is a deterministic function of the parameters for a seed (changing by
@@ -15,11 +21,12 @@ steps where a rock's sequence of contacts changes, otherwise continuously).
 
 Search: derivative-free Nelder-Mead (scipy, with bounds) in the unit cube of the
 practical bounds (:data:`PRACTICAL_BOUNDS`, the effects' own bounds, or the caller's),
-from the base model's values, restarted once from its best point with a fresh small
-simplex (the usual guard against a collapsed simplex). Nelder-Mead rather than a
-Bayesian optimiser: with 1-4 parameters and an evaluation of tens of milliseconds it
-converges in ~100 evaluations, needs no extra dependency, and the bootstrap below
-needs many cheap local refits, which it does well.
+from the base model's values -- and, with ``screen``, also from the best point of a
+scrambled Sobol screen of the box when it beats them -- restarted once from the best
+optimum with a fresh small simplex (the usual guard against a collapsed simplex).
+Nelder-Mead rather than a Bayesian optimiser: with 1-4 parameters and an evaluation
+of tens of milliseconds it converges in ~100 evaluations, needs no extra dependency,
+and the bootstrap below needs many cheap local refits, which it does well.
 
 Uncertainty: a bootstrap over runs (Efron & Tibshirani 1993, ch. 6): the runs are
 resampled with replacement ``bootstrap`` times (equivalently, integer weights on the
@@ -51,9 +58,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.optimize import minimize
+from scipy.stats import qmc
 
 from fieldkit.errors import ArgumentError
-from fieldkit.fit.holdout import crps_ensemble
+from fieldkit.fit.holdout import crps_ensemble, crps_ensemble_many
+from fieldkit.fit.path_along import (
+    KINDS,
+    AlongObservations,
+    observed_along,
+    simulated_along,
+)
 from fieldkit.fit.path_runs import PathRun, one_kernel_thread, simulated_runouts
 from fieldkit.model.effects import registry
 from fieldkit.model.materials import MATERIAL_FIELDS
@@ -123,10 +137,29 @@ def parameter_bounds(name: str) -> tuple[float, float]:
 
 
 class PathObjective:
-    """Per-run CRPS of observed runouts against simulated ensembles.
+    """Proper scores of what was observed along the runs against simulated ensembles.
 
-    Runs with a non-finite observed runout are left out; run ``runs[i]`` always uses
-    the common random numbers ``default_rng([seed, i])``.
+    Every observed value of every kind (:data:`fieldkit.fit.path_along.KINDS`) is
+    scored by the CRPS of its simulated ensemble; the objective is the sum over
+    kinds of the kind's weighted mean CRPS divided by its scale,
+
+    .. math:: S(\\theta) = \\sum_k \\frac{1}{s_k \\sum_i w_{ki}}
+              \\sum_{i=1}^{N_k} w_{ki}\\, \\mathrm{CRPS}(F_{ki,\\theta}, y_{ki}),
+
+    (weights :math:`w_{ki}` = 1, but the flight length for flight heights),
+
+    with :math:`s_k = 1` when one kind is scored (the objective is then that kind's
+    mean CRPS in its unit: metres for runouts) and, when several are, :math:`s_k` =
+    the kind's mean CRPS under the starting parameters (:meth:`set_scales`), so that
+    each kind weighs alike and the objective starts at the number of kinds.
+
+    The objective is a sum of *units* (:meth:`units`): one per run when there are at
+    least two runs (a run's contribution over all its kinds), else one per observed
+    value, grouped by kind (*strata*). The bootstrap resamples units within strata,
+    and the slices' standard errors are those of a stratified sum.
+
+    Runs with a non-finite observed runout score no runout; run ``runs[i]`` always
+    uses the common random numbers ``default_rng([seed, i])``.
 
     Parameters
     ----------
@@ -138,36 +171,151 @@ class PathObjective:
         simulated without it).
     rocks, seed
         Rocks per run, and the seed of the common random numbers.
+    kinds
+        Kinds to score (default: every kind observed on some run).
     """
 
     def __init__(
-        self, runs: Sequence[PathRun], names: Sequence[str], rocks: int, seed: int
+        self,
+        runs: Sequence[PathRun],
+        names: Sequence[str],
+        rocks: int,
+        seed: int,
+        kinds: Sequence[str] | None = None,
     ):
-        self.runs = [r for r in runs if math.isfinite(r.observed_runout_m)]
-        self.index = [
-            i for i, r in enumerate(runs) if math.isfinite(r.observed_runout_m)
+        if kinds is not None:
+            unknown = sorted(set(kinds) - set(KINDS))
+            if unknown:
+                raise ArgumentError(
+                    f"unknown kinds {', '.join(unknown)} (known: {', '.join(KINDS)})",
+                    source="kinds",
+                )
+        self.all_runs = list(runs)
+        observed = [observed_along(r) for r in runs]
+        if kinds is not None:
+            observed = [
+                AlongObservations(
+                    {k: v for k, v in o.values.items() if k in kinds},
+                    o.speed_chainage_m if "speed_mps" in kinds else np.zeros(0),
+                    o.launch_range_m,
+                    o.weights,
+                )
+                for o in observed
+            ]
+        keep = [i for i, o in enumerate(observed) if o.values]
+        if not keep:
+            raise ArgumentError(
+                "no run has an observed runout or along-path observation",
+                source="runs",
+            )
+        self.index = keep
+        self.runs = [runs[i] for i in keep]
+        self.observed_along = [observed[i] for i in keep]
+        self.kinds = [
+            k for k in KINDS if any(k in o.values for o in self.observed_along)
         ]
-        if not self.runs:
-            raise ArgumentError("no run has an observed runout", source="runs")
         self.names = list(names)
         self.rocks = int(rocks)
         self.seed = int(seed)
         self.observed = np.array([r.observed_runout_m for r in self.runs], float)
         self._keys = [set(r.model.parameters()) for r in self.runs]
+        self.scales = dict.fromkeys(self.kinds, 1.0)
         self.evaluations = 0
+        # Flat layout of the observed values: kind, run (position in self.runs).
+        kind_of, run_of, weight = [], [], []
+        for j, o in enumerate(self.observed_along):
+            for k in self.kinds:
+                if k in o.values:
+                    kind_of += [k] * o.values[k].size
+                    run_of += [j] * o.values[k].size
+                    weight.append(o.weight(k))
+        self._kind = np.array(kind_of)
+        self._run = np.array(run_of, int)
+        self._weight = np.concatenate(weight)
+        self.counts = {k: int(np.sum(self._kind == k)) for k in self.kinds}
+        self._total = {
+            k: float(self._weight[self._kind == k].sum()) for k in self.kinds
+        }
+        if len(self.runs) >= 2:
+            self.strata = [np.arange(len(self.runs))]
+        else:
+            self.strata = [np.flatnonzero(self._kind == k) for k in self.kinds]
+
+    @property
+    def along(self) -> bool:
+        """Whether anything but runouts is scored."""
+        return self.kinds != ["runout_m"]
+
+    def _models(self, values: dict[str, float]):
+        for run, i, keys in zip(self.runs, self.index, self._keys, strict=True):
+            mine = {k: v for k, v in values.items() if k in keys}
+            yield run, i, (run.model.with_parameters(mine) if mine else run.model)
 
     def ensembles(self, values: dict[str, float]) -> list[np.ndarray]:
-        """Simulated runouts of every (observed) run with ``values`` set."""
+        """Simulated runouts of every scored run with ``values`` set."""
+        with one_kernel_thread():
+            return [
+                simulated_runouts(run, model, self.rocks, self.seed, i)
+                for run, i, model in self._models(values)
+            ]
+
+    def observation_scores(self, x: np.ndarray) -> np.ndarray:
+        """CRPS of every observed value (flat layout: runs, then kinds) at ``x``."""
+        values = dict(zip(self.names, map(float, x), strict=True))
+        self.evaluations += 1
         out = []
         with one_kernel_thread():
-            for run, i, keys in zip(self.runs, self.index, self._keys, strict=True):
-                mine = {k: v for k, v in values.items() if k in keys}
-                model = run.model.with_parameters(mine) if mine else run.model
-                out.append(simulated_runouts(run, model, self.rocks, self.seed, i))
-        return out
+            for (run, i, model), obs in zip(
+                self._models(values), self.observed_along, strict=True
+            ):
+                if self.along:
+                    sims = simulated_along(run, model, obs, self.rocks, self.seed, i)
+                else:
+                    sims = {
+                        "runout_m": [
+                            simulated_runouts(run, model, self.rocks, self.seed, i)
+                        ]
+                    }
+                for k in self.kinds:
+                    if k not in obs.values:
+                        continue
+                    ens, ys = sims[k], obs.values[k]
+                    if isinstance(ens[0], tuple):  # a weighted pool
+                        out.append(crps_ensemble_many(ens[0][0], ys, ens[0][1]))
+                    elif all(e is ens[0] for e in ens):
+                        out.append(crps_ensemble_many(ens[0], ys))
+                    else:
+                        pairs = zip(ens, ys, strict=True)
+                        out.append(np.array([crps_ensemble(e, y) for e, y in pairs]))
+        return np.concatenate(out)
+
+    def units(self, x: np.ndarray) -> np.ndarray:
+        """The objective's units at ``x`` (class docstring): their sum is S."""
+        scores = self.observation_scores(x)
+        scale = np.array([self.scales[k] * self._total[k] for k in self._kind])
+        parts = scores * self._weight / scale
+        if len(self.runs) >= 2:
+            return np.bincount(self._run, parts, minlength=len(self.runs))
+        return parts
+
+    def set_scales(self, x: np.ndarray) -> dict[str, float]:
+        """Scale every kind by its mean CRPS at ``x`` (when several are scored)."""
+        if len(self.kinds) > 1:
+            for k, mean in self.kind_means(x).items():
+                self.scales[k] = mean if mean > 0 else 1.0
+        return dict(self.scales)
+
+    def kind_means(self, x: np.ndarray) -> dict[str, float]:
+        """(Weighted) mean CRPS of each kind at ``x``, in the kind's unit."""
+        scores = self.observation_scores(x)
+        return {
+            k: float(np.average(scores[m], weights=self._weight[m]))
+            for k in self.kinds
+            for m in [self._kind == k]
+        }
 
     def per_run(self, x: np.ndarray) -> np.ndarray:
-        """CRPS [m] of each run at parameter vector ``x`` (order of ``names``)."""
+        """CRPS [m] of each scored run's runout at ``x`` (NaN: none observed)."""
         values = dict(zip(self.names, map(float, x), strict=True))
         self.evaluations += 1
         return np.array(
@@ -178,8 +326,8 @@ class PathObjective:
         )
 
     def __call__(self, x: np.ndarray) -> float:
-        """Mean CRPS [m] over runs at ``x``."""
-        return float(np.mean(self.per_run(x)))
+        """The objective S at ``x``."""
+        return float(np.sum(self.units(x)))
 
 
 @dataclass
@@ -198,7 +346,7 @@ class PathFitResult:
     pinned: list[bool]
     objective_start: float
     objective_optimum: float
-    run_crps: np.ndarray  # per observed run, at the optimum
+    run_crps: np.ndarray  # runout CRPS per scored run, at the optimum (NaN: none)
     run_ids: list[str]
     n_runs: int
     n_evaluations: int
@@ -208,6 +356,11 @@ class PathFitResult:
     bootstrap: np.ndarray  # (B, p) refitted values
     model: Model
     notes: list[str] = field(default_factory=list)
+    kinds: list[str] = field(default_factory=lambda: ["runout_m"])
+    kind_counts: dict[str, int] = field(default_factory=dict)
+    scales: dict[str, float] = field(default_factory=dict)
+    kind_start: dict[str, float] = field(default_factory=dict)
+    kind_optimum: dict[str, float] = field(default_factory=dict)
 
     def value(self, name: str) -> float:
         """The fitted value of ``name``."""
@@ -249,11 +402,25 @@ class PathFitResult:
             ],
             "correlation": self.correlation.tolist(),
             "slice_compatible": self.compatible.tolist(),
-            "objective": "mean CRPS of observed runouts [m]",
+            "objective": (
+                "mean CRPS of observed runouts [m]"
+                if self.kinds == ["runout_m"]
+                else "sum over kinds of the mean CRPS / its value at the start"
+            ),
+            "kinds": [
+                {
+                    "kind": k,
+                    "observations": self.kind_counts.get(k, 0),
+                    "scale": self.scales.get(k, 1.0),
+                    "crps_start": self.kind_start.get(k, math.nan),
+                    "crps_optimum": self.kind_optimum.get(k, math.nan),
+                }
+                for k in self.kinds
+            ],
             "objective_start": self.objective_start,
             "objective_optimum": self.objective_optimum,
             "runs": [
-                {"path_id": i, "crps_m": float(c)}
+                {"path_id": i, "crps_m": float(c) if math.isfinite(c) else None}
                 for i, c in zip(self.run_ids, self.run_crps, strict=True)
             ],
             "n_runs": self.n_runs,
@@ -264,6 +431,15 @@ class PathFitResult:
             "bootstrap_size": int(self.bootstrap.shape[0]),
             "notes": list(self.notes),
         }
+
+
+def _stratified_se(diff: np.ndarray, strata: Sequence[np.ndarray]) -> float:
+    """Standard error of ``diff.sum()`` with units i.i.d. within each stratum."""
+    var = 0.0
+    for stratum in strata:
+        if stratum.size > 1:
+            var += stratum.size * float(np.var(diff[stratum], ddof=1))
+    return math.sqrt(var)
 
 
 def _simplex(u0: np.ndarray, step: float) -> np.ndarray:
@@ -308,6 +484,8 @@ def fit_paths(
     max_evaluations: int | None = None,
     bootstrap_evaluations: int | None = None,
     slice_points: int = 9,
+    kinds: Sequence[str] | None = None,
+    screen: int = 0,
 ) -> PathFitResult:
     """Fit the ``free`` parameters to the observed runouts of ``runs``.
 
@@ -340,6 +518,14 @@ def fit_paths(
     slice_points
         Points of the objective's slice across each parameter's bound range (module
         docstring).
+    screen
+        Points of a scrambled Sobol screen of the bound box evaluated before the
+        search; when the best beats the start, the search also starts from it and
+        keeps the better optimum (0: start from the base model only).
+    kinds
+        What to score (:data:`fieldkit.fit.path_along.KINDS`; default every kind
+        observed on some run: runouts, and along the paths flight heights, impact
+        spacing and speeds where the runs carry them).
 
     Returns
     -------
@@ -357,8 +543,9 @@ def fit_paths(
                 f"unknown parameter {name} (known: {', '.join(known)})", source="free"
             )
     bounds = dict(bounds or {})
-    lower = np.array([bounds.get(n, parameter_bounds(n))[0] for n in names], float)
-    upper = np.array([bounds.get(n, parameter_bounds(n))[1] for n in names], float)
+    box = [bounds[n] if n in bounds else parameter_bounds(n) for n in names]
+    lower = np.array([lo for lo, _ in box], float)
+    upper = np.array([hi for _, hi in box], float)
     if np.any(~(upper > lower)):
         raise ArgumentError("every upper bound must exceed its lower", source="bounds")
     start = dict(start or {})
@@ -371,31 +558,71 @@ def fit_paths(
     x0 = clipped
     span = upper - lower
     p = len(names)
-    objective = PathObjective(runs, names, rocks, seed)
+    objective = PathObjective(runs, names, rocks, seed, kinds)
     n_runs = len(objective.runs)
     if n_runs < len(runs):
-        notes.append(f"{len(runs) - n_runs} runs without an observed runout left out")
+        notes.append(f"{len(runs) - n_runs} runs without any observation left out")
+    unscored = sum(1 for r in objective.runs if not math.isfinite(r.observed_runout_m))
+    if unscored:
+        notes.append(f"{unscored} runs without an observed runout: no runout scored")
+    if n_runs == 1 and bootstrap:
+        notes.append(
+            "one run: the bootstrap resamples its observed values within each kind "
+            "(the values of one path are not independent: the intervals are a lower "
+            "bound on the uncertainty)"
+        )
 
     def to_x(u):
         return lower + span * np.clip(u, 0.0, 1.0)
 
-    weights = np.ones(n_runs)
+    n_units = sum(s.size for s in objective.strata)
+    weights = np.ones(n_units)
 
     def f(u):
-        crps = objective.per_run(to_x(u))
+        units = objective.units(to_x(u))
         if objective.evaluations % 25 == 0:
             say(f"  {objective.evaluations} evaluations")
-        return float(np.dot(weights, crps) / weights.sum())
+        return float(np.dot(weights, units))
 
     u0 = (x0 - lower) / span
+    scales = objective.set_scales(x0)
+    kind_start = objective.kind_means(x0)
+    unit = "m" if objective.kinds == ["runout_m"] else ""
+    if len(objective.kinds) > 1:
+        say(
+            "scored: "
+            + ", ".join(f"{k} ({objective.counts[k]})" for k in objective.kinds)
+            + "; each scaled by its CRPS at the start"
+        )
     f0 = f(u0)
-    say(f"fit {p} parameters to {n_runs} runs ({rocks} rocks each): start {f0:.3f} m")
+    say(
+        f"fit {p} parameters to {n_runs} runs ({rocks} rocks each): "
+        f"start {f0:.3f}{unit and ' ' + unit}"
+    )
     budget = max_evaluations or max(150, 60 * p)
-    u1, f1, n1 = _minimise(f, u0, 0.15, int(budget * 0.7))
-    u2, f2, _ = _minimise(f, u1, 0.05, max(budget - n1, p + 2))
+    starts = [u0]
+    if screen > 0:
+        # Screen the cube (scrambled Sobol points, seeded): an objective of
+        # simulated paths can have several basins (a rolling and a bouncing
+        # regime), and Nelder-Mead only finds the one it starts in.
+        sobol = qmc.Sobol(p, scramble=True, seed=np.random.default_rng([seed, 3]))
+        points = sobol.random(screen)
+        values = np.array([f(u) for u in points])
+        best = int(np.argmin(values))
+        say(f"screened {screen} points: best {values[best]:.3f} (start {f0:.3f})")
+        if values[best] < f0:
+            starts.append(points[best])
+    first = int(budget * 0.7) // len(starts)
+    u1, f1, n1 = min((_minimise(f, u, 0.15, first) for u in starts), key=lambda r: r[1])
+    u2, f2, _ = _minimise(f, u1, 0.05, max(budget - first * len(starts), p + 2))
     u_best, f_best = (u2, f2) if f2 <= f1 else (u1, f1)
     x_best = to_x(u_best)
-    say(f"optimum {f_best:.3f} m after {objective.evaluations} evaluations")
+    say(
+        f"optimum {f_best:.3f}{unit and ' ' + unit} after {objective.evaluations} "
+        "evaluations"
+    )
+    best_units = objective.units(x_best)
+    kind_optimum = objective.kind_means(x_best)
     run_crps = objective.per_run(x_best)
     at_bound = np.isclose(u_best, 0.0, atol=1e-3) | np.isclose(u_best, 1.0, atol=1e-3)
     for n, flag in zip(names, at_bound, strict=True):
@@ -406,8 +633,10 @@ def fit_paths(
     short = bootstrap_evaluations or 20 * p + 10
     boot = np.empty((bootstrap, p))
     for b in range(bootstrap):
-        weights = np.bincount(rng.integers(0, n_runs, n_runs), minlength=n_runs)
-        weights = weights.astype(float)
+        weights = np.zeros(n_units)
+        for stratum in objective.strata:
+            draw = rng.integers(0, stratum.size, stratum.size)
+            weights[stratum] = np.bincount(draw, minlength=stratum.size)
         # Each resample also draws new simulated rocks: the fitted values carry
         # the Monte Carlo error of a finite ensemble, which a bootstrap over runs
         # with the optimum's own rocks would leave out.
@@ -417,7 +646,7 @@ def fit_paths(
         if (b + 1) % 10 == 0:
             say(f"bootstrap {b + 1}/{bootstrap}")
     objective.seed = seed
-    weights = np.ones(n_runs)
+    weights = np.ones(n_units)
     if bootstrap >= 2:
         stderr = boot.std(axis=0, ddof=1)
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -439,9 +668,9 @@ def fit_paths(
         for value in grid:
             x = x_best.copy()
             x[j] = value
-            diff = objective.per_run(x) - run_crps
-            se = diff.std(ddof=1) / math.sqrt(n_runs) if n_runs > 1 else 0.0
-            if diff.mean() <= Z90 * se:
+            diff = objective.units(x) - best_units
+            se = _stratified_se(diff, objective.strata)
+            if diff.sum() <= Z90 * se:
                 ok.append(value)
         compatible[j] = min(ok), max(ok)
     say(f"slices done after {objective.evaluations} evaluations")
@@ -492,7 +721,12 @@ def fit_paths(
         compatible=compatible,
         pinned=pinned,
         objective_start=f0,
-        objective_optimum=float(np.mean(run_crps)),
+        objective_optimum=float(np.sum(best_units)),
+        kinds=list(objective.kinds),
+        kind_counts=dict(objective.counts),
+        scales=scales,
+        kind_start=kind_start,
+        kind_optimum=kind_optimum,
         run_crps=run_crps,
         run_ids=[r.path_id for r in objective.runs],
         n_runs=n_runs,

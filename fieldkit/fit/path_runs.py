@@ -21,13 +21,15 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numba
 import numpy as np
 
-from fieldkit.model.model_file import Model
+from fieldkit.errors import ArgumentError, InputFileError
+from fieldkit.model.model_file import Body, Model
 from fieldkit.model.simulate import simulate
+from fieldkit.path_observations import PathObservations
 
 
 @dataclass(frozen=True)
@@ -70,6 +72,107 @@ def simulated_runouts(
     at negative chainage)."""
     result = simulate(model, rocks, np.random.default_rng([seed, index]))
     return np.asarray(result.runout_x_m, float) - float(model.seeder.x_m)
+
+
+def run_body(body: Body, row) -> Body:
+    """The block of a run: ``body`` with the run's ``mass_kg``, ``radius_m`` and
+    ``gyration_m`` where they are finite (a new radius without a gyration: that of
+    a solid sphere, sqrt(0.4) r)."""
+    mass, radius = float(row["mass_kg"]), float(row["radius_m"])
+    if not (math.isfinite(mass) or math.isfinite(radius)):
+        return body
+    r = radius if math.isfinite(radius) else body.radius_m
+    gyration = float(row["gyration_m"])
+    if not math.isfinite(gyration):
+        gyration = math.sqrt(0.4) * r if math.isfinite(radius) else body.gyration_m
+    return Body(
+        mass_kg=mass if math.isfinite(mass) else body.mass_kg,
+        radius_m=r,
+        gyration_m=gyration,
+    )
+
+
+def section_runs(observations: PathObservations, base_model: Model) -> list[PathRun]:
+    """Runs observed along the base model's own profile (section coordinates).
+
+    For observations already on one 2-D section -- an ImpactTable from ``reduce``
+    through :func:`fieldkit.io.path_observations.observations_from_impact_table` --
+    whose x is the chainage of ``base_model``'s profile (its elevations may be on
+    another datum: only chainages are used). Each run keeps the base model with its
+    own block (mass, radius, gyration where given) and the seeder moved to the
+    release chainage at the seeder's own height above the ground; the observed
+    runout and every along-path chainage are measured from the release.
+
+    Raises
+    ------
+    InputFileError
+        Plan observations, or a release or deposit off the profile (the file and
+        the run named).
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> from fieldkit.model.model_file import model_from_dict
+    >>> m = model_from_dict({"profile": {"x_m": [0, 50], "z_m": [30, 0],
+    ...   "material": "rock"}, "materials": {"rock": {"e_n": 0.3, "e_t": 0.8,
+    ...   "friction_deg": 25}}, "body": {"mass_kg": 100, "radius_m": 0.2},
+    ...   "seeder": {"x_m": 0, "z_m": 31}})
+    >>> obs = PathObservations(pd.DataFrame({"path_id": ["a"],
+    ...     "release_x_m": [5.0], "release_y_m": [0.0], "release_z_m": [800.0],
+    ...     "deposit_x_m": [45.0], "deposit_y_m": [0.0], "deposit_z_m": [760.0]}),
+    ...     coordinates="section")
+    >>> run = section_runs(obs, m)[0]
+    >>> run.observed_runout_m, run.model.seeder.x_m, run.model.seeder.z_m
+    (40.0, 5.0, 28.0)
+    """
+    source = observations.source or "observations"
+    if observations.coordinates != "section":
+        raise InputFileError(
+            "the observations are in a plan grid: cut their sections from a DEM "
+            "(fieldkit.fit.path_sections.path_runs)",
+            source=source,
+        )
+    profile = base_model.profile
+    x0, x1 = float(profile.x_m[0]), float(profile.x_m[-1])
+    seeder = base_model.seeder
+    above = seeder.z_m - float(np.interp(seeder.x_m, profile.x_m, profile.z_m))
+    runs = []
+    for path_id in observations.path_ids():
+        row = observations.row(path_id)
+        release = float(row["release_x_m"])
+        deposit = float(row["deposit_x_m"])
+        for what, x in (("release", release), ("deposit", deposit)):
+            if math.isfinite(x) and not x0 <= x <= x1:
+                raise InputFileError(
+                    f"the {what} (x = {x:g} m) is off the model's profile "
+                    f"[{x0:g}, {x1:g}] m",
+                    source=source,
+                    where=path_id,
+                )
+        body = run_body(base_model.body, row)
+        ground = float(np.interp(release, profile.x_m, profile.z_m))
+        moved = replace(seeder, x_m=release, z_m=ground + above)
+        model = replace(base_model, body=body, seeder=moved)
+        along = observations.along_path(path_id)
+        extra = {}
+        if len(along):
+            extra["along_chainage_m"] = along["x_m"].to_numpy(float) - release
+            extra["along_z_m"] = along["z_m"].to_numpy(float)
+            for name in along.columns[5:]:
+                extra[f"along_{name}"] = along[name].to_numpy(float)
+        runs.append(
+            PathRun(
+                path_id=path_id,
+                model=model,
+                observed_runout_m=deposit - release,
+                lateral_offset_m=0.0,
+                group=str(row["group"]),
+                observations=extra,
+            )
+        )
+    if not runs:
+        raise ArgumentError("no runs in the observations", source="observations")
+    return runs
 
 
 @contextmanager

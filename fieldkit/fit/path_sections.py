@@ -65,14 +65,14 @@ from dataclasses import replace
 import numpy as np
 
 from fieldkit.errors import ArgumentError, InputFileError
-from fieldkit.fit.path_runs import PathRun
+from fieldkit.fit.path_runs import PathRun, run_body
 from fieldkit.io.dem import INSIDE, DemGrid
 from fieldkit.model.dem_profile import (
     Section,
     profile_along_polyline,
     steepest_descent_line,
 )
-from fieldkit.model.model_file import Body, Model
+from fieldkit.model.model_file import Model
 from fieldkit.model.profile import Profile
 from fieldkit.path_observations import PathObservations
 
@@ -366,9 +366,7 @@ def _extend_to_edge(grid, section: Section, step: float) -> Section:
     vertices = np.column_stack([px, py]).tolist()
     vertices.append([px[-1] + t * dx / norm, py[-1] + t * dy / norm])
     cut = profile_along_polyline(grid, vertices, step)
-    return replace(
-        cut, ending=f"{section.ending}, then straight on to the grid edge"
-    )
+    return replace(cut, ending=f"{section.ending}, then straight on to the grid edge")
 
 
 def nearest_on_section(section: Section, x: float, y: float) -> tuple[float, float]:
@@ -439,19 +437,7 @@ def _run_model(base: Model, cut: Section, names, row, back=None) -> Model:
         z = np.concatenate([back.z_m[:-1], z])
         names = [names[0]] * (len(back.chainage_m) - 1) + names
     profile = Profile.from_arrays(x, z, names, source=base.source)
-    radius = float(row["radius_m"])
-    mass = float(row["mass_kg"])
-    body = base.body
-    if math.isfinite(radius) or math.isfinite(mass):
-        r = radius if math.isfinite(radius) else body.radius_m
-        gyration = float(row["gyration_m"])
-        if not math.isfinite(gyration):
-            gyration = math.sqrt(0.4) * r if math.isfinite(radius) else body.gyration_m
-        body = Body(
-            mass_kg=mass if math.isfinite(mass) else body.mass_kg,
-            radius_m=r,
-            gyration_m=gyration,
-        )
+    body = run_body(base.body, row)
     ground = float(cut.z_m[0])
     own = float(row["release_ground_z_m"])
     above = float(row["release_z_m"]) - (own if math.isfinite(own) else ground)

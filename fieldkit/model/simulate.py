@@ -147,12 +147,22 @@ def body_of(model: Model, mass_kg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return model.body.radius_m * cube, model.body.gyration_m * cube
 
 
+def impact_columns(
+    rec: np.ndarray, impacts: np.ndarray, first_rock: int
+) -> dict[str, np.ndarray]:
+    """Kernel impact rows of consecutive rocks as named arrays
+    (:data:`kernel.RECORD_COLUMNS` plus ``rock``, the rock's index in the run)."""
+    cols = dict(zip(kernel.RECORD_COLUMNS, rec.T, strict=True))
+    cols["rock"] = np.repeat(np.arange(first_rock, first_rock + impacts.size), impacts)
+    return cols
+
+
 def impact_frame(
     rec: np.ndarray, impacts: np.ndarray, first_rock: int, names: tuple[str, ...]
 ) -> ImpactTable:
     """ImpactTable (derived) from kernel impact rows of consecutive rocks."""
-    cols = dict(zip(kernel.RECORD_COLUMNS, rec.T, strict=True))
-    rock = np.repeat(np.arange(first_rock, first_rock + impacts.size), impacts)
+    cols = impact_columns(rec, impacts, first_rock)
+    rock = cols["rock"]
     starts = np.repeat(np.cumsum(impacts) - impacts, impacts)
     number = np.arange(rec.shape[0]) - starts + 1
     frame = pd.DataFrame(
@@ -193,6 +203,7 @@ def simulate(
     on_impact_chunk: Callable[[ImpactTable], None] | None = None,
     progress: Callable[[int, int], None] | None = None,
     envelope_dx_m: float | None = None,
+    on_impact_columns: Callable[[dict[str, np.ndarray]], None] | None = None,
 ) -> SimulationResult:
     """Simulate ``rocks`` rocks of ``model`` with the random numbers of ``rng``.
 
@@ -209,6 +220,11 @@ def simulate(
         Called with (rocks done, rocks) after each chunk.
     envelope_dx_m
         Bin width of the bounce-height envelope; None = no envelope.
+    on_impact_columns
+        With ``record_impacts``: receives each chunk's impacts as the kernel's named
+        arrays (:func:`impact_columns`) instead of an ImpactTable -- for callers that
+        need a few columns of many simulations (a path fit), without the table's
+        derived columns.
 
     Examples
     --------
@@ -294,11 +310,12 @@ def simulate(
             tic = time.perf_counter()
             run(rec, offsets, True)
             wall += time.perf_counter() - tic
-            table = impact_frame(rec, counts, a, inputs.material_names)
-            if on_impact_chunk is not None:
-                on_impact_chunk(table)
+            if on_impact_columns is not None:
+                on_impact_columns(impact_columns(rec, counts, a))
+            elif on_impact_chunk is not None:
+                on_impact_chunk(impact_frame(rec, counts, a, inputs.material_names))
             else:
-                tables.append(table)
+                tables.append(impact_frame(rec, counts, a, inputs.material_names))
         if progress is not None:
             progress(b, rocks)
     analysis = [
@@ -340,7 +357,7 @@ def simulate(
         )
         paths.append(trace[:count].copy())
     table = None
-    if record_impacts and on_impact_chunk is None:
+    if record_impacts and on_impact_chunk is None and on_impact_columns is None:
         table = ImpactTable(
             pd.concat([t.frame for t in tables], ignore_index=True), source="simulation"
         )

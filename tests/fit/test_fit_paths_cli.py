@@ -37,12 +37,51 @@ def test_tschamut_fit_writes_model_json_and_holdout_scores(cli, tmp_path):
     assert (tmp_path / "rep" / "holdout.png").stat().st_size > 20_000
 
 
-def test_path_fit_needs_all_three_inputs(cli, tmp_path):
+def test_path_fit_on_a_dem_needs_all_three_inputs(cli, tmp_path):
     r = cli("fit", "--model", BASE, "--paths", SPLIT / "calibration_release_points.csv",
-            "-o", tmp_path / "m.json")  # fmt: skip
+            "--dem", DATA / "terrain.asc", "-o", tmp_path / "m.json")  # fmt: skip
     assert r.exit_code == 1
     assert "needs --paths, --deposits and --dem" in r.output
     assert not (tmp_path / "m.json").exists()
+
+
+TORNADO = Path(__file__).parents[2] / "surveys" / "tornado_mountain"
+
+
+def test_surveyed_path_fit_from_an_impact_table(cli, tmp_path):
+    """--paths alone: a reduced ImpactTable fitted on the model's own profile, every
+    kind of along-path observation scored; the bad-input cases are one line."""
+    table = tmp_path / "a.csv"
+    r = cli(
+        "reduce", "--impacts", TORNADO / "boulder_a_impacts.gpx",
+        "--theta0", "32.6", "--mass", "3750", "--radius", "0.725",
+        "--path-id", "boulder_a", "-o", table,
+    )  # fmt: skip
+    assert r.exit_code == 0, r.output
+    model = TORNADO / "model_rocfall_table_7_1.json"
+    r = cli(
+        "fit", "--paths", table, "--model", model,
+        "--free", "materials.colluvium.e_t", "--rocks", "30", "--bootstrap", "2",
+        "--screen", "2", "-o", tmp_path / "cal.json", "--json", tmp_path / "fit.json",
+    )  # fmt: skip
+    assert r.exit_code == 0, r.output
+    fit = json.loads((tmp_path / "fit.json").read_text())
+    kinds = {k["kind"]: k for k in fit["kinds"]}
+    assert set(kinds) == {"runout_m", "flight_height_m", "impact_spacing_m",
+                          "speed_mps"}  # fmt: skip
+    assert kinds["speed_mps"]["observations"] == 49  # impacts B-45 (A is the release)
+    assert fit["objective_optimum"] < fit["objective_start"] == pytest.approx(4.0)
+    assert fit["section"] == "the model's own profile"
+    assert "flight_height_m (48 observed)" in r.output
+    bad = [
+        (["--bound", "materials.colluvium.e_t=0.9"], "expected NAME=LO,HI"),
+        (["--holdout-paths", table, "--holdout-deposits", table], "need a DEM"),
+    ]
+    for extra, message in bad:
+        r = cli("fit", "--paths", table, "--model", model, "-o", tmp_path / "x.json",
+                *extra)  # fmt: skip
+        assert r.exit_code == 1 and message in r.output, r.output
+        assert not (tmp_path / "x.json").exists()
 
 
 def test_mismatched_ids_one_line_nothing_written(cli, tmp_path):
