@@ -1,0 +1,156 @@
+"""The site a grid target is written on: a DEM, or the model's section extruded.
+
+Grid simulators (Rockyfor3D, r.stone, RAMMS) need a terrain and, cell by cell, the
+ground material and where rocks start. fieldkit's model is a 2-D section, so a site
+is either
+
+* a DEM the user gives (:func:`site_from_dem`): every cell takes the model's one
+  material (a model with several has no plan map of them -- refused, naming them),
+  and rocks start in the cell of a release point the user gives; or
+* the section extruded across (:func:`site_from_section`): columns along the chainage
+  (x = chainage), a few rows across with the same ground, each cell the material of
+  the segment under its centre, rocks starting in the cells of the seeder's
+  chainage. The README of the export states which.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from fieldkit.errors import ArgumentError
+from fieldkit.io.dem import INSIDE, DemGrid
+from fieldkit.model.model_file import Model
+
+
+@dataclass(frozen=True)
+class ExportSite:
+    """Terrain, materials and release cells of a grid export.
+
+    Attributes
+    ----------
+    grid
+        Elevations (NaN = nodata), row 0 north.
+    material
+        ``(nrows, ncols)`` material name of each cell ("" where there is no ground).
+    release
+        ``(nrows, ncols)`` bool: the cells rocks start from.
+    description
+        One line for the README: where the grid came from.
+    """
+
+    grid: DemGrid
+    material: np.ndarray
+    release: np.ndarray
+    description: str
+
+
+def site_from_dem(
+    model: Model, grid: DemGrid, release_xy: tuple[float, float] | None
+) -> ExportSite:
+    """A site on the user's DEM (module docstring).
+
+    Raises
+    ------
+    ArgumentError
+        A model with several materials; no release point, or one outside the DEM.
+    """
+    if len(model.materials) != 1:
+        raise ArgumentError(
+            f"the model has {len(model.materials)} materials "
+            f"({', '.join(model.materials)}) and no plan map of them: export it on "
+            "its own section (`extrude`) or give a one-material model",
+            source="dem",
+        )
+    if release_xy is None:
+        raise ArgumentError(
+            "a DEM site needs the release point (x, y) in the DEM's grid: the "
+            "model's seeder is a chainage on its own profile",
+            source="release_xy",
+        )
+    x, y = (float(v) for v in release_xy)
+    _, _, _, status = grid.sample(x, y)
+    if status[0] != INSIDE:
+        raise ArgumentError(
+            f"the release ({x:g}, {y:g}) has no ground in the DEM {grid.source}: "
+            + grid.problem_at(x, y, int(status[0])),
+            source="release_xy",
+        )
+    name = next(iter(model.materials))
+    valid = np.isfinite(grid.values)
+    material = np.where(valid, name, "").astype(object)
+    release = np.zeros(grid.shape, bool)
+    col = int(np.argmin(np.abs(grid.x_m - x)))
+    row = int(np.argmin(np.abs(grid.y_m - y)))
+    release[row, col] = True
+    return ExportSite(
+        grid,
+        material,
+        release,
+        f"the DEM {grid.source} ({grid.shape[1]} x {grid.shape[0]} cells of "
+        f"{grid.cellsize_m:g} m); material {name} everywhere; release cell at "
+        f"({grid.x_m[col]:.10g}, {grid.y_m[row]:.10g})",
+    )
+
+
+def site_from_section(
+    model: Model, *, cellsize_m: float | None = None, rows: int = 5
+) -> ExportSite:
+    """The model's section extruded to ``rows`` cells across (module docstring).
+
+    Cells of ``cellsize_m`` (default: the profile length / 500, rounded to 0.5 m,
+    at least 0.5 m); column centres from the profile's first x; rows centred on
+    y = 0; every cell of a column has the profile's elevation at its centre.
+
+    Examples
+    --------
+    >>> from fieldkit.model.model_file import model_from_dict
+    >>> m = model_from_dict({"profile": {"x_m": [0, 10, 20], "z_m": [10, 0, -1],
+    ...   "material": ["rock", "talus"]}, "materials": {"rock": {"e_n": 0.3,
+    ...   "e_t": 0.8, "friction_deg": 25}, "talus": {"e_n": 0.3, "e_t": 0.8,
+    ...   "friction_deg": 30}}, "body": {"mass_kg": 100, "radius_m": 0.2},
+    ...   "seeder": {"x_m": 1, "z_m": 11}})
+    >>> s = site_from_section(m, cellsize_m=5, rows=3)
+    >>> s.grid.values[1].tolist(), s.material[1].tolist()
+    ([7.5, 2.5, -0.25, -0.75], ['rock', 'rock', 'talus', 'talus'])
+    >>> s.release.sum(), s.grid.y_m.tolist()
+    (np.int64(3), [5.0, 0.0, -5.0])
+    """
+    x = np.asarray(model.profile.x_m, float)
+    length = float(x[-1] - x[0])
+    if cellsize_m is None:
+        cellsize_m = max(0.5, round(length / 500.0 / 0.5) * 0.5)
+    cell = float(cellsize_m)
+    if not (math.isfinite(cell) and cell > 0):
+        raise ArgumentError(
+            f"cellsize_m must be > 0 (got {cell:g})", source="cellsize_m"
+        )
+    if not (isinstance(rows, int) and rows >= 2):
+        raise ArgumentError(
+            f"rows must be a whole number >= 2 (got {rows})", source="rows"
+        )
+    ncols = max(2, int(math.floor(length / cell)))
+    centres = x[0] + cell * (np.arange(ncols) + 0.5)
+    z = np.interp(centres, x, model.profile.z_m)
+    segment = np.clip(np.searchsorted(x, centres, side="right") - 1, 0, x.size - 2)
+    names = np.asarray(model.profile.material, dtype=object)[segment]
+    grid = DemGrid.from_corner(
+        np.tile(z, (rows, 1)),
+        x_left_m=float(x[0]),
+        y_top_m=0.5 * rows * cell,
+        cellsize_m=cell,
+        source=f"{model.source or 'model'} (section extruded)",
+    )
+    release = np.zeros(grid.shape, bool)
+    seed_col = int(np.clip(np.floor((model.seeder.x_m - x[0]) / cell), 0, ncols - 1))
+    release[:, seed_col] = True
+    return ExportSite(
+        grid,
+        np.tile(names, (rows, 1)),
+        release,
+        f"the model's 2-D section extruded to {rows} rows of {ncols} cells of "
+        f"{cell:g} m (x = chainage, y across, the same ground in every row); "
+        f"release cells in the column at chainage {centres[seed_col]:.10g} m",
+    )
