@@ -45,14 +45,11 @@ import numpy as np
 from fieldkit.diagnose.impacts import diagnose_impacts
 from fieldkit.fit.path_fit import fit_paths
 from fieldkit.fit.path_runs import section_runs
-from fieldkit.fit.synthetic import with_effects
 from fieldkit.impact_table import ImpactTable
 from fieldkit.io.impacts import read_impacts
 from fieldkit.io.path_observations import observations_from_impact_table
 from fieldkit.io.trees import read_trees
 from fieldkit.model import read_model, simulate
-from fieldkit.model.model_file import Model
-from fieldkit.model.profile import Profile
 from fieldkit.physics.bodies import resolve_body
 from fieldkit.reduce.pipeline import ReduceOptions, reduce_path
 from fieldkit.survey import Survey
@@ -70,8 +67,6 @@ PATH_FREE = {
     "materials.bench.e_n": (0.05, 1.2),
     "materials.bench.e_t": (0.1, 0.98),
 }
-#: Where the railway bench starts: the segments ending at impacts 43-45 and beyond.
-BENCH_FROM_X_M = 587.2
 PATH_ROCKS, PATH_SCREEN, PATH_BOOTSTRAP = 150, 16, 8
 #: Survey materials -> Table 7-1 materials (the upper slope is "rock" there).
 MATERIALS = {"talus": "rock", "bench": "rock"}
@@ -128,22 +123,6 @@ def figures(name: str, model) -> dict:
     return out
 
 
-def path_start_model(thesis: Model) -> Model:
-    """Table 7-1 with eq. 7.1 (RocFall's "scale Rn by velocity", K = 9.144 m/s) and
-    the bench (segments from :data:`BENCH_FROM_X_M`) a material of its own, starting
-    from the colluvium's values."""
-    model = with_effects(thesis, {"velocity_scaled_restitution": {}})
-    x = model.profile.x_m
-    names = [
-        "bench" if x[j] >= BENCH_FROM_X_M else m
-        for j, m in enumerate(model.profile.material)
-    ]
-    profile = Profile.from_arrays(x, model.profile.z_m, names, source=thesis.source)
-    materials = dict(model.materials)
-    materials["bench"] = replace(materials["colluvium"], name="bench")
-    return replace(model, profile=profile, materials=materials)
-
-
 def main() -> None:
     table = reduced_table()
     thesis = read_model(SURVEY / "model_rocfall_table_7_1.json")
@@ -167,7 +146,9 @@ def main() -> None:
     ))  # fmt: skip
     calibrated = replace(calibrated, provenance=dict(thesis.provenance))
 
-    start = path_start_model(thesis)
+    # surveys/tornado_mountain/model_path_start.json: Table 7-1 + eq. 7.1 (K =
+    # 9.144 m/s) + the bench (segments from x = 587.2 m) as its own material.
+    start = read_model(SURVEY / "model_path_start.json")
     runs = section_runs(observations_from_impact_table(table), start)
     fit = fit_paths(
         runs,
