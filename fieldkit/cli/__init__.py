@@ -16,9 +16,11 @@ from fieldkit._version import __version__
 from fieldkit.cli import (
     diagnose,
     effects,
+    export,
     fence,
     fit,
     impact,
+    import_model,
     profile,
     reduce,
     simulate,
@@ -68,6 +70,8 @@ app.command("effects")(effects.effects)
 app.command("synth")(synth.synth)
 app.command("fit")(fit.fit)
 app.command("diagnose")(diagnose.diagnose)
+app.command("export")(export.export)
+app.command("import-model")(import_model.import_model)
 
 # typer bundles its own click; reach its base exception through a public class.
 _USAGE_ERRORS = next(

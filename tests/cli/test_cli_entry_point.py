@@ -26,6 +26,8 @@ COMMANDS = [
     "effects",
     "synth",
     "fit",
+    "export",
+    "import-model",
 ]
 REPO = Path(__file__).resolve().parents[2]
 

@@ -1,0 +1,70 @@
+"""The export targets fieldkit knows, by the name ``fieldkit export --to`` takes."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from fieldkit.errors import ArgumentError
+from fieldkit.export.json_model import export_json
+from fieldkit.export.result import Export
+from fieldkit.export.rocfall import export_rocfall
+from fieldkit.export.site import ExportSite
+from fieldkit.model.model_file import Model
+
+
+@dataclass(frozen=True)
+class Target:
+    """One export target.
+
+    Attributes
+    ----------
+    name
+        What ``--to`` takes.
+    export
+        ``(model, site) -> Export``.
+    grid
+        Whether it writes rasters and so needs an :class:`ExportSite`.
+    what
+        One line for the help.
+    """
+
+    name: str
+    export: Callable[[Model, ExportSite | None], Export]
+    grid: bool
+    what: str
+
+
+#: Target name -> Target, in the order the help lists them.
+TARGETS: dict[str, Target] = {
+    t.name: t
+    for t in (
+        Target("rocfall", export_rocfall, False, "RocFall blocks and slope"),
+        Target("json", export_json, False, "the model with uncertainties"),
+    )
+}
+
+
+def target(name: str) -> Target:
+    """The target called ``name``.
+
+    Raises
+    ------
+    ArgumentError
+        An unknown name, listing the known ones.
+
+    Examples
+    --------
+    >>> target("json").grid
+    False
+    >>> try:
+    ...     target("rocfal")
+    ... except ArgumentError as e:
+    ...     print(e)
+    unknown target 'rocfal' (known: rocfall, json)
+    """
+    if name not in TARGETS:
+        raise ArgumentError(
+            f"unknown target {name!r} (known: {', '.join(TARGETS)})", source="to"
+        )
+    return TARGETS[name]
