@@ -6,7 +6,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from fieldkit.errors import ArgumentError
+from fieldkit.export.crsp import export_crsp
 from fieldkit.export.json_model import export_json
+from fieldkit.export.ramms import export_ramms
 from fieldkit.export.result import Export
 from fieldkit.export.rocfall import export_rocfall
 from fieldkit.export.site import ExportSite
@@ -40,6 +42,8 @@ TARGETS: dict[str, Target] = {
     t.name: t
     for t in (
         Target("rocfall", export_rocfall, False, "RocFall blocks and slope"),
+        Target("crsp", export_crsp, False, "CRSP slope cells (feet) and rock"),
+        Target("ramms", export_ramms, True, "RAMMS categories and the DEM"),
         Target("json", export_json, False, "the model with uncertainties"),
     )
 }
@@ -61,7 +65,7 @@ def target(name: str) -> Target:
     ...     target("rocfal")
     ... except ArgumentError as e:
     ...     print(e)
-    unknown target 'rocfal' (known: rocfall, json)
+    unknown target 'rocfal' (known: rocfall, crsp, ramms, json)
     """
     if name not in TARGETS:
         raise ArgumentError(
