@@ -43,11 +43,10 @@ import re
 
 import numpy as np
 
-from fieldkit.errors import ArgumentError
 from fieldkit.export.ascii_grid import ascii_grid_text
 from fieldkit.export.fitted import with_error
 from fieldkit.export.result import Export, Mapped
-from fieldkit.export.site import ExportSite
+from fieldkit.export.site import ExportSite, checked_site
 from fieldkit.model.model_file import Model
 
 #: RAMMS::ROCKFALL terrain categories, softest first (code = index + 1).
@@ -133,10 +132,7 @@ def export_ramms(model: Model, site: ExportSite | None = None) -> Export:
     ArgumentError
         No site.
     """
-    if site is None:
-        raise ArgumentError(
-            "ramms needs a grid site: a DEM or the section extruded", source="site"
-        )
+    site = checked_site(site, "ramms")
     picks = {name: recommend(name) for name in model.materials}
     return Export(
         target="ramms",

@@ -64,7 +64,7 @@ from fieldkit.errors import ArgumentError
 from fieldkit.export.ascii_grid import ascii_grid_text
 from fieldkit.export.fitted import with_error
 from fieldkit.export.result import Export, Mapped
-from fieldkit.export.site import ExportSite
+from fieldkit.export.site import ExportSite, checked_site, ground_cells
 from fieldkit.model.effects.slope_roughness import dip_sd_rad
 from fieldkit.model.materials import Material
 from fieldkit.model.model_file import Body, Model
@@ -212,27 +212,6 @@ def _dip_sd_deg(model: Model, material: Material) -> float:
     return math.degrees(sd)
 
 
-def _ground(site: ExportSite) -> np.ndarray:
-    """Cells with ground: a finite elevation and a material."""
-    return np.isfinite(site.grid.values) & (site.material != "")
-
-
-def _check_site(site: ExportSite | None) -> ExportSite:
-    if site is None:
-        raise ArgumentError(
-            f"{TARGET} needs a grid site: a DEM or the section extruded", source="site"
-        )
-    if not np.isclose(site.grid.dx_m, site.grid.dy_m, rtol=1e-9):
-        raise ArgumentError(
-            f"{TARGET} needs square cells (got {site.grid.dx_m:g} x "
-            f"{site.grid.dy_m:g} m)",
-            source="site",
-        )
-    if not (site.release & _ground(site)).any():
-        raise ArgumentError("the site has no release cell on ground", source="site")
-    return site
-
-
 def export_rockyfor3d(model: Model, site: ExportSite | None = None) -> Export:
     """Rockyfor3D's input grids for ``model`` on ``site`` (module docstring).
 
@@ -243,9 +222,9 @@ def export_rockyfor3d(model: Model, site: ExportSite | None = None) -> Export:
         or a roughness Rockyfor3D cannot take (:func:`sphere_block`,
         :func:`obstacle_heights`).
     """
-    site = _check_site(site)
+    site = checked_site(site, TARGET)
     grid = site.grid
-    ground = _ground(site)
+    ground = ground_cells(site)
     source = site.release & ground
     present = [n for n in model.materials if (site.material[ground] == n).any()]
     soil = {n: nearest_soil_type(model.materials[n].e_n) for n in present}
@@ -308,7 +287,7 @@ written, so the run is without forest and nets."""
 
 def _mapped(model, site, present, soil, dip, rg, diameter, density) -> list[Mapped]:
     body = model.body
-    n_source = int((site.release & _ground(site)).sum())
+    n_source = int((site.release & ground_cells(site)).sum())
     out = [
         Mapped(
             "site terrain (DEM or extruded profile)",

@@ -63,7 +63,7 @@ from fieldkit.errors import ArgumentError
 from fieldkit.export.ascii_grid import ascii_grid_text
 from fieldkit.export.fitted import with_error
 from fieldkit.export.result import Export, Mapped
-from fieldkit.export.site import ExportSite
+from fieldkit.export.site import ExportSite, checked_site, ground_cells
 from fieldkit.model.materials import Material
 from fieldkit.model.model_file import Model
 
@@ -151,27 +151,6 @@ def _check(model: Model, names: list[str]) -> None:
             )
 
 
-def _ground(site: ExportSite) -> np.ndarray:
-    """Cells with ground: a finite elevation and a material."""
-    return np.isfinite(site.grid.values) & (site.material != "")
-
-
-def _check_site(site: ExportSite | None) -> ExportSite:
-    if site is None:
-        raise ArgumentError(
-            f"{TARGET} needs a grid site: a DEM or the section extruded", source="site"
-        )
-    if not np.isclose(site.grid.dx_m, site.grid.dy_m, rtol=1e-9):
-        raise ArgumentError(
-            f"{TARGET} needs square cells (got {site.grid.dx_m:g} x "
-            f"{site.grid.dy_m:g} m)",
-            source="site",
-        )
-    if not (site.release & _ground(site)).any():
-        raise ArgumentError("the site has no release cell on ground", source="site")
-    return site
-
-
 def export_rstone(
     model: Model, site: ExportSite | None = None, *, rocks: int = DEFAULT_ROCKS
 ) -> Export:
@@ -192,13 +171,13 @@ def export_rstone(
         No site, no release cell on ground, ``rocks`` < 1, a restitution above 1, a
         friction angle above 45 deg, or a DEM whose relief exceeds 9998 m.
     """
-    site = _check_site(site)
+    site = checked_site(site, TARGET)
     if isinstance(rocks, bool) or not isinstance(rocks, int) or rocks < 1:
         raise ArgumentError(
             f"rocks must be a whole number >= 1 (got {rocks})", source="rocks"
         )
     grid = site.grid
-    ground = _ground(site)
+    ground = ground_cells(site)
     source = site.release & ground
     present = [n for n in model.materials if (site.material[ground] == n).any()]
     _check(model, present)
@@ -305,7 +284,7 @@ stop_vel are the values derived from the model (see the tables below)."""
 
 
 def _mapped(model, site, present, offset, per_cell, options) -> list[Mapped]:
-    n_source = int((site.release & _ground(site)).sum())
+    n_source = int((site.release & ground_cells(site)).sum())
     shift = f"; raised by {offset:g} m (r.stone needs elevations > 0)" if offset else ""
     out = [
         Mapped(

@@ -154,3 +154,32 @@ def site_from_section(
         f"{cell:g} m (x = chainage, y across, the same ground in every row); "
         f"release cells in the column at chainage {centres[seed_col]:.10g} m",
     )
+
+
+def ground_cells(site: ExportSite) -> np.ndarray:
+    """Cells with ground: a finite elevation and a material."""
+    return np.isfinite(site.grid.values) & (site.material != "")
+
+
+def checked_site(site: ExportSite | None, target: str) -> ExportSite:
+    """``site``, checked for a grid target: given, square cells, a release cell on
+    ground.
+
+    Raises
+    ------
+    ArgumentError
+        What is missing, naming ``target``.
+    """
+    if site is None:
+        raise ArgumentError(
+            f"{target} needs a grid site: a DEM or the section extruded", source="site"
+        )
+    if not np.isclose(site.grid.dx_m, site.grid.dy_m, rtol=1e-9):
+        raise ArgumentError(
+            f"{target} needs square cells (got {site.grid.dx_m:g} x "
+            f"{site.grid.dy_m:g} m)",
+            source="site",
+        )
+    if not (site.release & ground_cells(site)).any():
+        raise ArgumentError("the site has no release cell on ground", source="site")
+    return site

@@ -11,6 +11,8 @@ from fieldkit.export.json_model import export_json
 from fieldkit.export.ramms import export_ramms
 from fieldkit.export.result import Export
 from fieldkit.export.rocfall import export_rocfall
+from fieldkit.export.rockyfor3d import export_rockyfor3d
+from fieldkit.export.rstone import export_rstone
 from fieldkit.export.site import ExportSite
 from fieldkit.model.model_file import Model
 
@@ -43,7 +45,9 @@ TARGETS: dict[str, Target] = {
     for t in (
         Target("rocfall", export_rocfall, False, "RocFall blocks and slope"),
         Target("crsp", export_crsp, False, "CRSP slope cells (feet) and rock"),
+        Target("rockyfor3d", export_rockyfor3d, True, "Rockyfor3D ASCII grids"),
         Target("ramms", export_ramms, True, "RAMMS categories and the DEM"),
+        Target("rstone", export_rstone, True, "r.stone (GRASS GIS) rasters"),
         Target("json", export_json, False, "the model with uncertainties"),
     )
 }
@@ -65,7 +69,7 @@ def target(name: str) -> Target:
     ...     target("rocfal")
     ... except ArgumentError as e:
     ...     print(e)
-    unknown target 'rocfal' (known: rocfall, crsp, ramms, json)
+    to: unknown target 'rocfal' (known: rocfall, crsp, rockyfor3d, ramms, rstone, json)
     """
     if name not in TARGETS:
         raise ArgumentError(

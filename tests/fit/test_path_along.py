@@ -62,9 +62,7 @@ def _surveyed_paths(truth: dict[str, float], n: int, seed: int) -> list[PathRun]
     base = section_model(120.0, 30.0, upper_deg=35.0)
     base = base.with_parameters({"materials.talus.e_n": 0.6})
     truth_model = base.with_parameters(truth)
-    result = simulate(
-        truth_model, n, np.random.default_rng(seed), record_impacts=True
-    )
+    result = simulate(truth_model, n, np.random.default_rng(seed), record_impacts=True)
     frame = result.impact_table.frame
     release = float(base.seeder.x_m)
     runs = []

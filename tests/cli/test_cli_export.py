@@ -1,0 +1,138 @@
+"""`fieldkit export`: every target from the command line, the README beside the files,
+and bad input refused in one line with nothing written."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from fieldkit.io.dem import read_dem
+from fieldkit.model.model_file import read_model
+
+REPO = Path(__file__).resolve().parents[2]
+TABLE_7_1 = REPO / "surveys" / "tornado_mountain" / "model_rocfall_table_7_1.json"
+TSCHAMUT = REPO / "examples" / "tschamut" / "model_base.json"
+TERRAIN = REPO / "tests" / "data" / "tschamut2014" / "terrain.asc"
+README_SECTIONS = (
+    "## What was mapped to what",
+    "## What could not be mapped, and why",
+    "## Units",
+    "## Residual mismatch where a class or category was chosen",
+)
+
+
+@pytest.mark.parametrize(
+    "target, extra",
+    [
+        ("rocfall", []),
+        ("crsp", []),
+        ("json", []),
+        ("rockyfor3d", ["--extrude", "--cellsize", "5"]),
+        ("ramms", ["--extrude", "--cellsize", "5"]),
+        ("rstone", ["--extrude", "--cellsize", "5"]),
+    ],
+)
+def test_every_target_writes_its_files_and_a_readme(cli, tmp_path, target, extra):
+    out = tmp_path / target
+    r = cli("export", TABLE_7_1, "--to", target, "-o", out, *extra)
+    assert r.exit_code == 0, r.output
+    readme = (out / "README.md").read_text(encoding="utf-8")
+    for heading in README_SECTIONS:
+        assert heading in readme, heading
+    files = {p.name for p in out.iterdir()} - {"README.md"}
+    assert files and all(f"`{name}`" in readme for name in files)
+    assert f"{target}:" in r.output
+
+
+def test_grid_files_share_the_extruded_grid(cli, tmp_path):
+    out = tmp_path / "r3d"
+    r = cli("export", TABLE_7_1, "--to", "rockyfor3d", "-o", out, "--extrude",
+            "--cellsize", "5", "--rows", "3")  # fmt: skip
+    assert r.exit_code == 0, r.output
+    grids = [read_dem(p) for p in sorted(out.glob("*.asc"))]
+    assert len(grids) >= 2
+    for g in grids:
+        assert g.shape == grids[0].shape == (3, 140)  # 700 m of profile / 5 m
+        assert g.x_m[0] == grids[0].x_m[0] == 2.5
+
+
+def test_grid_target_on_a_dem(cli, tmp_path):
+    out = tmp_path / "rstone"
+    r = cli("export", TSCHAMUT, "--to", "rstone", "-o", out, "--dem", TERRAIN,
+            "--release", "30.602,235.28")  # fmt: skip
+    assert r.exit_code == 0, r.output
+    dem = read_dem(TERRAIN)
+    written = [read_dem(p) for p in out.glob("*.asc")]
+    assert written and all(g.shape == dem.shape for g in written)
+    assert "the DEM" in (out / "README.md").read_text(encoding="utf-8")
+
+
+def test_json_round_trip_keeps_every_parameter(cli, tmp_path):
+    r = cli("export", TABLE_7_1, "--to", "json", "-o", tmp_path / "j")
+    assert r.exit_code == 0, r.output
+    again = read_model(tmp_path / "j" / "model.json")
+    assert again.parameters() == read_model(TABLE_7_1).parameters()
+    table = json.loads((tmp_path / "j" / "parameters.json").read_text())
+    assert {row["name"] for row in table} == set(again.parameters())
+
+
+def test_unknown_target_lists_the_known_ones(cli, tmp_path, fails):
+    r = cli("export", TABLE_7_1, "--to", "rocfal", "-o", tmp_path / "x")
+    fails(r, "--to", "rocfal", "rocfall, crsp, rockyfor3d, ramms, rstone, json")
+    assert not (tmp_path / "x").exists()
+
+
+def test_a_folder_that_is_not_empty_needs_force(cli, tmp_path, fails):
+    out = tmp_path / "full"
+    out.mkdir()
+    (out / "mine.txt").write_text("keep me")
+    fails(cli("export", TABLE_7_1, "--to", "json", "-o", out), "not empty", "--force")
+    assert {p.name for p in out.iterdir()} == {"mine.txt"}
+    r = cli("export", TABLE_7_1, "--to", "json", "-o", out, "--force")
+    assert r.exit_code == 0, r.output
+    assert (out / "mine.txt").read_text() == "keep me"
+    assert (out / "model.json").is_file()
+
+
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (["--to", "rockyfor3d"], ["--dem", "extrude"]),
+        (["--to", "rocfall", "--dem", TERRAIN], ["not a grid target"]),
+        (
+            ["--to", "ramms", "--dem", TERRAIN, "--release", "1,2"],
+            ["2 materials", "rock, colluvium"],
+        ),  # fmt: skip
+        (["--to", "ramms", "--extrude", "--release", "1,2"], ["--release"]),
+    ],
+)
+def test_grid_inputs_refused_in_one_line(cli, tmp_path, fails, args, words):
+    out = tmp_path / "x"
+    fails(cli("export", TABLE_7_1, "-o", out, *args), *words)
+    assert not out.exists()
+
+
+def test_a_dem_site_needs_its_release_point(cli, tmp_path, fails):
+    out = tmp_path / "x"
+    r = cli("export", TSCHAMUT, "--to", "ramms", "-o", out, "--dem", TERRAIN)
+    fails(r, "--release", "release point")
+    assert not out.exists()
+
+
+def test_release_outside_the_dem_refused(cli, tmp_path, fails):
+    out = tmp_path / "x"
+    r = cli("export", TSCHAMUT, "--to", "rockyfor3d", "-o", out, "--dem", TERRAIN,
+            "--release", "-500,-500")  # fmt: skip
+    fails(r, "--release", "no ground")
+    assert not out.exists()
+
+
+def test_a_model_file_without_what_a_model_needs(cli, tmp_path, fails):
+    bad = tmp_path / "bad.json"
+    data = json.loads(TABLE_7_1.read_text())
+    del data["materials"]
+    bad.write_text(json.dumps(data))
+    fails(cli("export", bad, "--to", "json", "-o", tmp_path / "x"), "materials")
+    assert not (tmp_path / "x").exists()
