@@ -43,9 +43,10 @@ def test_shell_blocks_run(repo_copy, shell_commands, run_shell, monkeypatch):
     selected = [b for b in blocks("") if not renders_video(b)]
     ran = run_blocks(selected, repo_copy, shell_commands, run_shell, monkeypatch)
     # --version, reduce, impact, fence, view (2), effects, simulate, profile, synth,
-    # fit, fit --paths, diagnose, synth --track, diagnose (track); the video block
+    # fit, fit --paths (2), diagnose, synth --track, diagnose (track), export (2),
+    # import-model; the video block
     # runs when slow
-    assert ran == 16
+    assert ran == 19
     assert (repo_copy / "boulder_a.csv").is_file()
     assert (repo_copy / "boulder_a.rrd").is_file()
     assert {p.name for p in (repo_copy / "figs").iterdir()} >= {"section.png"}
@@ -56,6 +57,8 @@ def test_shell_blocks_run(repo_copy, shell_commands, run_shell, monkeypatch):
     assert (out / "calibrated.json").is_file() and (out / "after.json").is_file()
     assert (out / "tschamut_calibrated.json").is_file()
     assert (out / "boulder_a_path.json").is_file()
+    assert (out / "from_rocfall.json").is_file()
+    assert (out / "r3d" / "soiltype.asc").is_file()
     assert (out / "diagnosis" / "report.md").is_file()
     assert (out / "track_diagnosis" / "report.md").is_file()
 

@@ -114,7 +114,13 @@ def export_crsp(model: Model, site: ExportSite | None = None) -> Export:
     rock_mapped, rock_mismatch = _mapped_rock(model, shape, shape_note)
     velocity_mapped, velocity_mismatch = _velocity_scaling(model)
     mapped += rock_mapped + _mapped_geometry(model) + velocity_mapped
-    mismatches = [_rt_mismatch(), *mismatches, *rock_mismatch, *velocity_mismatch]
+    mismatches = [
+        _rt_mismatch(),
+        *mismatches,
+        *rock_mismatch,
+        *velocity_mismatch,
+        *_rn_above_one(model),
+    ]
     return Export(
         target="crsp",
         title="CRSP (Colorado Rockfall Simulation Program), 2-D",
@@ -223,17 +229,44 @@ def start_csv(model: Model) -> str:
 
 
 def _check_coefficients(model: Model) -> None:
+    """Rt in (0, 1]; Rn too, except that a model with velocity scaling of e_n may
+    carry Rn > 1: CRSP scales Rn by 1 / (1 + (v/K)^2) itself (thesis §7.3.4), so
+    such an Rn is what the scaled law was calibrated with (RocFall's rule too)."""
     low, high = COEFFICIENT_RANGE
+    scaled = "velocity_scaled_restitution" in model.effects
     for name, material in model.materials.items():
         for field, target in (("e_n", "Rn"), ("e_t", "Rt")):
             value = getattr(material, field)
-            if not low < value <= high:
+            top = math.inf if (field == "e_n" and scaled) else high
+            if not low < value <= top:
+                why = (
+                    " (a coefficient above 1 adds energy at every impact; Rn above "
+                    "1 is exported only for a model with velocity scaling of e_n, "
+                    "velocity_scaled_restitution, which CRSP applies itself)"
+                    if value > high
+                    else ""
+                )
                 raise ArgumentError(
                     f"materials.{name}.{field} = {value:g} is outside CRSP's {target} "
-                    f"range ({low:g}, {high:g}] (a coefficient above 1 adds energy at "
-                    "every impact)",
+                    f"range ({low:g}, {high:g}]{why}",
                     source="model",
                 )
+
+
+def _rn_above_one(model: Model) -> list[str]:
+    """Mismatch lines for Rn > 1 written with CRSP's own velocity scaling."""
+    out = []
+    for name, material in model.materials.items():
+        if material.e_n > COEFFICIENT_RANGE[1]:
+            v = CRSP_K_MPS * math.sqrt(material.e_n - 1.0)
+            out.append(
+                f"{name} Rn = {material.e_n:.4g} > 1, written as calibrated with "
+                f"velocity scaling: with CRSP's K = 30 ft/s the scaled Rn is below 1 "
+                f"for normal impact speeds above {m_to_ft(v):.3g} ft/s "
+                f"({v:.3g} m/s); whether CRSP 4.0 accepts an Rn above 1 is not "
+                "confirmed (its manual could not be read)"
+            )
+    return out
 
 
 def _surface(model: Model, name: str) -> tuple[float, float, float]:

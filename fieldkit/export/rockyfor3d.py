@@ -63,6 +63,7 @@ import numpy as np
 from fieldkit.errors import ArgumentError
 from fieldkit.export.ascii_grid import ascii_grid_text
 from fieldkit.export.fitted import with_error
+from fieldkit.export.lumped import lumped_equivalent
 from fieldkit.export.result import Export, Mapped
 from fieldkit.export.site import ExportSite, checked_site, ground_cells
 from fieldkit.model.effects.slope_roughness import dip_sd_rad
@@ -223,6 +224,7 @@ def export_rockyfor3d(model: Model, site: ExportSite | None = None) -> Export:
         :func:`obstacle_heights`).
     """
     site = checked_site(site, TARGET)
+    model, lumped = lumped_equivalent(model, TARGET)
     grid = site.grid
     ground = ground_cells(site)
     source = site.release & ground
@@ -270,7 +272,7 @@ def export_rockyfor3d(model: Model, site: ExportSite | None = None) -> Export:
             "soiltype (0-7) and blshape (0-4) are codes; NODATA_value -9999 where "
             "the site has no ground",
         ],
-        mismatches=_mismatches(model, present, soil, diameter, density),
+        mismatches=[*lumped, *_mismatches(model, present, soil, diameter, density)],
         notes=_notes(model, site, present),
         how_to_use=HOW_TO_USE,
     )

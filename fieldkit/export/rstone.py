@@ -62,6 +62,7 @@ import numpy as np
 from fieldkit.errors import ArgumentError
 from fieldkit.export.ascii_grid import ascii_grid_text
 from fieldkit.export.fitted import with_error
+from fieldkit.export.lumped import lumped_equivalent
 from fieldkit.export.result import Export, Mapped
 from fieldkit.export.site import ExportSite, checked_site, ground_cells
 from fieldkit.model.materials import Material
@@ -172,6 +173,7 @@ def export_rstone(
         friction angle above 45 deg, or a DEM whose relief exceeds 9998 m.
     """
     site = checked_site(site, TARGET)
+    model, lumped = lumped_equivalent(model, TARGET)
     if isinstance(rocks, bool) or not isinstance(rocks, int) or rocks < 1:
         raise ArgumentError(
             f"rocks must be a whole number >= 1 (got {rocks})", source="rocks"
@@ -230,7 +232,7 @@ def export_rstone(
             else "dem: metres (fieldkit's SI), as given",
             "sources: numbers of trajectories; start_vel, stop_vel in m/s",
         ],
-        mismatches=_mismatches(model, present, offset, options),
+        mismatches=[*lumped, *_mismatches(model, present, offset, options)],
         notes=_notes(site),
         how_to_use=_how_to_use(options),
     )

@@ -116,6 +116,15 @@ def test_coefficients_outside_crsp_refused(field, value, target):
     assert f"CRSP's {target} range (0, 1]" in message
 
 
+def test_rn_above_one_with_velocity_scaling_is_written_with_its_mismatch():
+    data = small(e_n=1.25)
+    data["effects"] = {"velocity_scaled_restitution": {}}
+    export = export_crsp(model_from_dict(data))
+    assert rows(export.files["cells.csv"])[0]["Rn"] == "1.250"
+    # scaled Rn = 1.25 / (1 + (v/K)^2) < 1 for v > K sqrt(0.25) = 15 ft/s (K 30 ft/s)
+    assert any("above 15 ft/s" in m for m in export.mismatches), export.mismatches
+
+
 def test_restitution_of_one_is_accepted():
     cells = rows(export_crsp(model_from_dict(small(e_n=1.0))).files["cells.csv"])
     assert cells[0]["Rn"] == "1.000"
