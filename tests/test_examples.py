@@ -54,6 +54,19 @@ EXPECTED = {
         r"speed_mps\s+\d+\.\d+ ->\s+\d+\.\d+ \(49 observed\)",
         r"calibrated on boulder A's path\s+\d",
     ],
+    # Issue 12 item 3: boulder A survey -> reduce -> fit --paths -> export to every
+    # target, each folder with its files and README.md
+    "export_tornado_mountain.py": [
+        r"wrote .*boulder_a\.csv \(50 rows\)",
+        r"materials\.colluvium\.e_n: 1\.\d+ ± 0\.0\d+",
+        r"rocfall: 6 files",
+        r"crsp: 4 files",
+        r"json: 3 files",
+        r"rockyfor3d: 11 files",
+        r"ramms: 4 files",
+        r"rstone: 6 files",
+        r"mismatch: colluvium: rstone has no velocity_scaled_restitution",
+    ],
     # docs/real-data-diagnosis.md: Tornado Mountain boulder A's 48 impacts, naive
     # eq. 5.4 slope 0.71 (thesis pooled 1.03); the one-impact surveys are refused
     "diagnose_real_data.py": [

@@ -90,7 +90,7 @@ def test_every_command_shown_is_in_a_block_that_runs():
     inline = re.findall(r"`(fieldkit [^`]*)`", FENCE.sub("", README))
     assert inline
     for text in inline:
-        assert re.fullmatch(r"fieldkit [a-z]+( --help)?", text), text
+        assert re.fullmatch(r"fieldkit [a-z][a-z-]*( --help)?", text), text
 
 
 def test_points_only_inside_the_repository():
