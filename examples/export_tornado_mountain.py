@@ -30,7 +30,8 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 SURVEY = HERE.parent / "surveys" / "tornado_mountain"
 SEED = 2004
-#: (target, extra arguments): grid targets on the extruded section (5 m cells: r.stone steps 5 m).
+#: (target, extra arguments): grid targets on the extruded section, 5 m cells
+#: (r.stone steps 5 m).
 TARGETS = [
     ("rocfall", []),
     ("crsp", []),
