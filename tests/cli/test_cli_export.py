@@ -136,3 +136,16 @@ def test_a_model_file_without_what_a_model_needs(cli, tmp_path, fails):
     bad.write_text(json.dumps(data))
     fails(cli("export", bad, "--to", "json", "-o", tmp_path / "x"), "materials")
     assert not (tmp_path / "x").exists()
+
+
+@pytest.mark.parametrize("target", ["rocfall", "crsp", "rstone"])
+def test_values_the_target_refuses_leave_nothing_behind(cli, tmp_path, fails, target):
+    # e_t = 1.05 on the colluvium: every restitution-pair target refuses Rt > 1
+    data = json.loads(TABLE_7_1.read_text())
+    data["materials"]["colluvium"]["e_t"] = 1.05
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(data))
+    out = tmp_path / "x"
+    extra = ["--extrude"] if target == "rstone" else []
+    fails(cli("export", bad, "--to", target, "-o", out, *extra), "colluvium", "1.05")
+    assert not out.exists()
