@@ -95,7 +95,9 @@ def synthetic_site(
             PathRun(
                 path_id=f"run{i:02d}",
                 model=base,
-                observed_runout_m=observed - float(base.profile.x_m[0]),
+                # the runout as simulated_runouts measures it: from the release
+                # (the seeder's chainage), not from the profile's first vertex
+                observed_runout_m=observed - float(base.seeder.x_m),
                 group="synthetic",
             )
         )
