@@ -27,6 +27,7 @@ from __future__ import annotations
 import math
 import os
 import re
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -182,9 +183,9 @@ def model_from_rocfall(
 # ---------------------------------------------------------------- text blocks --
 
 
-def _entries(text: Text, kind: str) -> list[_Block]:
-    """The blocks of a materials or rock-type text (``kind`` names the header)."""
-    blocks: list[_Block] = []
+def _key_value_lines(text: Text) -> Iterator[tuple[int, re.Match, str]]:
+    """(line number, match of :data:`_LINE`, normalised key) of every line that is
+    not blank or a comment; a line that is not ``key: value`` is an error."""
     for n, raw in enumerate(text.text.splitlines(), start=1):
         line = raw.split("#", 1)[0].strip()
         if not line:
@@ -196,7 +197,13 @@ def _entries(text: Text, kind: str) -> list[_Block]:
                 source=text.source,
                 where=f"line {n}",
             )
-        key = " ".join(match["key"].lower().split())
+        yield n, match, " ".join(match["key"].lower().split())
+
+
+def _entries(text: Text, kind: str) -> list[_Block]:
+    """The blocks of a materials or rock-type text (``kind`` names the header)."""
+    blocks: list[_Block] = []
+    for n, match, key in _key_value_lines(text):
         header = _BLOCK.match(key)
         if header is not None and header["kind"] == kind:
             try:
@@ -601,18 +608,7 @@ def _settings(text: Text | None, notes: list[str]) -> tuple[dict, dict, str]:
         )
         return {}, {}, "material"
     entries: dict[str, _Entry] = {}
-    for n, raw in enumerate(text.text.splitlines(), start=1):
-        line = raw.split("#", 1)[0].strip()
-        if not line:
-            continue
-        match = _LINE.match(line)
-        if match is None:
-            raise InputFileError(
-                f"expected 'key: value' (got {line!r})",
-                source=text.source,
-                where=f"line {n}",
-            )
-        key = " ".join(match["key"].lower().split())
+    for n, match, key in _key_value_lines(text):
         unit = None if match["unit"] is None else match["unit"].strip().lower()
         entries[key] = _Entry(key, unit, match["value"].strip(), n)
     known = {

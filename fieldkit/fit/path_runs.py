@@ -92,6 +92,19 @@ def run_body(body: Body, row) -> Body:
     )
 
 
+def along_arrays(along, chainage_m: np.ndarray) -> dict[str, np.ndarray]:
+    """:attr:`PathRun.observations` of a run's along-path points (the rows of
+    :meth:`PathObservations.along_path`): their chainage on the run's section, their
+    elevation, and every value column as ``along_<name>``."""
+    out = {
+        "along_chainage_m": np.asarray(chainage_m, float),
+        "along_z_m": along["z_m"].to_numpy(float),
+    }
+    for name in along.columns[5:]:
+        out[f"along_{name}"] = along[name].to_numpy(float)
+    return out
+
+
 def section_runs(observations: PathObservations, base_model: Model) -> list[PathRun]:
     """Runs observed along the base model's own profile (section coordinates).
 
@@ -156,10 +169,7 @@ def section_runs(observations: PathObservations, base_model: Model) -> list[Path
         along = observations.along_path(path_id)
         extra = {}
         if len(along):
-            extra["along_chainage_m"] = along["x_m"].to_numpy(float) - release
-            extra["along_z_m"] = along["z_m"].to_numpy(float)
-            for name in along.columns[5:]:
-                extra[f"along_{name}"] = along[name].to_numpy(float)
+            extra = along_arrays(along, along["x_m"].to_numpy(float) - release)
         runs.append(
             PathRun(
                 path_id=path_id,

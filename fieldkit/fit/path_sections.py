@@ -65,7 +65,7 @@ from dataclasses import replace
 import numpy as np
 
 from fieldkit.errors import ArgumentError, InputFileError
-from fieldkit.fit.path_runs import PathRun, run_body
+from fieldkit.fit.path_runs import PathRun, along_arrays, run_body
 from fieldkit.io.dem import INSIDE, DemGrid
 from fieldkit.model.dem_profile import (
     Section,
@@ -234,11 +234,8 @@ def path_runs(
                     for x, y in zip(along["x_m"], along["y_m"], strict=True)
                 ]
             ).T
-            extra["along_chainage_m"] = c
+            extra |= along_arrays(along, c)
             extra["along_offset_m"] = o
-            extra["along_z_m"] = along["z_m"].to_numpy(float)
-            for name in along.columns[5:]:
-                extra[f"along_{name}"] = along[name].to_numpy(float)
         runs.append(
             PathRun(
                 path_id=path_id,
