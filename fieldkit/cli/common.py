@@ -8,13 +8,14 @@ flags (see :mod:`fieldkit.errors`); :data:`FLAGS` maps those names to the flags,
 from __future__ import annotations
 
 import functools
+import math
 import re
 from collections.abc import Callable, Mapping
 from typing import Annotated, ParamSpec, TypeVar, overload
 
 import typer
 
-from fieldkit.errors import FieldkitError
+from fieldkit.errors import ArgumentError, FieldkitError
 from fieldkit.physics.bodies import SHAPES, UNIT_WEIGHT_KN_M3, ResolvedBody
 
 P = ParamSpec("P")
@@ -246,3 +247,17 @@ UnitWeightOpt = Annotated[
         help=f"Rock unit weight for --shape, kN/m3 (default {UNIT_WEIGHT_KN_M3:g}).",
     ),
 ]
+
+
+def parse_point(text: str, flag: str) -> tuple[float, float]:
+    """``"X,Y"`` -> (x, y); a one-line error naming the flag otherwise."""
+    parts = text.replace(";", ",").split(",")
+    try:
+        x, y = (float(p) for p in parts)
+    except ValueError:
+        raise ArgumentError(
+            f"{flag} '{text}' is not X,Y (two numbers in metres, e.g. 30.6,235.3)"
+        ) from None
+    if not (math.isfinite(x) and math.isfinite(y)):
+        raise ArgumentError(f"{flag} '{text}' must be finite numbers")
+    return x, y

@@ -12,7 +12,7 @@ from typing import Annotated
 
 import typer
 
-from fieldkit.cli.common import one_line_errors
+from fieldkit.cli.common import one_line_errors, parse_point
 from fieldkit.errors import ArgumentError
 from fieldkit.outputs import OutputSet, write_file
 
@@ -25,18 +25,6 @@ FLAGS = {
     "rows": "--rows",
     "model_file": "MODEL",
 }
-
-
-def _point(text: str) -> tuple[float, float]:
-    parts = text.split(",")
-    try:
-        x, y = (float(p) for p in parts)
-    except ValueError:
-        raise ArgumentError(
-            f"{text!r}: expected X,Y (two numbers in the DEM's grid)",
-            source="release_xy",
-        ) from None
-    return x, y
 
 
 def _refuse_full_folder(folder: Path, force: bool) -> None:
@@ -128,7 +116,7 @@ def export(
         model = read_model(model_file)
         site = None
         if dem is not None:
-            point = _point(release) if release is not None else None
+            point = parse_point(release, "--release") if release is not None else None
             site = site_from_dem(model, read_dem(dem), point)
         elif extrude:
             site = site_from_section(model, cellsize_m=cellsize, rows=rows)

@@ -18,7 +18,7 @@ from typing import Annotated
 
 import typer
 
-from fieldkit.cli.common import note, one_line_errors
+from fieldkit.cli.common import note, one_line_errors, parse_point
 from fieldkit.errors import ArgumentError
 from fieldkit.io.dem import DemGrid, read_dem
 from fieldkit.io.profile_csv import read_profile_csv
@@ -33,20 +33,6 @@ from fieldkit.outputs import OutputSet, write_text
 
 #: Columns of the profile CSV, in order.
 COLUMNS = ("x_m", "z_m", "plan_x_m", "plan_y_m", "material")
-
-
-def _point(text: str, flag: str) -> tuple[float, float]:
-    """``"X,Y"`` -> (x, y); a one-line error naming the flag otherwise."""
-    parts = text.replace(";", ",").split(",")
-    try:
-        x, y = (float(p) for p in parts)
-    except ValueError:
-        raise ArgumentError(
-            f"{flag} '{text}' is not X,Y (two numbers in metres, e.g. 30.6,235.3)"
-        ) from None
-    if not (math.isfinite(x) and math.isfinite(y)):
-        raise ArgumentError(f"{flag} '{text}' must be finite numbers")
-    return x, y
 
 
 def profile_csv_text(section: Section) -> str:
@@ -97,8 +83,8 @@ def _cut(
     max_length: float | None,
 ) -> tuple[Section, list[str]]:
     """The section of a DEM, and lines saying how it was cut."""
-    start_xy = _point(start, "--from")
-    vertices = [start_xy, *(_point(t, "--to") for t in to)]
+    start_xy = parse_point(start, "--from")
+    vertices = [start_xy, *(parse_point(t, "--to") for t in to)]
     lines = [_describe_grid(grid)]
     spacing = grid.cellsize_m / 2 if step is None else step
     step_text = f"step {spacing:g} m" + (
