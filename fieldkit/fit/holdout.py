@@ -37,8 +37,8 @@ def crps_ensemble(samples: np.ndarray, observed: float) -> float:
     """CRPS [same unit as the data] of the empirical distribution of ``samples`` at
     ``observed``.
 
-    Computed exactly in O(n log n) by sorting: with :math:`x_{(1)} \\le \\dots \\le
-    x_{(n)}`,
+    Computed exactly in O(n log n) by sorting (:func:`crps_ensemble_many` with equal
+    weights): with :math:`x_{(1)} \\le \\dots \\le x_{(n)}`,
 
     .. math::
         \\mathrm{CRPS} = \\frac1n \\sum_i |x_i - y|
@@ -68,14 +68,7 @@ def crps_ensemble(samples: np.ndarray, observed: float) -> float:
     >>> crps_ensemble(np.array([2.0]), 5.0)  # one member: absolute error
     3.0
     """
-    x = np.asarray(samples, float).ravel()
-    x = np.sort(x[np.isfinite(x)])
-    y = float(observed)
-    n = x.size
-    if n == 0 or not np.isfinite(y):
-        return float("nan")
-    spread = np.dot(2.0 * np.arange(1, n + 1) - n - 1.0, x) / (n * n)
-    return float(np.mean(np.abs(x - y)) - spread)
+    return float(crps_ensemble_many(samples, np.array([float(observed)]))[0])
 
 
 def crps_ensemble_many(
