@@ -294,7 +294,10 @@ class PathObjective:
 
     def units(self, x: np.ndarray) -> np.ndarray:
         """The objective's units at ``x`` (class docstring): their sum is S."""
-        scores = self.observation_scores(x)
+        return self.units_of(self.observation_scores(x))
+
+    def units_of(self, scores: np.ndarray) -> np.ndarray:
+        """The units of :meth:`observation_scores` already computed."""
         scale = np.array([self.scales[k] * self._total[k] for k in self._kind])
         parts = scores * self._weight / scale
         if len(self.runs) >= 2:
@@ -303,14 +306,21 @@ class PathObjective:
 
     def set_scales(self, x: np.ndarray) -> dict[str, float]:
         """Scale every kind by its mean CRPS at ``x`` (when several are scored)."""
+        return self.set_scales_of(self.observation_scores(x))
+
+    def set_scales_of(self, scores: np.ndarray) -> dict[str, float]:
+        """:meth:`set_scales` from :meth:`observation_scores` already computed."""
         if len(self.kinds) > 1:
-            for k, mean in self.kind_means(x).items():
+            for k, mean in self.kind_means_of(scores).items():
                 self.scales[k] = mean if mean > 0 else 1.0
         return dict(self.scales)
 
     def kind_means(self, x: np.ndarray) -> dict[str, float]:
         """(Weighted) mean CRPS of each kind at ``x``, in the kind's unit."""
-        scores = self.observation_scores(x)
+        return self.kind_means_of(self.observation_scores(x))
+
+    def kind_means_of(self, scores: np.ndarray) -> dict[str, float]:
+        """:meth:`kind_means` from :meth:`observation_scores` already computed."""
         return {
             k: float(np.average(scores[m], weights=self._weight[m]))
             for k in self.kinds
@@ -319,14 +329,14 @@ class PathObjective:
 
     def per_run(self, x: np.ndarray) -> np.ndarray:
         """CRPS [m] of each scored run's runout at ``x`` (NaN: none observed)."""
-        values = dict(zip(self.names, map(float, x), strict=True))
-        self.evaluations += 1
-        return np.array(
-            [
-                crps_ensemble(e, y)
-                for e, y in zip(self.ensembles(values), self.observed, strict=True)
-            ]
-        )
+        return self.per_run_of(self.observation_scores(x))
+
+    def per_run_of(self, scores: np.ndarray) -> np.ndarray:
+        """:meth:`per_run` from :meth:`observation_scores` already computed."""
+        out = np.full(len(self.runs), np.nan)
+        runout = self._kind == "runout_m"
+        out[self._run[runout]] = scores[runout]
+        return out
 
     def __call__(self, x: np.ndarray) -> float:
         """The objective S at ``x``."""
@@ -588,8 +598,9 @@ def fit_paths(
         return float(np.dot(weights, units))
 
     u0 = (x0 - lower) / span
-    scales = objective.set_scales(x0)
-    kind_start = objective.kind_means(x0)
+    start_scores = objective.observation_scores(x0)
+    scales = objective.set_scales_of(start_scores)
+    kind_start = objective.kind_means_of(start_scores)
     unit = "m" if objective.kinds == ["runout_m"] else ""
     if len(objective.kinds) > 1:
         say(
@@ -597,7 +608,7 @@ def fit_paths(
             + ", ".join(f"{k} ({objective.counts[k]})" for k in objective.kinds)
             + "; each scaled by its CRPS at the start"
         )
-    f0 = f(u0)
+    f0 = float(np.sum(objective.units_of(start_scores)))
     say(
         f"fit {p} parameters to {n_runs} runs ({rocks} rocks each): "
         f"start {f0:.3f}{unit and ' ' + unit}"
@@ -624,9 +635,10 @@ def fit_paths(
         f"optimum {f_best:.3f}{unit and ' ' + unit} after {objective.evaluations} "
         "evaluations"
     )
-    best_units = objective.units(x_best)
-    kind_optimum = objective.kind_means(x_best)
-    run_crps = objective.per_run(x_best)
+    best_scores = objective.observation_scores(x_best)
+    best_units = objective.units_of(best_scores)
+    kind_optimum = objective.kind_means_of(best_scores)
+    run_crps = objective.per_run_of(best_scores)
     at_bound = np.isclose(u_best, 0.0, atol=1e-3) | np.isclose(u_best, 1.0, atol=1e-3)
     for n, flag in zip(names, at_bound, strict=True):
         if flag:
