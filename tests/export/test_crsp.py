@@ -12,14 +12,7 @@ import pytest
 from fieldkit.errors import ArgumentError
 from fieldkit.export.crsp import export_crsp
 from fieldkit.export.site import site_from_section
-from fieldkit.model.model_file import model_from_dict, read_model
-
-TORNADO = "surveys/tornado_mountain/model_rocfall_table_7_1.json"
-
-
-@pytest.fixture(scope="module")
-def tornado(repo):
-    return read_model(repo / TORNADO)
+from fieldkit.model.model_file import model_from_dict
 
 
 def rows(text: str) -> list[dict[str, str]]:

@@ -12,14 +12,7 @@ from fieldkit.errors import ArgumentError
 from fieldkit.export.ramms import category_at, export_ramms, recommend
 from fieldkit.export.site import site_from_dem, site_from_section
 from fieldkit.io.dem import DemGrid, read_dem
-from fieldkit.model.model_file import model_from_dict, read_model
-
-TORNADO = "surveys/tornado_mountain/model_rocfall_table_7_1.json"
-
-
-@pytest.fixture(scope="module")
-def tornado(repo):
-    return read_model(repo / TORNADO)
+from fieldkit.model.model_file import model_from_dict
 
 
 @pytest.fixture(scope="module")

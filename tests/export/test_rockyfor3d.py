@@ -41,17 +41,6 @@ GRIDS = (
 HEADER_KEYS = ["ncols", "nrows", "xllcorner", "yllcorner", "cellsize", "NODATA_value"]
 
 
-@pytest.fixture(scope="module")
-def tornado(repo):
-    return read_model(repo / "surveys/tornado_mountain/model_rocfall_table_7_1.json")
-
-
-def _write(export, folder):
-    for name, text in export.files.items():
-        (folder / name).write_text(text)
-    return {name: read_dem(folder / name) for name in export.files}
-
-
 def _one_material(e_n=0.4, **extra):
     material = {"e_n": e_n, "e_t": 0.8, "friction_deg": 30, **extra}
     return model_from_dict(
@@ -70,11 +59,11 @@ def test_a_grid_target_needs_a_site(tornado):
         export_rockyfor3d(tornado, None)
 
 
-def test_tornado_section_grids_reread(tornado, tmp_path):
+def test_tornado_section_grids_reread(tornado, tmp_path, written_grids):
     site = site_from_section(tornado, cellsize_m=10, rows=3)
     export = export_rockyfor3d(tornado, site)
     assert sorted(export.files) == sorted(GRIDS)
-    grids = _write(export, tmp_path)
+    grids = written_grids(export, tmp_path)
     for name, text in export.files.items():
         keys = [line.split()[0] for line in text.splitlines()[:6]]
         assert keys == HEADER_KEYS, name
@@ -93,8 +82,8 @@ def test_tornado_section_grids_reread(tornado, tmp_path):
     np.testing.assert_allclose(dem.values, site.grid.values, atol=5e-4)
 
 
-def test_tornado_codes_block_and_source_cells(tornado, tmp_path):
-    grids = _write(
+def test_tornado_codes_block_and_source_cells(tornado, tmp_path, written_grids):
+    grids = written_grids(
         export_rockyfor3d(tornado, site_from_section(tornado, cellsize_m=10, rows=3)),
         tmp_path,
     )
@@ -112,8 +101,8 @@ def test_tornado_codes_block_and_source_cells(tornado, tmp_path):
         np.testing.assert_allclose(grids[name].values, source * 1.45)
 
 
-def test_tornado_obstacle_heights(tornado, tmp_path):
-    grids = _write(
+def test_tornado_obstacle_heights(tornado, tmp_path, written_grids):
+    grids = written_grids(
         export_rockyfor3d(tornado, site_from_section(tornado, cellsize_m=10, rows=3)),
         tmp_path,
     )
@@ -218,11 +207,11 @@ def test_roughness_without_the_effect_is_smooth():
         assert values == {"0"}
 
 
-def test_cells_without_ground_are_nodata(tmp_path):
+def test_cells_without_ground_are_nodata(tmp_path, written_grids):
     values = np.array([[30.0, 25.0, 20.0], [29.0, np.nan, 19.0], [28.0, 23.0, 18.0]])
     grid = DemGrid.from_corner(values, x_left_m=0, y_top_m=30, cellsize_m=10)
     model = _one_material()
-    grids = _write(
+    grids = written_grids(
         export_rockyfor3d(model, site_from_dem(model, grid, (5.0, 25.0))), tmp_path
     )
     for name, g in grids.items():
@@ -232,11 +221,11 @@ def test_cells_without_ground_are_nodata(tmp_path):
     assert grids["soiltype.asc"].values[0, 0] == 4  # e_n 0.40: nearest 0.38
 
 
-def test_tschamut_dem_site(repo, tmp_path):
+def test_tschamut_dem_site(repo, tmp_path, written_grids):
     model = read_model(repo / "examples/tschamut/model_base.json")
     terrain = read_dem(repo / "tests/data/tschamut2014/terrain.asc")
     site = site_from_dem(model, terrain, (33.4, 236.67))  # release v004
-    grids = _write(export_rockyfor3d(model, site), tmp_path)
+    grids = written_grids(export_rockyfor3d(model, site), tmp_path)
     head = (repo / "tests/data/tschamut2014/terrain.asc").read_text().splitlines()[:6]
     assert [line.split()[0].lower() for line in head] == [
         k.lower() for k in HEADER_KEYS

@@ -28,17 +28,6 @@ RASTERS = ("dem.asc", "sources.asc", "nrest.asc", "trest.asc", "friction.asc")
 HEADER_KEYS = ["ncols", "nrows", "xllcorner", "yllcorner", "cellsize", "NODATA_value"]
 
 
-@pytest.fixture(scope="module")
-def tornado(repo):
-    return read_model(repo / "surveys/tornado_mountain/model_rocfall_table_7_1.json")
-
-
-def _write(export, folder):
-    for name, text in export.files.items():
-        (folder / name).write_text(text)
-    return {name: read_dem(folder / name) for name in export.files}
-
-
 def _one_material(**material):
     return model_from_dict(
         {
@@ -57,11 +46,11 @@ def test_a_grid_target_needs_a_site(tornado):
         export_rstone(tornado)
 
 
-def test_tornado_section_rasters_reread(tornado, tmp_path):
+def test_tornado_section_rasters_reread(tornado, tmp_path, written_grids):
     site = site_from_section(tornado, cellsize_m=10, rows=3)
     export = export_rstone(tornado, site)
     assert sorted(export.files) == sorted(RASTERS)
-    grids = _write(export, tmp_path)
+    grids = written_grids(export, tmp_path)
     for name, text in export.files.items():
         keys = [line.split()[0] for line in text.splitlines()[:6]]
         assert keys == HEADER_KEYS, name
@@ -130,9 +119,9 @@ def test_percent_rounding_by_hand(value, expected):
     assert percent(value) == expected
 
 
-def test_percent_written_to_the_rasters(tmp_path):
+def test_percent_written_to_the_rasters(tmp_path, written_grids):
     model = _one_material(e_n=0.625, e_t=0.285)
-    grids = _write(
+    grids = written_grids(
         export_rstone(model, site_from_section(model, cellsize_m=5)), tmp_path
     )
     assert (grids["nrest.asc"].values == 63).all()
@@ -170,11 +159,11 @@ def test_values_outside_rstone_are_refused(material, message):
         export_rstone(model, site_from_section(model, cellsize_m=5))
 
 
-def test_rocks_shared_over_release_cells(tmp_path):
+def test_rocks_shared_over_release_cells(tmp_path, written_grids):
     model = _one_material()
     site = site_from_section(model, cellsize_m=5, rows=3)
     export = export_rstone(model, site, rocks=10)
-    sources = _write(export, tmp_path)["sources.asc"].values
+    sources = written_grids(export, tmp_path)["sources.asc"].values
     assert sources.sum() == 9 and sources.max() == 3  # round(10 / 3) = 3 a cell
     with pytest.raises(ArgumentError, match="rocks must be a whole number >= 1"):
         export_rstone(model, site, rocks=0)
@@ -185,11 +174,11 @@ def test_small_cells_are_noted(tornado):
     assert any("smaller than r.stone's 5 m" in n for n in export.notes)
 
 
-def test_tschamut_dem_site(repo, tmp_path):
+def test_tschamut_dem_site(repo, tmp_path, written_grids):
     model = read_model(repo / "examples/tschamut/model_base.json")
     terrain = read_dem(repo / "tests/data/tschamut2014/terrain.asc")
     export = export_rstone(model, site_from_dem(model, terrain, (33.4, 236.67)))
-    grids = _write(export, tmp_path)
+    grids = written_grids(export, tmp_path)
     for g in grids.values():
         assert g.shape == (46, 43)
         np.testing.assert_allclose(g.x_m, terrain.x_m)
