@@ -55,6 +55,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.stats import norm, truncnorm
 
 from fieldkit.errors import ArgumentError
 from fieldkit.export.fitted import with_error
@@ -197,10 +198,9 @@ def truncated_mean(d: Distribution) -> float:
     if d.kind != 2 or d.sd <= 0.0:
         return d.mean
     a, b = -d.rel_min / d.sd, d.rel_max / d.sd
-    mass = _cdf(b) - _cdf(a)
-    if mass <= 0.0:
+    if not a < b:  # no width left between the bounds
         return d.mean
-    return d.mean + d.sd * (_pdf(a) - _pdf(b)) / mass
+    return float(truncnorm.mean(a, b, loc=d.mean, scale=d.sd))
 
 
 def clipped_mean(mean: float, sd: float) -> float:
@@ -214,15 +214,7 @@ def clipped_mean(mean: float, sd: float) -> float:
     if sd <= 0.0:
         return max(mean, 0.0)
     z = mean / sd
-    return mean * _cdf(z) + sd * _pdf(z)
-
-
-def _pdf(z: float) -> float:
-    return math.exp(-0.5 * z * z) / math.sqrt(2.0 * math.pi)
-
-
-def _cdf(z: float) -> float:
-    return 0.5 * (1.0 + math.erf(z / math.sqrt(2.0)))
+    return float(mean * norm.cdf(z) + sd * norm.pdf(z))
 
 
 def _cut(d: Distribution) -> bool:
