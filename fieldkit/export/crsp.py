@@ -23,7 +23,8 @@ mass from them; thesis §7.2): fieldkit's body is a mass, a contact radius and a
 radius of gyration, so the shape is chosen from the gyration ratio ``k / r`` (solid
 sphere ``sqrt(2/5) = 0.632``; cylinder or disk about its rolling axis
 ``sqrt(1/2) = 0.707``), the diameter is ``2 r`` and the density is the mass over the
-volume of a sphere of radius ``r`` (:func:`sphere_density_kg_m3`).
+volume of a sphere of radius ``r``
+(:func:`fieldkit.physics.bodies.sphere_density_kg_m3`).
 
 What could not be confirmed from the sources available (the stored copy of the
 CRSP 4.0 manual gave its title page only): CRSP's own input limits for Rn, Rt and S,
@@ -44,6 +45,7 @@ from fieldkit.export.fitted import with_error
 from fieldkit.export.result import Export, Mapped
 from fieldkit.export.site import ExportSite
 from fieldkit.model.model_file import Model
+from fieldkit.physics.bodies import sphere_density_kg_m3
 
 #: Metres in one international foot (exact).
 M_PER_FT = 0.3048
@@ -147,17 +149,6 @@ def m_to_ft(value_m: float | np.ndarray) -> float | np.ndarray:
     (1.0, 1148.294)
     """
     return value_m / M_PER_FT
-
-
-def sphere_density_kg_m3(mass_kg: float, radius_m: float) -> float:
-    """Density of a solid sphere of ``mass_kg`` and ``radius_m``: m / (4/3 pi r^3).
-
-    Examples
-    --------
-    >>> round(sphere_density_kg_m3(4 / 3 * math.pi * 2650, 1.0), 6)
-    2650.0
-    """
-    return mass_kg / (4.0 / 3.0 * math.pi * radius_m**3)
 
 
 def rock_shape(radius_m: float, gyration_m: float) -> tuple[str, str]:

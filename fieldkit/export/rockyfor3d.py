@@ -69,6 +69,7 @@ from fieldkit.export.site import ExportSite, checked_site, ground_cells
 from fieldkit.model.effects.slope_roughness import dip_sd_rad
 from fieldkit.model.materials import Material
 from fieldkit.model.model_file import Body, Model
+from fieldkit.physics.bodies import sphere_density_kg_m3
 
 TARGET = "rockyfor3d"
 TITLE = "Rockyfor3D (ecorisQ)"
@@ -191,7 +192,7 @@ def sphere_block(body: Body) -> tuple[float, int]:
     (1.45, 2349)
     """
     diameter = 2.0 * body.radius_m
-    density = round(body.mass_kg / (math.pi / 6.0 * diameter**3))
+    density = round(sphere_density_kg_m3(body.mass_kg, body.radius_m))
     if density < 1:
         raise ArgumentError(
             f"body: mass_kg {body.mass_kg:g} in a sphere of radius_m "

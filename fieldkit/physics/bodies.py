@@ -689,3 +689,15 @@ def _direct_body(
         radius_source=None if radius is None else "given",
         gyration_source=None if gyration is None else gyration_source,
     )
+
+
+def sphere_density_kg_m3(mass_kg: float, radius_m: float) -> float:
+    """Density of a solid sphere of ``mass_kg`` and ``radius_m``: m / (4/3 pi r^3)
+    (the sphere a lumped-mass or sphere-only simulator puts in a block's place).
+
+    Examples
+    --------
+    >>> round(sphere_density_kg_m3(4 / 3 * math.pi * 2650, 1.0), 6)
+    2650.0
+    """
+    return mass_kg / (4.0 / 3.0 * math.pi * radius_m**3)
