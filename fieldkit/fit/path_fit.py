@@ -627,7 +627,7 @@ def fit_paths(
         if values[best] < f0:
             starts.append(points[best])
     first = int(budget * 0.7) // len(starts)
-    u1, f1, n1 = min((_minimise(f, u, 0.15, first) for u in starts), key=lambda r: r[1])
+    u1, f1, _ = min((_minimise(f, u, 0.15, first) for u in starts), key=lambda r: r[1])
     u2, f2, _ = _minimise(f, u1, 0.05, max(budget - first * len(starts), p + 2))
     u_best, f_best = (u2, f2) if f2 <= f1 else (u1, f1)
     x_best = to_x(u_best)
