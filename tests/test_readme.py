@@ -41,19 +41,22 @@ def run_blocks(selected, repo_copy, shell_commands, run_shell, monkeypatch) -> i
 
 def test_shell_blocks_run(repo_copy, shell_commands, run_shell, monkeypatch):
     selected = [b for b in blocks("") if not renders_video(b)]
+    before = {p.name for p in repo_copy.iterdir()}
     ran = run_blocks(selected, repo_copy, shell_commands, run_shell, monkeypatch)
     # --version, reduce, impact, fence, view (2), effects, simulate, profile, synth,
     # fit, fit --paths (2), diagnose, synth --track, diagnose (track), export (2),
     # import-model; the video block
     # runs when slow
     assert ran == 19
-    assert (repo_copy / "boulder_a.csv").is_file()
-    assert (repo_copy / "boulder_a.rrd").is_file()
-    assert {p.name for p in (repo_copy / "figs").iterdir()} >= {"section.png"}
-    assert (repo_copy / "sim" / "summary.json").is_file()
-    assert (repo_copy / "sim" / "impacts.parquet").is_file()
-    assert (repo_copy / "tschamut_profile.csv").is_file()
+    # every README command writes under out/ only (issue 17): nothing new at the root
+    assert {p.name for p in repo_copy.iterdir()} - before == {"out"}
     out = repo_copy / "out"
+    assert (out / "boulder_a.csv").is_file()
+    assert (out / "boulder_a.rrd").is_file()
+    assert {p.name for p in (out / "reduce_figures").iterdir()} >= {"section.png"}
+    assert (out / "sim" / "summary.json").is_file()
+    assert (out / "sim" / "impacts.parquet").is_file()
+    assert (out / "tschamut_profile.csv").is_file()
     assert (out / "calibrated.json").is_file() and (out / "after.json").is_file()
     assert (out / "tschamut_calibrated.json").is_file()
     assert (out / "boulder_a_path.json").is_file()
@@ -68,9 +71,8 @@ def test_video_blocks_run(repo_copy, shell_commands, run_shell, monkeypatch):
     selected = [b for b in blocks("") if renders_video(b)]
     assert len(selected) == 1
     assert run_blocks(selected, repo_copy, shell_commands, run_shell, monkeypatch) == 2
-    assert (repo_copy / "impacts.csv").is_file() and (
-        repo_copy / "bounce.rrd"
-    ).is_file()
+    bounce = repo_copy / "out" / "bounce"
+    assert (bounce / "impacts.csv").is_file() and (bounce / "bounce.rrd").is_file()
 
 
 def test_python_blocks_run_and_print_what_the_comments_say():
