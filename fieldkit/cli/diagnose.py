@@ -223,7 +223,7 @@ def diagnose(
             from fieldkit.impact_table import ImpactTable
             from fieldkit.model.model_file import read_model
 
-            base = read_model(model) if model is not None else None
+            base = read_model(model, outputs=outputs) if model is not None else None
             table = ImpactTable.read(input_file)
             diagnosis = diagnose_impacts(
                 table, base, rng=rng, folds=folds, progress=progress

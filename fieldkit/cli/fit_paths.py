@@ -92,7 +92,7 @@ def fit_paths_command(
             outputs.plan(json_file, argument="--json")
         if report is not None:
             outputs.plan(report / "holdout.png", argument="--report")
-        base = read_model(model_file)
+        base = read_model(model_file, outputs=outputs)
         if on_dem:
             grid = read_dem(dem)
             calibration = path_runs(

@@ -181,7 +181,7 @@ def simulate(
 
             for name in point_figure_names(analysis_x):
                 outputs.plan(figures / name, argument="--figures")
-        model = read_model(model_file)
+        model = read_model(model_file, outputs=outputs)
         if seed is None:
             seed = secrets.randbits(32)
             note(f"`seed` not given: used {seed}; pass --seed {seed} to reproduce")
