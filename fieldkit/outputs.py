@@ -818,7 +818,10 @@ def json_text(data: object, *, indent: int = 2) -> str:
     """
     import json
 
-    return json.dumps(_json_ready(data), indent=indent, allow_nan=False) + "\n"
+    return (
+        json.dumps(_json_ready(data), indent=indent, allow_nan=False, default=str)
+        + "\n"
+    )
 
 
 def write_json(

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import secrets
 from pathlib import Path
 from typing import Annotated
@@ -11,7 +10,7 @@ import typer
 
 from fieldkit.cli.common import note, one_line_errors
 from fieldkit.errors import ArgumentError
-from fieldkit.outputs import OutputSet, write_text
+from fieldkit.outputs import OutputSet, write_json, write_text
 
 FLAGS = {
     "json_file": "--json",
@@ -230,9 +229,7 @@ def diagnose(
             )
         diagnosis.notes.append(f"fold seed {seed}")
         if json_file is not None:
-            write_text(
-                json_file, json.dumps(diagnosis.to_json(), indent=2) + "\n", outputs
-            )
+            write_json(json_file, diagnosis.to_json(), outputs)
         text = None
         if report_dir is not None:
             text = _write_report(report_dir, diagnosis, [str(p) for p in inputs],

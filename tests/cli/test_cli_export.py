@@ -210,3 +210,26 @@ def test_import_model_says_what_it_wrote(cli, tmp_path):
     r = cli("import-model", folder, "--from", "rocfall", "-o", model)
     assert r.exit_code == 0, r.output
     assert f"wrote {model}" in r.stdout.splitlines()
+
+
+def _strict_json(path):
+    def refuse(name):
+        raise AssertionError(f"{path.name} holds the non-JSON literal {name}")
+
+    return json.loads(path.read_text(encoding="utf-8"), parse_constant=refuse)
+
+
+def test_json_outputs_write_non_finite_numbers_as_null(cli, tmp_path):
+    # a fit's record may hold a standard error that is not finite (unidentifiable)
+    data = json.loads(TABLE_7_1.read_text())
+    data["provenance"] = {"fit": {"stderr": {"a": float("nan"), "b": float("inf")}}}
+    model = tmp_path / "model.json"
+    model.write_text(json.dumps(data))  # Python writes NaN and Infinity literals
+    out = tmp_path / "j"
+    r = cli("export", model, "--to", "json", "-o", out)
+    assert r.exit_code == 0, r.output
+    written = _strict_json(out / "model.json")
+    assert written["provenance"]["fit"]["stderr"] == {"a": None, "b": None}
+    _strict_json(out / "parameters.json")
+    again = cli("export", out / "model.json", "--to", "json", "-o", tmp_path / "k")
+    assert again.exit_code == 0, again.output
