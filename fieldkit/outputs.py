@@ -849,11 +849,14 @@ def csv_text(rows: Iterable[Iterable[object]]) -> str:
     import csv
     import io
 
-    buffer = io.StringIO()
-    writer = csv.writer(buffer, lineterminator="\n")
+    lines = []
     for row in rows:
-        writer.writerow([_csv_cell(c) for c in row])
-    return buffer.getvalue()
+        # "\r\n" makes the writer quote a cell holding either character; each
+        # line then ends in "\n" alone, as every other text file fieldkit writes
+        buffer = io.StringIO()
+        csv.writer(buffer, lineterminator="\r\n").writerow([_csv_cell(c) for c in row])
+        lines.append(buffer.getvalue()[:-2] + "\n")
+    return "".join(lines)
 
 
 def _csv_cell(cell: object) -> object:

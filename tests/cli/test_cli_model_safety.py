@@ -239,3 +239,85 @@ def test_a_body_within_bounds_is_exported_unchanged(cli, tmp_path):
     assert r.exit_code == 0, r.output
     written = json.loads((tmp_path / "x" / "model.json").read_text())
     assert written["body"] == {"mass_kg": 500, "radius_m": 0.36, "gyration_m": 0.36}
+
+
+NAME_CASES = [
+    ("=cmd|' /C calc'!A0", "formula"),
+    ("talus,rock", "comma"),
+    ("talus\nrn: 0.99", "line break"),
+    ("talus#2", "hash"),
+    ("", "empty"),
+    ("x" * 65, "too long"),
+]
+
+
+@pytest.mark.parametrize("name, why", NAME_CASES, ids=[c[1] for c in NAME_CASES])
+def test_material_names_that_would_inject_are_refused(cli, fails, tmp_path, name, why):
+    def rename(data):
+        data["materials"][name] = data["materials"].pop("talus")
+        data["profile"]["material"] = ["rock", name, name]
+
+    bad = _bad(tmp_path, rename)
+    out = tmp_path / "x"
+    r = cli("export", bad, "--to", "rocfall", "-o", out)
+    fails(r, "bad.json", "materials", repr(name)[:20], "not allowed")
+    assert not out.exists()
+
+
+def test_a_material_name_in_a_profile_csv_is_checked_too(cli, fails, tmp_path):
+    (tmp_path / "profile.csv").write_text(PROFILE_CSV.replace("talus", "=1+1"))
+    data = json.loads(json.dumps(MODEL))
+    data["materials"]["=1+1"] = data["materials"].pop("talus")
+    model = tmp_path / "model.json"
+    model.write_text(json.dumps(data))
+    fails(cli("export", model, "--to", "json", "-o", tmp_path / "x"),
+          "profile.csv", "material", "'=1+1'", "not allowed")  # fmt: skip
+
+
+def _rocfall_folder(cli, tmp_path, repo):
+    folder = tmp_path / "rocfall"
+    model = repo / "surveys" / "tornado_mountain" / "model_rocfall_table_7_1.json"
+    r = cli("export", model, "--to", "rocfall", "-o", folder)
+    assert r.exit_code == 0, r.output
+    return folder
+
+
+def test_import_model_refuses_a_setting_given_twice(cli, fails, tmp_path, repo):
+    folder = _rocfall_folder(cli, tmp_path, repo)
+    settings = folder / "project_settings.txt"
+    lines = settings.read_text().splitlines()
+    first = next(
+        i for i, t in enumerate(lines) if t.startswith("scale rn by velocity:")
+    )
+    lines.append("scale rn by velocity: off")
+    settings.write_text("\n".join(lines) + "\n")
+    out = tmp_path / "back.json"
+    fails(cli("import-model", folder, "-o", out), "project_settings.txt",
+          f"line {len(lines)}", "'scale rn by velocity' given twice",
+          f"first on line {first + 1}")  # fmt: skip
+    assert not out.exists()
+
+
+def test_import_model_refuses_an_injected_material_name(cli, fails, tmp_path, repo):
+    folder = _rocfall_folder(cli, tmp_path, repo)
+    materials = folder / "materials.txt"
+    text = materials.read_text()
+    materials.write_text(text.replace("material 1: rock", "material 1: =HYPERLINK(1)"))
+    out = tmp_path / "back.json"
+    fails(cli("import-model", folder, "-o", out), "materials.txt", "line",
+          "'=HYPERLINK(1)'", "not allowed")  # fmt: skip
+    assert not out.exists()
+
+
+def test_export_then_import_keeps_every_material_value(cli, tmp_path, repo):
+    folder = _rocfall_folder(cli, tmp_path, repo)
+    out = tmp_path / "back.json"
+    r = cli("import-model", folder, "-o", out)
+    assert r.exit_code == 0, r.output
+    back = json.loads(out.read_text())["materials"]
+    model = repo / "surveys" / "tornado_mountain" / "model_rocfall_table_7_1.json"
+    original = json.loads(model.read_text())["materials"]
+    assert set(back) == set(original)
+    for name, values in original.items():
+        for key in ("e_n", "e_t"):
+            assert back[name][key] == pytest.approx(values[key], abs=1e-12), name
