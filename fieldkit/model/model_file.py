@@ -366,6 +366,8 @@ def _profile(prof: dict, source: str, *, base_dir, read: list[str]) -> Profile:
         units = _text(prof, "units", source) if prof.get("units") is not None else None
         ranges = _text(prof, "materials", source) if "materials" in prof else None
         read.append(str(path))
+        if kind == "dem" and path.with_suffix(".prj").is_file():
+            read.append(str(path.with_suffix(".prj")))  # its CRS (fieldkit.io.dem)
         try:
             if kind == "csv":
                 vertices = read_profile_csv(path, units=units)
