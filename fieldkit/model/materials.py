@@ -149,7 +149,7 @@ def check_number(
     try:
         number = float(value)
     except OverflowError:  # an integer beyond the float range
-        number = math.copysign(math.inf, value)
+        number = math.inf if value > 0 else -math.inf
     if not math.isfinite(number):
         raise InputFileError(
             f"must be a finite number (got {number})", source=source, where=where

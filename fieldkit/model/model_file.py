@@ -296,7 +296,7 @@ def _body(data: dict, source: str) -> Body:
     given = {"gyration_m": None, **data}
     for key, (lower, upper) in BODY_BOUNDS.items():
         value = given[key]
-        if value is None:
+        if value is None and key == "gyration_m":
             value = math.sqrt(0.4) * values["radius_m"]
         values[key] = check_number(
             value, lower, upper, source=source, where=f"body.{key}",

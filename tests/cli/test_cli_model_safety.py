@@ -146,6 +146,9 @@ TYPE_CASES = [
     ("trees", {"x_m": "abc", "diameter_m": [1], "height_m": [1]},
      "trees.x_m: must be a list of numbers"),
     ("profile.z_m", [100, "a", 62, 54], "profile.z_m: must be a list of numbers"),
+    ("profile.x_m", [0, 12, 40, 10**400], "profile.x_m: must be a list of numbers"),
+    ("body.mass_kg", None, "body.mass_kg: must be a number (got None)"),
+    ("body.radius_m", 10**400, "body.radius_m: must be a finite number"),
 ]  # fmt: skip
 
 
