@@ -49,7 +49,7 @@ import numpy as np
 
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.io.dem import INSIDE, NODATA, OUTSIDE, DemGrid
-from fieldkit.model.materials import MATERIAL_NAME
+from fieldkit.model.materials import MATERIAL_NAME, check_material_name
 
 #: Material of every segment when no chainage ranges are given.
 DEFAULT_MATERIAL = "ground"
@@ -301,6 +301,8 @@ def section_from_vertices(
     x = np.asarray(x_m, dtype=float)
     nan = np.full(x.shape, np.nan)
     names = (DEFAULT_MATERIAL,) * (len(x) - 1) if material is None else tuple(material)
+    for name in dict.fromkeys(names):  # one rule for material names (materials.py)
+        check_material_name(name, source=source, where="material")
     return Section(
         chainage_m=x,
         z_m=np.asarray(z_m, dtype=float),

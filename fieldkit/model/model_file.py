@@ -63,7 +63,7 @@ from fieldkit.model.dem_profile import (
     steepest_descent_line,
 )
 from fieldkit.model.effects import registry
-from fieldkit.model.materials import Material, check_material_name, check_number
+from fieldkit.model.materials import Material, check_number
 from fieldkit.model.profile import Profile
 from fieldkit.model.seeder import Seeder
 from fieldkit.outputs import OutputSet, json_text, write_file
@@ -371,8 +371,6 @@ def _profile(prof: dict, source: str, *, base_dir, read: list[str]) -> Profile:
         try:
             if kind == "csv":
                 vertices = read_profile_csv(path, units=units)
-                for name in dict.fromkeys(vertices.material or ()):
-                    check_material_name(name, source=str(path), where="material")
                 section = section_from_vertices(
                     vertices.x_m, vertices.z_m, vertices.material, source=str(path)
                 )

@@ -324,3 +324,12 @@ def test_export_then_import_keeps_every_material_value(cli, tmp_path, repo):
     for name, values in original.items():
         for key in ("e_n", "e_t"):
             assert back[name][key] == pytest.approx(values[key], abs=1e-12), name
+
+
+def test_profile_refuses_an_injected_material_name_in_its_csv(cli, fails, tmp_path):
+    vertices = tmp_path / "vertices.csv"
+    vertices.write_text(PROFILE_CSV.replace("talus", "=HYPERLINK(1)", 1))
+    out = tmp_path / "profile.csv"
+    fails(cli("profile", vertices, "-o", out), "vertices.csv", "'=HYPERLINK(1)'",
+          "not allowed")  # fmt: skip
+    assert not out.exists()
