@@ -23,6 +23,7 @@ def export_json(model: Model, site: ExportSite | None = None) -> Export:
 
     Examples
     --------
+    >>> import json
     >>> from fieldkit.model.model_file import model_from_dict
     >>> m = model_from_dict({"profile": {"x_m": [0, 10], "z_m": [5, 0],
     ...   "material": "rock"}, "materials": {"rock": {"e_n": 0.3, "e_t": 0.8,
