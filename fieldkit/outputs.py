@@ -45,12 +45,38 @@ in place; if writing one fails, the regular files are restored all the same. A s
 or a block device is refused. A symbolic link is followed: the file it points to is
 replaced and the link stays a link; a link to an input is refused like the input.
 
+Outputs confined to a folder
+----------------------------
+A command that writes a set of files *into* a folder (``export -o DIR``) plans each
+with ``within=DIR``: the file must then be written inside DIR. A path under DIR that
+resolves outside it -- a symbolic link in DIR (or a linked sub-folder) pointing
+elsewhere -- is **refused**, naming the link (``DIR/slope.csv: is a symbolic link to
+/etc/x, outside DIR; remove it or write elsewhere``): following it would replace a
+file the user never named, and silently replacing the link by a file would destroy
+what the user set up. DIR itself may be a link (the user named it).
+
+Inputs known late
+-----------------
+Some inputs are only known once a file is read (the profile CSV or DEM a model file
+names). :meth:`OutputSet.add_inputs` adds them and checks every output planned so far
+against them, so a command plans its outputs first and still never replaces a file
+it read (``fieldkit.model.model_file.read_model(path, outputs=...)`` does this for
+every file a model reads).
+
 File-system errors (permission denied, read-only file system, no space left on the
 device, ...) raise :class:`~fieldkit.errors.OutputFileError` naming the output path
 (``out/x.csv: permission denied``). A new file gets the usual permissions, ``0o666``
 less the umask, not the private mode of a temporary file. Temporary files have short
 names (``.fk-XXXXXXXX.csv``) in the target's own folder, so any target name that fits
 the file system has a temporary name that fits.
+
+JSON files
+----------
+Every JSON file fieldkit writes goes through :func:`write_json` (text by
+:func:`json_text`): numpy numbers and arrays become JSON numbers and lists, and a
+number that is not finite (NaN, +-Infinity) becomes ``null`` -- JSON has no literal
+for it (``NaN`` is not JSON; strict readers refuse the file). ``allow_nan=False``
+makes any slip an error instead of an invalid file.
 
 Spreadsheet safety
 ------------------
@@ -60,7 +86,9 @@ such cells as text in an XLSX sheet (string type, quote prefix: the value is kep
 verbatim). In a CSV meant for spreadsheets (the ImpactTable CSV) :func:`escape_formulas`
 prefixes them with a single quote ``'``, and :func:`unescape_formulas` removes exactly
 that prefix when the file is read back, so a round trip is lossless. Only text cells
-are touched: a column of numbers (``-2.5``) is never quoted.
+are touched: a column of numbers (``-2.5``) is never quoted. Small CSV files written
+as text (exports) go through :func:`csv_text`: the csv module quotes commas, quotes
+and line breaks, and :func:`escape_formula` protects text cells.
 
 Examples
 --------
@@ -226,7 +254,34 @@ class OutputSet:
         """The planned paths, in order, as given."""
         return [o.path for o in self._outputs]
 
-    def plan(self, path: PathArg, *, argument: str | None = None) -> Path:
+    def add_inputs(self, paths: Iterable[PathArg | None]) -> None:
+        """Add files the command reads, known only now (``None`` skipped).
+
+        Every output planned so far is checked against them at once.
+
+        Raises
+        ------
+        OutputFileError
+            A planned output is one of ``paths`` (naming the output).
+        """
+        new = [(Path(p), _identity(p)) for p in paths if p is not None]
+        self._inputs.extend(new)
+        for out in self._outputs:
+            for given, other in new:
+                if _same_file(out.identity, other):
+                    also = "" if given == out.path else f" ({given})"
+                    raise OutputFileError(
+                        f"output would overwrite an input file{also}",
+                        source=out.path,
+                    )
+
+    def plan(
+        self,
+        path: PathArg,
+        *,
+        argument: str | None = None,
+        within: PathArg | None = None,
+    ) -> Path:
         """Reserve ``path`` for an output; its writer is added later.
 
         Parameters
@@ -236,6 +291,10 @@ class OutputSet:
         argument
             What named it, for messages: the command line passes its option
             (``"--json"``); without it the path is named.
+        within
+            A folder the file must be written in (module docstring, "Outputs
+            confined to a folder"): a path that a symbolic link takes outside it
+            is refused.
 
         Returns
         -------
@@ -250,6 +309,8 @@ class OutputSet:
         """
         target = Path(path)
         identity = _identity(target)
+        if within is not None:
+            _refuse_outside(target, Path(within))
         self._refuse_inputs(target, identity)
         through = _check_target(target, identity[0])
         for other in self._outputs:
@@ -437,6 +498,28 @@ class OutputSet:
         for folder in reversed(created):
             with contextlib.suppress(OSError):
                 folder.rmdir()
+
+
+def _refuse_outside(target: Path, folder: Path) -> None:
+    """Refuse ``target`` (a path under ``folder``) when links take it outside."""
+    root = os.path.realpath(folder)
+    real = os.path.realpath(target)
+    if os.path.commonpath([root, real]) == root:
+        return
+    link = target
+    for part in [target, *target.parents]:  # the link nearest the file
+        if part == folder or part in folder.parents:
+            break
+        if part.is_symlink():
+            link = part
+            break
+    raise OutputFileError(
+        f"is a symbolic link to {os.readlink(link)}, outside {folder}; remove it "
+        "or write elsewhere"
+        if link.is_symlink()
+        else f"lies outside {folder}",
+        source=link,
+    )
 
 
 def _name(argument: str | None, path: Path) -> str:
@@ -701,3 +784,86 @@ def protect_formula_cells(worksheet) -> None:
             if isinstance(cell.value, str) and is_formula_like(cell.value):
                 cell.data_type = "s"
                 cell.quotePrefix = True
+
+
+# ---------------------------------------------------------------- JSON and CSV text
+def _json_ready(value: object) -> object:
+    """``value`` with numpy types made plain and non-finite numbers made None."""
+    if isinstance(value, dict):
+        return {str(k): _json_ready(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_json_ready(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return [_json_ready(v) for v in value.tolist()]
+    if isinstance(value, bool | np.bool_):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, float | np.floating):
+        number = float(value)
+        return number if np.isfinite(number) else None
+    if isinstance(value, os.PathLike):
+        return os.fspath(value)
+    return value
+
+
+def json_text(data: object, *, indent: int = 2) -> str:
+    """``data`` as JSON text ending in a newline; non-finite numbers as ``null``.
+
+    Examples
+    --------
+    >>> json_text({"a": float("nan"), "b": np.float64(2.5), "c": [np.int64(3)]},
+    ...           indent=None)
+    '{"a": null, "b": 2.5, "c": [3]}\\n'
+    """
+    import json
+
+    return (
+        json.dumps(_json_ready(data), indent=indent, allow_nan=False, default=str)
+        + "\n"
+    )
+
+
+def write_json(
+    path: PathArg, data: object, outputs: OutputSet | None = None, *, indent: int = 2
+) -> Path:
+    """Write ``data`` as a JSON file (:func:`json_text`) through :func:`write_file`.
+
+    The one JSON writer of fieldkit: numpy values are plain JSON and NaN or
+    +-Infinity are written as ``null`` (never as the invalid literals ``NaN``,
+    ``Infinity``).
+    """
+    return write_text(path, json_text(data, indent=indent), outputs)
+
+
+def csv_text(rows: Iterable[Iterable[object]]) -> str:
+    """Rows as CSV text: cells quoted by the csv module where needed (commas,
+    quotes, line breaks), formula-like text cells escaped (:func:`escape_formula`);
+    numbers, and text that is a number (``"-2.5"``), are written as given.
+
+    Examples
+    --------
+    >>> csv_text([["id", "name"], [1, "=cmd|' /C calc'!A0"], [2, "a,b"], ["-2.5", 3]])
+    'id,name\\n1,\\'=cmd|\\' /C calc\\'!A0\\n2,"a,b"\\n-2.5,3\\n'
+    """
+    import csv
+    import io
+
+    lines = []
+    for row in rows:
+        # "\r\n" makes the writer quote a cell holding either character; each
+        # line then ends in "\n" alone, as every other text file fieldkit writes
+        buffer = io.StringIO()
+        csv.writer(buffer, lineterminator="\r\n").writerow([_csv_cell(c) for c in row])
+        lines.append(buffer.getvalue()[:-2] + "\n")
+    return "".join(lines)
+
+
+def _csv_cell(cell: object) -> object:
+    if not isinstance(cell, str):
+        return cell
+    try:
+        float(cell)
+    except ValueError:
+        return escape_formula(cell)
+    return cell

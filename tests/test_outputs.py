@@ -157,3 +157,48 @@ def test_impact_table_round_trip_keeps_formula_like_names(tmp_path, suffix):
     assert back["point"].tolist() == names
     assert set(back["path_id"]) == {"=A1"} and set(back["material"]) == {"-rock"}
     assert back["z_m"].tolist() == [-1.0] * n
+
+
+@given(st.lists(st.lists(st.text(), min_size=1, max_size=4), min_size=1, max_size=5))
+def test_csv_text_reads_back_cell_for_cell(rows):
+    import csv
+    import io
+
+    from fieldkit.outputs import csv_text
+
+    back = list(csv.reader(io.StringIO(csv_text(rows), newline="")))
+    expected = []
+    for row in rows:
+        cells = []
+        for cell in row:
+            try:
+                float(cell)
+                cells.append(cell)
+            except ValueError:
+                cells.append(escape_formula(cell))
+        expected.append(cells)
+    # the csv module writes a row of one empty cell as an empty line, read back as []
+    assert [r or [""] for r in back] == expected
+    for read, written in zip(back, rows, strict=True):
+        if read:
+            assert [unescape_formula(c) for c in read] == written
+
+
+def test_add_inputs_checks_outputs_planned_before(tmp_path):
+    read_late = tmp_path / "profile.csv"
+    read_late.write_text("x\n")
+    outputs = OutputSet()
+    outputs.plan(tmp_path / "other.json")
+    outputs.plan(read_late)
+    with pytest.raises(OutputFileError, match="would overwrite an input"):
+        outputs.add_inputs([read_late])
+
+
+def test_within_refuses_a_link_out_but_not_a_file_in(tmp_path):
+    folder = tmp_path / "out"
+    folder.mkdir()
+    (folder / "link.txt").symlink_to(tmp_path / "elsewhere.txt")
+    outputs = OutputSet()
+    outputs.plan(folder / "plain.txt", within=folder)
+    with pytest.raises(OutputFileError, match="symbolic link .* outside"):
+        outputs.plan(folder / "link.txt", within=folder)

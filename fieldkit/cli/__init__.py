@@ -3,11 +3,24 @@
 Each command module defines a single function decorated with
 :func:`fieldkit.cli.common.one_line_errors`; this module registers them, and
 :func:`main` (the console script) makes usage errors one line as well.
+
+Termination
+-----------
+``SIGTERM`` (a timeout, a CI job cancelled, ``docker stop``, ``kill``) and ``SIGHUP``
+(the terminal closed) end a command the way Ctrl-C does: :func:`main` turns them into
+a :class:`Terminated` exception, so every :class:`~fieldkit.outputs.OutputSet`
+unwinds -- a streamed temporary file and the folders made for it are removed, files
+already there are left as they were -- then prints ``error: terminated by SIGTERM``
+and exits with ``128 + signal`` (143 for SIGTERM, 129 for SIGHUP), as a shell
+reports a process killed by that signal. A second signal while unwinding is ignored
+so the cleanup finishes. ``kill -9`` cannot be caught (see :mod:`fieldkit.outputs`).
 """
 
 from __future__ import annotations
 
+import signal
 import sys
+import threading
 from typing import Annotated
 
 import typer
@@ -79,17 +92,59 @@ _USAGE_ERRORS = next(
 )
 
 
+#: Signals that end a command like Ctrl-C (module docstring, "Termination").
+TERMINATING_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
+
+
+class Terminated(BaseException):  # noqa: N818 -- named for what happened, as SystemExit
+    """A terminating signal arrived (not an ``Exception``: nothing may swallow it).
+
+    Parameters
+    ----------
+    signum
+        The signal's number.
+    """
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _terminate(signum: int, frame: object) -> None:
+    for other in TERMINATING_SIGNALS:  # let the unwinding finish
+        signal.signal(other, signal.SIG_IGN)
+    raise Terminated(signum)
+
+
 def main(argv: list[str] | None = None) -> None:
     """Console entry point: like ``app()``, but a usage error is one line on stderr.
 
     ``fieldkit reduce --theta0 abc`` prints ``error: fieldkit reduce: Invalid value
-    for '--theta0': ...`` and exits 2 (typer's default is a framed box).
+    for '--theta0': ...`` and exits 2 (typer's default is a framed box). SIGTERM and
+    SIGHUP unwind the command like Ctrl-C (module docstring, "Termination").
     """
     args = sys.argv[1:] if argv is None else list(argv)
     if not args:
         args = ["--help"]
+    previous = {}
+    if threading.current_thread() is threading.main_thread():
+        previous = {s: signal.signal(s, _terminate) for s in TERMINATING_SIGNALS}
+    try:
+        _run(args)
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+
+
+def _run(args: list[str]) -> None:
     try:
         code = app(args=args, prog_name="fieldkit", standalone_mode=False)
+    except Terminated as exc:
+        name = signal.Signals(exc.signum).name
+        typer.echo(
+            f"error: terminated by {name}; unfinished outputs were removed", err=True
+        )
+        sys.exit(128 + exc.signum)
     except _USAGE_ERRORS as exc:
         command = " ".join(["fieldkit", *args[:1]]) if args[:1] else "fieldkit"
         message = " ".join(exc.format_message().split())

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import secrets
 from pathlib import Path
 from typing import Annotated
@@ -11,7 +10,7 @@ import typer
 
 from fieldkit.cli.common import note, one_line_errors
 from fieldkit.errors import ArgumentError
-from fieldkit.outputs import OutputSet, write_text
+from fieldkit.outputs import OutputSet, write_json, write_text
 
 FLAGS = {
     "json_file": "--json",
@@ -223,16 +222,14 @@ def diagnose(
             from fieldkit.impact_table import ImpactTable
             from fieldkit.model.model_file import read_model
 
-            base = read_model(model) if model is not None else None
+            base = read_model(model, outputs=outputs) if model is not None else None
             table = ImpactTable.read(input_file)
             diagnosis = diagnose_impacts(
                 table, base, rng=rng, folds=folds, progress=progress
             )
         diagnosis.notes.append(f"fold seed {seed}")
         if json_file is not None:
-            write_text(
-                json_file, json.dumps(diagnosis.to_json(), indent=2) + "\n", outputs
-            )
+            write_json(json_file, diagnosis.to_json(), outputs)
         text = None
         if report_dir is not None:
             text = _write_report(report_dir, diagnosis, [str(p) for p in inputs],

@@ -13,6 +13,7 @@ from typing import Annotated
 import typer
 
 from fieldkit.cli.common import one_line_errors, parse_point
+from fieldkit.cli.progress import report_written, step
 from fieldkit.errors import ArgumentError
 from fieldkit.outputs import OutputSet, write_file
 
@@ -33,7 +34,8 @@ def _refuse_full_folder(folder: Path, force: bool) -> None:
     if folder.is_dir() and any(folder.iterdir()) and not force:
         raise ArgumentError(
             f"{folder} exists and is not empty (give --force to write into it; files "
-            "of the same names are replaced, others left alone)",
+            "of the same names are replaced, others left alone; a symbolic link "
+            "there is refused, never followed out of the folder)",
             source="output",
         )
 
@@ -113,23 +115,28 @@ def export(
     _refuse_full_folder(output, force)
     inputs = [model_file] + ([dem] if dem is not None else [])
     with OutputSet(inputs=inputs) as outputs:
-        model = read_model(model_file)
+        model = read_model(model_file, outputs=outputs)
         site = None
-        if dem is not None:
-            point = parse_point(release, "--release") if release is not None else None
-            site = site_from_dem(model, read_dem(dem), point)
-        elif extrude:
-            site = site_from_section(model, cellsize_m=cellsize, rows=rows)
-        result = chosen.export(model, site)
+        with step(f"exporting to {chosen.name}", announce=False):
+            if dem is not None:
+                point = (
+                    parse_point(release, "--release") if release is not None else None
+                )
+                site = site_from_dem(model, read_dem(dem), point)
+            elif extrude:
+                site = site_from_section(model, cellsize_m=cellsize, rows=rows)
+            result = chosen.export(model, site)
         files = dict(result.files)
         if site is not None:
             result.notes.insert(0, f"grid: {site.description}")
         files["README.md"] = result.readme(str(model_file))
         for name in files:
-            outputs.plan(output / name, argument="-o")
+            outputs.plan(output / name, argument="-o", within=output)
         for name, content in files.items():
             write_file(output / name, _writer(content), outputs)
-        outputs.commit()
+        with step(f"writing {len(files)} files", announce=False):
+            written = outputs.commit()
+    report_written(written)
     typer.echo(
         f"{chosen.name}: {len(files)} files -> {output}/ "
         f"({len(result.mapped)} quantities mapped, {len(result.unmapped)} not "

@@ -6,7 +6,6 @@ time-force comparison of rigid, flexible and stiff structures (section 8.3.2).
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Annotated
@@ -155,7 +154,7 @@ def fence(
         fieldkit fence --mass 520 --gyration 0.35 --radius 0.43 \\
           --speed-in 22 --angle-in 50 --spin-in 18
     """
-    from fieldkit.outputs import OutputSet, write_text
+    from fieldkit.outputs import OutputSet, write_json
     from fieldkit.physics.fence_impact import fence_impact
 
     rock = body_from_options(
@@ -201,7 +200,7 @@ def fence(
         )
         lines.append(f"figure: {figure}")
     if out is not None:
-        write_text(out, json.dumps(_results(result), indent=2) + "\n", outputs)
+        write_json(out, _results(result), outputs)
         lines.append(f"results: {out}")
     outputs.commit()
     typer.echo("\n".join(lines))

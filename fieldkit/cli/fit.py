@@ -208,7 +208,7 @@ def fit(
         if report is not None:
             outputs.plan(report / "report.md", argument="--report")
             outputs.plan(report / "residuals.png", argument="--report")
-        model = read_model(model_file)
+        model = read_model(model_file, outputs=outputs)
         table = ImpactTable.read(table_file)
         result, calibrated = fit_impacts(table, model)
         provenance = {

@@ -8,14 +8,13 @@ section (:func:`fieldkit.fit.path_sections.path_runs`), fit
 
 from __future__ import annotations
 
-import json
 from dataclasses import replace
 from pathlib import Path
 
 import typer
 
 from fieldkit.errors import ArgumentError
-from fieldkit.outputs import OutputSet, write_text
+from fieldkit.outputs import OutputSet, write_json
 
 
 def default_free(model) -> list[str]:
@@ -92,7 +91,7 @@ def fit_paths_command(
             outputs.plan(json_file, argument="--json")
         if report is not None:
             outputs.plan(report / "holdout.png", argument="--report")
-        base = read_model(model_file)
+        base = read_model(model_file, outputs=outputs)
         if on_dem:
             grid = read_dem(dem)
             calibration = path_runs(
@@ -137,7 +136,7 @@ def fit_paths_command(
             replace(result.model, provenance=provenance), output, outputs=outputs
         )
         if json_file is not None:
-            write_text(json_file, json.dumps(summary, indent=2) + "\n", outputs)
+            write_json(json_file, summary, outputs)
         outputs.commit()
     for p in summary["parameters"]:
         lo, hi = p["interval90"]

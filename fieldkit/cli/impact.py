@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Annotated
@@ -23,7 +22,7 @@ from fieldkit.cli.common import (
     warn,
 )
 from fieldkit.errors import ArgumentError
-from fieldkit.outputs import OutputSet, write_text
+from fieldkit.outputs import OutputSet, write_json
 from fieldkit.physics.bodies import ResolvedBody
 from fieldkit.physics.impact_mechanics import (
     ImpactResult,
@@ -380,6 +379,6 @@ def impact(
             "minimum_friction_to_stop_slip": mu_min,
             "impulse_unit": "N s" if mass_known else "N s/kg",
         }  # fmt: skip
-        write_text(json_out, json.dumps(payload, indent=2) + "\n", outputs)
+        write_json(json_out, payload, outputs)
     for path in outputs.commit():
         typer.echo(f"wrote {path}")

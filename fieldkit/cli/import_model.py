@@ -14,6 +14,7 @@ from typing import Annotated
 import typer
 
 from fieldkit.cli.common import note, one_line_errors
+from fieldkit.cli.progress import report_written
 from fieldkit.errors import ArgumentError
 from fieldkit.outputs import OutputSet
 
@@ -100,9 +101,10 @@ def import_model(
                                                     "folder": str(folder),
                                                     "notes": notes}}  # fmt: skip
         write_model(replace(model, provenance=provenance), output, outputs=outputs)
-        outputs.commit()
+        written = outputs.commit()
     for line in notes:
         note(line)
+    report_written(written)
     typer.echo(
         f"{len(model.materials)} materials, {len(model.profile.x_m)} slope vertices "
         f"-> {output}"

@@ -29,7 +29,7 @@ from fieldkit.model.dem_profile import (
     section_from_vertices,
     steepest_descent_line,
 )
-from fieldkit.outputs import OutputSet, write_text
+from fieldkit.outputs import OutputSet, csv_text, write_text
 
 #: Columns of the profile CSV, in order.
 COLUMNS = ("x_m", "z_m", "plan_x_m", "plan_y_m", "material")
@@ -37,15 +37,15 @@ COLUMNS = ("x_m", "z_m", "plan_x_m", "plan_y_m", "material")
 
 def profile_csv_text(section: Section) -> str:
     """The profile CSV (module docstring): the last row's material is empty."""
-    lines = [",".join(COLUMNS)]
+    rows = [list(COLUMNS)]
     materials = (*section.material, "")
     for c, z, x, y, m in zip(
         section.chainage_m, section.z_m, section.plan_x_m, section.plan_y_m, materials,
         strict=True,
     ):  # fmt: skip
-        plan = f"{x:.4f},{y:.4f}" if math.isfinite(x) else ","
-        lines.append(f"{c:.4f},{z:.4f},{plan},{m}")
-    return "\n".join(lines) + "\n"
+        plan = [f"{x:.4f}", f"{y:.4f}"] if math.isfinite(x) else ["", ""]
+        rows.append([f"{c:.4f}", f"{z:.4f}", *plan, m])
+    return csv_text(rows)  # quoted and formula-escaped by the csv module
 
 
 def _describe_grid(grid: DemGrid) -> str:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 import secrets
 import sys
@@ -14,7 +13,7 @@ import typer
 
 from fieldkit.cli.common import note, one_line_errors
 from fieldkit.errors import ArgumentError
-from fieldkit.outputs import OutputSet, write_text
+from fieldkit.outputs import OutputSet, write_json
 
 #: Rows an XLSX sheet holds (the header takes one).
 XLSX_MAX_ROWS = 1_048_576 - 1
@@ -64,14 +63,6 @@ def parse_measured(text: str):
     if "x_m" not in values:
         raise ArgumentError(f"{text!r} lacks x=<position m>", source="measured")
     return Measured(**values)
-
-
-def _jsonable(value):
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    return str(value)
 
 
 def _fmt(d: dict, key: str, unit: str = "") -> str:
@@ -181,7 +172,7 @@ def simulate(
 
             for name in point_figure_names(analysis_x):
                 outputs.plan(figures / name, argument="--figures")
-        model = read_model(model_file)
+        model = read_model(model_file, outputs=outputs)
         if seed is None:
             seed = secrets.randbits(32)
             note(f"`seed` not given: used {seed}; pass --seed {seed} to reproduce")
@@ -233,11 +224,7 @@ def simulate(
             recorded.write(impacts, outputs=outputs)
         stats = result.summary()
         if summary is not None:
-            write_text(
-                summary,
-                json.dumps(stats, indent=2, default=_jsonable) + "\n",
-                outputs,
-            )
+            write_json(summary, stats, outputs)
         if figures is not None:
             from fieldkit.viz.simulation_figure import write_simulation_figures
 

@@ -169,7 +169,7 @@ def synth(
         return
     with OutputSet(inputs=[model_file]) as outputs:
         outputs.plan(output, argument="-o")
-        model = read_model(model_file)
+        model = read_model(model_file, outputs=outputs)
         if seed is None:
             seed = secrets.randbits(32)
             note(f"`seed` not given: used {seed}; pass --seed {seed} to reproduce")
@@ -221,7 +221,7 @@ def _synth_track(
         )
     with OutputSet(inputs=[model_file]) as outputs:
         outputs.plan(output, argument="-o")
-        model = with_effects(read_model(model_file), hidden)
+        model = with_effects(read_model(model_file, outputs=outputs), hidden)
         if seed is None:
             seed = secrets.randbits(32)
             note(f"`seed` not given: used {seed}; pass --seed {seed} to reproduce")

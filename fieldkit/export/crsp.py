@@ -45,6 +45,7 @@ from fieldkit.export.fitted import with_error
 from fieldkit.export.result import Export, Mapped
 from fieldkit.export.site import ExportSite
 from fieldkit.model.model_file import Model
+from fieldkit.outputs import csv_text
 from fieldkit.physics.bodies import sphere_density_kg_m3
 
 #: Metres in one international foot (exact).
@@ -178,14 +179,17 @@ def cells_csv(model: Model, surface: dict[str, tuple[float, float, float]]) -> s
     """The cell table: one CRSP cell per profile segment, in feet."""
     x = np.asarray(m_to_ft(np.asarray(model.profile.x_m, float)))
     y = np.asarray(m_to_ft(np.asarray(model.profile.z_m, float)))
-    lines = ["cell,begin_x_ft,begin_y_ft,end_x_ft,end_y_ft,S_ft,Rt,Rn,material"]
+    rows = [
+        "cell,begin_x_ft,begin_y_ft,end_x_ft,end_y_ft,S_ft,Rt,Rn,material".split(",")
+    ]
     for j, name in enumerate(model.profile.material):
         s_ft, rt, rn = surface[name]
-        lines.append(
-            f"{j + 1},{x[j]:.2f},{y[j]:.2f},{x[j + 1]:.2f},{y[j + 1]:.2f},"
-            f"{s_ft:.2f},{rt:.3f},{rn:.3f},{name}"
+        rows.append(
+            [str(j + 1)]
+            + [f"{v:.2f}" for v in (x[j], y[j], x[j + 1], y[j + 1], s_ft)]
+            + [f"{rt:.3f}", f"{rn:.3f}", name]
         )
-    return "\n".join(lines) + "\n"
+    return csv_text(rows)
 
 
 def rock_csv(model: Model, shape: str) -> str:

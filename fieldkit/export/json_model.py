@@ -9,13 +9,13 @@ the table a report or another tool reads without knowing fieldkit's model format
 
 from __future__ import annotations
 
-import json
 import math
 
 from fieldkit.export.fitted import fitted_parameters, with_error
 from fieldkit.export.result import Export, Mapped
 from fieldkit.export.site import ExportSite
 from fieldkit.model.model_file import Model, model_to_dict
+from fieldkit.outputs import json_text
 
 
 def export_json(model: Model, site: ExportSite | None = None) -> Export:
@@ -23,6 +23,7 @@ def export_json(model: Model, site: ExportSite | None = None) -> Export:
 
     Examples
     --------
+    >>> import json
     >>> from fieldkit.model.model_file import model_from_dict
     >>> m = model_from_dict({"profile": {"x_m": [0, 10], "z_m": [5, 0],
     ...   "material": "rock"}, "materials": {"rock": {"e_n": 0.3, "e_t": 0.8,
@@ -55,8 +56,8 @@ def export_json(model: Model, site: ExportSite | None = None) -> Export:
         target="json",
         title="fieldkit model (JSON)",
         files={
-            "model.json": json.dumps(model_to_dict(model), indent=1) + "\n",
-            "parameters.json": json.dumps(rows, indent=1) + "\n",
+            "model.json": json_text(model_to_dict(model), indent=1),
+            "parameters.json": json_text(rows, indent=1),
         },
         mapped=mapped,
         notes=[

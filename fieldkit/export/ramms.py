@@ -48,6 +48,7 @@ from fieldkit.export.fitted import with_error
 from fieldkit.export.result import Export, Mapped
 from fieldkit.export.site import ExportSite, checked_site
 from fieldkit.model.model_file import Model
+from fieldkit.outputs import csv_text
 
 #: RAMMS::ROCKFALL terrain categories, softest first (code = index + 1).
 CATEGORIES = (
@@ -249,7 +250,7 @@ def categories_csv(
     """Per material: the recommendation, the category's parameters, the reason."""
     head = ["material", "cells", "code", "category", "neighbour", "position"]
     head += list(PARAMETER_NAMES) + ["parameters", "reason"]
-    lines = [",".join(head)]
+    lines = [head]
     for name, (category, neighbour, position, why) in picks.items():
         values = category_parameters(category) if category else {}
         confirmed = ""
@@ -269,8 +270,8 @@ def categories_csv(
         ]
         row += [f"{values[p]:g}" if p in values else "" for p in PARAMETER_NAMES]
         row += [confirmed, why]
-        lines.append(",".join(_csv_field(v) for v in row))
-    return "\n".join(lines) + "\n"
+        lines.append(row)
+    return csv_text(lines)
 
 
 def category_parameters(category: str) -> dict[str, float]:
@@ -282,12 +283,6 @@ def category_parameters(category: str) -> dict[str, float]:
     (0.8, {'mu_max': 2.0, 'epsilon': 0.0})
     """
     return {**COMMON, **PARAMETERS.get(category, {})}
-
-
-def _csv_field(value: str) -> str:
-    if any(c in value for c in ',"\n'):
-        return '"' + value.replace('"', '""') + '"'
-    return value
 
 
 def _mapped(

@@ -62,6 +62,7 @@ from fieldkit.export.fitted import with_error
 from fieldkit.export.result import Export, Mapped
 from fieldkit.export.site import ExportSite
 from fieldkit.model.model_file import Model
+from fieldkit.outputs import csv_text
 
 #: RocFall distribution ids (the issue's list; RocFall3 help "Random Variables").
 DISTRIBUTIONS: dict[int, str] = {
@@ -394,17 +395,17 @@ def slope_csv(model: Model) -> str:
     """``slope.csv``: ``x_m,y_m,material_id`` (of the segment to the next vertex)."""
     ids = material_ids(model)
     p = model.profile
-    rows = ["x_m,y_m,material_id"]
+    rows = [["x_m", "y_m", "material_id"]]
     for j, (x, z) in enumerate(zip(p.x_m, p.z_m, strict=True)):
         mat = str(ids[p.material[j]]) if j < p.segments else ""
-        rows.append(f"{number(x)},{number(z)},{mat}")
-    return "\n".join(rows) + "\n"
+        rows.append([number(x), number(z), mat])
+    return csv_text(rows)
 
 
 def material_ids_csv(model: Model) -> str:
     """``material_ids.csv``: ``id,name``."""
-    rows = ["id,name"] + [f"{i},{name}" for name, i in material_ids(model).items()]
-    return "\n".join(rows) + "\n"
+    rows = [["id", "name"]] + [[i, name] for name, i in material_ids(model).items()]
+    return csv_text(rows)
 
 
 def export_rocfall(model: Model, site: ExportSite | None = None) -> Export:

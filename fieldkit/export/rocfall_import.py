@@ -33,7 +33,7 @@ from pathlib import Path
 
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.export.rocfall import DISTRIBUTIONS, MATERIAL_KEYS, ROCK_KEYS
-from fieldkit.model.materials import MATERIAL_FIELDS
+from fieldkit.model.materials import MATERIAL_FIELDS, check_material_name
 from fieldkit.model.model_file import CORE_DEFAULTS, Model, model_from_dict
 
 #: Density of the sphere that gives an imported rock its radius [kg/m^3] (stated).
@@ -214,7 +214,7 @@ def _entries(text: Text, kind: str) -> list[_Block]:
                     source=text.source,
                     where=f"line {n}",
                 ) from None
-            name = match["value"].strip() or f"{kind} {ident}"
+            name = match["value"].strip() or f"{kind.replace(' ', '_')}_{ident}"
             for b in blocks:
                 if b.ident == ident:
                     raise InputFileError(
@@ -334,6 +334,7 @@ def _materials(text: Text, notes: list[str]) -> dict[int, tuple[str, dict]]:
     out: dict[int, tuple[str, dict]] = {}
     seen: dict[str, int] = {}
     for block in _entries(text, "material"):
+        check_material_name(block.name, source=text.source, where=f"line {block.line}")
         label = f"material {block.ident} ({block.name})"
         if block.name in seen:
             raise InputFileError(
@@ -609,6 +610,13 @@ def _settings(text: Text | None, notes: list[str]) -> tuple[dict, dict, str]:
         return {}, {}, "material"
     entries: dict[str, _Entry] = {}
     for n, match, key in _key_value_lines(text):
+        if key in entries:
+            raise InputFileError(
+                f"setting {key!r} given twice (first on line {entries[key].line}); "
+                "give each setting once",
+                source=text.source,
+                where=f"line {n}",
+            )
         unit = None if match["unit"] is None else match["unit"].strip().lower()
         entries[key] = _Entry(key, unit, match["value"].strip(), n)
     known = {

@@ -49,6 +49,7 @@ import numpy as np
 
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.io.dem import INSIDE, NODATA, OUTSIDE, DemGrid
+from fieldkit.model.materials import MATERIAL_NAME, check_material_name
 
 #: Material of every segment when no chainage ranges are given.
 DEFAULT_MATERIAL = "ground"
@@ -142,7 +143,6 @@ class MaterialRange:
     material: str
 
 
-_NAME = re.compile(r"^[A-Za-z_][\w.-]*$")
 _RANGE = re.compile(
     r"^\s*(?P<start>[^-:]+?)\s*-\s*(?P<end>[^:]*?)\s*:\s*(?P<name>.+?)\s*$"
 )
@@ -178,10 +178,10 @@ def parse_material_ranges(ranges: str | Sequence[MaterialRange]) -> list[Materia
                 )
             start = _range_number(match["start"], part)
             end = None if not match["end"] else _range_number(match["end"], part)
-            if not _NAME.match(match["name"]):
+            if not MATERIAL_NAME.fullmatch(match["name"]):
                 raise ArgumentError(
                     f"material name '{match['name']}' in '{part.strip()}': use "
-                    "letters, digits, _ . - (starting with a letter or _)",
+                    "1-64 letters, digits, _ . - (starting with a letter or _)",
                     source="ranges",
                 )
             items.append(MaterialRange(start, end, match["name"]))
@@ -301,6 +301,8 @@ def section_from_vertices(
     x = np.asarray(x_m, dtype=float)
     nan = np.full(x.shape, np.nan)
     names = (DEFAULT_MATERIAL,) * (len(x) - 1) if material is None else tuple(material)
+    for name in dict.fromkeys(names):  # one rule for material names (materials.py)
+        check_material_name(name, source=source, where="material")
     return Section(
         chainage_m=x,
         z_m=np.asarray(z_m, dtype=float),

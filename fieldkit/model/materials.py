@@ -6,32 +6,82 @@ of the sliding/rolling phase (eq. 7.3), each with an optional standard deviation
 (fieldkit's default SD is 0, stated; RocFall's Table 7-1 footnote suggests 0.04 for
 the coefficients), and the two roughness measures of the ``slope_roughness`` effect:
 CRSP's roughness ``s`` [m] (eq. 7.4) and RocFall's SD of the segment dip [deg].
+
+Every field has a finite bound (:data:`MATERIAL_FIELDS`), chosen so that a value
+outside it is a typing or unit error rather than a ground:
+
+* ``e_n`` in [0, 5]: ``e_n > 1`` is legal for shallow impacts (docs/architecture.md
+  §2; eq. 5.4 gives e_n = 3.7 at 5 deg with the thesis' a = 19.5, b = 1.03) but a
+  constant ground coefficient above 5 multiplies the normal speed five-fold at
+  every impact;
+* ``e_t`` in [0, 2]: measured ``e_t`` exceed 1 only where spin turns into
+  translation (flagged ``e_t > 1`` in an ImpactTable, up to about 1.5); a constant
+  above 2 would double the tangential speed at every impact;
+* the SDs of ``e_n`` and ``e_t`` at most half their mean's range (2.5, 1): a wider
+  spread is all truncation at 0;
+* ``friction_deg`` in [0, 89] deg (tan 90 deg is infinite), its SD <= 45 deg;
+* ``roughness_m`` <= 10 m: CRSP's roughness is the height of the ground's
+  irregularities felt by a block (classes up to ~3 m); ``roughness_deg_sd`` <= 45.
+
+A material **name** (:func:`check_material_name`) is 1 to 64 characters: letters,
+digits, ``_``, ``.`` and ``-``, starting with a letter or ``_`` (``rock``,
+``talus_2``, ``Geröll``). The name is written into other programs' files (RocFall's
+``material 1: name`` lines, CSV columns, chainage ranges ``0-40:rock``), where a
+comma, colon, ``#``, quote or line break would change their meaning and a leading
+``=`` would make a spreadsheet run it.
 """
 
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, fields
 
 from fieldkit.errors import InputFileError
 
-#: Material fields: name -> (lower bound, upper bound, unit, meaning).
+#: Material fields: name -> (lower bound, upper bound, unit, meaning); the bounds
+#: are explained in the module docstring.
 MATERIAL_FIELDS: dict[str, tuple[float, float, str, str]] = {
-    "e_n": (0.0, math.inf, "-", "normal coefficient of restitution (eq. 4.6)"),
-    "e_t": (0.0, math.inf, "-", "tangential coefficient of restitution (eq. 4.7)"),
+    "e_n": (0.0, 5.0, "-", "normal coefficient of restitution (eq. 4.6)"),
+    "e_t": (0.0, 2.0, "-", "tangential coefficient of restitution (eq. 4.7)"),
     "friction_deg": (0.0, 89.0, "deg", "friction angle of sliding/rolling (eq. 7.3)"),
-    "e_n_sd": (0.0, math.inf, "-", "SD of e_n, drawn per impact"),
-    "e_t_sd": (0.0, math.inf, "-", "SD of e_t, drawn per impact"),
+    "e_n_sd": (0.0, 2.5, "-", "SD of e_n, drawn per impact"),
+    "e_t_sd": (0.0, 1.0, "-", "SD of e_t, drawn per impact"),
     "friction_deg_sd": (
         0.0,
         45.0,
         "deg",
         "SD of the friction angle, per segment entry",
     ),
-    "roughness_m": (0.0, math.inf, "m", "CRSP roughness s of eq. 7.4"),
+    "roughness_m": (0.0, 10.0, "m", "CRSP roughness s of eq. 7.4"),
     "roughness_deg_sd": (0.0, 45.0, "deg", "RocFall SD of the segment dip"),
 }
 REQUIRED = ("e_n", "e_t", "friction_deg")
+#: A material name (module docstring): letters, digits, ``_ . -``, at most 64.
+MATERIAL_NAME = re.compile(r"[^\W\d][\w.-]{0,63}")
+
+
+def check_material_name(name: object, *, source: str, where: str) -> str:
+    """``name`` if it is a valid material name, else a one-line InputFileError.
+
+    Examples
+    --------
+    >>> check_material_name("talus_2", source="m.json", where="materials")
+    'talus_2'
+    >>> check_material_name("=cmd|x", source="m.json", where="materials")
+    ... # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    fieldkit.errors.InputFileError: m.json: materials: material name '=cmd|x' ...
+    """
+    if isinstance(name, str) and MATERIAL_NAME.fullmatch(name):
+        return name
+    raise InputFileError(
+        f"material name {name!r} is not allowed: use 1-64 letters, digits, _ . - "
+        "starting with a letter or _",
+        source=source,
+        where=where,
+    )
 
 
 @dataclass(frozen=True)
@@ -57,6 +107,7 @@ class Material:
         >>> Material.from_dict("rock", {"e_n": 0.5, "e_t": 0.9, "friction_deg": 30}).e_t
         0.9
         """
+        check_material_name(name, source=source, where="materials")
         where = f"materials.{name}"
         if not isinstance(data, dict):
             raise InputFileError("must be an object", source=source, where=where)
@@ -89,14 +140,20 @@ def check_number(
     where: str,
     unit: str = "",
 ) -> float:
-    """``value`` as a float in ``[lower, upper]``, else a one-line InputFileError."""
+    """``value`` as a finite float in ``[lower, upper]``, else a one-line
+    InputFileError (NaN and +-Infinity are refused whatever the bounds)."""
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise InputFileError(
-            f"must be a number (got {value!r})", source=source, where=where
+            f"must be a number (got {_shown(value)})", source=source, where=where
         )
-    number = float(value)
-    if math.isnan(number):
-        raise InputFileError("must be a number (got NaN)", source=source, where=where)
+    try:
+        number = float(value)
+    except OverflowError:  # an integer beyond the float range
+        number = math.inf if value > 0 else -math.inf
+    if not math.isfinite(number):
+        raise InputFileError(
+            f"must be a finite number (got {number})", source=source, where=where
+        )
     unit = "" if unit in ("", "-") else f" {unit}"
     if number < lower:
         raise InputFileError(
@@ -107,3 +164,9 @@ def check_number(
             f"must be <= {upper:g}{unit} (got {number:g})", source=source, where=where
         )
     return number
+
+
+def _shown(value: object) -> str:
+    """A short ``repr`` of a wrong value for a one-line message."""
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."

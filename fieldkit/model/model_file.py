@@ -12,6 +12,35 @@ Core settings (``"core"``) all have defaults, stated by :data:`CORE_DEFAULTS`:
 * ``drag_dt_s`` = 0.25: longest flight substep when ``air_drag`` is on (substeps
   are also kept short enough for drag to change the speed by < 0.2 %, see
   :mod:`fieldkit.model.effects.air_drag`).
+
+Every number must be finite (JSON's ``NaN`` and ``Infinity`` are refused) and lie
+within a physical bound; the bounds are wide enough for any rockfall and narrow
+enough to catch a typing or unit error:
+
+* body (:data:`BODY_BOUNDS`): mass in (0, 1e9] kg and contact radius in (0, 50] m
+  -- the largest single blocks of rockfall inventories are ~1e5 m3 (~3e8 kg, a
+  sphere of r = 29 m); beyond that it is a rock avalanche, which a lumped-mass
+  model does not describe; the gyration k must be <= r
+  (:class:`fieldkit.physics.bodies.Body`: every mass point lies within r of the
+  centre, a thin hoop is the limit k = r);
+* seeder (:data:`SEEDER_BOUNDS`): speeds |v| <= 100 m/s (a free fall of 500 m) and
+  spin |omega| <= 500 rad/s (a 0.2 m block rolling at 100 m/s), SDs as large; the
+  start at most 1000 m above the ground; a release height <= 1000 m;
+* trees: trunk diameter in (0, 5] m, height in (0, 150] m (the tallest trees are
+  ~115 m);
+* materials: see :mod:`fieldkit.model.materials` (also for the material names);
+* effects: each parameter's own bounds (``fieldkit effects NAME``).
+
+The profile's x must increase strictly, so every segment dips between -90 and 90
+degrees (inside the contract's (-180, 180] degrees).
+
+Files a model reads
+-------------------
+A model whose profile comes from a CSV or a DEM reads those files too.
+:attr:`Model.source_files` lists every file read (the model file first);
+``read_model(path, outputs=outputs)`` adds them to a command's
+:class:`~fieldkit.outputs.OutputSet` inputs, so no output of the command can
+replace them.
 """
 
 from __future__ import annotations
@@ -19,12 +48,13 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 import numpy as np
 
-from fieldkit.errors import FieldkitError, InputFileError
+from fieldkit.errors import ArgumentError, FieldkitError, InputFileError
 from fieldkit.io.dem import read_dem
 from fieldkit.io.profile_csv import read_profile_csv
 from fieldkit.model.dem_profile import (
@@ -36,7 +66,7 @@ from fieldkit.model.effects import registry
 from fieldkit.model.materials import Material, check_number
 from fieldkit.model.profile import Profile
 from fieldkit.model.seeder import Seeder
-from fieldkit.outputs import OutputSet, write_file
+from fieldkit.outputs import OutputSet, json_text, write_file
 
 #: Core settings -> (default, lower, upper, unit).
 CORE_DEFAULTS: dict[str, tuple[float, float, float, str]] = {
@@ -46,6 +76,18 @@ CORE_DEFAULTS: dict[str, tuple[float, float, float, str]] = {
     "drag_dt_s": (0.25, 1e-4, 5.0, "s"),
 }
 G_MPS2 = 9.81
+#: Body fields -> (lower, upper) [SI]; the lower bound is exclusive (module docstring).
+BODY_BOUNDS: dict[str, tuple[float, float]] = {
+    "mass_kg": (0.0, 1e9),
+    "radius_m": (0.0, 50.0),
+    "gyration_m": (0.0, 50.0),
+}
+#: Largest |speed| [m/s], |spin| [rad/s] and height above the ground [m] of a start.
+SEEDER_BOUNDS: dict[str, float] = {"mps": 100.0, "radps": 500.0, "m": 1000.0}
+#: Largest tree trunk diameter and height [m].
+TREE_BOUNDS: dict[str, float] = {"diameter_m": 5.0, "height_m": 150.0}
+#: JSON nesting deeper than this is refused (a model file is 4 levels deep).
+MAX_JSON_DEPTH = 64
 
 
 @dataclass(frozen=True)
@@ -79,6 +121,9 @@ class Model:
     trees: Trees | None = None
     source: str = ""
     provenance: dict = field(default_factory=dict)
+    #: Every file read to build the model: the model file (when read from one),
+    #: then its profile CSV or DEM (module docstring, "Files a model reads").
+    source_files: tuple[str, ...] = ()
 
     def parameters(self) -> dict[str, float]:
         """Flat namespaced view of the fittable numbers.
@@ -119,7 +164,9 @@ class Model:
             else:
                 data["effects"][parts[0]][parts[1]] = value
         model = model_from_dict(data, source=self.source)
-        return replace(model, provenance=dict(self.provenance))
+        return replace(
+            model, provenance=dict(self.provenance), source_files=self.source_files
+        )
 
 
 def _object(data: object, where: str, source: str) -> dict:
@@ -165,9 +212,11 @@ def model_from_dict(
     for key in ("profile", "materials", "body", "seeder"):
         if key not in data:
             raise InputFileError("missing", source=source, where=key)
+    read: list[str] = []
     profile = _profile(
-        _object(data["profile"], "profile", source), source, base_dir=base_dir
-    )
+        _object(data["profile"], "profile", source), source, base_dir=base_dir,
+        read=read,
+    )  # fmt: skip
     mats = _object(data["materials"], "materials", source)
     materials = {
         name: Material.from_dict(name, value, source=source)
@@ -181,21 +230,7 @@ def model_from_dict(
                 source=source,
                 where="profile.material",
             )
-    body_data = _object(data["body"], "body", source)
-    _unknown(body_data, {"mass_kg", "radius_m", "gyration_m"}, "body", source)
-    body_values = {}
-    for key in ("mass_kg", "radius_m"):
-        if key not in body_data:
-            raise InputFileError("missing", source=source, where=f"body.{key}")
-        body_values[key] = check_number(
-            body_data[key], 1e-9, math.inf, source=source, where=f"body.{key}"
-        )
-    # Solid sphere k = sqrt(2/5) r when not given (stated here: eq. of bodies.py).
-    gyration = body_data.get("gyration_m", math.sqrt(0.4) * body_values["radius_m"])
-    body_values["gyration_m"] = check_number(
-        gyration, 1e-9, math.inf, source=source, where="body.gyration_m"
-    )
-    body = Body(**body_values)
+    body = _body(_object(data["body"], "body", source), source)
     seeder = _seeder(_object(data["seeder"], "seeder", source), profile, source)
     effects_data = _object(data.get("effects", {}), "effects", source)
     effects: dict[str, dict[str, float]] = {}
@@ -243,10 +278,68 @@ def model_from_dict(
         trees=trees,
         source=source,
         provenance=dict(provenance) if isinstance(provenance, dict) else {},
+        source_files=tuple(read),
     )
 
 
-def _profile(prof: dict, source: str, *, base_dir) -> Profile:
+def _body(data: dict, source: str) -> Body:
+    """The body, bounded (:data:`BODY_BOUNDS`) and checked as
+    :class:`fieldkit.physics.bodies.Body` checks a body (k <= r)."""
+    from fieldkit.physics.bodies import Body as PhysicalBody
+
+    _unknown(data, set(BODY_BOUNDS), "body", source)
+    values = {}
+    for key in ("mass_kg", "radius_m"):
+        if key not in data:
+            raise InputFileError("missing", source=source, where=f"body.{key}")
+    # Solid sphere k = sqrt(2/5) r when not given (physics.bodies, Table 4-1).
+    given = {"gyration_m": None, **data}
+    for key, (lower, upper) in BODY_BOUNDS.items():
+        value = given[key]
+        if value is None and key == "gyration_m":
+            value = math.sqrt(0.4) * values["radius_m"]
+        values[key] = check_number(
+            value, lower, upper, source=source, where=f"body.{key}",
+            unit="kg" if key == "mass_kg" else "m",
+        )  # fmt: skip
+        if values[key] <= lower:
+            raise InputFileError(
+                f"must be > {lower:g} (got {values[key]:g})",
+                source=source,
+                where=f"body.{key}",
+            )
+    try:
+        PhysicalBody(**values)
+    except ArgumentError as exc:
+        raise InputFileError(
+            exc.message, source=source, where=f"body.{exc.source}"
+        ) from None
+    return Body(**values)
+
+
+#: Arguments of the section readers -> the profile field that gives them.
+_PROFILE_FIELDS = {
+    "ranges": "materials",
+    "units": "units",
+    "vertices_xy": "line",
+    "start_xy": "from",
+    "spacing_m": "step_m",
+    "step_m": "step_m",
+    "max_length_m": "max_length_m",
+}
+
+
+def _text(prof: dict, key: str, source: str) -> str:
+    """A text field of a profile entry (a file name, units, ranges)."""
+    value = prof[key]
+    if not isinstance(value, str) or not value.strip():
+        raise InputFileError(
+            f"must be text (got {value!r})"[:80], source=source, where=f"profile.{key}"
+        )
+    return value
+
+
+def _profile(prof: dict, source: str, *, base_dir, read: list[str]) -> Profile:
     """The slope profile from where a user has it (docs/architecture.md §5).
 
     * vertex lists: ``{"x_m": [...], "z_m": [...], "material": [...]}``;
@@ -269,16 +362,30 @@ def _profile(prof: dict, source: str, *, base_dir) -> Profile:
             else {"dem", "from", "line", "step_m", "max_length_m", "materials"}
         )
         _unknown(prof, allowed, "profile", source)
-        path = base / str(prof[kind])
-        if kind == "csv":
-            vertices = read_profile_csv(path, units=prof.get("units"))
-            section = section_from_vertices(
-                vertices.x_m, vertices.z_m, vertices.material, source=str(path)
-            )
-        else:
-            section = _dem_section(prof, path, source)
-        if "materials" in prof:
-            section = section.with_materials(str(prof["materials"]))
+        path = base / _text(prof, kind, source)
+        units = _text(prof, "units", source) if prof.get("units") is not None else None
+        ranges = _text(prof, "materials", source) if "materials" in prof else None
+        read.append(str(path))
+        if kind == "dem" and path.with_suffix(".prj").is_file():
+            read.append(str(path.with_suffix(".prj")))  # its CRS (fieldkit.io.dem)
+        try:
+            if kind == "csv":
+                vertices = read_profile_csv(path, units=units)
+                section = section_from_vertices(
+                    vertices.x_m, vertices.z_m, vertices.material, source=str(path)
+                )
+            else:
+                section = _dem_section(prof, path, source)
+            if ranges is not None:
+                section = section.with_materials(ranges)
+        except ArgumentError as exc:  # names an argument: here a field of profile
+            if exc.source not in _PROFILE_FIELDS:
+                raise
+            raise InputFileError(
+                exc.message,
+                source=source,
+                where=f"profile.{_PROFILE_FIELDS[exc.source]}",
+            ) from None
         return Profile.from_arrays(
             section.chainage_m, section.z_m, section.material, source=source
         )
@@ -293,20 +400,43 @@ def _profile(prof: dict, source: str, *, base_dir) -> Profile:
 
 def _dem_section(prof: dict, path: Path, source: str):
     """The section of a ``"dem"`` profile entry (steepest descent or polyline)."""
-    grid = read_dem(path)
-    step = prof.get("step_m")
-    step = 0.5 * grid.cellsize_m if step is None else float(step)
     if ("from" in prof) == ("line" in prof):
         raise InputFileError(
             "give either `from` [x, y] (steepest descent) or `line` [[x, y], ...]",
             source=source,
             where="profile.dem",
         )
+    for key in ("step_m", "max_length_m"):
+        if prof.get(key) is not None:
+            check_number(prof[key], 0.0, 1e6, source=source, where=f"profile.{key}",
+                         unit="m")  # fmt: skip
+    points = _plan_points(prof, "line" if "line" in prof else "from", source)
+    grid = read_dem(path)
+    step = prof.get("step_m")
+    step = 0.5 * grid.cellsize_m if step is None else float(step)
     if "line" in prof:
-        return profile_along_polyline(grid, prof["line"], step)
+        return profile_along_polyline(grid, points, step)
     return steepest_descent_line(
-        grid, prof["from"], step, max_length_m=prof.get("max_length_m")
+        grid, points[0], step, max_length_m=prof.get("max_length_m")
     )
+
+
+def _plan_points(prof: dict, key: str, source: str) -> list[tuple[float, float]]:
+    """``from`` ([x, y]) or ``line`` ([[x, y], ...]) as checked plan points."""
+    value = prof[key]
+    shape = "[x, y]" if key == "from" else "[[x, y], ...] (two or more points)"
+    items = [value] if key == "from" else value
+    if not isinstance(items, list) or not items:
+        raise InputFileError(f"must be {shape}", source=source, where=f"profile.{key}")
+    points = []
+    for i, item in enumerate(items):
+        where = f"profile.{key}" + ("" if key == "from" else f"[{i}]")
+        if not isinstance(item, list) or len(item) != 2:
+            raise InputFileError(f"must be {shape}", source=source, where=where)
+        points.append(
+            tuple(check_number(v, -1e9, 1e9, source=source, where=where) for v in item)
+        )
+    return points
 
 
 def _seeder(data: dict, profile: Profile, source: str) -> Seeder:
@@ -323,15 +453,27 @@ def _seeder(data: dict, profile: Profile, source: str) -> Seeder:
                 where=f"seeder.{key}",
             )
     values: dict[str, float | None] = {}
+    span = float(profile.x_m[-1] - profile.x_m[0])
     for key in names:
         if data.get(key) is None:
             continue
-        lower = 0.0 if key.endswith("_sd_m") or "_sd_" in key else -math.inf
-        if key == "height_m":
+        unit = key.rsplit("_", 1)[-1]
+        lower, upper = -math.inf, math.inf
+        if unit in ("mps", "radps"):
+            upper = SEEDER_BOUNDS[unit]
+            lower = -upper
+        if "_sd_" in key or key == "height_m":
             lower = 0.0
+        if key in ("x_sd_m",):
+            upper = span
+        elif key in ("z_sd_m", "height_m"):
+            upper = SEEDER_BOUNDS["m"]
+        elif key == "mass_sd_kg":
+            upper = BODY_BOUNDS["mass_kg"][1]
         values[key] = check_number(
-            data[key], lower, math.inf, source=source, where=f"seeder.{key}"
-        )
+            data[key], lower, upper, source=source, where=f"seeder.{key}",
+            unit={"mps": "m/s", "radps": "rad/s", "m": "m", "kg": "kg"}.get(unit, ""),
+        )  # fmt: skip
     if "z_m" not in values:
         values["z_m"] = math.nan
     seeder = Seeder(**values)
@@ -359,6 +501,13 @@ def _seeder(data: dict, profile: Profile, source: str) -> Seeder:
                 source=source,
                 where="seeder.z_m",
             )
+        if seeder.z_m > ground + SEEDER_BOUNDS["m"]:
+            raise InputFileError(
+                f"start is more than {SEEDER_BOUNDS['m']:g} m above the ground "
+                f"({seeder.z_m:g} m; ground {ground:g} m at x = {seeder.x_m:g} m)",
+                source=source,
+                where="seeder.z_m",
+            )
     return seeder
 
 
@@ -369,8 +518,10 @@ def _trees(data: dict, profile: Profile, source: str) -> Trees:
         if key not in data:
             raise InputFileError("missing", source=source, where=f"trees.{key}")
         try:
+            if isinstance(data[key], str):
+                raise TypeError(key)
             arrays[key] = np.asarray(data[key], float).reshape(-1)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise InputFileError(
                 "must be a list of numbers", source=source, where=f"trees.{key}"
             ) from None
@@ -386,24 +537,87 @@ def _trees(data: dict, profile: Profile, source: str) -> Trees:
             )
         if np.any(arrays[key] <= 0):
             raise InputFileError("must be > 0", source=source, where=f"trees.{key}")
+        if np.any(arrays[key] > TREE_BOUNDS[key]):
+            raise InputFileError(
+                f"must be <= {TREE_BOUNDS[key]:g} m (got {arrays[key].max():g})",
+                source=source,
+                where=f"trees.{key}",
+            )
     order = np.argsort(arrays["x_m"], kind="stable")
     return Trees(**{k: v[order] for k, v in arrays.items()})
 
 
-def read_model(path: str | os.PathLike[str]) -> Model:
-    """Read and validate a JSON model file (one-line errors naming the file)."""
+def read_model(
+    path: str | os.PathLike[str], *, outputs: OutputSet | None = None
+) -> Model:
+    """Read and validate a JSON model file (one-line errors naming the file).
+
+    Parameters
+    ----------
+    path
+        The model file (JSON, UTF-8).
+    outputs
+        The calling command's outputs: every file the model reads
+        (:attr:`Model.source_files`) is added to its inputs, so no output replaces
+        them (:meth:`fieldkit.outputs.OutputSet.add_inputs`).
+
+    Raises
+    ------
+    InputFileError
+        The file cannot be read, is not UTF-8 or not JSON, is nested deeper than
+        :data:`MAX_JSON_DEPTH`, or has a bad field (named).
+    OutputFileError
+        A planned output of ``outputs`` is a file the model reads.
+    """
     path = Path(path)
+    if outputs is not None:
+        outputs.add_inputs([path])
     try:
         text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputFileError(
+            f"not a UTF-8 text file (byte {exc.start})", source=path
+        ) from None
     except OSError as exc:
-        raise InputFileError(f"cannot read ({exc.strerror})", source=path) from None
+        reason = exc.strerror or type(exc).__name__
+        raise InputFileError(f"cannot read ({reason})", source=path) from None
+    depth = _json_depth(text)
+    if depth > MAX_JSON_DEPTH:
+        raise InputFileError(
+            f"JSON nested {depth} levels deep (a model file has at most "
+            f"{MAX_JSON_DEPTH})",
+            source=path,
+        )
     try:
+        # NaN and +-Infinity (not JSON, but Python writes them) are read as floats
+        # so that the check of their field refuses them by name
         data = json.loads(text)
     except json.JSONDecodeError as exc:
         raise InputFileError(
             f"not valid JSON ({exc.msg})", source=path, where=f"line {exc.lineno}"
         ) from None
-    return model_from_dict(data, source=str(path), base_dir=path.parent)
+    model = model_from_dict(data, source=str(path), base_dir=path.parent)
+    model = replace(model, source_files=(str(path), *model.source_files))
+    if outputs is not None:
+        outputs.add_inputs(model.source_files)
+    return model
+
+
+_JSON_STRING = re.compile(r'"(?:[^"\\]|\\.)*"', re.DOTALL)
+
+
+def _json_depth(text: str) -> int:
+    """Deepest nesting of ``[`` and ``{`` outside strings (no recursion).
+
+    Examples
+    --------
+    >>> _json_depth('{"a": [[1], "]]]"], "b": {"c": "[{"}}')
+    3
+    """
+    code = np.frombuffer(_JSON_STRING.sub("", text).encode(), dtype=np.uint8)
+    step = np.isin(code, (ord("["), ord("{"))).astype(np.int64)
+    step -= np.isin(code, (ord("]"), ord("}")))
+    return int(np.cumsum(step).max(initial=0))
 
 
 def model_to_dict(model: Model) -> dict:
@@ -444,7 +658,7 @@ def write_model(
     model: Model, path: str | os.PathLike[str], *, outputs: OutputSet | None = None
 ) -> None:
     """Write ``model`` as JSON (through ``outputs`` when given)."""
-    text = json.dumps(model_to_dict(model), indent=1) + "\n"
+    text = json_text(model_to_dict(model), indent=1)
 
     def writer(tmp: Path) -> None:
         tmp.write_text(text, encoding="utf-8")

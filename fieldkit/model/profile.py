@@ -41,7 +41,7 @@ class Profile:
         def numbers(values: object, name: str) -> np.ndarray:
             try:
                 array = np.asarray(values, dtype=float)
-            except (TypeError, ValueError):
+            except (TypeError, ValueError, OverflowError):
                 raise InputFileError(
                     "must be a list of numbers", source=source, where=f"profile.{name}"
                 ) from None

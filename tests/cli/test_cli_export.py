@@ -149,3 +149,87 @@ def test_values_the_target_refuses_leave_nothing_behind(cli, tmp_path, fails, ta
     extra = ["--extrude"] if target == "rstone" else []
     fails(cli("export", bad, "--to", target, "-o", out, *extra), "colluvium", "1.05")
     assert not out.exists()
+
+
+def test_export_force_never_follows_a_link_out_of_the_folder(
+    cli, tmp_path, fails, digest
+):
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    target = elsewhere / "keep.txt"
+    target.write_text("not fieldkit's\n")
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "slope.csv").symlink_to(target)
+    before = digest(target)
+    r = cli("export", TABLE_7_1, "--to", "rocfall", "-o", out, "--force")
+    fails(r, "slope.csv", "symbolic link", str(target), "outside")
+    assert digest(target) == before
+    assert sorted(p.name for p in out.iterdir()) == ["slope.csv"]
+    assert (out / "slope.csv").is_symlink()
+    assert sorted(p.name for p in elsewhere.iterdir()) == ["keep.txt"]
+
+
+def test_export_force_refuses_a_linked_sub_folder_too(cli, tmp_path, fails):
+    # a link to a folder outside, in place of a file name the target writes
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "README.md").symlink_to(outside / "README.md")
+    fails(cli("export", TABLE_7_1, "--to", "json", "-o", out, "--force"),
+          "README.md", "outside")  # fmt: skip
+    assert list(outside.iterdir()) == []
+
+
+def test_a_linked_output_folder_itself_is_written(cli, tmp_path):
+    real = tmp_path / "real"
+    real.mkdir()
+    (tmp_path / "link").symlink_to(real)
+    r = cli("export", TABLE_7_1, "--to", "json", "-o", tmp_path / "link")
+    assert r.exit_code == 0, r.output
+    assert sorted(p.name for p in real.iterdir()) == [
+        "README.md", "model.json", "parameters.json"
+    ]  # fmt: skip
+
+
+def test_export_says_what_it_wrote(cli, tmp_path):
+    out = tmp_path / "rocfall"
+    r = cli("export", TABLE_7_1, "--to", "rocfall", "-o", out)
+    assert r.exit_code == 0, r.output
+    wrote = [line[len("wrote ") :] for line in r.stdout.splitlines()
+             if line.startswith("wrote ")]  # fmt: skip
+    assert sorted(wrote) == sorted(str(p) for p in out.iterdir())
+    assert len(wrote) == 6
+
+
+def test_import_model_says_what_it_wrote(cli, tmp_path):
+    folder = tmp_path / "rocfall"
+    assert cli("export", TABLE_7_1, "--to", "rocfall", "-o", folder).exit_code == 0
+    model = tmp_path / "back.json"
+    r = cli("import-model", folder, "--from", "rocfall", "-o", model)
+    assert r.exit_code == 0, r.output
+    assert f"wrote {model}" in r.stdout.splitlines()
+
+
+def _strict_json(path):
+    def refuse(name):
+        raise AssertionError(f"{path.name} holds the non-JSON literal {name}")
+
+    return json.loads(path.read_text(encoding="utf-8"), parse_constant=refuse)
+
+
+def test_json_outputs_write_non_finite_numbers_as_null(cli, tmp_path):
+    # a fit's record may hold a standard error that is not finite (unidentifiable)
+    data = json.loads(TABLE_7_1.read_text())
+    data["provenance"] = {"fit": {"stderr": {"a": float("nan"), "b": float("inf")}}}
+    model = tmp_path / "model.json"
+    model.write_text(json.dumps(data))  # Python writes NaN and Infinity literals
+    out = tmp_path / "j"
+    r = cli("export", model, "--to", "json", "-o", out)
+    assert r.exit_code == 0, r.output
+    written = _strict_json(out / "model.json")
+    assert written["provenance"]["fit"]["stderr"] == {"a": None, "b": None}
+    _strict_json(out / "parameters.json")
+    again = cli("export", out / "model.json", "--to", "json", "-o", tmp_path / "k")
+    assert again.exit_code == 0, again.output

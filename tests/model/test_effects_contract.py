@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
@@ -45,7 +46,12 @@ def test_metadata_is_complete_and_defaults_in_bounds(name):
 def test_neutral_parameters_reproduce_the_base_model_exactly(name):
     rng_args = dict(record_impacts=True, analysis_x_m=[50.0])
     base = simulate(build(sd=True), 300, np.random.default_rng(11), **rng_args)
-    neutral = build({name: effect(name).neutral()}, sd=True)
+    # the neutral values go to the simulator directly: a neutral value may be
+    # infinite (velocity_scaled_restitution's K), which no model file may hold
+    # (non-finite numbers are refused there; an effect is off by leaving it out)
+    neutral = replace(
+        build({name: {}}, sd=True), effects={name: effect(name).neutral()}
+    )
     other = simulate(neutral, 300, np.random.default_rng(11), **rng_args)
     assert same_result(base, other)
     assert np.array_equal(

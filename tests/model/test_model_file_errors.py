@@ -40,7 +40,7 @@ CASES = [
     ("sd < 0", lambda d: d["materials"]["rock"].update(e_t_sd=-0.02),
      "materials.rock.e_t_sd: must be >= 0 (got -0.02)"),
     ("seeder sd < 0", lambda d: d["seeder"].update(vx_sd_mps=-1),
-     "seeder.vx_sd_mps: must be >= 0 (got -1)"),
+     "seeder.vx_sd_mps: must be >= 0 m/s (got -1)"),
     ("unknown effect", lambda d: d.update(effects={"drag": {}}),
      "effects.drag: unknown effect (known: angle_dependent_restitution, "
      "velocity_scaled_restitution, rotation_friction, slope_roughness, mass_loss, "

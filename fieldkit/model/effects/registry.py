@@ -117,8 +117,15 @@ def validate(
             raise ArgumentError(
                 f"must be a number (got {value!r})", source=source, where=where
             )
-        number = float(value)
-        if math.isnan(number) or not p.lower <= number <= p.upper:
+        try:
+            number = float(value)
+        except OverflowError:  # an integer beyond the float range
+            number = math.inf
+        if not math.isfinite(number):
+            raise ArgumentError(
+                f"must be a finite number (got {number})", source=source, where=where
+            )
+        if not p.lower <= number <= p.upper:
             raise ArgumentError(
                 f"must be in [{p.lower:g}, {p.upper:g}] {p.units} (got {number:g})",
                 source=source,
