@@ -8,8 +8,9 @@ from typing import Annotated
 
 import typer
 
-from fieldkit.cli.common import one_line_errors
-from fieldkit.errors import ArgumentError
+from fieldkit.cli.common import note, one_line_errors
+from fieldkit.cli.progress import report_written, step
+from fieldkit.errors import ArgumentError, FieldkitError
 from fieldkit.outputs import OutputSet, write_text
 
 FLAGS = {
@@ -23,8 +24,59 @@ FLAGS = {
     "holdout_releases": "--holdout-paths",
     "holdout_deposits": "--holdout-deposits",
     "bound": "--bound",
+    "bounds": "--bound",
     "screen": "--screen",
+    "rocks": "--rocks",
+    "seed": "--seed",
+    "bootstrap": "--bootstrap",
+    "free": "--free",
+    "material": "--material",
+    "preset": "--preset",
 }
+
+MaterialOpt = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--material",
+        help="Map a surveyed material onto one of the model's: SURVEYED=MODEL, e.g. "
+        "talus=colluvium (repeatable; always applied).",
+    ),
+]
+PresetOpt = Annotated[
+    Path | None,
+    typer.Option(
+        "--preset",
+        help="A survey preset (TOML, e.g. surveys/tornado_mountain/"
+        "boulder_a_preset.toml): its [materials] mapping, applied only to surveyed "
+        "materials the model does not have; --material overrides it.",
+    ),
+]
+
+
+def mapped_table(
+    table, model, material: list[str] | None, preset: Path | None, required=True
+):
+    """``table`` with its materials mapped onto ``model``'s (one rule for fit, the
+    path fit and diagnose: :func:`fieldkit.fit.material_map.map_materials`); each
+    mapping is stated on stderr. ``model`` None: no model to check against."""
+    from fieldkit.fit.material_map import map_materials, parse_mapping
+    from fieldkit.io.preset import read_preset
+
+    explicit = parse_mapping(material)
+    preset_map, source = {}, "the preset"
+    if preset is not None:
+        preset_map, source = read_preset(preset).materials, str(preset)
+    mapping = map_materials(
+        table,
+        None if model is None else list(model.materials),
+        explicit,
+        preset_map,
+        preset_source=source,
+        required=required,
+    )
+    for text in mapping.notes:
+        note(text)
+    return mapping
 
 
 def _paths(options: dict) -> None:
@@ -68,6 +120,8 @@ def _paths(options: dict) -> None:
         section=options["section"],
         screen=options["screen"],
         bounds=options["bound"],
+        material=options["material"],
+        preset=options["preset"],
     )
 
 
@@ -149,6 +203,8 @@ def fit(
             help="Path fit: search bounds NAME=LO,HI of a free parameter (repeatable).",
         ),
     ] = None,
+    material: MaterialOpt = None,
+    preset: PresetOpt = None,
     section: Annotated[
         str,
         typer.Option(
@@ -203,28 +259,37 @@ def fit(
     from fieldkit.impact_table import ImpactTable
     from fieldkit.model.model_file import read_model, write_model
 
-    with OutputSet(inputs=[table_file, model_file]) as outputs:
+    with OutputSet(inputs=[table_file, model_file, preset]) as outputs:
         outputs.plan(output, argument="-o")
         if report is not None:
             outputs.plan(report / "report.md", argument="--report")
             outputs.plan(report / "residuals.png", argument="--report")
         model = read_model(model_file)
         table = ImpactTable.read(table_file)
-        result, calibrated = fit_impacts(table, model)
-        provenance = {
-            **calibrated.provenance,
-            "fit": result.provenance(str(table_file)),
-        }
-        write_model(replace(calibrated, provenance=provenance), output, outputs=outputs)
+        mapping = mapped_table(table, model, material, preset)
+        with step(f"fitting {model_file.name} to {len(table)} rows of {table_file}"):
+            result, calibrated = fit_impacts(mapping.table, model)
         text = result.report()
+        if not result.success:
+            raise FieldkitError(
+                f"the fit did not converge ({result.message}): no calibrated model "
+                "written",
+                source=str(table_file),
+            )
+        fit_record = result.provenance(str(table_file))
+        fit_record["material_map"] = mapping.provenance()
+        provenance = {**calibrated.provenance, "fit": fit_record}
+        write_model(replace(calibrated, provenance=provenance), output, outputs=outputs)
         if report is not None:
             from fieldkit.viz.fit_figure import write_residual_figure
 
-            derived = table.derive()
+            derived = mapping.table.derive()
+            mapped = "".join(f"* {n}\n" for n in mapping.notes)
             write_text(
                 report / "report.md",
-                f"# Impact fit\n\ntable: `{table_file}`, base model: `{model_file}`\n\n"
-                f"```\n{text}\n```\n\n![residuals](residuals.png)\n",
+                f"# Impact fit\n\ntable: `{table_file}`, base model: `{model_file}`\n"
+                f"\n{mapped + chr(10) if mapped else ''}```\n{text}\n```\n\n"
+                "![residuals](residuals.png)\n",
                 outputs,
             )
             write_residual_figure(
@@ -234,6 +299,6 @@ def fit(
                 derived.column("vi_mps"),
                 outputs=outputs,
             )
-        outputs.commit()
+        written = outputs.commit()
     typer.echo(text)
-    typer.echo(f"calibrated model -> {output}")
+    report_written(written)

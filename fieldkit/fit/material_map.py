@@ -94,6 +94,7 @@ def map_materials(
     preset: Mapping[str, str] | None = None,
     *,
     preset_source: str = "the preset",
+    required: bool = True,
 ) -> MaterialMapping:
     """Map ``table``'s surveyed materials onto ``model_materials`` (module docstring).
 
@@ -111,6 +112,10 @@ def map_materials(
         Mappings of a survey preset, applied only to materials the model lacks.
     preset_source
         How notes and errors name the preset (its file).
+    required
+        Whether every surveyed material must end up a material of the model (an
+        impact fit, a diagnosis); ``False`` where the table's materials are not
+        used (a path fit on the model's own profile): those left out are noted.
 
     Returns
     -------
@@ -186,7 +191,12 @@ def map_materials(
     mapped = labels.replace(rules) if rules else labels
     if known is not None:
         lacking = sorted(set(mapped.dropna()) - set(known))
-        if lacking:
+        if lacking and not required:
+            notes.append(
+                f"material(s) {', '.join(lacking)} of the table not in the model: "
+                "not used (the model's profile carries the materials)"
+            )
+        elif lacking:
             raise InputFileError(
                 f"material(s) {', '.join(lacking)} not in the model (it has "
                 f"{', '.join(known)}); map each onto one of them with `material` "
