@@ -48,6 +48,15 @@ class SurveyPreset:
     reduce: dict[str, float | str] = field(default_factory=dict)
     materials: dict[str, str] = field(default_factory=dict)
 
+    def body(self) -> dict[str, float]:
+        """The body values, as keyword arguments of
+        :func:`fieldkit.physics.bodies.resolve_body` (``mass_kg``, ...)."""
+        return {
+            k: float(v)
+            for k, v in self.reduce.items()
+            if k in ("mass_kg", "radius_m", "gyration_m")
+        }
+
 
 def read_preset(path: str | Path) -> SurveyPreset:
     """Read a survey preset (module docstring for the format).
