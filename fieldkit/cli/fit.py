@@ -267,7 +267,8 @@ def fit(
         model = read_model(model_file)
         table = ImpactTable.read(table_file)
         mapping = mapped_table(table, model, material, preset)
-        with step(f"fitting {model_file.name} to {len(table)} rows of {table_file}"):
+        # a weighted least squares of a few parameters: short, shown on a terminal
+        with step(f"fitting {model_file.name} to {table_file}", announce=False):
             result, calibrated = fit_impacts(mapping.table, model)
         text = result.report()
         if not result.success:

@@ -136,10 +136,11 @@ def check_settings(*, rocks: int, seed: int, bootstrap: int, screen: int) -> Non
     Examples
     --------
     >>> check_settings(rocks=200, seed=0, bootstrap=20, screen=16)
-    >>> check_settings(rocks=0, seed=0, bootstrap=20, screen=16)
-    Traceback (most recent call last):
-    ...
-    fieldkit.errors.ArgumentError: rocks must be between 1 and 20,000 (got 0)...
+    >>> try:
+    ...     check_settings(rocks=0, seed=0, bootstrap=20, screen=16)
+    ... except ArgumentError as exc:
+    ...     print(exc.message.split(":")[0])
+    rocks must be between 1 and 20,000 (got 0)
     """
     limits = (
         ("rocks", rocks, 1, MAX_ROCKS, "rocks per run and evaluation"),
