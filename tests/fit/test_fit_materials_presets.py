@@ -187,3 +187,48 @@ def test_a_one_impact_path_is_refused(cli, tmp_path, boulder_a, fails):
     r = cli("fit", "--paths", one, "--model", TABLE_7_1, "-o", out)
     fails(r, "1 surveyed point", "at least 3", "release", "stopped")
     assert not out.exists()
+
+
+def test_fit_figures_label_axes_in_words_and_explain_every_mark(tmp_path):
+    """The residual figure of an impact fit and the held-out figure of a path fit:
+    axis labels in words with units, one legend entry for every kind of mark."""
+    import numpy as np
+
+    from fieldkit.fit.fit_result import FitResult
+    from fieldkit.viz.fit_figure import residual_figure
+    from fieldkit.viz.holdout_figure import holdout_figure
+
+    result = FitResult(
+        names=["materials.rock.e_n"], values=np.array([0.5]),
+        stderr=np.array([0.1]), start=np.array([0.4]), lower=np.array([0.0]),
+        upper=np.array([2.0]), correlation=np.ones((1, 1)), chi2=4.0, redchi=1.0,
+        aic=0.0, bic=0.0, ndata=4, nparams=1, n_impacts=2, success=True,
+        message="ok", weighting="unit weights (the table has no *_sd columns)",
+        residuals=np.array([0.1, -0.2, 0.3, 0.0]),
+        residual_kind=np.array(["vfn", "vft", "vfn", "vft"]),
+        residual_row=np.array([0, 0, 1, 1]),
+    )  # fmt: skip
+    fig = residual_figure(result, np.array([20.0, 30.0]), np.array([10.0, 12.0]))
+    left, right = fig.axes[:2]
+    assert left.get_xlabel() == "impact angle to the ground θ_i (degrees)"
+    assert right.get_xlabel() == "impact speed v_i (m/s)"
+    assert left.get_ylabel() == "residual: observed − predicted (m/s)"
+    legend = [t.get_text() for t in left.get_legend().get_texts()]
+    assert legend == ["normal rebound velocity v_fN",
+                      "tangential rebound velocity v_fT", "prediction = observation"]
+    rng = np.random.default_rng(0)
+    validation = {
+        "path_ids": ["a", "b"], "observed": np.array([80.0, 90.0]),
+        "ensembles": {"calibrated": [rng.normal(85, 5, 50)] * 2,
+                      "uncalibrated": [rng.normal(95, 5, 50)] * 2,
+                      "climatology": [rng.normal(85, 8, 50)]},
+        "forecasts": {k: {"mean_crps": 1.0}
+                      for k in ("calibrated", "uncalibrated", "climatology")},
+    }  # fmt: skip
+    ax = holdout_figure(validation).axes[0]
+    assert ax.get_xlabel() == "runout along the section from the release (m)"
+    assert ax.get_ylabel() == "held-out run"
+    legend = {t.get_text() for t in ax.get_legend().get_texts()}
+    assert {"observed runout", "calibrated model", "starting (uncalibrated) model",
+            "median simulated runout", "50 % of simulated runouts (thick)",
+            "90 % of simulated runouts (thin)"} <= legend  # fmt: skip
