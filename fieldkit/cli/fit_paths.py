@@ -58,10 +58,8 @@ def _value(p: dict) -> str:
     """``value ± SE (90 % lo to hi; start s)``, without ± when there is no SE."""
     lo, hi = p["interval90"]
     if p["stderr"] is None:
-        return (
-            f"{p['value']:.4g} (no standard error; values the runs cannot tell from "
-            f"it: {lo:.4g} to {hi:.4g}; start {p['start']:.4g})"
-        )
+        span = f"; the runs cannot tell it from {lo:.4g} to {hi:.4g}" if hi > lo else ""
+        return f"{p['value']:.4g} (no standard error{span}; start {p['start']:.4g})"
     return (
         f"{p['value']:.4g} ± {p['stderr']:.2g} (90 % {lo:.4g} to {hi:.4g}; "
         f"start {p['start']:.4g})"
