@@ -144,8 +144,8 @@ def fit(
         Path | None,
         typer.Option(
             "--report",
-            help="Write report.md and residuals.png (impacts) or holdout.png (paths) "
-            "into this folder.",
+            help="Write report.md into this folder, with residuals.png (impacts) or, "
+            "with held-out runs, holdout.png (paths).",
         ),
     ] = None,
     releases: Annotated[
@@ -181,19 +181,31 @@ def fit(
         ),
     ] = None,
     rocks: Annotated[
-        int, typer.Option("--rocks", help="Path fit: rocks per run and evaluation.")
+        int,
+        typer.Option(
+            "--rocks", help="Path fit: rocks per run and evaluation (1 to 20,000)."
+        ),
     ] = 200,
     seed: Annotated[
-        int, typer.Option("--seed", help="Path fit: seed of the common random numbers.")
+        int,
+        typer.Option(
+            "--seed", help="Path fit: seed of the common random numbers (0 to 2^32-1)."
+        ),
     ] = 0,
     bootstrap: Annotated[
-        int, typer.Option("--bootstrap", help="Path fit: bootstrap resamples of runs.")
+        int,
+        typer.Option(
+            "--bootstrap",
+            help="Path fit: bootstrap resamples of runs (0 to 1,000; fewer than 10 "
+            "give no standard errors or correlations).",
+        ),
     ] = 20,
     screen: Annotated[
         int,
         typer.Option(
             "--screen",
-            help="Path fit: Sobol points screened for a better start (0: none).",
+            help="Path fit: Sobol points screened for a better start (0: none; at "
+            "most 4,096).",
         ),
     ] = 16,
     bound: Annotated[

@@ -21,6 +21,7 @@ from fieldkit.cli.common import (
     print_body_notes,
     with_flags,
 )
+from fieldkit.cli.progress import step
 from fieldkit.errors import ArgumentError
 from fieldkit.impact_table import FORMATS
 from fieldkit.outputs import OutputSet
@@ -338,7 +339,9 @@ def reduce(
         position_error=error_model,
     )
     survey = Survey(points, tree_set)
-    reduction = reduce_path(survey, options)
+    # seconds for a surveyed path (Monte Carlo uncertainty): shown on a terminal
+    with step(f"reducing {len(points.frame)} points", announce=False):
+        reduction = reduce_path(survey, options)
     table = reduction.table
 
     if out is not None:

@@ -232,3 +232,17 @@ def test_fit_figures_label_axes_in_words_and_explain_every_mark(tmp_path):
     assert {"observed runout", "calibrated model", "starting (uncalibrated) model",
             "median simulated runout", "50 % of simulated runouts (thick)",
             "90 % of simulated runouts (thin)"} <= legend  # fmt: skip
+
+
+def test_material_mapping_is_refused_for_runs_on_a_dem(cli, tmp_path, fails):
+    data = Path(__file__).parents[1] / "data" / "tschamut2014"
+    split = data / "calibration_split"
+    base = Path(__file__).parents[2] / "examples" / "tschamut" / "model_base.json"
+    out = tmp_path / "m.json"
+    r = cli(
+        "fit", "--model", base, "--paths", split / "calibration_release_points.csv",
+        "--deposits", split / "calibration_observed_deposition.csv",
+        "--dem", data / "terrain.asc", "--material", "talus=meadow", "-o", out,
+    )  # fmt: skip
+    fails(r, "--material", "ImpactTable", "DEM")
+    assert not out.exists()
