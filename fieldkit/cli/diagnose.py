@@ -10,7 +10,7 @@ from typing import Annotated
 import typer
 
 from fieldkit.cli.common import note, one_line_errors
-from fieldkit.cli.fit import MaterialOpt, PresetOpt, mapped_table
+from fieldkit.cli.material_options import MaterialOpt, PresetOpt, mapped_table
 from fieldkit.errors import ArgumentError
 from fieldkit.outputs import OutputSet, write_text
 

@@ -178,7 +178,7 @@ def fit_paths_command(
     preset: Path | None = None,
 ) -> None:
     """Run the path-level fit (see the command's help)."""
-    from fieldkit.cli.fit import mapped_table
+    from fieldkit.cli.material_options import mapped_table
     from fieldkit.cli.progress import report_written, step
     from fieldkit.fit.path_fit import check_settings, fit_paths
     from fieldkit.fit.path_runs import section_runs
