@@ -178,8 +178,10 @@ def fit_paths_command(
     preset: Path | None = None,
 ) -> None:
     """Run the path-level fit (see the command's help)."""
+    from fieldkit.cli.common import note
     from fieldkit.cli.material_options import mapped_table
     from fieldkit.cli.progress import report_written, step
+    from fieldkit.fit.material_map import profile_disagreements
     from fieldkit.fit.path_fit import check_settings, fit_paths
     from fieldkit.fit.path_runs import section_runs
     from fieldkit.fit.path_sections import path_runs
@@ -217,6 +219,7 @@ def fit_paths_command(
         base = read_model(model_file)
         mapping = []
         material_map: dict[str, str] = {}
+        material_check = None
         if on_dem:
             grid = read_dem(dem)
             with step(f"cutting the sections of {releases.name} from {dem.name}"):
@@ -231,6 +234,20 @@ def fit_paths_command(
             calibration = section_runs(
                 observations_from_impact_table(mapped.table.derive()), base
             )
+            profile = base.profile
+            compared, differ = profile_disagreements(
+                mapped.table, profile.x_m, profile.material
+            )
+            check = (
+                f"the table's materials (as mapped) agree with the model's profile at "
+                f"{compared - len(differ)} of {compared} surveyed points"
+                + (f"; they differ at {'; '.join(differ[:3])}" if differ else "")
+                + (f" and {len(differ) - 3} more" if len(differ) > 3 else "")
+                + (" (the fit uses the profile's)" if differ else "")
+            )
+            note(check)
+            mapping = [*mapping, check]
+            material_check = {"points_compared": compared, "differences": differ}
         held = None
         if holdout:
             with step("cutting the held-out sections"):
@@ -248,6 +265,8 @@ def fit_paths_command(
         summary = result.to_dict()
         summary["section"] = section if on_dem else "the model's own profile"
         summary["material_map"] = material_map
+        if material_check is not None:
+            summary["material_check"] = material_check
         if held is not None:
             with step(f"scoring {len(held)} held-out runs ({rocks} rocks each)"):
                 validation = validate(held, calibration, fitted, rocks=rocks, seed=seed)

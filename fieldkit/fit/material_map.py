@@ -22,8 +22,11 @@ is what a fit records in its provenance.
 
 from __future__ import annotations
 
+import bisect
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
+
+import pandas as pd
 
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.impact_table import ImpactTable
@@ -133,8 +136,7 @@ def map_materials(
 
     Examples
     --------
-    >>> import pandas as pd
-    >>> t = ImpactTable(pd.DataFrame({"material": ["talus", "bench", "colluvium"]}))
+    >>> t = _example_table(["talus", "bench", "colluvium"], [5.0, 15.0, 25.0])
     >>> m = map_materials(t, ["rock", "colluvium", "bench"],
     ...                   preset={"talus": "colluvium", "bench": "colluvium"})
     >>> m.table.frame["material"].tolist(), m.applied
@@ -214,3 +216,72 @@ def map_materials(
         counts=counts,
         notes=notes,
     )
+
+
+#: A surveyed point this close to a profile vertex is at the vertex (chainages
+#: recomputed from geographic positions differ from the section's by ~1e-5 m).
+AT_VERTEX_M = 1e-3
+
+
+def profile_disagreements(
+    table: ImpactTable, x_m: Sequence[float], material: Sequence[str]
+) -> tuple[int, list[str]]:
+    """Where the table's (mapped) materials differ from a model profile's.
+
+    A path fitted on a model's own profile takes its materials from the profile,
+    not from the table; this says whether the two agree. A surveyed point at
+    chainage ``x`` is compared with the profile segment that ends at or beyond it
+    (a segment takes the material of its downslope end, as in the Tornado models);
+    a point within :data:`AT_VERTEX_M` of a vertex is at it; points before the
+    profile's first vertex or at it are not compared.
+
+    Parameters
+    ----------
+    table
+        An ImpactTable with ``x_m`` and ``material`` (materials already mapped).
+    x_m, material
+        The profile's vertex chainages and per-segment materials.
+
+    Returns
+    -------
+    compared, differences
+        How many points were compared, and one ``"point P (x m): surveyed S,
+        profile M"`` entry per difference.
+
+    Examples
+    --------
+    >>> t = _example_table(["rock", "rock", "rock"], [0.0, 5.0, 15.0])
+    >>> profile_disagreements(t, [0, 10, 20], ["rock", "soil"])
+    (2, ['point 3 (x = 15 m): surveyed rock, profile soil'])
+    """
+    frame = table.frame
+    if "material" not in frame or "x_m" not in frame:
+        return 0, []
+    edges = list(map(float, x_m))
+    compared, out = 0, []
+    points = frame["point"] if "point" in frame else pd.Series(range(1, len(frame) + 1))
+    for point, x, surveyed in zip(points, frame["x_m"], frame["material"],
+                                  strict=True):  # fmt: skip
+        x = float(x)
+        if pd.isna(surveyed) or not (edges[0] + AT_VERTEX_M < x <= edges[-1]):
+            continue
+        segment = max(bisect.bisect_left(edges, x - AT_VERTEX_M) - 1, 0)
+        compared += 1
+        if material[segment] != surveyed:
+            out.append(
+                f"point {point} (x = {x:g} m): surveyed {surveyed}, "
+                f"profile {material[segment]}"
+            )
+    return compared, out
+
+
+def _example_table(material: list[str], x_m: list[float]) -> ImpactTable:
+    """A small ImpactTable for the examples (points 1, 2, ...)."""
+    n = len(material)
+    zeros = [0.0] * n
+    return ImpactTable(pd.DataFrame({
+        "path_id": ["a"] * n, "point": [str(i + 1) for i in range(n)], "x_m": x_m,
+        "z_m": [-x for x in x_m], "slope_deg": [30.0] * n, "vi_x_mps": zeros,
+        "vi_z_mps": zeros, "vf_x_mps": zeros, "vf_z_mps": zeros,
+        "material": material,
+    }))  # fmt: skip

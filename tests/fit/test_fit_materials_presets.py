@@ -152,6 +152,8 @@ def test_path_fit_report_without_holdout(cli, tmp_path, boulder_a):
     fit = json.loads(js.read_text())
     assert fit["parameters"][0]["stderr"] is None and fit["correlation"] is None
     assert fit["material_map"] == {"talus": "colluvium", "bench": "colluvium"}
+    assert fit["material_check"] == {"points_compared": 49, "differences": []}
+    assert "agree with the model's profile at 49 of 49 surveyed points" in r.stderr
     assert "NaN" not in js.read_text()
     for path in (out, js, rep / "report.md"):
         assert f"wrote {path}" in r.stdout
@@ -177,6 +179,26 @@ def test_path_fit_refuses_bad_sizes_at_once(cli, tmp_path, boulder_a, fails, ext
     r = cli("fit", "--paths", boulder_a, "--model", TABLE_7_1, "-o", out, *extra)
     fails(r, *words)
     assert not out.exists()
+
+
+def test_path_fit_checks_mapped_materials_against_the_profile(cli, tmp_path,
+                                                             boulder_a):  # fmt: skip
+    """The path fit uses the model's profile: unmapped, boulder A's talus and bench
+    differ from Table 7-1's colluvium there (stated); path_start keeps its bench."""
+    js = tmp_path / "fit.json"
+    base = ("fit", "--paths", boulder_a, "--free", "materials.colluvium.e_t",
+            "--rocks", "5", "--bootstrap", "0", "--screen", "0",
+            "-o", tmp_path / "cal.json", "--json", js)  # fmt: skip
+    r = cli(*base, "--model", TABLE_7_1)
+    assert r.exit_code == 0, r.output
+    check = json.loads(js.read_text())["material_check"]
+    assert check["points_compared"] == 49 and len(check["differences"]) == 5
+    assert "point D (x = 48 m): surveyed talus, profile colluvium" in r.stderr
+    r = cli(*base, "--model", PATH_START, "--preset", PRESET)
+    assert r.exit_code == 0, r.output
+    fit = json.loads(js.read_text())
+    assert fit["material_map"] == {"talus": "colluvium"}
+    assert fit["material_check"]["differences"] == []
 
 
 def test_a_one_impact_path_is_refused(cli, tmp_path, boulder_a, fails):
@@ -214,8 +236,11 @@ def test_fit_figures_label_axes_in_words_and_explain_every_mark(tmp_path):
     assert right.get_xlabel() == "impact speed v_i (m/s)"
     assert left.get_ylabel() == "residual: observed − predicted (m/s)"
     legend = [t.get_text() for t in left.get_legend().get_texts()]
-    assert legend == ["normal rebound velocity v_fN",
-                      "tangential rebound velocity v_fT", "prediction = observation"]
+    assert legend == [
+        "normal rebound velocity v_fN",
+        "tangential rebound velocity v_fT",
+        "prediction = observation",
+    ]
     rng = np.random.default_rng(0)
     validation = {
         "path_ids": ["a", "b"], "observed": np.array([80.0, 90.0]),
