@@ -210,8 +210,8 @@ def diagnose(
         if _is_track(input_file):
             if model is not None or output is not None or material or preset:
                 raise ArgumentError(
-                    "a track is diagnosed at flight level: --model and -o apply to "
-                    "ImpactTables only",
+                    "a track is diagnosed at flight level: --model, -o, --material "
+                    "and --preset apply to ImpactTables only",
                     source="model",
                 )
             if radius is None:
