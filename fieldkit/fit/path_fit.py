@@ -509,7 +509,8 @@ class PathFitResult:
                 f"SD of the {self.bootstrap.shape[0]} bootstrap refits"
                 if self.bootstrap.shape[0] >= MIN_BOOTSTRAP_SE
                 else f"none: {self.bootstrap.shape[0]} bootstrap resamples are fewer "
-                f"than {MIN_BOOTSTRAP_SE}"
+                f"than {MIN_BOOTSTRAP_SE}; interval90 is only the objective's slice "
+                "(the values the runs cannot tell from the optimum)"
             ),
             "notes": list(self.notes),
         }
