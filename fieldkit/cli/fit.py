@@ -31,9 +31,17 @@ FLAGS = {
     "seed": "--seed",
     "bootstrap": "--bootstrap",
     "free": "--free",
+    "section": "--section",
     "material": "--material",
     "preset": "--preset",
 }
+
+#: Path-fit settings left unset on the command line take these values.
+PATH_DEFAULTS = {"rocks": 200, "seed": 0, "bootstrap": 20, "screen": 16,
+                 "section": "descent"}  # fmt: skip
+#: Options of the path fit only: refused by an impact fit, never silently ignored.
+PATH_ONLY = ("json_file", "holdout_releases", "holdout_deposits", "free", "rocks",
+             "seed", "bootstrap", "screen", "bound", "section")  # fmt: skip
 
 
 def _paths(options: dict) -> None:
@@ -71,11 +79,17 @@ def _paths(options: dict) -> None:
         holdout_releases=options["holdout_releases"],
         holdout_deposits=options["holdout_deposits"],
         free=options["free"],
-        rocks=options["rocks"],
-        seed=options["seed"],
-        bootstrap=options["bootstrap"],
-        section=options["section"],
-        screen=options["screen"],
+        rocks=PATH_DEFAULTS["rocks"] if options["rocks"] is None else options["rocks"],
+        seed=PATH_DEFAULTS["seed"] if options["seed"] is None else options["seed"],
+        bootstrap=(
+            PATH_DEFAULTS["bootstrap"]
+            if options["bootstrap"] is None
+            else options["bootstrap"]
+        ),
+        section=options["section"] or PATH_DEFAULTS["section"],
+        screen=(
+            PATH_DEFAULTS["screen"] if options["screen"] is None else options["screen"]
+        ),
         bounds=options["bound"],
         material=options["material"],
         preset=options["preset"],
@@ -138,33 +152,36 @@ def fit(
         ),
     ] = None,
     rocks: Annotated[
-        int,
+        int | None,
         typer.Option(
-            "--rocks", help="Path fit: rocks per run and evaluation (1 to 20,000)."
+            "--rocks",
+            help="Path fit: rocks per run and evaluation (1 to 20,000; default 200).",
         ),
-    ] = 200,
+    ] = None,
     seed: Annotated[
-        int,
+        int | None,
         typer.Option(
-            "--seed", help="Path fit: seed of the common random numbers (0 to 2^32-1)."
+            "--seed",
+            help="Path fit: seed of the common random numbers (0 to 2^32-1; "
+            "default 0).",
         ),
-    ] = 0,
+    ] = None,
     bootstrap: Annotated[
-        int,
+        int | None,
         typer.Option(
             "--bootstrap",
-            help="Path fit: bootstrap resamples of runs (0 to 1,000; fewer than 10 "
-            "give no standard errors or correlations).",
+            help="Path fit: bootstrap resamples of runs (0 to 1,000; default 20; "
+            "fewer than 10 give no standard errors or correlations).",
         ),
-    ] = 20,
+    ] = None,
     screen: Annotated[
-        int,
+        int | None,
         typer.Option(
             "--screen",
             help="Path fit: Sobol points screened for a better start (0: none; at "
-            "most 4,096).",
+            "most 4,096; default 16).",
         ),
-    ] = 16,
+    ] = None,
     bound: Annotated[
         list[str] | None,
         typer.Option(
@@ -175,13 +192,13 @@ def fit(
     material: MaterialOpt = None,
     preset: PresetOpt = None,
     section: Annotated[
-        str,
+        str | None,
         typer.Option(
             "--section",
-            help="Path fit: 'descent' (steepest descent from each release) or "
-            "'release-deposit' (honest for calibration only).",
+            help="Path fit: 'descent' (steepest descent from each release, the "
+            "default) or 'release-deposit' (honest for calibration only).",
         ),
-    ] = "descent",
+    ] = None,
 ) -> None:
     """Fit restitution and effect parameters to measured impacts (weighted LSQ).
 
@@ -223,6 +240,15 @@ def fit(
         raise ArgumentError(
             "give an ImpactTable, or --paths, --deposits and --dem for a path fit",
             source="table_file",
+        )
+    options = locals()
+    given = [name for name in PATH_ONLY if options[name] not in (None, [])]
+    if given:
+        also = ", ".join(FLAGS[name] for name in given[1:])
+        raise ArgumentError(
+            "for a path fit (--paths) only; an impact fit has no such setting"
+            + (f" (nor {also})" if also else ""),
+            source=given[0],
         )
     from fieldkit.fit.impact_fit import fit_impacts
     from fieldkit.impact_table import ImpactTable

@@ -271,3 +271,20 @@ def test_material_mapping_is_refused_for_runs_on_a_dem(cli, tmp_path, fails):
     )  # fmt: skip
     fails(r, "--material", "ImpactTable", "DEM")
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("extra", "words"),
+    [
+        (["--rocks", "-5"], ["--rocks", "for a path fit (--paths) only"]),
+        (["--bootstrap", "2", "--seed", "-1"], ["--seed", "nor --bootstrap"]),
+        (["--json", "fit.json"], ["--json", "for a path fit"]),
+    ],
+)
+def test_impact_fit_refuses_path_fit_settings(cli, tmp_path, boulder_a, fails,
+                                              extra, words):  # fmt: skip
+    out = tmp_path / "cal.json"
+    r = cli("fit", boulder_a, "--model", TABLE_7_1, "--preset", PRESET, "-o", out,
+            *extra)  # fmt: skip
+    fails(r, *words)
+    assert not out.exists() and not (tmp_path / "fit.json").exists()
