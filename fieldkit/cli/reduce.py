@@ -205,12 +205,13 @@ def reduce(
     point) and --height-sigma (default 0.25 m per tree strike); the summary
     states the model and how many e_n are known to better than 0.1.
 
-    Example (thesis Table 2-4, Tornado Mountain boulder A; from the
-    repository root):
+    Example (thesis Table 2-4, Tornado Mountain boulder A, whose preset holds
+    --theta0 32.6 --mass 3750 --radius 0.725 --gyration 0.46 --path-id boulder_a;
+    from the repository root):
 
         fieldkit reduce --impacts surveys/tornado_mountain/boulder_a_impacts.gpx \\
-          --trees surveys/tornado_mountain/boulder_a_trees.csv --theta0 32.6 \\
-          --mass 3750 --radius 0.725 --gyration 0.46 \\
+          --trees surveys/tornado_mountain/boulder_a_trees.csv \\
+          --preset surveys/tornado_mountain/boulder_a_preset.toml \\
           -o out/boulder_a.csv --figures out/figures
     """
     from fieldkit.reduce.pipeline import ReduceOptions, reduce_path
