@@ -31,7 +31,9 @@ and the bootstrap below needs many cheap local refits, which it does well.
 Uncertainty: a bootstrap over runs (Efron & Tibshirani 1993, ch. 6): the runs are
 resampled with replacement ``bootstrap`` times (equivalently, integer weights on the
 per-run CRPS) and the fit is repeated from the optimum with a short budget. The
-standard error of a parameter is the SD of its bootstrap values; the 90 % interval is
+standard error of a parameter is the SD of its bootstrap values (with at least
+:data:`MIN_BOOTSTRAP_SE` resamples; with fewer there is no standard error, no
+correlation, and the interval is the slice below alone); the 90 % interval is
 ``value ± t SE`` clipped to the bounds (t: Student's 95 % quantile with one degree of
 freedom fewer than the resampled units -- 1.761 for 15 runs -- since an SE from a
 few runs is itself uncertain); the correlation matrix is that of the
