@@ -234,6 +234,7 @@ def diagnose(
             diagnosis = diagnose_impacts(
                 table, base, rng=rng, folds=folds, progress=progress
             )
+            diagnosis.notes.extend(mapping.notes)
         diagnosis.notes.append(f"fold seed {seed}")
         if json_file is not None:
             write_text(

@@ -100,10 +100,13 @@ def test_diagnose_maps_materials(cli, tmp_path, boulder_a, fails):
     r = cli("diagnose", boulder_a, "--model", TABLE_7_1, "--seed", "1")
     fails(r, "not in the model", "--material")
     out = tmp_path / "after.json"
+    js = tmp_path / "diagnosis.json"
     r = cli("diagnose", boulder_a, "--model", TABLE_7_1, "--preset", PRESET,
-            "--seed", "1", "-o", out)  # fmt: skip
+            "--seed", "1", "-o", out, "--json", js)  # fmt: skip
     assert r.exit_code == 0, r.output
     assert "material talus -> colluvium" in r.stderr
+    notes = json.loads(js.read_text())["notes"]
+    assert any(n.startswith("material bench -> colluvium (3 rows") for n in notes)
     provenance = json.loads(out.read_text())["provenance"]["diagnose"]
     assert provenance["material_map"] == {"talus": "colluvium", "bench": "colluvium"}
 
