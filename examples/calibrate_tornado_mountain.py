@@ -6,10 +6,11 @@ script does the comparison with fieldkit, on the same simulator for both models:
 
 1. reduce boulder A's survey (46 impacts, 21 tree strikes) to an ImpactTable, as
    ``fieldkit reduce`` does, with the default survey error model (``*_sd`` columns);
-2. diagnose it against the Table 7-1 model (materials mapped: the survey's ``talus``
-   and ``bench`` impacts are on the upper slope Table 7-1 calls ``rock``) — the
-   rebound velocities pick the impact law and fit its parameters and each material's
-   e_n, e_t (held out in blocks: one surveyed path);
+2. diagnose it against the Table 7-1 model (materials mapped as boulder A's preset
+   and the model's provenance state: Table 7-1 lists rock and colluvium only, so the
+   survey's ``talus`` and ``bench`` impacts use colluvium) — the rebound velocities
+   pick the impact law and fit its parameters and each material's e_n, e_t (held
+   out in blocks: one surveyed path);
 3. calibrate the simulator on the whole path (``fieldkit fit --paths`` on an
    ImpactTable: :func:`fieldkit.fit.path_fit.fit_paths`), starting from Table 7-1
    with two changes a path fit needs: RocFall's velocity scaling of e_n (eq. 7.1,
@@ -43,11 +44,13 @@ from pathlib import Path
 import numpy as np
 
 from fieldkit.diagnose.impacts import diagnose_impacts
+from fieldkit.fit.material_map import map_materials
 from fieldkit.fit.path_fit import fit_paths
 from fieldkit.fit.path_runs import section_runs
 from fieldkit.impact_table import ImpactTable
 from fieldkit.io.impacts import read_impacts
 from fieldkit.io.path_observations import observations_from_impact_table
+from fieldkit.io.preset import read_preset
 from fieldkit.io.trees import read_trees
 from fieldkit.model import read_model, simulate
 from fieldkit.physics.bodies import resolve_body
@@ -67,9 +70,10 @@ PATH_FREE = {
     "materials.bench.e_n": (0.05, 1.2),
     "materials.bench.e_t": (0.1, 0.98),
 }
-PATH_ROCKS, PATH_SCREEN, PATH_BOOTSTRAP = 150, 16, 8
-#: Survey materials -> Table 7-1 materials (the upper slope is "rock" there).
-MATERIALS = {"talus": "rock", "bench": "rock"}
+PATH_ROCKS, PATH_SCREEN, PATH_BOOTSTRAP = 150, 16, 10
+#: Boulder A's reduce options and material mapping, stated once
+#: (``fieldkit reduce --preset``, ``fieldkit fit --preset``).
+PRESET = read_preset(SURVEY / "boulder_a_preset.toml")
 
 _spec = importlib.util.spec_from_file_location(
     "simulate_tornado_mountain", HERE / "simulate_tornado_mountain.py"
@@ -79,15 +83,15 @@ _spec.loader.exec_module(sim)
 
 
 def reduced_table() -> ImpactTable:
-    """Boulder A's ImpactTable, materials named as in Table 7-1."""
+    """Boulder A's ImpactTable (surveyed materials), reduced with the preset."""
     points = read_impacts(SURVEY / "boulder_a_impacts.gpx")
     trees = read_trees(SURVEY / "boulder_a_trees.csv", points)
-    body = resolve_body(mass_kg=3750, radius_m=0.725, gyration_m=0.46)
-    options = ReduceOptions(path_id="boulder_a", theta0_deg=32.6, body=body)
-    table = reduce_path(Survey(points, trees), options).table
-    frame = table.frame.copy()
-    frame["material"] = frame["material"].replace(MATERIALS)
-    return ImpactTable(frame, source=table.source)
+    options = ReduceOptions(
+        path_id=PRESET.reduce["path_id"],
+        theta0_deg=PRESET.reduce["theta0_deg"],
+        body=resolve_body(**PRESET.body()),
+    )
+    return reduce_path(Survey(points, trees), options).table
 
 
 def figures(name: str, model) -> dict:
@@ -126,7 +130,11 @@ def figures(name: str, model) -> dict:
 def main() -> None:
     table = reduced_table()
     thesis = read_model(SURVEY / "model_rocfall_table_7_1.json")
-    d = diagnose_impacts(table, thesis, rng=np.random.default_rng(SEED))
+    mapped = map_materials(table, list(thesis.materials), preset=PRESET.materials,
+                           preset_source="the preset")  # fmt: skip
+    for text in mapped.notes:
+        print(text)
+    d = diagnose_impacts(mapped.table, thesis, rng=np.random.default_rng(SEED))
     print(
         f"boulder A: {d.n_rows} impacts; held out: {d.groups}\n"
         f"Table 7-1 impact laws: held-out RMSE {d.baseline.cv_rmse:.3f} m/s"

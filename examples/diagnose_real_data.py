@@ -46,6 +46,7 @@ from fieldkit.diagnose.impacts import diagnose_impacts
 from fieldkit.errors import FieldkitError
 from fieldkit.impact_table import ImpactTable
 from fieldkit.io.impacts import read_impacts
+from fieldkit.io.preset import read_preset
 from fieldkit.io.trees import read_trees
 from fieldkit.physics.bodies import resolve_body
 from fieldkit.physics.local_axes import angle_to_ground_deg, to_section
@@ -76,14 +77,17 @@ class Dataset:
     extra: dict = field(default_factory=dict)
 
 
+#: Boulder A's reduce options, stated once (``fieldkit reduce --preset``).
+BOULDER_A = read_preset(SURVEYS / "tornado_mountain" / "boulder_a_preset.toml")
+
 DATASETS = (
     Dataset(
         "tornado_mountain",
         "tornado_mountain/boulder_a_impacts.gpx",
-        {"mass_kg": 3750, "radius_m": 0.725, "gyration_m": 0.46},
-        theta0_deg=32.6,
+        BOULDER_A.body(),
+        theta0_deg=BOULDER_A.reduce["theta0_deg"],
         trees="tornado_mountain/boulder_a_trees.csv",
-        path_id="boulder_a",
+        path_id=BOULDER_A.reduce["path_id"],
         thesis="Table 2-4",
     ),
     Dataset(

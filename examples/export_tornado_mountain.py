@@ -81,9 +81,8 @@ def main(out: Path) -> None:
     table = out / "boulder_a.csv"
     fieldkit(
         "reduce", "--impacts", SURVEY / "boulder_a_impacts.gpx",
-        "--trees", SURVEY / "boulder_a_trees.csv", "--theta0", "32.6",
-        "--mass", "3750", "--radius", "0.725", "--gyration", "0.46",
-        "--path-id", "boulder_a", "-o", table,
+        "--trees", SURVEY / "boulder_a_trees.csv",
+        "--preset", SURVEY / "boulder_a_preset.toml", "-o", table,
     )  # fmt: skip
     bounds = []
     for name, (lo, hi) in calibrate.PATH_FREE.items():
@@ -91,7 +90,8 @@ def main(out: Path) -> None:
     calibrated = out / "calibrated.json"
     fieldkit(
         "fit", "--paths", table, "--model", SURVEY / "model_path_start.json",
-        *bounds, "--rocks", str(calibrate.PATH_ROCKS),
+        "--preset", SURVEY / "boulder_a_preset.toml", *bounds,
+        "--rocks", str(calibrate.PATH_ROCKS),
         "--bootstrap", str(calibrate.PATH_BOOTSTRAP), "--seed", str(SEED),
         "-o", calibrated, "--json", out / "fit.json",
     )  # fmt: skip

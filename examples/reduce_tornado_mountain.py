@@ -6,7 +6,9 @@ points and 21 broken trees. This script does with the Python API what
 
 1. read the GPS waypoints and the tree strikes,
 2. solve every flight (a tree strike fixes its parabola exactly; other flights use the
-   site's mean restitution angle, 32.6 deg),
+   site's mean restitution angle; it, the body and the path id are boulder A's preset,
+   ``surveys/tornado_mountain/boulder_a_preset.toml``, as ``fieldkit reduce --preset``
+   reads them),
 3. look at impact #26, the one the thesis details in Fig. 2.8,
 4. write the ImpactTable and the section figure.
 
@@ -20,6 +22,7 @@ import tempfile
 from pathlib import Path
 
 from fieldkit.io.impacts import read_impacts
+from fieldkit.io.preset import read_preset
 from fieldkit.io.trees import read_trees
 from fieldkit.physics.bodies import resolve_body
 from fieldkit.reduce.pipeline import ReduceOptions, reduce_path
@@ -36,8 +39,12 @@ def main(out_dir: Path) -> None:
     print(f"{len(points.frame)} points, {len(trees.frame)} tree strikes")
     print(f"heights: {points.height_reference}")
 
-    body = resolve_body(mass_kg=3750, radius_m=0.725, gyration_m=0.46)
-    options = ReduceOptions(path_id="boulder_a", theta0_deg=32.6, body=body)
+    preset = read_preset(SURVEY / "boulder_a_preset.toml")
+    options = ReduceOptions(
+        path_id=preset.reduce["path_id"],
+        theta0_deg=preset.reduce["theta0_deg"],
+        body=resolve_body(**preset.body()),
+    )
     reduction = reduce_path(Survey(points, trees), options)
     table = reduction.table  # e_n_sd etc. from the default position error, stated:
     print(format_summary(summarize(table, reduction.uncertainty)))

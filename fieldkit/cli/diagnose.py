@@ -9,6 +9,7 @@ from typing import Annotated
 import typer
 
 from fieldkit.cli.common import note, one_line_errors
+from fieldkit.cli.material_options import MaterialOpt, PresetOpt, mapped_table
 from fieldkit.errors import ArgumentError
 from fieldkit.outputs import OutputSet, write_json, write_text
 
@@ -20,6 +21,8 @@ FLAGS = {
     "output": "-o",
     "folds": "--folds",
     "seed": "--seed",
+    "material": "--material",
+    "preset": "--preset",
 }
 
 
@@ -155,6 +158,8 @@ def diagnose(
             "kg/m3 sphere of --radius.",
         ),
     ] = None,  # fmt: skip
+    material: MaterialOpt = None,
+    preset: PresetOpt = None,
 ) -> None:
     """Compare model and measurements; rank the missing effects; add them stepwise.
 
@@ -184,7 +189,7 @@ def diagnose(
             source="output",
         )
     inputs = [input_file] + ([model] if model is not None else [])
-    with OutputSet(inputs=inputs) as outputs:
+    with OutputSet(inputs=[*inputs, preset]) as outputs:
         if json_file is not None:
             outputs.plan(json_file, argument="--json")
         if report_dir is not None:
@@ -202,10 +207,10 @@ def diagnose(
             typer.echo(f"  scoring {message}", err=True)
 
         if _is_track(input_file):
-            if model is not None or output is not None:
+            if model is not None or output is not None or material or preset:
                 raise ArgumentError(
-                    "a track is diagnosed at flight level: --model and -o apply to "
-                    "ImpactTables only",
+                    "a track is diagnosed at flight level: --model, -o, --material "
+                    "and --preset apply to ImpactTables only",
                     source="model",
                 )
             if radius is None:
@@ -223,10 +228,12 @@ def diagnose(
             from fieldkit.model.model_file import read_model
 
             base = read_model(model, outputs=outputs) if model is not None else None
-            table = ImpactTable.read(input_file)
+            mapping = mapped_table(ImpactTable.read(input_file), base, material, preset)
+            table = mapping.table
             diagnosis = diagnose_impacts(
                 table, base, rng=rng, folds=folds, progress=progress
             )
+            diagnosis.notes.extend(mapping.notes)
         diagnosis.notes.append(f"fold seed {seed}")
         if json_file is not None:
             write_json(json_file, diagnosis.to_json(), outputs)
@@ -252,6 +259,7 @@ def diagnose(
                 **after.provenance,
                 "diagnose": {
                     "table": str(input_file),
+                    "material_map": mapping.provenance(),
                     "added": [s.added for s in diagnosis.steps],
                     "cv_rmse_mps": diagnosis.after.cv_rmse,
                     "params_sd": diagnosis.after.params_sd,

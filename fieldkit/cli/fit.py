@@ -9,7 +9,9 @@ from typing import Annotated
 import typer
 
 from fieldkit.cli.common import one_line_errors
-from fieldkit.errors import ArgumentError
+from fieldkit.cli.material_options import MaterialOpt, PresetOpt, mapped_table
+from fieldkit.cli.progress import report_written, step
+from fieldkit.errors import ArgumentError, FieldkitError
 from fieldkit.outputs import OutputSet, write_text
 
 FLAGS = {
@@ -23,8 +25,23 @@ FLAGS = {
     "holdout_releases": "--holdout-paths",
     "holdout_deposits": "--holdout-deposits",
     "bound": "--bound",
+    "bounds": "--bound",
     "screen": "--screen",
+    "rocks": "--rocks",
+    "seed": "--seed",
+    "bootstrap": "--bootstrap",
+    "free": "--free",
+    "section": "--section",
+    "material": "--material",
+    "preset": "--preset",
 }
+
+#: Path-fit settings left unset on the command line take these values.
+PATH_DEFAULTS = {"rocks": 200, "seed": 0, "bootstrap": 20, "screen": 16,
+                 "section": "descent"}  # fmt: skip
+#: Options of the path fit only: refused by an impact fit, never silently ignored.
+PATH_ONLY = ("json_file", "holdout_releases", "holdout_deposits", "free", "rocks",
+             "seed", "bootstrap", "screen", "bound", "section")  # fmt: skip
 
 
 def _paths(options: dict) -> None:
@@ -62,12 +79,20 @@ def _paths(options: dict) -> None:
         holdout_releases=options["holdout_releases"],
         holdout_deposits=options["holdout_deposits"],
         free=options["free"],
-        rocks=options["rocks"],
-        seed=options["seed"],
-        bootstrap=options["bootstrap"],
-        section=options["section"],
-        screen=options["screen"],
+        rocks=PATH_DEFAULTS["rocks"] if options["rocks"] is None else options["rocks"],
+        seed=PATH_DEFAULTS["seed"] if options["seed"] is None else options["seed"],
+        bootstrap=(
+            PATH_DEFAULTS["bootstrap"]
+            if options["bootstrap"] is None
+            else options["bootstrap"]
+        ),
+        section=options["section"] or PATH_DEFAULTS["section"],
+        screen=(
+            PATH_DEFAULTS["screen"] if options["screen"] is None else options["screen"]
+        ),
         bounds=options["bound"],
+        material=options["material"],
+        preset=options["preset"],
     )
 
 
@@ -90,8 +115,8 @@ def fit(
         Path | None,
         typer.Option(
             "--report",
-            help="Write report.md and residuals.png (impacts) or holdout.png (paths) "
-            "into this folder.",
+            help="Write report.md into this folder, with residuals.png (impacts) or, "
+            "with held-out runs, holdout.png (paths).",
         ),
     ] = None,
     releases: Annotated[
@@ -127,21 +152,36 @@ def fit(
         ),
     ] = None,
     rocks: Annotated[
-        int, typer.Option("--rocks", help="Path fit: rocks per run and evaluation.")
-    ] = 200,
+        int | None,
+        typer.Option(
+            "--rocks",
+            help="Path fit: rocks per run and evaluation (1 to 20,000; default 200).",
+        ),
+    ] = None,
     seed: Annotated[
-        int, typer.Option("--seed", help="Path fit: seed of the common random numbers.")
-    ] = 0,
+        int | None,
+        typer.Option(
+            "--seed",
+            help="Path fit: seed of the common random numbers (0 to 2^32-1; "
+            "default 0).",
+        ),
+    ] = None,
     bootstrap: Annotated[
-        int, typer.Option("--bootstrap", help="Path fit: bootstrap resamples of runs.")
-    ] = 20,
+        int | None,
+        typer.Option(
+            "--bootstrap",
+            help="Path fit: bootstrap resamples of runs (0 to 1,000; default 20; "
+            "fewer than 10 give no standard errors or correlations).",
+        ),
+    ] = None,
     screen: Annotated[
-        int,
+        int | None,
         typer.Option(
             "--screen",
-            help="Path fit: Sobol points screened for a better start (0: none).",
+            help="Path fit: Sobol points screened for a better start (0: none; at "
+            "most 4,096; default 16).",
         ),
-    ] = 16,
+    ] = None,
     bound: Annotated[
         list[str] | None,
         typer.Option(
@@ -149,14 +189,16 @@ def fit(
             help="Path fit: search bounds NAME=LO,HI of a free parameter (repeatable).",
         ),
     ] = None,
+    material: MaterialOpt = None,
+    preset: PresetOpt = None,
     section: Annotated[
-        str,
+        str | None,
         typer.Option(
             "--section",
-            help="Path fit: 'descent' (steepest descent from each release) or "
-            "'release-deposit' (honest for calibration only).",
+            help="Path fit: 'descent' (steepest descent from each release, the "
+            "default) or 'release-deposit' (honest for calibration only).",
         ),
-    ] = "descent",
+    ] = None,
 ) -> None:
     """Fit restitution and effect parameters to measured impacts (weighted LSQ).
 
@@ -199,32 +241,51 @@ def fit(
             "give an ImpactTable, or --paths, --deposits and --dem for a path fit",
             source="table_file",
         )
+    options = locals()
+    given = [name for name in PATH_ONLY if options[name] not in (None, [])]
+    if given:
+        also = ", ".join(FLAGS[name] for name in given[1:])
+        raise ArgumentError(
+            "for a path fit (--paths) only; an impact fit has no such setting"
+            + (f" (nor {also})" if also else ""),
+            source=given[0],
+        )
     from fieldkit.fit.impact_fit import fit_impacts
     from fieldkit.impact_table import ImpactTable
     from fieldkit.model.model_file import read_model, write_model
 
-    with OutputSet(inputs=[table_file, model_file]) as outputs:
+    with OutputSet(inputs=[table_file, model_file, preset]) as outputs:
         outputs.plan(output, argument="-o")
         if report is not None:
             outputs.plan(report / "report.md", argument="--report")
             outputs.plan(report / "residuals.png", argument="--report")
         model = read_model(model_file, outputs=outputs)
         table = ImpactTable.read(table_file)
-        result, calibrated = fit_impacts(table, model)
-        provenance = {
-            **calibrated.provenance,
-            "fit": result.provenance(str(table_file)),
-        }
-        write_model(replace(calibrated, provenance=provenance), output, outputs=outputs)
+        mapping = mapped_table(table, model, material, preset)
+        # a weighted least squares of a few parameters: short, shown on a terminal
+        with step(f"fitting {model_file.name} to {table_file}", announce=False):
+            result, calibrated = fit_impacts(mapping.table, model)
         text = result.report()
+        if not result.success:
+            raise FieldkitError(
+                f"the fit did not converge ({result.message}): no calibrated model "
+                "written",
+                source=str(table_file),
+            )
+        fit_record = result.provenance(str(table_file))
+        fit_record["material_map"] = mapping.provenance()
+        provenance = {**calibrated.provenance, "fit": fit_record}
+        write_model(replace(calibrated, provenance=provenance), output, outputs=outputs)
         if report is not None:
             from fieldkit.viz.fit_figure import write_residual_figure
 
-            derived = table.derive()
+            derived = mapping.table.derive()
+            mapped = "".join(f"* {n}\n" for n in mapping.notes)
             write_text(
                 report / "report.md",
-                f"# Impact fit\n\ntable: `{table_file}`, base model: `{model_file}`\n\n"
-                f"```\n{text}\n```\n\n![residuals](residuals.png)\n",
+                f"# Impact fit\n\ntable: `{table_file}`, base model: `{model_file}`\n"
+                f"\n{mapped + chr(10) if mapped else ''}```\n{text}\n```\n\n"
+                "![residuals](residuals.png)\n",
                 outputs,
             )
             write_residual_figure(
@@ -234,6 +295,6 @@ def fit(
                 derived.column("vi_mps"),
                 outputs=outputs,
             )
-        outputs.commit()
+        written = outputs.commit()
     typer.echo(text)
-    typer.echo(f"calibrated model -> {output}")
+    report_written(written)

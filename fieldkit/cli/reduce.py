@@ -21,12 +21,22 @@ from fieldkit.cli.common import (
     print_body_notes,
     with_flags,
 )
+from fieldkit.cli.progress import step
 from fieldkit.errors import ArgumentError
 from fieldkit.impact_table import FORMATS
 from fieldkit.outputs import OutputSet
 
 #: Body values `reduce` needs: none (columns it cannot fill stay NaN).
 BODY_NEEDS: tuple[str, ...] = ()
+
+#: Preset ``[reduce]`` keys -> the options they stand for.
+PRESET_FLAGS = {
+    "theta0_deg": "--theta0",
+    "mass_kg": "--mass",
+    "radius_m": "--radius",
+    "gyration_m": "--gyration",
+    "path_id": "--path-id",
+}
 
 FIGURE_NAMES = (
     "section.png",
@@ -160,6 +170,16 @@ def reduce(
             "0.25: where on the scar the rock's centre passed).",
         ),
     ] = None,
+    preset: Annotated[
+        Path | None,
+        typer.Option(
+            "--preset",
+            help="A survey preset (TOML, e.g. surveys/tornado_mountain/"
+            "boulder_a_preset.toml): its [reduce] values (theta0_deg, mass_kg, "
+            "radius_m, gyration_m, path_id) for the options not given; the output "
+            "names each value taken from it.",
+        ),
+    ] = None,
     out: Annotated[
         Path | None,
         typer.Option("-o", "--out", help="Output table: .csv, .parquet or .xlsx."),
@@ -185,17 +205,38 @@ def reduce(
     point) and --height-sigma (default 0.25 m per tree strike); the summary
     states the model and how many e_n are known to better than 0.1.
 
-    Example (thesis Table 2-4, Tornado Mountain boulder A; from the
-    repository root):
+    Example (thesis Table 2-4, Tornado Mountain boulder A, whose preset holds
+    --theta0 32.6 --mass 3750 --radius 0.725 --gyration 0.46 --path-id boulder_a;
+    from the repository root):
 
         fieldkit reduce --impacts surveys/tornado_mountain/boulder_a_impacts.gpx \\
-          --trees surveys/tornado_mountain/boulder_a_trees.csv --theta0 32.6 \\
-          --mass 3750 --radius 0.725 --gyration 0.46 \\
+          --trees surveys/tornado_mountain/boulder_a_trees.csv \\
+          --preset surveys/tornado_mountain/boulder_a_preset.toml \\
           -o out/boulder_a.csv --figures out/figures
     """
     from fieldkit.reduce.pipeline import ReduceOptions, reduce_path
     from fieldkit.reduce.summary import format_summary, summarize
     from fieldkit.survey import Survey
+
+    from_preset: list[str] = []
+    overridden: list[str] = []
+    if preset is not None:
+        from fieldkit.io.preset import read_preset
+
+        given = read_preset(preset).reduce
+        if shape is not None or dimensions is not None:
+            given.pop("gyration_m", None)  # the shape gives k
+        current = {"theta0_deg": theta0, "mass_kg": mass, "radius_m": radius,
+                   "gyration_m": gyration, "path_id": path_id}  # fmt: skip
+        for key, value in given.items():
+            if current[key] is None:
+                current[key] = value
+                from_preset.append(f"{PRESET_FLAGS[key]} {value}")
+            else:
+                overridden.append(f"{PRESET_FLAGS[key]} {current[key]}")
+        theta0, mass, radius = (current[k] for k in ("theta0_deg", "mass_kg",
+                                                     "radius_m"))  # fmt: skip
+        gyration, path_id = current["gyration_m"], current["path_id"]
 
     if (impacts is None) == (fieldbook is None):
         raise ArgumentError(
@@ -257,7 +298,7 @@ def reduce(
             f"unknown table format {out.suffix!r}; use one of {', '.join(FORMATS)}",
             source=str(out),
         )
-    outputs = OutputSet(inputs=[impacts, fieldbook, stations, trees])
+    outputs = OutputSet(inputs=[impacts, fieldbook, stations, trees, preset])
     if out is not None:
         outputs.plan(out, argument="-o")
     for name in FIGURE_NAMES if figures is not None else ():
@@ -299,7 +340,9 @@ def reduce(
         position_error=error_model,
     )
     survey = Survey(points, tree_set)
-    reduction = reduce_path(survey, options)
+    # seconds for a surveyed path (Monte Carlo uncertainty): shown on a terminal
+    with step(f"reducing {len(points.frame)} points", announce=False):
+        reduction = reduce_path(survey, options)
     table = reduction.table
 
     if out is not None:
@@ -313,14 +356,19 @@ def reduce(
         write_section_figure(table, paths[0], survey=survey, outputs=outputs)
         write_restitution_figures(table, paths[1], paths[2], outputs=outputs)
         write_energy_figures(table, paths[3], paths[4], outputs=outputs)
-    outputs.commit()
+    written = outputs.commit()
+    if preset is not None:
+        note(
+            f"from the preset {preset}: {', '.join(from_preset) or 'nothing'}"
+            + (f"; from the command line instead: {', '.join(overridden)}"
+               if overridden else "")
+        )  # fmt: skip
     typer.echo(f"body: {body.description}")
     print_body_notes(body)
     for text in (*points.notes, *(tree_set.notes if tree_set else ())):
         note(text)
     summary = summarize(table, reduction.uncertainty)
     typer.echo(with_flags(format_summary(summary)))
-    if out is not None:
-        typer.echo(f"wrote {out} ({len(table)} rows)")
-    if figures is not None:
-        typer.echo(f"wrote {len(FIGURE_NAMES)} figures to {figures}/")
+    for path in written:
+        rows = f" ({len(table)} rows)" if out is not None and path == out else ""
+        typer.echo(f"wrote {path}{rows}")

@@ -31,7 +31,9 @@ and the bootstrap below needs many cheap local refits, which it does well.
 Uncertainty: a bootstrap over runs (Efron & Tibshirani 1993, ch. 6): the runs are
 resampled with replacement ``bootstrap`` times (equivalently, integer weights on the
 per-run CRPS) and the fit is repeated from the optimum with a short budget. The
-standard error of a parameter is the SD of its bootstrap values; the 90 % interval is
+standard error of a parameter is the SD of its bootstrap values (with at least
+:data:`MIN_BOOTSTRAP_SE` resamples; with fewer there is no standard error, no
+correlation, and the interval is the slice below alone); the 90 % interval is
 ``value ± t SE`` clipped to the bounds (t: Student's 95 % quantile with one degree of
 freedom fewer than the resampled units -- 1.761 for 15 runs -- since an SE from a
 few runs is itself uncertain); the correlation matrix is that of the
@@ -53,6 +55,7 @@ estimation. JASA 102(477), 359-378.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 from collections.abc import Callable, Sequence
@@ -99,6 +102,64 @@ CORRELATION_LIMIT = 0.95
 Z90 = 1.6448536269514722
 #: Seed offset of the bootstrap's resampling stream (default_rng([seed, this])).
 BOOTSTRAP_STREAM = 7_919
+#: Fewest bootstrap resamples that give a standard error and correlations: the SD of
+#: B values is itself uncertain by about 1/sqrt(2 (B - 1)) of itself (24 % at 10,
+#: 71 % at 2), and the correlation of 2 points is always +-1. Below it the fit states
+#: no standard error, no correlation, and its 90 % interval is the objective's slice.
+MIN_BOOTSTRAP_SE = 10
+#: Upper limits of the fit's sizes: every one of the hundreds of evaluations
+#: simulates ``rocks`` rocks per run; each resample is a refit; each screen point an
+#: evaluation.
+MAX_ROCKS = 20_000
+MAX_BOOTSTRAP = 1_000
+MAX_SCREEN = 4_096
+MAX_SEED = 2**32 - 1
+
+#: ``step(description, total)``: a context manager yielding ``advance(done, total)``
+#: (:func:`fieldkit.cli.progress.step` on the command line).
+Step = Callable[[str, int | None], contextlib.AbstractContextManager]
+
+
+@contextlib.contextmanager
+def _no_step(description: str, total: int | None = None):
+    yield lambda done, of: None
+
+
+def check_settings(*, rocks: int, seed: int, bootstrap: int, screen: int) -> None:
+    """Refuse sizes the fit cannot use, before any work is done.
+
+    Raises
+    ------
+    ArgumentError
+        ``rocks`` not in 1..MAX_ROCKS, ``seed`` not in 0..MAX_SEED, ``bootstrap``
+        not in 0..MAX_BOOTSTRAP, ``screen`` not in 0..MAX_SCREEN (each names its
+        argument and the limit).
+
+    Examples
+    --------
+    >>> check_settings(rocks=200, seed=0, bootstrap=20, screen=16)
+    >>> try:
+    ...     check_settings(rocks=0, seed=0, bootstrap=20, screen=16)
+    ... except ArgumentError as exc:
+    ...     print(exc.message.split(":")[0])
+    rocks must be between 1 and 20,000 (got 0)
+    """
+    limits = (
+        ("rocks", rocks, 1, MAX_ROCKS, "rocks per run and evaluation"),
+        ("seed", seed, 0, MAX_SEED, "a seed of numpy's generator"),
+        ("bootstrap", bootstrap, 0, MAX_BOOTSTRAP, "each resample is a refit; "
+         f"{MIN_BOOTSTRAP_SE} or more give standard errors"),
+        ("screen", screen, 0, MAX_SCREEN, "each point is one evaluation"),
+    )  # fmt: skip
+    for name, value, lo, hi, why in limits:
+        if isinstance(value, bool) or not isinstance(value, int | np.integer):
+            raise ArgumentError(f"{name} must be a whole number (got {value!r})",
+                                source=name)  # fmt: skip
+        if not lo <= value <= hi:
+            raise ArgumentError(
+                f"{name} must be between {lo:,} and {hi:,} (got {value}): {why}",
+                source=name,
+            )
 
 
 def parameter_bounds(name: str) -> tuple[float, float]:
@@ -395,7 +456,7 @@ class PathFitResult:
                 {
                     "name": n,
                     "value": float(v),
-                    "stderr": float(s),
+                    "stderr": _finite(s),
                     "interval90": [float(a), float(b)],
                     "start": float(s0),
                     "bounds": [float(lo), float(hi)],
@@ -413,7 +474,11 @@ class PathFitResult:
                     strict=True,
                 )
             ],
-            "correlation": self.correlation.tolist(),
+            "correlation": (
+                self.correlation.tolist()
+                if np.isfinite(self.correlation).all()
+                else None
+            ),
             "slice_compatible": self.compatible.tolist(),
             "objective": (
                 "mean CRPS of observed runouts [m]"
@@ -425,8 +490,8 @@ class PathFitResult:
                     "kind": k,
                     "observations": self.kind_counts.get(k, 0),
                     "scale": self.scales.get(k, 1.0),
-                    "crps_start": self.kind_start.get(k, math.nan),
-                    "crps_optimum": self.kind_optimum.get(k, math.nan),
+                    "crps_start": _finite(self.kind_start.get(k, math.nan)),
+                    "crps_optimum": _finite(self.kind_optimum.get(k, math.nan)),
                 }
                 for k in self.kinds
             ],
@@ -442,8 +507,20 @@ class PathFitResult:
             "rocks": self.rocks,
             "seed": self.seed,
             "bootstrap_size": int(self.bootstrap.shape[0]),
+            "standard_errors": (
+                f"SD of the {self.bootstrap.shape[0]} bootstrap refits"
+                if self.bootstrap.shape[0] >= MIN_BOOTSTRAP_SE
+                else f"none: {self.bootstrap.shape[0]} bootstrap resamples are fewer "
+                f"than {MIN_BOOTSTRAP_SE}; interval90 is only the objective's slice "
+                "(the values the runs cannot tell from the optimum)"
+            ),
             "notes": list(self.notes),
         }
+
+
+def _finite(x: float) -> float | None:
+    """``x`` as a float, or None where it is not finite (JSON has no NaN)."""
+    return float(x) if math.isfinite(x) else None
 
 
 def _stratified_se(diff: np.ndarray, strata: Sequence[np.ndarray]) -> float:
@@ -499,6 +576,7 @@ def fit_paths(
     slice_points: int = 9,
     kinds: Sequence[str] | None = None,
     screen: int = 0,
+    step: Step | None = None,
 ) -> PathFitResult:
     """Fit the ``free`` parameters to the observed runouts of ``runs``.
 
@@ -539,6 +617,10 @@ def fit_paths(
         What to score (:data:`fieldkit.fit.path_along.KINDS`; default every kind
         observed on some run: runouts, and along the paths flight heights, impact
         spacing and speeds where the runs carry them).
+    step
+        ``step(description, total)`` context manager around each long stage (the
+        search, the bootstrap, the slices), yielding ``advance(done, total)``;
+        default: none.
 
     Returns
     -------
@@ -546,6 +628,8 @@ def fit_paths(
     """
     t0 = time.perf_counter()
     say = progress or (lambda _msg: None)
+    stage = step or _no_step
+    check_settings(rocks=rocks, seed=seed, bootstrap=bootstrap, screen=screen)
     names = list(free)
     if not names:
         raise ArgumentError("no free parameters", source="free")
@@ -614,21 +698,25 @@ def fit_paths(
         f"start {f0:.3f}{unit and ' ' + unit}"
     )
     budget = max_evaluations or max(150, 60 * p)
-    starts = [u0]
-    if screen > 0:
-        # Screen the cube (scrambled Sobol points, seeded): an objective of
-        # simulated paths can have several basins (a rolling and a bouncing
-        # regime), and Nelder-Mead only finds the one it starts in.
-        sobol = qmc.Sobol(p, scramble=True, seed=np.random.default_rng([seed, 3]))
-        points = sobol.random(screen)
-        values = np.array([f(u) for u in points])
-        best = int(np.argmin(values))
-        say(f"screened {screen} points: best {values[best]:.3f} (start {f0:.3f})")
-        if values[best] < f0:
-            starts.append(points[best])
-    first = int(budget * 0.7) // len(starts)
-    u1, f1, _ = min((_minimise(f, u, 0.15, first) for u in starts), key=lambda r: r[1])
-    u2, f2, _ = _minimise(f, u1, 0.05, max(budget - first * len(starts), p + 2))
+    description = f"fitting {p} parameters to {n_runs} runs ({rocks} rocks each)"
+    with stage(description, None):
+        starts = [u0]
+        if screen > 0:
+            # Screen the cube (scrambled Sobol points, seeded): an objective of
+            # simulated paths can have several basins (a rolling and a bouncing
+            # regime), and Nelder-Mead only finds the one it starts in.
+            sobol = qmc.Sobol(p, scramble=True, seed=np.random.default_rng([seed, 3]))
+            points = sobol.random(screen)
+            values = np.array([f(u) for u in points])
+            best = int(np.argmin(values))
+            say(f"screened {screen} points: best {values[best]:.3f} (start {f0:.3f})")
+            if values[best] < f0:
+                starts.append(points[best])
+        first = int(budget * 0.7) // len(starts)
+        u1, f1, _ = min(
+            (_minimise(f, u, 0.15, first) for u in starts), key=lambda r: r[1]
+        )
+        u2, f2, _ = _minimise(f, u1, 0.05, max(budget - first * len(starts), p + 2))
     u_best, f_best = (u2, f2) if f2 <= f1 else (u1, f1)
     x_best = to_x(u_best)
     say(
@@ -647,22 +735,28 @@ def fit_paths(
     rng = np.random.default_rng([seed, BOOTSTRAP_STREAM])
     short = bootstrap_evaluations or 20 * p + 10
     boot = np.empty((bootstrap, p))
-    for b in range(bootstrap):
-        weights = np.zeros(n_units)
-        for stratum in objective.strata:
-            draw = rng.integers(0, stratum.size, stratum.size)
-            weights[stratum] = np.bincount(draw, minlength=stratum.size)
-        # Each resample also draws new simulated rocks: the fitted values carry
-        # the Monte Carlo error of a finite ensemble, which a bootstrap over runs
-        # with the optimum's own rocks would leave out.
-        objective.seed = seed + 1 + b
-        ub, _, _ = _minimise(f, u_best, 0.05, short)
-        boot[b] = to_x(ub)
-        if (b + 1) % 10 == 0:
-            say(f"bootstrap {b + 1}/{bootstrap}")
+    with (
+        stage(f"bootstrap: {bootstrap} refits", bootstrap)
+        if bootstrap
+        else _no_step("")
+    ) as advance:
+        for b in range(bootstrap):
+            weights = np.zeros(n_units)
+            for stratum in objective.strata:
+                draw = rng.integers(0, stratum.size, stratum.size)
+                weights[stratum] = np.bincount(draw, minlength=stratum.size)
+            # Each resample also draws new simulated rocks: the fitted values carry
+            # the Monte Carlo error of a finite ensemble, which a bootstrap over runs
+            # with the optimum's own rocks would leave out.
+            objective.seed = seed + 1 + b
+            ub, _, _ = _minimise(f, u_best, 0.05, short)
+            boot[b] = to_x(ub)
+            advance(b + 1, bootstrap)
+            if (b + 1) % 10 == 0:
+                say(f"bootstrap {b + 1}/{bootstrap}")
     objective.seed = seed
     weights = np.ones(n_units)
-    if bootstrap >= 2:
+    if bootstrap >= MIN_BOOTSTRAP_SE:
         stderr = boot.std(axis=0, ddof=1)
         with np.errstate(invalid="ignore", divide="ignore"):
             corr = np.corrcoef(boot.T) if p > 1 else np.ones((1, 1))
@@ -671,23 +765,30 @@ def fit_paths(
     else:
         stderr = np.full(p, np.nan)
         corr = np.full((p, p), np.nan)
-        notes.append("no bootstrap: no standard errors or intervals")
+        notes.append(
+            f"{bootstrap} bootstrap resamples: too few for a standard error or "
+            f"correlations (at least {MIN_BOOTSTRAP_SE}); none given, and the 90 % "
+            "interval is only the objective's slice (the values the runs cannot tell "
+            "from the optimum)"
+        )
     # Slice of the objective across each bound range (others at the optimum): the
     # points the runs cannot tell from the optimum (paired mean CRPS difference
     # below Z90 times its SE over runs). A flat direction has no bootstrap spread
     # (every refit stays where it starts), so this is what reveals it.
     compatible = np.empty((p, 2))
-    for j in range(p):
-        grid = np.linspace(lower[j], upper[j], slice_points)
-        ok = [x_best[j]]
-        for value in grid:
-            x = x_best.copy()
-            x[j] = value
-            diff = objective.units(x) - best_units
-            se = _stratified_se(diff, objective.strata)
-            if diff.sum() <= Z90 * se:
-                ok.append(value)
-        compatible[j] = min(ok), max(ok)
+    with stage(f"slicing the objective across {p} bound ranges", p) as advance:
+        for j in range(p):
+            grid = np.linspace(lower[j], upper[j], slice_points)
+            ok = [x_best[j]]
+            for value in grid:
+                x = x_best.copy()
+                x[j] = value
+                diff = objective.units(x) - best_units
+                se = _stratified_se(diff, objective.strata)
+                if diff.sum() <= Z90 * se:
+                    ok.append(value)
+            compatible[j] = min(ok), max(ok)
+            advance(j + 1, p)
     say(f"slices done after {objective.evaluations} evaluations")
     # Student's t with (units - 1) degrees of freedom rather than the normal 1.645:
     # a bootstrap SE from 15 runs is itself uncertain (SBC: the normal interval
@@ -702,7 +803,9 @@ def fit_paths(
     )
     for j, n in enumerate(names):
         lo, hi = compatible[j]
-        if lo < interval[j, 0] or hi > interval[j, 1]:
+        if not np.isfinite(interval[j]).all():
+            interval[j] = lo, hi  # no standard error: the slice alone
+        elif lo < interval[j, 0] or hi > interval[j, 1]:
             notes.append(
                 f"{n}: the objective's slice cannot tell [{lo:g}, {hi:g}] from the "
                 f"optimum; its 90 % interval is widened to include it"

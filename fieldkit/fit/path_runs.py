@@ -105,6 +105,13 @@ def along_arrays(along, chainage_m: np.ndarray) -> dict[str, np.ndarray]:
     return out
 
 
+#: Fewest surveyed points of a path fitted on a model's own profile: its release
+#: (the first), one impact and where it stopped (the last). The runout is the
+#: distance from the first to the last, and the impacts between them are what the
+#: along-path kinds score; one or two points leave nothing but a runout of a point.
+MIN_SURVEYED_POINTS = 3
+
+
 def section_runs(observations: PathObservations, base_model: Model) -> list[PathRun]:
     """Runs observed along the base model's own profile (section coordinates).
 
@@ -119,8 +126,9 @@ def section_runs(observations: PathObservations, base_model: Model) -> list[Path
     Raises
     ------
     InputFileError
-        Plan observations, or a release or deposit off the profile (the file and
-        the run named).
+        Plan observations, a release or deposit off the profile, a deposit not
+        beyond its release, or a surveyed path of fewer than
+        :data:`MIN_SURVEYED_POINTS` points (the file and the run named).
 
     Examples
     --------
@@ -162,11 +170,26 @@ def section_runs(observations: PathObservations, base_model: Model) -> list[Path
                     source=source,
                     where=path_id,
                 )
+        along = observations.along_path(path_id)
+        if 0 < len(along) < MIN_SURVEYED_POINTS:
+            raise InputFileError(
+                f"{len(along)} surveyed point(s); a path needs at least "
+                f"{MIN_SURVEYED_POINTS} to be calibrated on: its release (the first), "
+                "an impact and where it stopped (the last)",
+                source=source,
+                where=f"path {path_id}",
+            )
+        if math.isfinite(deposit) and not deposit > release:
+            raise InputFileError(
+                f"the deposit (x = {deposit:g} m) is not beyond the release "
+                f"(x = {release:g} m): no runout to calibrate on",
+                source=source,
+                where=f"path {path_id}",
+            )
         body = run_body(base_model.body, row)
         ground = float(np.interp(release, profile.x_m, profile.z_m))
         moved = replace(seeder, x_m=release, z_m=ground + above)
         model = replace(base_model, body=body, seeder=moved)
-        along = observations.along_path(path_id)
         extra = {}
         if len(along):
             extra = along_arrays(along, along["x_m"].to_numpy(float) - release)

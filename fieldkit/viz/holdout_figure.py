@@ -12,6 +12,7 @@ from fieldkit.outputs import OutputSet
 from fieldkit.viz.figure_files import save_png
 
 _STYLE = {"calibrated": ("C0", 0.12), "uncalibrated": ("C7", -0.12)}
+_NAMES = {"calibrated": "calibrated", "uncalibrated": "starting (uncalibrated)"}
 
 
 def holdout_figure(validation: dict) -> Figure:
@@ -21,30 +22,36 @@ def holdout_figure(validation: dict) -> Figure:
     ids = validation["path_ids"]
     observed = validation["observed"]
     n = len(ids)
-    fig = Figure(figsize=(8.0, 0.35 * n + 1.8), layout="constrained")
+    fig = Figure(figsize=(8.0, 0.35 * n + 3.2), layout="constrained")
     ax = fig.add_subplot()
     clim = validation["ensembles"]["climatology"][0]
     lo, hi = np.percentile(clim, [5, 95])
-    ax.axvspan(lo, hi, color="0.9", label="climatology 5-95 %")
+    ax.axvspan(lo, hi, color="0.9", label="5-95 % of the calibration runs' observed "
+               "runouts (climatology)")  # fmt: skip
     y = np.arange(n)
     for name, (colour, dy) in _STYLE.items():
         for i, e in enumerate(validation["ensembles"][name]):
             q = np.percentile(e, [5, 25, 50, 75, 95])
             ax.plot([q[0], q[4]], [y[i] + dy] * 2, c=colour, lw=1)
             ax.plot([q[1], q[3]], [y[i] + dy] * 2, c=colour, lw=4,
-                    label=name if i == 0 else None)  # fmt: skip
+                    label=f"{_NAMES[name]} model" if i == 0 else None)  # fmt: skip
             ax.plot(q[2], y[i] + dy, "|", c="k", ms=8)
-    ax.plot(observed, y, "o", c="k", ms=5, label="observed")
+    ax.plot(observed, y, "o", c="k", ms=5, label="observed runout")
+    # what the thick and thin bars and the ticks are (one legend entry each)
+    ax.plot([], [], c="0.3", lw=4, label="50 % of simulated runouts (thick)")
+    ax.plot([], [], c="0.3", lw=1, label="90 % of simulated runouts (thin)")
+    ax.plot([], [], "|", c="k", ms=8, label="median simulated runout")
     ax.set_yticks(y, ids)
     ax.invert_yaxis()
-    ax.set_xlabel("runout along the section (m)")
+    ax.set_xlabel("runout along the section from the release (m)")
+    ax.set_ylabel("held-out run")
     s = validation["forecasts"]
     ax.set_title(
         "held-out runs: mean CRPS "
         + ", ".join(f"{k} {s[k]['mean_crps']:.1f} m" for k in s)
     )
     ax.grid(True, axis="x", alpha=0.3)
-    ax.legend(loc="lower right", fontsize=8)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2, fontsize=8)
     return fig
 
 

@@ -90,6 +90,13 @@ def test_figures_are_written(cli, survey, tmp_path):
     )
     for p in figures.iterdir():
         assert p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and p.stat().st_size > 10_000
+    # one 'wrote <path>' line per file, the table's with its row count
+    wrote = [x for x in result.stdout.splitlines() if x.startswith("wrote ")]
+    assert wrote == [f"wrote {tmp_path / 't.csv'} (5 rows)"] + [
+        f"wrote {figures / n}"
+        for n in ("section.png", "en_theta.png", "et_impacts.png",
+                  "energy_partition.png", "energy_head.png")
+    ]  # fmt: skip
 
 
 def test_shape_option_gives_the_table_4_1_body(cli, survey, tmp_path):

@@ -35,6 +35,10 @@ def test_tschamut_fit_writes_model_json_and_holdout_scores(cli, tmp_path):
     model = json.loads((tmp_path / "cal.json").read_text())
     assert model["provenance"]["fit_paths"]["n_runs"] == 18
     assert (tmp_path / "rep" / "holdout.png").stat().st_size > 20_000
+    report = (tmp_path / "rep" / "report.md").read_text()
+    assert "![held-out runouts](holdout.png)" in report and "## Held-out runs" in report
+    for name in ("cal.json", "fit.json", "rep/report.md", "rep/holdout.png"):
+        assert f"wrote {tmp_path / name}" in r.stdout
 
 
 def test_path_fit_on_a_dem_needs_all_three_inputs(cli, tmp_path):
