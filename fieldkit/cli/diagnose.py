@@ -22,6 +22,8 @@ FLAGS = {
     "folds": "--folds",
     "seed": "--seed",
 }
+#: Largest fold seed (numpy's generators take any integer >= 0; 64 bits are plenty).
+MAX_SEED = 2**64 - 1
 
 
 def _is_track(path: Path) -> bool:
@@ -179,6 +181,15 @@ def diagnose(
     """
     import numpy as np
 
+    from fieldkit.diagnose.groups import check_folds
+    from fieldkit.io.csv_table import check_readable
+
+    if seed is not None and not 0 <= seed <= MAX_SEED:
+        raise ArgumentError(
+            f"seed must be between 0 and 2^64 - 1 (got {seed})", source="seed"
+        )
+    check_folds(folds)
+    check_readable(input_file)
     if output is not None and model is None:
         raise ArgumentError(
             "-o needs --model (the base model supplies profile, body and seeder)",
@@ -210,15 +221,18 @@ def diagnose(
                     source="model",
                 )
             if radius is None:
-                raise ArgumentError(
-                    "a track needs --radius (the body's radius, m)", source="radius"
-                )
+                raise ArgumentError("a track needs --radius (the body's radius, m)")
             from fieldkit.cli.diagnose_track import diagnose_track_file
 
             diagnosis = diagnose_track_file(
                 input_file, radius_m=radius, mass_kg=mass, rng=rng, folds=folds
             )
         else:
+            if radius is not None or mass is not None:
+                raise ArgumentError(
+                    "--radius and --mass apply to a track only (an ImpactTable "
+                    "gives the body on every row)"
+                )
             from fieldkit.diagnose.impacts import diagnose_impacts
             from fieldkit.impact_table import ImpactTable
             from fieldkit.model.model_file import read_model

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from fieldkit.diagnose.diagnosis import Diagnosis
-from fieldkit.diagnose.flights import FlightSamples, diagnose_flights
+from fieldkit.diagnose.flights import FlightSamples, check_body, diagnose_flights
 from fieldkit.track import Track
 from fieldkit.tracking.flights.pipeline import analyse_track
 
@@ -80,7 +80,10 @@ def diagnose_track_file(
     InputFileError
         Unreadable track, fewer than three flights, a flight with too few samples
         (naming the file and the flight's rows).
+    ArgumentError
+        A radius or mass that is not finite, not positive or beyond its bound.
     """
+    check_body(radius_m, mass_kg)
     track = Track.read(path)
     track.source = str(path)
     flights = track_flights(track, radius_m=radius_m)

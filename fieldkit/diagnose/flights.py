@@ -53,6 +53,11 @@ MIN_FLIGHTS = 3
 MIN_FLIGHT_SAMPLES = 6
 #: Rock density assumed when no mass is given [kg/m^3] (sphere of the radius).
 ROCK_DENSITY_KG_M3 = 2650.0
+#: Largest body radius a flight diagnosis accepts [m]: a 25 m sphere of rock is
+#: 1.7e8 kg, beyond any single rockfall block (rock avalanches are not ballistic).
+MAX_RADIUS_M = 25.0
+#: Largest body mass a flight diagnosis accepts [kg] (a 25 m sphere of rock).
+MAX_MASS_KG = 2.0e8
 #: Family-wise level of the residual dependence tests (Holm correction).
 DEPENDENCE_ALPHA = 0.05
 #: Newton iterations on ``cd`` and Gauss-Newton iterations per flight.
@@ -297,6 +302,23 @@ def _skipped() -> dict[str, str]:
     return out
 
 
+def check_body(radius_m: float, mass_kg: float | None) -> None:
+    """Refuse a radius or mass that is not finite, not positive or beyond the bounds
+    (:data:`MAX_RADIUS_M`, :data:`MAX_MASS_KG`)."""
+    if not (math.isfinite(radius_m) and 0 < radius_m <= MAX_RADIUS_M):
+        raise ArgumentError(
+            f"radius_m must be > 0 and <= {MAX_RADIUS_M:g} m (got {radius_m:g})",
+            source="radius_m",
+        )
+    if mass_kg is not None and not (
+        math.isfinite(mass_kg) and 0 < mass_kg <= MAX_MASS_KG
+    ):
+        raise ArgumentError(
+            f"mass_kg must be > 0 and <= {MAX_MASS_KG:g} kg (got {mass_kg:g})",
+            source="mass_kg",
+        )
+
+
 def diagnose_flights(
     flights: list[FlightSamples],
     *,
@@ -334,13 +356,11 @@ def diagnose_flights(
     ------
     InputFileError
         Fewer than three flights, or a flight with too few samples.
+    ArgumentError
+        ``radius_m`` or ``mass_kg`` not finite, not positive or beyond
+        :data:`MAX_RADIUS_M`, :data:`MAX_MASS_KG`; ``folds`` out of range.
     """
-    if not (math.isfinite(radius_m) and radius_m > 0):
-        raise ArgumentError(
-            f"radius_m must be > 0 (got {radius_m:g})", source="radius_m"
-        )
-    if mass_kg is not None and not (math.isfinite(mass_kg) and mass_kg > 0):
-        raise ArgumentError(f"mass_kg must be > 0 (got {mass_kg:g})", source="mass_kg")
+    check_body(radius_m, mass_kg)
     data = _collect(flights, source)
     notes = [f"air density held at {_RHO:g} kg/m^3 (registry default)"]
     if mass_kg is None:
