@@ -10,6 +10,7 @@ from typing import Annotated
 import typer
 
 from fieldkit.cli.common import note, one_line_errors
+from fieldkit.cli.progress import report_written, step
 from fieldkit.errors import ArgumentError
 from fieldkit.outputs import OutputSet, write_text
 
@@ -38,70 +39,60 @@ def _is_track(path: Path) -> bool:
 
 
 def _summary(diagnosis) -> list[str]:
-    from fieldkit.diagnose.report import baseline_label
+    """What the command prints: the verdict in words, one line per candidate."""
+    from fieldkit.diagnose import labels
+    from fieldkit.diagnose.report import (
+        baseline_label,
+        dependence_sentence,
+        rankings,
+        rule_head,
+    )
 
     d = diagnosis
-    unit = "m/s" if d.metric.endswith("_mps") else "m"
+    unit = labels.unit(d.metric)
     lines = [
         f"held out: {d.groups}",
-        f"baseline ({baseline_label(d)}): {d.metric} {d.baseline.cv_rmse:.4g} {unit}",
+        f"baseline ({baseline_label(d)}): {labels.metric_words(d.metric)} "
+        f"{d.baseline.cv_rmse:.4g} {unit}",
+        f"rule: a candidate is recommended (*) when {rule_head(d)}",
     ]
     for c in d.candidates:
         mark = "*" if c.meaningful else " "
         lines.append(
             f" {mark} {c.effect:<30} {c.cv_rmse:.4g} {unit}  gain "
-            f"{c.improvement:+.1%} ± {c.improvement_se:.1%}"
+            f"{c.improvement:+.1%} ± {c.improvement_se:.1%} (standard error)"
         )
     for name, why in d.skipped.items():
         lines.append(f"   {name:<30} not tested: {why}")
+    rounds = rankings(d)
     for i, s in enumerate(d.steps):
         lines.append(
             f"step {i + 1}: add {s.added}: {s.cv_rmse_before:.4g} -> "
             f"{s.cv_rmse:.4g} {unit} ({1 - s.cv_rmse / s.cv_rmse_before:.1%} lower)"
         )
+        if i + 1 < len(rounds):
+            lines += [
+                f"   then {c.effect:<25} gain {c.improvement:+.1%} ± "
+                f"{c.improvement_se:.1%}{' *' if c.meaningful else ''}"
+                for c in rounds[i + 1]
+            ]
     lines += [f"confounded: {a}" for a in d.advice]
     lines.append(f"recommended: {d.recommended or 'nothing'} ({d.stopped})")
-    lines += [f"residuals still: {u}" for u in d.unexplained]
+    lines += [
+        f"residuals still: {dependence_sentence(x)}"
+        for x in sorted(d.dependence_after, key=lambda x: x.p_value)
+        if x.significant
+    ]
     return lines
 
 
 def _write_report(report_dir: Path, diagnosis, inputs, outputs: OutputSet) -> str:
-    from fieldkit.diagnose.report import figure_names, markdown
-    from fieldkit.viz.diagnose_figure import write_residual_figure
+    from fieldkit.diagnose.report import markdown
+    from fieldkit.viz.diagnose_figure import write_diagnosis_figures
 
-    d = diagnosis
-    text = markdown(d, title=inputs[0], inputs=inputs)
+    text = markdown(diagnosis, title=inputs[0], inputs=inputs)
     write_text(report_dir / "report.md", text, outputs)
-    arrays = d.arrays
-    unit = "m/s" if d.metric.endswith("_mps") else "m"
-    components = tuple(arrays.get("components", ("vfn", "vft", "omega_f")))
-    names = figure_names(d)
-    flags = [{x.feature for x in tests if x.significant}
-             for tests in arrays["dependence"]]  # fmt: skip
-    write_residual_figure(
-        report_dir / names[0],
-        arrays["features"],
-        [("baseline", arrays["baseline"], flags[0])],
-        components=components,
-        unit=unit,
-        title=f"baseline: {arrays.get('residual_kind', 'held-out')} residuals "
-        f"({d.metric} {d.baseline.cv_rmse:.4g})",
-        outputs=outputs,
-    )
-    before = arrays["baseline"]
-    for i, (step, after) in enumerate(zip(d.steps, arrays["steps"], strict=True)):
-        write_residual_figure(
-            report_dir / names[i + 1],
-            arrays["features"],
-            [(f"before ({step.cv_rmse_before:.4g})", before, flags[i]),
-             (f"after adding {step.added} ({step.cv_rmse:.4g})", after,
-              flags[i + 1])],
-            components=components,
-            unit=unit,
-            title=f"step {i + 1}: add {step.added}",
-            outputs=outputs,
-        )  # fmt: skip
-        before = after
+    write_diagnosis_figures(report_dir, diagnosis, outputs=outputs)
     return text
 
 
@@ -164,11 +155,16 @@ def diagnose(
     The baseline (constant e_n, e_t per material, or --model) is scored by its
     held-out error: k-fold cross-validation over paths (or blocks of consecutive
     impacts on a single-path survey). Residuals are tested against every feature
-    the table carries. Each candidate effect the data can inform is added,
-    refitted and scored on the held-out data; one is recommended only when its
-    gain exceeds its standard error, and look-alike candidates are reported as
-    confounded instead of picked. Accepted effects are added stepwise. A track
-    CSV is diagnosed at flight level (air_drag from the flight residuals).
+    the table carries (Holm-adjusted p-values). Each candidate effect the data
+    can inform is added, refitted and scored on the held-out data; one is
+    recommended only when it lowers the held-out error by more than 1 % and by
+    more than 2 standard errors of that gain (jackknife over the held-out
+    groups). Two candidates that both pass, neither of which lowers the other's
+    error by more than 1 % and 1 standard error, are reported as confounded and
+    neither is added. Accepted effects are added stepwise. A track CSV is
+    diagnosed at flight level: air_drag is recommended when it lowers the
+    held-out error of the flight positions by more than 2 standard errors of
+    that gain.
 
     Example (from the repository root):
 
@@ -209,10 +205,6 @@ def diagnose(
             seed = secrets.randbits(32)
             note(f"`seed` not given: used {seed}; pass --seed {seed} to reproduce")
         rng = np.random.default_rng(seed)
-
-        def progress(message: str) -> None:
-            typer.echo(f"  scoring {message}", err=True)
-
         if _is_track(input_file):
             if model is not None or output is not None:
                 raise ArgumentError(
@@ -223,10 +215,17 @@ def diagnose(
             if radius is None:
                 raise ArgumentError("a track needs --radius (the body's radius, m)")
             from fieldkit.cli.diagnose_track import diagnose_track_file
+            from fieldkit.diagnose.flights import check_body
 
-            diagnosis = diagnose_track_file(
-                input_file, radius_m=radius, mass_kg=mass, rng=rng, folds=folds
-            )
+            check_body(radius, mass)
+
+            with step(
+                f"diagnosing the flights of {input_file}: finding the flights, "
+                f"fitting air drag by {folds}-fold cross-validation"
+            ):
+                diagnosis = diagnose_track_file(
+                    input_file, radius_m=radius, mass_kg=mass, rng=rng, folds=folds
+                )
         else:
             if radius is not None or mass is not None:
                 raise ArgumentError(
@@ -239,9 +238,11 @@ def diagnose(
 
             base = read_model(model) if model is not None else None
             table = ImpactTable.read(input_file)
-            diagnosis = diagnose_impacts(
-                table, base, rng=rng, folds=folds, progress=progress
-            )
+            with step(
+                f"diagnosing {len(table)} impacts: scoring the baseline and each "
+                f"candidate effect by {folds}-fold cross-validation"
+            ):
+                diagnosis = diagnose_impacts(table, base, rng=rng, folds=folds)
         diagnosis.notes.append(f"fold seed {seed}")
         if json_file is not None:
             write_text(
@@ -249,8 +250,9 @@ def diagnose(
             )
         text = None
         if report_dir is not None:
-            text = _write_report(report_dir, diagnosis, [str(p) for p in inputs],
-                                 outputs)  # fmt: skip
+            with step(f"writing the report and its figures to {report_dir}"):
+                text = _write_report(report_dir, diagnosis,
+                                     [str(p) for p in inputs], outputs)  # fmt: skip
         if rrd is not None:
             from fieldkit.diagnose.report import markdown
             from fieldkit.viz.diagnose_recording import write_diagnosis_recording
@@ -258,7 +260,8 @@ def diagnose(
             text = text or markdown(
                 diagnosis, title=str(input_file), inputs=[str(p) for p in inputs]
             )
-            write_diagnosis_recording(rrd, diagnosis, text, outputs=outputs)
+            with step(f"writing the recording {rrd}", announce=False):
+                write_diagnosis_recording(rrd, diagnosis, text, outputs=outputs)
         if output is not None:
             from dataclasses import replace
 
@@ -275,6 +278,7 @@ def diagnose(
                 },
             }
             write_model(replace(after, provenance=provenance), output, outputs=outputs)
-        outputs.commit()
+        written = outputs.commit()
     for line in _summary(diagnosis):
         typer.echo(line)
+    report_written(written)

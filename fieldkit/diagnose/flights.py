@@ -40,8 +40,14 @@ from fieldkit.diagnose.diagnosis import (
     Step,
 )
 from fieldkit.diagnose.groups import make_groups
-from fieldkit.diagnose.residual_tests import holm
-from fieldkit.diagnose.scoring import DEFAULT_Z, held_out, improvement, meaningful
+from fieldkit.diagnose.residual_tests import describe, mark_holm
+from fieldkit.diagnose.scoring import (
+    DEFAULT_Z,
+    held_out,
+    improvement,
+    meaningful,
+    recommendation_rule,
+)
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.model import drag_flight
 from fieldkit.model.effects import air_drag, registry
@@ -253,17 +259,20 @@ def _dependence(
             rho = 0.0 if not np.isfinite(rho) else float(rho)
             p = 1.0 if not np.isfinite(p) else float(p)
             tests.append((feature, component, rho, p))
-    significant = holm([t[3] for t in tests], alpha)
-    return [
-        Dependence(
-            feature=feature,
-            component=f"position_{component}",
-            statistic=f"spearman rho = {rho:+.3f} (n = {data.t.size})",
-            p_value=p,
-            significant=bool(significant[i]),
-        )
-        for i, (feature, component, rho, p) in enumerate(tests)
-    ]
+    return mark_holm(
+        [
+            Dependence(
+                feature=feature,
+                component=f"position_{component}",
+                statistic=f"Spearman rho = {rho:+.3f} (n = {data.t.size})",
+                p_value=p,
+                significant=False,
+                p_method="Spearman",
+            )
+            for feature, component, rho, p in tests
+        ],
+        alpha,
+    )
 
 
 def _free_g_note(data: _Data) -> str:
@@ -422,7 +431,7 @@ def diagnose_flights(
         after, steps, final = baseline, [], base
         stopped = (
             f"air_drag does not improve the held-out error meaningfully "
-            f"(gain {gain:.4f} +- {se:.4f}, needs > {z:g} SE)"
+            f"(gain {gain:+.1%} ± {se:.1%}; needs more than {z:g} standard errors)"
         )
     before = _dependence(data, base)
     after_dep = _dependence(data, final)
@@ -447,8 +456,9 @@ def diagnose_flights(
         confounded=[],
         after=after,
         rule=(
-            f"an effect is recommended when its held-out gain exceeds {z:g} "
-            "jackknife standard error(s) over flights (gain > 0 and gain > z SE)"
+            f"air_drag is recommended when {recommendation_rule(z, 0.0)} (jackknife "
+            "over flights); no minimum gain, since cd = 0 is the ballistic baseline "
+            "exactly"
         ),
         groups=(
             f"{data.n_flights} flights (whole flights held out); "
@@ -459,12 +469,7 @@ def diagnose_flights(
         skipped=_skipped(),
         dependence_before=before,
         dependence_after=after_dep,
-        unexplained=[
-            f"{d.component} residual vs {d.feature} "
-            f"({d.statistic}, p = {d.p_value:.2g})"
-            for d in after_dep
-            if d.significant
-        ],
+        unexplained=describe(after_dep),
         worst=worst,
         notes=notes,
         n_data=n_obs,
