@@ -131,11 +131,21 @@ def diagnose(
         ),
     ] = None,
     folds: Annotated[
-        int, typer.Option("--folds", help="Cross-validation folds.", min=2)
+        int,
+        typer.Option(
+            "--folds",
+            help="Cross-validation folds, 2 to 100 (fewer when there are fewer "
+            "paths, blocks or flights).",
+            min=2,
+        ),
     ] = 5,
     seed: Annotated[
         int | None,
-        typer.Option("--seed", help="Seed of the fold split (drawn when omitted)."),
+        typer.Option(
+            "--seed",
+            help="Seed of the fold split, 0 to 2^64-1 (drawn and printed when "
+            "omitted).",
+        ),
     ] = None,
     radius: Annotated[
         float | None,
@@ -162,9 +172,9 @@ def diagnose(
     groups). Two candidates that both pass, neither of which lowers the other's
     error by more than 1 % and 1 standard error, are reported as confounded and
     neither is added. Accepted effects are added stepwise. A track CSV is
-    diagnosed at flight level: air_drag is recommended when it lowers the
-    held-out error of the flight positions by more than 2 standard errors of
-    that gain.
+    diagnosed at flight level, on the positions of its flights: air_drag is
+    recommended when it lowers the held-out error by more than 2 standard
+    errors of that gain.
 
     Example (from the repository root):
 
