@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import secrets
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Annotated
 
@@ -23,6 +25,8 @@ FLAGS = {
     "folds": "--folds",
     "seed": "--seed",
 }
+#: Most characters of a CSV's first line read to tell a track from a table.
+MAX_HEADER_CHARS = 1 << 20
 #: Largest fold seed (numpy's generators take any integer >= 0; 64 bits are plenty).
 MAX_SEED = 2**64 - 1
 
@@ -33,7 +37,7 @@ def _is_track(path: Path) -> bool:
     if path.suffix.lower() != ".csv":
         return False
     with open(path, encoding="utf-8", errors="replace") as handle:
-        header = handle.readline()
+        header = handle.readline(MAX_HEADER_CHARS)
     cells = [c.strip() for c in header.split(",")]
     return is_track_header(cells) and "vi_x_mps" not in cells
 
@@ -84,6 +88,23 @@ def _summary(diagnosis) -> list[str]:
         if x.significant
     ]
     return lines
+
+
+@contextlib.contextmanager
+def _step_once_checked(description: str) -> Iterator[Callable[[str], None]]:
+    """A progress callback for the library that starts :func:`step` at its first
+    call: the library calls it once the input has passed every check, so bad input
+    is refused in one line before any progress is shown."""
+    with contextlib.ExitStack() as stack:
+        started = False
+
+        def progress(_message: str) -> None:
+            nonlocal started
+            if not started:
+                started = True
+                stack.enter_context(step(description))
+
+        yield progress
 
 
 def _write_report(report_dir: Path, diagnosis, inputs, outputs: OutputSet) -> str:
@@ -229,13 +250,14 @@ def diagnose(
 
             check_body(radius, mass)
 
-            with step(
-                f"diagnosing the flights of {input_file}: finding the flights, "
-                f"fitting air drag by {folds}-fold cross-validation"
-            ):
+            with _step_once_checked(
+                f"diagnosing the flights of {input_file}: fitting air drag by "
+                f"{folds}-fold cross-validation"
+            ) as progress:
                 diagnosis = diagnose_track_file(
-                    input_file, radius_m=radius, mass_kg=mass, rng=rng, folds=folds
-                )
+                    input_file, radius_m=radius, mass_kg=mass, rng=rng, folds=folds,
+                    progress=progress,
+                )  # fmt: skip
         else:
             if radius is not None or mass is not None:
                 raise ArgumentError(
@@ -248,11 +270,13 @@ def diagnose(
 
             base = read_model(model) if model is not None else None
             table = ImpactTable.read(input_file)
-            with step(
+            with _step_once_checked(
                 f"diagnosing {len(table)} impacts: scoring the baseline and each "
                 f"candidate effect by {folds}-fold cross-validation"
-            ):
-                diagnosis = diagnose_impacts(table, base, rng=rng, folds=folds)
+            ) as progress:
+                diagnosis = diagnose_impacts(
+                    table, base, rng=rng, folds=folds, progress=progress
+                )
         diagnosis.notes.append(f"fold seed {seed}")
         if json_file is not None:
             write_text(

@@ -9,6 +9,7 @@ written by `fieldkit track`), else from
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -61,6 +62,7 @@ def diagnose_track_file(
     mass_kg: float | None,
     rng: np.random.Generator,
     folds: int,
+    progress: Callable[[str], None] | None = None,
 ) -> Diagnosis:
     """Diagnose the flights of the track file ``path`` (is ``air_drag`` missing?).
 
@@ -74,6 +76,8 @@ def diagnose_track_file(
         Random generator for the cross-validation folds.
     folds
         Folds (whole flights held out).
+    progress
+        Passed to :func:`diagnose_flights` (called once the flights are checked).
 
     Raises
     ------
@@ -94,6 +98,7 @@ def diagnose_track_file(
         rng=rng,
         folds=folds,
         source=str(path),
+        progress=progress,
     )
     diagnosis.notes.insert(
         0, f"{len(flights)} flights from {track.meta['flights_from']}"

@@ -27,6 +27,7 @@ impact-level diagnosis.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -337,6 +338,7 @@ def diagnose_flights(
     folds: int = 5,
     z: float = DEFAULT_Z,
     source: str | None = None,
+    progress: Callable[[str], None] | None = None,
 ) -> Diagnosis:
     """Whether ``air_drag`` improves the held-out fit of a track's flights.
 
@@ -355,6 +357,9 @@ def diagnose_flights(
         Standard errors a gain must exceed to be meaningful.
     source
         The track file, for messages.
+    progress
+        Called with a short message once the flights have passed every check and
+        the fitting starts (a caller shows progress from then on).
 
     Returns
     -------
@@ -371,6 +376,8 @@ def diagnose_flights(
     """
     check_body(radius_m, mass_kg)
     data = _collect(flights, source)
+    if progress is not None:
+        progress("fitting")
     notes = [f"air density held at {_RHO:g} kg/m^3 (registry default)"]
     if mass_kg is None:
         mass_kg = sphere_mass_kg(radius_m)

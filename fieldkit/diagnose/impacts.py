@@ -234,7 +234,9 @@ def diagnose_impacts(
     confounding (see :func:`_alike`).
     ``rng`` deals the groups to folds (a seed reproduces the diagnosis exactly);
     ``candidates`` restricts the candidate effects (default: every one the table
-    can inform). See the module docstring for the method.
+    can inform); ``progress`` is called with a short message before each model is
+    scored, the first time once every check of the table has passed. See the
+    module docstring for the method.
 
     Raises
     ------

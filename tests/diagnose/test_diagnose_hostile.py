@@ -7,6 +7,7 @@ before any work: the checks never need a real diagnosis.
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 #: (argv after ``diagnose``, fragment of the error line)
@@ -84,3 +85,31 @@ def test_hostile_input_is_one_line_and_writes_nothing(
     assert "Traceback" not in r.output
     assert not out.exists()
     assert {p: digest(p) for p in (table, track)} == before
+
+
+def test_input_refused_after_reading_is_still_one_line(tmp_path, cli, fails):
+    """Checks made while diagnosing (too few impacts, too few flights) refuse before
+    any progress is announced: stderr holds the error line alone."""
+    from diagnose_cases import hidden_table
+
+    from fieldkit.diagnose.flights import sphere_mass_kg
+    from fieldkit.fit.synthetic_track import synthetic_track
+    from fieldkit.impact_table import ImpactTable
+
+    table = tmp_path / "two.csv"
+    frame = hidden_table((), noise=0.05, paths=3, seed=0).frame.iloc[:2]
+    ImpactTable(frame.assign(path_id="A"), source="two").write(table)
+    r = cli("diagnose", table, "--seed", "1", "--json", tmp_path / "out" / "d.json")
+    fails(r, "two.csv", "too few impacts to diagnose", "need at least 3")
+    rng = np.random.default_rng(0)
+    track = synthetic_track(
+        radius_m=0.2, mass_kg=sphere_mass_kg(0.2), cd=0.0,
+        launch_speed_mps=np.full(2, 15.0), launch_angle_deg=np.full(2, 15.0),
+        surface_angle_deg=35.0, fps=200.0, noise_m=0.005, rng=rng,
+    )  # fmt: skip
+    path = tmp_path / "two_flights.csv"
+    track.write(path)
+    r = cli("diagnose", path, "--radius", "0.2", "--seed", "1",
+            "--report", tmp_path / "out" / "rep")  # fmt: skip
+    fails(r, "two_flights.csv", "2 flight(s) found; at least 3 are needed")
+    assert not (tmp_path / "out").exists()
