@@ -80,14 +80,23 @@ def _panel(ax, values, residual, components) -> None:
 
 
 def _legend(
-    fig: Figure, components: tuple[str, ...], unit: str, what: str, ncols: int
+    fig: Figure,
+    components: tuple[str, ...],
+    present: list[bool],
+    unit: str,
+    what: str,
+    ncols: int,
 ) -> None:
+    """The legend under the panels: one entry per residual drawn (a component
+    without data, e.g. spin never measured, is left out), the median, zero."""
+    shown = [j for j in range(len(components)) if present[j]]
     handles = [
         Line2D([], [], ls="", marker="o", ms=4, alpha=0.6, color=_COLOURS[j % 3])
-        for j in range(len(components))
+        for j in shown
     ]
     texts = [
-        f"{labels.component(c)} ({unit}), one point per {what}" for c in components
+        f"{labels.component(components[j])} ({unit}), one point per {what}"
+        for j in shown
     ]
     handles += [
         Line2D([], [], color="grey", lw=2),
@@ -137,8 +146,13 @@ def residual_figure(
             if c == 0:
                 ax.set_ylabel(f"residual, measured − model ({unit})")
             if r == 0:
-                ax.set_title(label, fontsize=10)
-    _legend(fig, components, unit, what, ncols=min(2, len(columns)))
+                ax.set_title(textwrap.fill(label, int(11 * width / len(columns))),
+                             fontsize=10)  # fmt: skip
+    present = [
+        any(np.isfinite(residual[:, j]).any() for _, residual, _ in columns)
+        for j in range(len(components))
+    ]
+    _legend(fig, components, present, unit, what, ncols=min(2, len(columns)))
     wrap = int(11 * width)
     fig.suptitle("\n".join(textwrap.fill(line, wrap) for line in title.split("\n")))
     return fig

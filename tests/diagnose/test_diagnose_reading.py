@@ -244,3 +244,27 @@ def test_track_report_names_flights_once_and_says_what_is_fixed(
         assert texts[0] == "horizontal position x (m), one point per sample of a flight"
         for ax in fig.get_axes():
             assert ax.get_xlabel().split("\n")[0] in labels.FEATURES.values()
+
+
+def test_legend_leaves_out_a_residual_without_data(tmp_path, cli, figures):
+    """Spins estimated (not measured): no spin residual is drawn, so the legend
+    does not promise one; wide column titles are wrapped, not cut."""
+    import pandas as pd
+
+    from fieldkit.impact_table import ImpactTable
+
+    frame = hidden_table((ANGLE,), noise=0.05, paths=15, seed=0).frame.copy()
+    frame["omega_source"] = pd.Series(["estimated"] * len(frame), dtype="string")
+    table = tmp_path / "estimated.csv"
+    ImpactTable(frame, source="estimated").write(table)
+    figures.clear()
+    r = cli("diagnose", table, "--seed", "0", "--report", tmp_path / "rep")
+    assert r.exit_code == 0, r.output
+    assert len(figures) == 2
+    for _, fig in figures:
+        texts = [t.get_text() for t in fig.legends[0].get_texts()]
+        assert len(texts) == 4 and not any("ω_f" in t for t in texts), texts
+    after = figures[1][1].get_axes()[1].get_title()
+    assert (
+        after.startswith("after adding angle-dependent restitution") and "\n" in after
+    )
