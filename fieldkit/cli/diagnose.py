@@ -56,7 +56,7 @@ def _summary(diagnosis) -> list[str]:
     unit = labels.unit(d.metric)
     lines = [
         f"held out: {d.groups}",
-        f"baseline ({baseline_label(d)}): {labels.metric_words(d.metric)} "
+        f"baseline, {baseline_label(d)}: {labels.metric_words(d.metric)} "
         f"{d.baseline.cv_rmse:.4g} {unit}",
         f"rule: a candidate is recommended (*) when {rule_head(d)}",
     ]

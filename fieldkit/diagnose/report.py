@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 
-from fieldkit.diagnose import labels
+from fieldkit.diagnose import labels, residual_tests
 from fieldkit.diagnose.diagnosis import Candidate, Dependence, Diagnosis
 
 
@@ -104,12 +104,17 @@ def _worst_line(w: dict, unit: str) -> str:
 
 
 def dependence_sentence(d: Dependence) -> str:
-    """One dependence in words, each p-value labelled (raw, Holm-adjusted)."""
+    """One dependence in words, each p-value labelled (which test; raw or
+    Holm-adjusted)."""
+    raw = (
+        "the smaller p doubled"
+        if d.p_method == residual_tests.COMBINED_P
+        else d.p_method.split(": ")[-1] or "the test alone"
+    )
     return (
         f"{labels.component(d.component)} residuals depend on "
         f"{labels.feature(d.feature)}: {d.statistic}; p = {_p(d.p_value)} "
-        f"({d.p_method or 'the test alone'}), Holm-adjusted p = {_p(d.p_holm)} "
-        f"≤ {d.alpha:g}"
+        f"({raw}), Holm-adjusted p = {_p(d.p_holm)} ≤ {d.alpha:g}"
     )
 
 
@@ -205,7 +210,12 @@ def markdown(diagnosis: Diagnosis, *, title: str, inputs: list[str]) -> str:
             "rule (see *Which effect is missing*)."
         )
     out += [f"Stopped: {d.stopped}.", ""]
-    if d.unexplained:
+    if d.unexplained and d.confounded:
+        out.append(
+            "**Residual structure left**: the confounded candidates below may "
+            "explain it, but the data cannot tell which, so neither was added:"
+        )
+    elif d.unexplained:
         out.append(
             "**Residual structure no candidate explains** (physics outside "
             "fieldkit's vocabulary, or a data problem):"

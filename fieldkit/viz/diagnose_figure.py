@@ -207,8 +207,7 @@ def write_diagnosis_figures(
                     tests[0],
                 )
             ],
-            title=f"Residuals of the baseline ({baseline_label(d)}) against each "
-            "feature",
+            title=f"Baseline, {baseline_label(d)}: residuals against each feature",
             outputs=outputs,
             **common,
         )

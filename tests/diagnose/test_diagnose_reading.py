@@ -196,8 +196,8 @@ def test_residual_structure_left_is_said_in_words(tmp_path, cli):
     ]
     assert len(left) == 1, r.stdout
     assert re.search(
-        r"; p = [\de.+-]+ \(continuous features: the smaller of the Spearman and the "
-        r"binned Kruskal-Wallis p, doubled \(Bonferroni over the two\)\), "
+        r"; Spearman p = [\de.+-]+; Kruskal-Wallis over 5 quantile bins p = "
+        r"[\de.+-]+; p = [\de.+-]+ \(the smaller p doubled\), "
         r"Holm-adjusted p = [\de.+-]+ ≤ 0.01$",
         left[0],
     ), left[0]
@@ -268,3 +268,19 @@ def test_legend_leaves_out_a_residual_without_data(tmp_path, cli, figures):
     assert (
         after.startswith("after adding angle-dependent restitution") and "\n" in after
     )
+
+
+def test_confounded_structure_is_not_called_unexplained(tmp_path, cli):
+    """Angle and speed laws that the data cannot tell apart: the residual trend
+    left is the one they would both explain, and the report says so."""
+    from diagnose_cases import narrow_speed_table
+
+    table = tmp_path / "narrow.csv"
+    narrow_speed_table(np.random.default_rng(0)).write(table)
+    r = cli("diagnose", table, "--seed", "0", "--report", tmp_path / "rep")
+    assert r.exit_code == 0, r.output
+    text = (tmp_path / "rep" / "report.md").read_text()
+    assert "### Confounded" in text
+    assert "**Residual structure left**: the confounded candidates" in text
+    assert "no candidate explains" not in text
+    assert "|v_in| = |v_i| sin θi rises with the impact angle θi" in text
