@@ -59,12 +59,13 @@ def _summary(diagnosis) -> list[str]:
         f"baseline, {baseline_label(d)}: {labels.metric_words(d.metric)} "
         f"{d.baseline.cv_rmse:.4g} {unit}",
         f"rule: a candidate is recommended (*) when {rule_head(d)}",
+        "candidates, best first: held-out RMS error, gain ± its standard error",
     ]
     for c in d.candidates:
         mark = "*" if c.meaningful else " "
         lines.append(
             f" {mark} {c.effect:<30} {c.cv_rmse:.4g} {unit}  gain "
-            f"{c.improvement:+.1%} ± {c.improvement_se:.1%} (standard error)"
+            f"{c.improvement:+.1%} ± {c.improvement_se:.1%}"
         )
     for name, why in d.skipped.items():
         lines.append(f"   {name:<30} not tested: {why}")
@@ -75,11 +76,14 @@ def _summary(diagnosis) -> list[str]:
             f"{s.cv_rmse:.4g} {unit} ({1 - s.cv_rmse / s.cv_rmse_before:.1%} lower)"
         )
         if i + 1 < len(rounds):
-            lines += [
-                f"   then {c.effect:<25} gain {c.improvement:+.1%} ± "
-                f"{c.improvement_se:.1%}{' *' if c.meaningful else ''}"
-                for c in rounds[i + 1]
-            ]
+            lines.append(
+                f"  then, against the model after step {i + 1}: "
+                + "; ".join(
+                    f"{'* ' if c.meaningful else ''}{c.effect} gain "
+                    f"{c.improvement:+.1%} ± {c.improvement_se:.1%}"
+                    for c in rounds[i + 1]
+                )
+            )
     lines += [f"confounded: {a}" for a in d.advice]
     lines.append(f"recommended: {d.recommended or 'nothing'} ({d.stopped})")
     lines += [

@@ -78,7 +78,8 @@ def test_two_steps_report_one_table_per_ranking(two_effects):
     assert "Ranked in *Which effect is missing* above." in text
     assert "Candidates ranked against the model after step 1:" in text
     assert "Candidates ranked against the model after step 2 (none passes" in text
-    assert "   then " in r.stdout  # the later rankings are printed too
+    # the later rankings are printed too
+    assert "  then, against the model after step 2: " in r.stdout
 
 
 def test_report_names_quantities_in_words_with_units(two_effects):
