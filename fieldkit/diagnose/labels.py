@@ -198,14 +198,41 @@ def value_with_se(
     return f"{text} ± {sd:.2g}{tail}"
 
 
+#: A fitted value this many times an effect parameter's default, when the
+#: parameter's neutral value is infinite, leaves the effect practically off.
+PRACTICALLY_OFF = 100.0
+
+
+def remark(name: str, value: float) -> str:
+    """Why an effect parameter's value is special: at a bound, or so far towards an
+    infinite neutral value that the effect does nothing (empty otherwise)."""
+    parts = name.split(".")
+    spec = registry.BY_NAME.get(parts[0])
+    if spec is None or len(parts) != 2 or not math.isfinite(value):
+        return ""
+    for p in spec.parameters:
+        if p.name != parts[1]:
+            continue
+        if p.neutral == math.inf and value > PRACTICALLY_OFF * p.default:
+            return " (practically its neutral value ∞: the effect is off)"
+        for bound, side in ((p.lower, "lower"), (p.upper, "upper")):
+            if math.isfinite(bound) and abs(value - bound) <= 1e-6 * max(1, abs(bound)):
+                return f" (at its {side} bound)"
+    return ""
+
+
 def parameter_text(name: str, value: float, sd: float | None) -> str:
-    """``short name = value ± SE unit`` for one parameter (compact, for tables).
+    """``short name = value ± SE unit`` for one parameter (compact, for tables),
+    saying when the value sits at a bound or leaves its effect off.
 
     Examples
     --------
     >>> parameter_text("velocity_scaled_restitution.k_mps", 37.77, 1.91)
     'k_mps = 37.77 ± 1.9 m/s'
+    >>> parameter_text("velocity_scaled_restitution.k_mps", 1.0e5, 1.1e10)
+    'k_mps = 1e+05 ± 1.1e+10 m/s (practically its neutral value ∞: the effect is off)'
     >>> parameter_text("gravity_mps2", 9.81, None)
     'gravity_mps2 = 9.81 m/s² (fixed, not fitted)'
     """
-    return f"{short(name)} = {value_with_se(value, sd, unit=parameter(name)[1])}"
+    text = value_with_se(value, sd, unit=parameter(name)[1])
+    return f"{short(name)} = {text}{remark(name, value)}"

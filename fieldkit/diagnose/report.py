@@ -53,7 +53,8 @@ def _params_table(params: dict, sds: dict) -> list[str]:
     rows = ["| parameter | value ± standard error |", "|---|---|"]
     for k, v in params.items():
         words, unit = labels.parameter(k)
-        rows.append(_row(words, labels.value_with_se(v, sds.get(k), unit=unit)))
+        text = labels.value_with_se(v, sds.get(k), unit=unit) + labels.remark(k, v)
+        rows.append(_row(words, text))
     return rows
 
 
