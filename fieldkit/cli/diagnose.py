@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import contextlib
 import secrets
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Annotated
 
@@ -10,6 +12,7 @@ import typer
 
 from fieldkit.cli.common import note, one_line_errors
 from fieldkit.cli.material_options import MaterialOpt, PresetOpt, mapped_table
+from fieldkit.cli.progress import report_written, step
 from fieldkit.errors import ArgumentError
 from fieldkit.outputs import OutputSet, write_json, write_text
 
@@ -24,6 +27,10 @@ FLAGS = {
     "material": "--material",
     "preset": "--preset",
 }
+#: Most characters of a CSV's first line read to tell a track from a table.
+MAX_HEADER_CHARS = 1 << 20
+#: Largest fold seed (numpy's generators take any integer >= 0; 64 bits are plenty).
+MAX_SEED = 2**64 - 1
 
 
 def _is_track(path: Path) -> bool:
@@ -32,19 +39,29 @@ def _is_track(path: Path) -> bool:
     if path.suffix.lower() != ".csv":
         return False
     with open(path, encoding="utf-8", errors="replace") as handle:
-        header = handle.readline()
+        header = handle.readline(MAX_HEADER_CHARS)
     cells = [c.strip() for c in header.split(",")]
     return is_track_header(cells) and "vi_x_mps" not in cells
 
 
 def _summary(diagnosis) -> list[str]:
-    from fieldkit.diagnose.report import baseline_label
+    """What the command prints: the verdict in words, one line per candidate."""
+    from fieldkit.diagnose import labels
+    from fieldkit.diagnose.report import (
+        baseline_label,
+        dependence_sentence,
+        rankings,
+        rule_head,
+    )
 
     d = diagnosis
-    unit = "m/s" if d.metric.endswith("_mps") else "m"
+    unit = labels.unit(d.metric)
     lines = [
         f"held out: {d.groups}",
-        f"baseline ({baseline_label(d)}): {d.metric} {d.baseline.cv_rmse:.4g} {unit}",
+        f"baseline, {baseline_label(d)}: {labels.metric_words(d.metric)} "
+        f"{d.baseline.cv_rmse:.4g} {unit}",
+        f"rule: a candidate is recommended (*) when {rule_head(d)}",
+        "candidates, best first: held-out RMS error, gain ± its standard error",
     ]
     for c in d.candidates:
         mark = "*" if c.meaningful else " "
@@ -54,54 +71,55 @@ def _summary(diagnosis) -> list[str]:
         )
     for name, why in d.skipped.items():
         lines.append(f"   {name:<30} not tested: {why}")
+    rounds = rankings(d)
     for i, s in enumerate(d.steps):
         lines.append(
             f"step {i + 1}: add {s.added}: {s.cv_rmse_before:.4g} -> "
             f"{s.cv_rmse:.4g} {unit} ({1 - s.cv_rmse / s.cv_rmse_before:.1%} lower)"
         )
+        if i + 1 < len(rounds):
+            lines.append(
+                f"  then, against the model after step {i + 1}: "
+                + "; ".join(
+                    f"{'* ' if c.meaningful else ''}{c.effect} gain "
+                    f"{c.improvement:+.1%} ± {c.improvement_se:.1%}"
+                    for c in rounds[i + 1]
+                )
+            )
     lines += [f"confounded: {a}" for a in d.advice]
     lines.append(f"recommended: {d.recommended or 'nothing'} ({d.stopped})")
-    lines += [f"residuals still: {u}" for u in d.unexplained]
+    lines += [
+        f"residuals still: {dependence_sentence(x)}"
+        for x in sorted(d.dependence_after, key=lambda x: x.p_value)
+        if x.significant
+    ]
     return lines
 
 
-def _write_report(report_dir: Path, diagnosis, inputs, outputs: OutputSet) -> str:
-    from fieldkit.diagnose.report import figure_names, markdown
-    from fieldkit.viz.diagnose_figure import write_residual_figure
+@contextlib.contextmanager
+def _step_once_checked(description: str) -> Iterator[Callable[[str], None]]:
+    """A progress callback for the library that starts :func:`step` at its first
+    call: the library calls it once the input has passed every check, so bad input
+    is refused in one line before any progress is shown."""
+    with contextlib.ExitStack() as stack:
+        started = False
 
-    d = diagnosis
-    text = markdown(d, title=inputs[0], inputs=inputs)
+        def progress(_message: str) -> None:
+            nonlocal started
+            if not started:
+                started = True
+                stack.enter_context(step(description))
+
+        yield progress
+
+
+def _write_report(report_dir: Path, diagnosis, inputs, outputs: OutputSet) -> str:
+    from fieldkit.diagnose.report import markdown
+    from fieldkit.viz.diagnose_figure import write_diagnosis_figures
+
+    text = markdown(diagnosis, title=inputs[0], inputs=inputs)
     write_text(report_dir / "report.md", text, outputs)
-    arrays = d.arrays
-    unit = "m/s" if d.metric.endswith("_mps") else "m"
-    components = tuple(arrays.get("components", ("vfn", "vft", "omega_f")))
-    names = figure_names(d)
-    flags = [{x.feature for x in tests if x.significant}
-             for tests in arrays["dependence"]]  # fmt: skip
-    write_residual_figure(
-        report_dir / names[0],
-        arrays["features"],
-        [("baseline", arrays["baseline"], flags[0])],
-        components=components,
-        unit=unit,
-        title=f"baseline: {arrays.get('residual_kind', 'held-out')} residuals "
-        f"({d.metric} {d.baseline.cv_rmse:.4g})",
-        outputs=outputs,
-    )
-    before = arrays["baseline"]
-    for i, (step, after) in enumerate(zip(d.steps, arrays["steps"], strict=True)):
-        write_residual_figure(
-            report_dir / names[i + 1],
-            arrays["features"],
-            [(f"before ({step.cv_rmse_before:.4g})", before, flags[i]),
-             (f"after adding {step.added} ({step.cv_rmse:.4g})", after,
-              flags[i + 1])],
-            components=components,
-            unit=unit,
-            title=f"step {i + 1}: add {step.added}",
-            outputs=outputs,
-        )  # fmt: skip
-        before = after
+    write_diagnosis_figures(report_dir, diagnosis, outputs=outputs)
     return text
 
 
@@ -140,11 +158,21 @@ def diagnose(
         ),
     ] = None,
     folds: Annotated[
-        int, typer.Option("--folds", help="Cross-validation folds.", min=2)
+        int,
+        typer.Option(
+            "--folds",
+            help="Cross-validation folds, 2 to 100 (fewer when there are fewer "
+            "paths, blocks or flights).",
+            min=2,
+        ),
     ] = 5,
     seed: Annotated[
         int | None,
-        typer.Option("--seed", help="Seed of the fold split (drawn when omitted)."),
+        typer.Option(
+            "--seed",
+            help="Seed of the fold split, 0 to 2^64-1 (drawn and printed when "
+            "omitted).",
+        ),
     ] = None,
     radius: Annotated[
         float | None,
@@ -166,11 +194,16 @@ def diagnose(
     The baseline (constant e_n, e_t per material, or --model) is scored by its
     held-out error: k-fold cross-validation over paths (or blocks of consecutive
     impacts on a single-path survey). Residuals are tested against every feature
-    the table carries. Each candidate effect the data can inform is added,
-    refitted and scored on the held-out data; one is recommended only when its
-    gain exceeds its standard error, and look-alike candidates are reported as
-    confounded instead of picked. Accepted effects are added stepwise. A track
-    CSV is diagnosed at flight level (air_drag from the flight residuals).
+    the table carries (Holm-adjusted p-values). Each candidate effect the data
+    can inform is added, refitted and scored on the held-out data; one is
+    recommended only when it lowers the held-out error by more than 1 % and by
+    more than 2 standard errors of that gain (jackknife over the held-out
+    groups). Two candidates that both pass, neither of which lowers the other's
+    error by more than 1 % and 1 standard error, are reported as confounded and
+    neither is added. Accepted effects are added stepwise. A track CSV is
+    diagnosed at flight level, on the positions of its flights: air_drag is
+    recommended when it lowers the held-out error by more than 2 standard
+    errors of that gain.
 
     Example (from the repository root):
 
@@ -183,6 +216,15 @@ def diagnose(
     """
     import numpy as np
 
+    from fieldkit.diagnose.groups import check_folds
+    from fieldkit.io.csv_table import check_readable
+
+    if seed is not None and not 0 <= seed <= MAX_SEED:
+        raise ArgumentError(
+            f"seed must be between 0 and 2^64 - 1 (got {seed})", source="seed"
+        )
+    check_folds(folds)
+    check_readable(input_file)
     if output is not None and model is None:
         raise ArgumentError(
             "-o needs --model (the base model supplies profile, body and seeder)",
@@ -202,10 +244,6 @@ def diagnose(
             seed = secrets.randbits(32)
             note(f"`seed` not given: used {seed}; pass --seed {seed} to reproduce")
         rng = np.random.default_rng(seed)
-
-        def progress(message: str) -> None:
-            typer.echo(f"  scoring {message}", err=True)
-
         if _is_track(input_file):
             if model is not None or output is not None or material or preset:
                 raise ArgumentError(
@@ -214,15 +252,26 @@ def diagnose(
                     source="model",
                 )
             if radius is None:
-                raise ArgumentError(
-                    "a track needs --radius (the body's radius, m)", source="radius"
-                )
+                raise ArgumentError("a track needs --radius (the body's radius, m)")
             from fieldkit.cli.diagnose_track import diagnose_track_file
+            from fieldkit.diagnose.flights import check_body
 
-            diagnosis = diagnose_track_file(
-                input_file, radius_m=radius, mass_kg=mass, rng=rng, folds=folds
-            )
+            check_body(radius, mass)
+
+            with _step_once_checked(
+                f"diagnosing the flights of {input_file}: fitting air drag by "
+                f"{folds}-fold cross-validation"
+            ) as progress:
+                diagnosis = diagnose_track_file(
+                    input_file, radius_m=radius, mass_kg=mass, rng=rng, folds=folds,
+                    progress=progress,
+                )  # fmt: skip
         else:
+            if radius is not None or mass is not None:
+                raise ArgumentError(
+                    "--radius and --mass apply to a track only (an ImpactTable "
+                    "gives the body on every row)"
+                )
             from fieldkit.diagnose.impacts import diagnose_impacts
             from fieldkit.impact_table import ImpactTable
             from fieldkit.model.model_file import read_model
@@ -230,17 +279,22 @@ def diagnose(
             base = read_model(model, outputs=outputs) if model is not None else None
             mapping = mapped_table(ImpactTable.read(input_file), base, material, preset)
             table = mapping.table
-            diagnosis = diagnose_impacts(
-                table, base, rng=rng, folds=folds, progress=progress
-            )
+            with _step_once_checked(
+                f"diagnosing {len(table)} impacts: scoring the baseline and each "
+                f"candidate effect by {folds}-fold cross-validation"
+            ) as progress:
+                diagnosis = diagnose_impacts(
+                    table, base, rng=rng, folds=folds, progress=progress
+                )
             diagnosis.notes.extend(mapping.notes)
         diagnosis.notes.append(f"fold seed {seed}")
         if json_file is not None:
             write_json(json_file, diagnosis.to_json(), outputs)
         text = None
         if report_dir is not None:
-            text = _write_report(report_dir, diagnosis, [str(p) for p in inputs],
-                                 outputs)  # fmt: skip
+            with step(f"writing the report and its figures to {report_dir}"):
+                text = _write_report(report_dir, diagnosis,
+                                     [str(p) for p in inputs], outputs)  # fmt: skip
         if rrd is not None:
             from fieldkit.diagnose.report import markdown
             from fieldkit.viz.diagnose_recording import write_diagnosis_recording
@@ -248,7 +302,8 @@ def diagnose(
             text = text or markdown(
                 diagnosis, title=str(input_file), inputs=[str(p) for p in inputs]
             )
-            write_diagnosis_recording(rrd, diagnosis, text, outputs=outputs)
+            with step(f"writing the recording {rrd}", announce=False):
+                write_diagnosis_recording(rrd, diagnosis, text, outputs=outputs)
         if output is not None:
             from dataclasses import replace
 
@@ -266,6 +321,7 @@ def diagnose(
                 },
             }
             write_model(replace(after, provenance=provenance), output, outputs=outputs)
-        outputs.commit()
+        written = outputs.commit()
     for line in _summary(diagnosis):
         typer.echo(line)
+    report_written(written)

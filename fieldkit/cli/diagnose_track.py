@@ -9,12 +9,13 @@ written by `fieldkit track`), else from
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
 from fieldkit.diagnose.diagnosis import Diagnosis
-from fieldkit.diagnose.flights import FlightSamples, diagnose_flights
+from fieldkit.diagnose.flights import FlightSamples, check_body, diagnose_flights
 from fieldkit.track import Track
 from fieldkit.tracking.flights.pipeline import analyse_track
 
@@ -61,6 +62,7 @@ def diagnose_track_file(
     mass_kg: float | None,
     rng: np.random.Generator,
     folds: int,
+    progress: Callable[[str], None] | None = None,
 ) -> Diagnosis:
     """Diagnose the flights of the track file ``path`` (is ``air_drag`` missing?).
 
@@ -74,13 +76,18 @@ def diagnose_track_file(
         Random generator for the cross-validation folds.
     folds
         Folds (whole flights held out).
+    progress
+        Passed to :func:`diagnose_flights` (called once the flights are checked).
 
     Raises
     ------
     InputFileError
         Unreadable track, fewer than three flights, a flight with too few samples
         (naming the file and the flight's rows).
+    ArgumentError
+        A radius or mass that is not finite, not positive or beyond its bound.
     """
+    check_body(radius_m, mass_kg)
     track = Track.read(path)
     track.source = str(path)
     flights = track_flights(track, radius_m=radius_m)
@@ -91,6 +98,7 @@ def diagnose_track_file(
         rng=rng,
         folds=folds,
         source=str(path),
+        progress=progress,
     )
     diagnosis.notes.insert(
         0, f"{len(flights)} flights from {track.meta['flights_from']}"

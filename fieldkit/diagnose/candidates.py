@@ -103,7 +103,7 @@ def separating_measurement(first: str, second: str, problem: ImpactProblem) -> s
         return (
             f"{first} and {second} cannot be told apart with these data: impact "
             f"speeds span only {lo:.1f}-{hi:.1f} m/s, so the normal speed "
-            "|vin| = |v| sin(theta_i) rises with the angle "
+            "|v_in| = |v_i| sin θi rises with the impact angle θi "
             f"({a_lo:.0f}-{a_hi:.0f} deg) "
             "and an angle law and a speed law predict the same rebounds; impacts at "
             "similar angles over a wider range of speeds (drops from different "

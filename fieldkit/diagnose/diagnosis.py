@@ -90,8 +90,14 @@ class Dependence:
     feature: str
     component: str  # which residual (vfn, vft, omega_f, position, ...)
     statistic: str  # what was computed, e.g. "spearman rho = -0.41"
-    p_value: float
+    p_value: float  # raw: this test alone, before the family-wise correction
     significant: bool  # after the family-wise correction
+    #: What ``p_value`` is, in words (which test, how two were combined).
+    p_method: str = ""
+    #: ``p_value`` adjusted by Holm's method over the tests of one residual set.
+    p_holm: float = math.nan
+    #: Family-wise level: significant when ``p_holm <= alpha``.
+    alpha: float = math.nan
 
     def to_json(self) -> dict:
         """Plain dict."""
@@ -101,6 +107,9 @@ class Dependence:
             "statistic": self.statistic,
             "p_value": _num(self.p_value),
             "significant": bool(self.significant),
+            "p_method": self.p_method,
+            "p_holm": _num(self.p_holm),
+            "alpha": _num(self.alpha),
         }
 
 
@@ -130,7 +139,9 @@ class Diagnosis:
     n_rows: int = 0
     #: Arrays for figures and recordings (not in the JSON): ``features``,
     #: ``baseline``/``after``/``steps`` held-out residuals, ``weight``, ``path_id``,
-    #: ``dependence`` (tests of the baseline and of each step), ``after_model``.
+    #: ``dependence`` (tests of the baseline and of each step), ``after_model``,
+    #: ``rankings`` (the candidates ranked in every round, the last, unaccepted
+    #: one included).
     arrays: dict = field(default_factory=dict, repr=False)
 
     def to_json(self) -> dict:

@@ -27,6 +27,7 @@ impact-level diagnosis.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -40,8 +41,14 @@ from fieldkit.diagnose.diagnosis import (
     Step,
 )
 from fieldkit.diagnose.groups import make_groups
-from fieldkit.diagnose.residual_tests import holm
-from fieldkit.diagnose.scoring import DEFAULT_Z, held_out, improvement, meaningful
+from fieldkit.diagnose.residual_tests import describe, mark_holm
+from fieldkit.diagnose.scoring import (
+    DEFAULT_Z,
+    held_out,
+    improvement,
+    meaningful,
+    recommendation_rule,
+)
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.model import drag_flight
 from fieldkit.model.effects import air_drag, registry
@@ -53,6 +60,11 @@ MIN_FLIGHTS = 3
 MIN_FLIGHT_SAMPLES = 6
 #: Rock density assumed when no mass is given [kg/m^3] (sphere of the radius).
 ROCK_DENSITY_KG_M3 = 2650.0
+#: Largest body radius a flight diagnosis accepts [m]: a 25 m sphere of rock is
+#: 1.7e8 kg, beyond any single rockfall block (rock avalanches are not ballistic).
+MAX_RADIUS_M = 25.0
+#: Largest body mass a flight diagnosis accepts [kg] (a 25 m sphere of rock).
+MAX_MASS_KG = 2.0e8
 #: Family-wise level of the residual dependence tests (Holm correction).
 DEPENDENCE_ALPHA = 0.05
 #: Newton iterations on ``cd`` and Gauss-Newton iterations per flight.
@@ -248,17 +260,20 @@ def _dependence(
             rho = 0.0 if not np.isfinite(rho) else float(rho)
             p = 1.0 if not np.isfinite(p) else float(p)
             tests.append((feature, component, rho, p))
-    significant = holm([t[3] for t in tests], alpha)
-    return [
-        Dependence(
-            feature=feature,
-            component=f"position_{component}",
-            statistic=f"spearman rho = {rho:+.3f} (n = {data.t.size})",
-            p_value=p,
-            significant=bool(significant[i]),
-        )
-        for i, (feature, component, rho, p) in enumerate(tests)
-    ]
+    return mark_holm(
+        [
+            Dependence(
+                feature=feature,
+                component=f"position_{component}",
+                statistic=f"Spearman rho = {rho:+.3f} (n = {data.t.size})",
+                p_value=p,
+                significant=False,
+                p_method="Spearman",
+            )
+            for feature, component, rho, p in tests
+        ],
+        alpha,
+    )
 
 
 def _free_g_note(data: _Data) -> str:
@@ -297,6 +312,23 @@ def _skipped() -> dict[str, str]:
     return out
 
 
+def check_body(radius_m: float, mass_kg: float | None) -> None:
+    """Refuse a radius or mass that is not finite, not positive or beyond the bounds
+    (:data:`MAX_RADIUS_M`, :data:`MAX_MASS_KG`)."""
+    if not (math.isfinite(radius_m) and 0 < radius_m <= MAX_RADIUS_M):
+        raise ArgumentError(
+            f"radius_m must be > 0 and <= {MAX_RADIUS_M:g} m (got {radius_m:g})",
+            source="radius_m",
+        )
+    if mass_kg is not None and not (
+        math.isfinite(mass_kg) and 0 < mass_kg <= MAX_MASS_KG
+    ):
+        raise ArgumentError(
+            f"mass_kg must be > 0 and <= {MAX_MASS_KG:g} kg (got {mass_kg:g})",
+            source="mass_kg",
+        )
+
+
 def diagnose_flights(
     flights: list[FlightSamples],
     *,
@@ -306,6 +338,7 @@ def diagnose_flights(
     folds: int = 5,
     z: float = DEFAULT_Z,
     source: str | None = None,
+    progress: Callable[[str], None] | None = None,
 ) -> Diagnosis:
     """Whether ``air_drag`` improves the held-out fit of a track's flights.
 
@@ -324,6 +357,9 @@ def diagnose_flights(
         Standard errors a gain must exceed to be meaningful.
     source
         The track file, for messages.
+    progress
+        Called with a short message once the flights have passed every check and
+        the fitting starts (a caller shows progress from then on).
 
     Returns
     -------
@@ -334,14 +370,14 @@ def diagnose_flights(
     ------
     InputFileError
         Fewer than three flights, or a flight with too few samples.
+    ArgumentError
+        ``radius_m`` or ``mass_kg`` not finite, not positive or beyond
+        :data:`MAX_RADIUS_M`, :data:`MAX_MASS_KG`; ``folds`` out of range.
     """
-    if not (math.isfinite(radius_m) and radius_m > 0):
-        raise ArgumentError(
-            f"radius_m must be > 0 (got {radius_m:g})", source="radius_m"
-        )
-    if mass_kg is not None and not (math.isfinite(mass_kg) and mass_kg > 0):
-        raise ArgumentError(f"mass_kg must be > 0 (got {mass_kg:g})", source="mass_kg")
+    check_body(radius_m, mass_kg)
     data = _collect(flights, source)
+    if progress is not None:
+        progress("fitting")
     notes = [f"air density held at {_RHO:g} kg/m^3 (registry default)"]
     if mass_kg is None:
         mass_kg = sphere_mass_kg(radius_m)
@@ -402,7 +438,7 @@ def diagnose_flights(
         after, steps, final = baseline, [], base
         stopped = (
             f"air_drag does not improve the held-out error meaningfully "
-            f"(gain {gain:.4f} +- {se:.4f}, needs > {z:g} SE)"
+            f"(gain {gain:+.1%} ± {se:.1%}; needs more than {z:g} standard errors)"
         )
     before = _dependence(data, base)
     after_dep = _dependence(data, final)
@@ -427,8 +463,9 @@ def diagnose_flights(
         confounded=[],
         after=after,
         rule=(
-            f"an effect is recommended when its held-out gain exceeds {z:g} "
-            "jackknife standard error(s) over flights (gain > 0 and gain > z SE)"
+            f"air_drag is recommended when {recommendation_rule(z, 0.0)} (jackknife "
+            "over flights); no minimum gain, since cd = 0 is the ballistic baseline "
+            "exactly"
         ),
         groups=(
             f"{data.n_flights} flights (whole flights held out); "
@@ -439,12 +476,7 @@ def diagnose_flights(
         skipped=_skipped(),
         dependence_before=before,
         dependence_after=after_dep,
-        unexplained=[
-            f"{d.component} residual vs {d.feature} "
-            f"({d.statistic}, p = {d.p_value:.2g})"
-            for d in after_dep
-            if d.significant
-        ],
+        unexplained=describe(after_dep),
         worst=worst,
         notes=notes,
         n_data=n_obs,

@@ -15,12 +15,43 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fieldkit.errors import ArgumentError
+
 #: Paths needed before groups are whole paths (fewer: blocks along the paths).
 MIN_PATH_GROUPS = 10
 #: Groups wanted when a table has too few paths (blocks of consecutive impacts).
 BLOCK_GROUPS = 20
 #: Folds of the cross-validation (fewer when there are fewer groups).
 DEFAULT_FOLDS = 5
+#: Fewest folds: one to fit on and one to hold out.
+MIN_FOLDS = 2
+#: Most folds. Every model is refitted once per fold, so the time grows with the
+#: folds, while the held-out error barely changes beyond about ten (and a table
+#: never has more folds than groups: the folds are clipped to the groups).
+MAX_FOLDS = 100
+
+
+def check_folds(folds: int) -> int:
+    """``folds`` if it lies in [:data:`MIN_FOLDS`, :data:`MAX_FOLDS`], else raise.
+
+    Raises
+    ------
+    ArgumentError
+        Naming the argument ``folds`` and the limits.
+
+    Examples
+    --------
+    >>> check_folds(5)
+    5
+    """
+    if not MIN_FOLDS <= folds <= MAX_FOLDS:
+        raise ArgumentError(
+            f"folds must be between {MIN_FOLDS} and {MAX_FOLDS} (got {folds}): each "
+            "fold refits every model, and more than about ten folds barely change "
+            "the held-out error",
+            source="folds",
+        )
+    return folds
 
 
 @dataclass(frozen=True)
@@ -79,7 +110,13 @@ def make_groups(
     ...                 blocks=4)
     >>> g.unit, g.group.tolist()
     ('block', [0, 0, 1, 1, 2, 2, 3, 3])
+
+    Raises
+    ------
+    ArgumentError
+        ``folds`` outside [:data:`MIN_FOLDS`, :data:`MAX_FOLDS`] (:func:`check_folds`).
     """
+    check_folds(folds)
     labels = np.asarray(path_id).astype(str)
     n = labels.size
     _, path_index = np.unique(labels, return_inverse=True)

@@ -49,6 +49,7 @@ from fieldkit.diagnose.scoring import (
     held_out,
     improvement,
     meaningful,
+    recommendation_rule,
     weighted_rmse,
 )
 from fieldkit.errors import InputFileError
@@ -233,7 +234,9 @@ def diagnose_impacts(
     confounding (see :func:`_alike`).
     ``rng`` deals the groups to folds (a seed reproduces the diagnosis exactly);
     ``candidates`` restricts the candidate effects (default: every one the table
-    can inform). See the module docstring for the method.
+    can inform); ``progress`` is called with a short message before each model is
+    scored, the first time once every check of the table has passed. See the
+    module docstring for the method.
 
     Raises
     ------
@@ -279,6 +282,7 @@ def diagnose_impacts(
     confounded: list[list[str]] = []
     advice: list[str] = []
     remaining = list(pool)
+    rankings: list[list[Candidate]] = []  # every round, the last one included
     accepted: list[Scored] = []
     stopped = "no candidate effect the data can inform" if not pool else ""
     while remaining:
@@ -288,14 +292,15 @@ def diagnose_impacts(
             variant = with_effects(current.model, {name: {}})
             scored[name] = scorer.score(variant, [*current.effects, name])
         ranked = _rank(current, scored, z)
+        rankings.append(ranked)
         if first is None:
             first = ranked
         best = ranked[0]
         if not best.meaningful:
             stopped = (
-                f"no remaining candidate improves the held-out error by more than "
-                f"{z:g} standard error(s) (best: {best.effect}, gain "
-                f"{best.improvement:+.3f} ± {best.improvement_se:.3f})"
+                "no remaining candidate passes the rule (best: "
+                f"{best.effect}, gain {best.improvement:+.1%} ± "
+                f"{best.improvement_se:.1%})"
             )
             break
         alike = _alike(scorer, scored, ranked, z_confound)
@@ -349,11 +354,11 @@ def diagnose_impacts(
         confounded=confounded,
         after=current.score(),
         rule=(
-            f"a candidate is recommended when its held-out gain exceeds {z:g} "
-            f"jackknife standard error(s) over the groups and {MIN_GAIN:.0%} of the "
-            "held-out error; the best and a meaningful runner-up are confounded "
-            "(neither added) when neither adds to the other a gain above "
-            f"{z_confound:g} standard error(s) and {MIN_GAIN:.0%}"
+            f"a candidate is recommended when {recommendation_rule(z)} (jackknife "
+            "over the held-out groups); the best and a runner-up that passes the "
+            "rule too are confounded (neither is added) when neither lowers the "
+            f"other's held-out error by more than {MIN_GAIN * 100:g} % and by more "
+            f"than {z_confound:g} standard error(s) of that gain"
         ),
         groups=groups.description,
         stopped=stopped,
@@ -376,6 +381,7 @@ def diagnose_impacts(
             "path_id": path_id,
             "after_model": current.model,
             "dependence": stage_tests,
+            "rankings": rankings,
         },
     )
 

@@ -3,7 +3,10 @@
 Sections follow the loop of the issue: the baseline and where it fails, which
 effect is missing (ranked, with the gain's standard error), each step with the
 held-out error before and after and the fitted parameters, what stays
-unexplained, and how the numbers were made. Figures are referenced by the file
+unexplained, and how the numbers were made. Every quantity is named in words with
+its unit through :mod:`fieldkit.diagnose.labels` (the figures use the same words);
+the JSON names (``cv_rmse_mps``, ``theta_i_deg``) appear only where a reader needs
+them to find a value in the ``--json`` file. Figures are referenced by the file
 names :func:`figure_names` gives; the caller writes them.
 """
 
@@ -11,7 +14,8 @@ from __future__ import annotations
 
 import math
 
-from fieldkit.diagnose.diagnosis import Candidate, Diagnosis
+from fieldkit.diagnose import labels, residual_tests
+from fieldkit.diagnose.diagnosis import Candidate, Dependence, Diagnosis
 
 
 def figure_names(diagnosis: Diagnosis) -> list[str]:
@@ -22,48 +26,147 @@ def figure_names(diagnosis: Diagnosis) -> list[str]:
 
 
 def _fmt(x: float, digits: int = 4) -> str:
-    return f"{x:.{digits}g}" if math.isfinite(x) else "—"
+    return f"{x:.{digits}g}" if math.isfinite(x) else "not finite"
 
 
-def _params(params: dict, sds: dict) -> str:
+def _row(*cells: object) -> str:
+    """One Markdown table row; a ``|`` inside a cell is escaped."""
+    return "| " + " | ".join(str(c).replace("|", "\\|") for c in cells) + " |"
+
+
+def _p(p: float) -> str:
+    """A p-value: two significant digits (``< 1e-300`` for an underflow to 0)."""
+    if not math.isfinite(p):
+        return "not computed"
+    return f"{p:.2g}" if p > 0 else "< 1e-300"
+
+
+def _params_inline(params: dict, sds: dict) -> str:
     if not params:
-        return "—"
-    return ", ".join(
-        f"{k} = {_fmt(v)} ± {_fmt(sds.get(k, math.nan), 2)}" for k, v in params.items()
-    )
+        return "none"
+    return ", ".join(labels.parameter_text(k, v, sds.get(k)) for k, v in params.items())
+
+
+def _params_table(params: dict, sds: dict) -> list[str]:
+    if not params:
+        return ["Fitted parameters: none."]
+    rows = ["| parameter | value ± standard error |", "|---|---|"]
+    for k, v in params.items():
+        words, unit = labels.parameter(k)
+        text = labels.value_with_se(v, sds.get(k), unit=unit) + labels.remark(k, v)
+        rows.append(_row(words, text))
+    return rows
+
+
+def rankings(diagnosis: Diagnosis) -> list[list[Candidate]]:
+    """The candidates ranked in every round: the first (``candidates``), one per
+    later step, and the last round that accepted nothing (when there was one)."""
+    ranked = diagnosis.arrays.get("rankings")
+    if ranked is not None:
+        return list(ranked)
+    return [diagnosis.candidates] if diagnosis.candidates else []
 
 
 def _candidate_rows(candidates: list[Candidate], unit: str) -> list[str]:
     rows = [
-        f"| rank | effect | held-out RMSE ({unit}) | gain | SE of gain | meaningful "
-        "| fitted parameters |",
+        f"| rank | effect | held-out RMS error ({unit}) | gain | standard error "
+        "of the gain | passes the rule | fitted parameters |",
         "|---|---|---|---|---|---|---|",
     ]
     for i, c in enumerate(candidates, 1):
+        se = (
+            f"{c.improvement_se:.1%}"
+            if math.isfinite(c.improvement_se)
+            else "undetermined (fewer than 3 groups)"
+        )
         rows.append(
-            f"| {i} | `{c.effect}` | {_fmt(c.cv_rmse)} | {c.improvement:+.1%} | "
-            f"{c.improvement_se:.1%} | {'yes' if c.meaningful else 'no'} | "
-            f"{_params(c.params, c.params_sd)} |"
+            _row(
+                i,
+                f"`{c.effect}`: {labels.effect(c.effect)}",
+                _fmt(c.cv_rmse),
+                f"{c.improvement:+.1%}",
+                se,
+                "yes" if c.meaningful else "no",
+                _params_inline(c.params, c.params_sd),
+            )
         )
     return rows
 
 
 def _worst_line(w: dict, unit: str) -> str:
-    if "row" not in w:  # flights: label and numbers as given
-        return "* " + ", ".join(
-            f"{k} {_fmt(v) if isinstance(v, float) else v}" for k, v in w.items()
-        )
+    if "flight" in w:  # flights: the label already names the flight and its rows
+        return f"* {w['flight']}: RMS position residual {_fmt(w['baseline_rmse_m'])} m"
     return (
         f"* row {w['row']} (path {w['path_id']}, point {w['point']}, "
-        f"{w['material']}): {w['component']} residual "
-        f"{w['residual_mps']:+.3g} {unit} ({w['z']:.1f} sd)"
+        f"{w['material']}): {labels.component(w['component'])} residual "
+        f"{w['residual_mps']:+.3g} {unit} ({w['z']:.1f} standard deviations of "
+        "its measurement)"
     )
+
+
+def dependence_sentence(d: Dependence) -> str:
+    """One dependence in words, each p-value labelled (which test; raw or
+    Holm-adjusted)."""
+    raw = (
+        "the smaller p doubled"
+        if d.p_method == residual_tests.COMBINED_P
+        else d.p_method.split(": ")[-1] or "the test alone"
+    )
+    return (
+        f"{labels.component(d.component)} residuals depend on "
+        f"{labels.feature(d.feature)}: {d.statistic}; p = {_p(d.p_value)} "
+        f"({raw}), Holm-adjusted p = {_p(d.p_holm)} ≤ {d.alpha:g}"
+    )
+
+
+def _dependence_section(tests: list[Dependence]) -> list[str]:
+    if not tests:
+        return ["No residual could be tested against a feature.", ""]
+    alpha = tests[0].alpha
+    hits = sorted((x for x in tests if x.significant), key=lambda x: x.p_value)
+    methods = "; ".join(dict.fromkeys(x.p_method for x in tests if x.p_method))
+    out = [
+        f"{len(tests)} tests, each residual against each feature. *p* is a test's "
+        f"own p-value ({methods or 'the test alone'}); *Holm p* is *p* adjusted by "
+        f"Holm's method over all {len(tests)} tests. A residual depends on a "
+        f"feature when its Holm p ≤ {alpha:g}.",
+        "",
+    ]
+    if hits:
+        out += [
+            "| residual | feature | test | p | Holm p |",
+            "|---|---|---|---|---|",
+        ]
+        out += [
+            _row(
+                labels.component(x.component),
+                labels.feature(x.feature),
+                x.statistic,
+                _p(x.p_value),
+                _p(x.p_holm),
+            )
+            for x in hits
+        ]
+        out.append("")
+        out.append(
+            f"The other {len(tests) - len(hits)} tests show no dependence "
+            f"(Holm p > {alpha:g})."
+        )
+    else:
+        out.append(f"The residuals depend on no feature (every Holm p > {alpha:g}).")
+    tested = sorted({x.feature for x in tests})
+    out += [
+        "",
+        "Features tested: " + "; ".join(labels.feature(f) for f in tested) + ".",
+        "",
+    ]
+    return out
 
 
 def baseline_label(d: Diagnosis) -> str:
     """What the baseline is, in words."""
     if d.metric == "cv_rmse_m":
-        base = "ballistic flights (g = 9.81 m/s^2)"
+        base = "ballistic flights (g = 9.81 m/s², no drag)"
     else:
         base = "constant e_n, e_t per material"
     return base + "".join(f" + {e}" for e in d.baseline.effects)
@@ -72,22 +175,28 @@ def baseline_label(d: Diagnosis) -> str:
 def markdown(diagnosis: Diagnosis, *, title: str, inputs: list[str]) -> str:
     """The full report for ``diagnosis`` (``inputs``: the files it read)."""
     d = diagnosis
-    unit = "m/s" if d.metric.endswith("_mps") else "m"
+    unit = labels.unit(d.metric)
+    error = labels.metric_words(d.metric)
     figs = figure_names(d)
+    components = d.arrays.get("components", ("vfn", "vft", "omega_f"))
     out = [f"# Diagnosis: {title}", ""]
     out += [f"* input: `{name}`" for name in inputs]
     out += [
         f"* {d.n_rows} rows, {d.n_data} data; held out: {d.groups}",
-        f"* metric: `{d.metric}` — weighted RMS of held-out residuals ({unit})",
+        f"* error measure: the {error} ({unit}), the weighted root-mean-square of "
+        "the residuals (measured − model) of data held out of the fit "
+        f"(`{d.metric}` in the JSON)",
+        "* residuals: " + ", ".join(labels.component(c) for c in components)
+        + f", all in {unit}",
         "",
         "## Verdict",
         "",
-    ]
+    ]  # fmt: skip
     if d.steps:
         added = ", ".join(f"`{s.added}`" for s in d.steps)
         fall = 1.0 - d.after.cv_rmse / d.baseline.cv_rmse
         out.append(
-            f"Missing physics found: {added}. Held-out error "
+            f"Missing physics found: {added}. Held-out RMS error "
             f"{_fmt(d.baseline.cv_rmse)} → {_fmt(d.after.cv_rmse)} {unit} "
             f"({fall:.1%} lower)."
         )
@@ -98,32 +207,42 @@ def markdown(diagnosis: Diagnosis, *, title: str, inputs: list[str]) -> str:
         )
     else:
         out.append(
-            "No effect recommended: the baseline already explains these data as well "
-            "as any candidate the data can inform (no held-out gain beyond its "
-            "standard error)."
+            "No effect recommended: no candidate the data can inform passes the "
+            "rule (see *Which effect is missing*)."
         )
     out += [f"Stopped: {d.stopped}.", ""]
-    if d.unexplained:
+    if d.unexplained and d.confounded:
+        out.append(
+            "**Residual structure left**: the confounded candidates below may "
+            "explain it, but the data cannot tell which, so neither was added:"
+        )
+    elif d.unexplained:
         out.append(
             "**Residual structure no candidate explains** (physics outside "
             "fieldkit's vocabulary, or a data problem):"
         )
-        out += [f"* residuals still: {u}" for u in d.unexplained]
+        out += [
+            f"* {dependence_sentence(x)}"
+            for x in sorted(d.dependence_after, key=lambda x: x.p_value)
+            if x.significant
+        ]
         out.append("")
     out += [
         "## Baseline: where it fails",
         "",
-        f"Model: {baseline_label(d)}; "
-        f"held-out RMSE {_fmt(d.baseline.cv_rmse)} {unit} "
-        f"(in-sample {_fmt(d.baseline.fit_rmse)}).",
-        "",
-        f"Fitted: {_params(d.baseline.params, d.baseline.params_sd)}",
+        f"Model: {baseline_label(d)}; held-out RMS error "
+        f"{_fmt(d.baseline.cv_rmse)} {unit} (in-sample "
+        f"{_fmt(d.baseline.fit_rmse)} {unit}).",
         "",
     ]
+    out += _params_table(d.baseline.params, d.baseline.params_sd)
+    out.append("")
     if d.per_material:
         out += [
-            f"| material | impacts | baseline RMSE ({unit}) | mean vfn residual | "
-            f"mean vft residual | after RMSE ({unit}) |",
+            f"| material | impacts | baseline held-out RMS error ({unit}) | mean "
+            f"normal rebound velocity v_fn residual ({unit}) | mean tangential "
+            f"rebound velocity v_ft residual ({unit}) | held-out RMS error after "
+            f"({unit}) |",
             "|---|---|---|---|---|---|",
         ]
         for m, e in d.per_material.items():
@@ -135,21 +254,28 @@ def markdown(diagnosis: Diagnosis, *, title: str, inputs: list[str]) -> str:
             )
         out.append("")
     if d.worst:
-        out += ["Worst impacts (held-out, baseline):", ""]
+        flights = "flight" in d.worst[0]
+        out += [
+            "Worst flights (baseline, each flight's own fit):"
+            if flights
+            else "Worst impacts (baseline, held out):",
+            "",
+        ]
         out += [_worst_line(w, unit) for w in d.worst]
         out.append("")
-    hits = [x for x in d.dependence_before if x.significant]
-    out.append("Residuals depend on:" if hits else "Residuals depend on no feature.")
-    out += [
-        f"* {x.feature} ({x.component}): {x.statistic}, p = {x.p_value:.2g}"
-        for x in sorted(hits, key=lambda x: x.p_value)
-    ]
-    tested = sorted({x.feature for x in d.dependence_before})
-    out += ["", f"Features tested: {', '.join(tested) or 'none'}.", ""]
+    out += ["### Do the residuals depend on a feature?", ""]
+    out += _dependence_section(d.dependence_before)
     kind = d.arrays.get("residual_kind", "held-out")
-    out += [f"![baseline residuals ({kind})]({figs[0]})", ""]
-    out += ["## Which effect is missing", ""]
-    out += _candidate_rows(d.candidates, unit) if d.candidates else ["No candidates."]
+    out += [f"![baseline residuals ({kind}) against each feature]({figs[0]})", ""]
+    rounds = rankings(d)
+    out += [
+        "## Which effect is missing",
+        "",
+        f"A candidate is recommended when {rule_head(d)}; the gain is 1 − "
+        "(the candidate's held-out RMS error) / (the model's before it).",
+        "",
+    ]
+    out += _candidate_rows(rounds[0], unit) if rounds else ["No candidates."]
     out.append("")
     if d.skipped:
         out += ["Not tested (the data cannot inform them):", ""]
@@ -163,21 +289,33 @@ def markdown(diagnosis: Diagnosis, *, title: str, inputs: list[str]) -> str:
         out += [
             f"## Step {i + 1}: add `{s.added}` — the error falls",
             "",
-            f"Held-out RMSE {_fmt(s.cv_rmse_before)} → {_fmt(s.cv_rmse)} {unit} "
-            f"({1 - s.cv_rmse / s.cv_rmse_before:.1%} lower).",
-            "",
-            f"Fitted: {_params(s.candidates[0].params, s.candidates[0].params_sd)}",
+            f"Held-out RMS error {_fmt(s.cv_rmse_before)} → {_fmt(s.cv_rmse)} {unit} "
+            f"({1 - s.cv_rmse / s.cv_rmse_before:.1%} lower). Fitted: "
+            f"{_params_inline(s.candidates[0].params, s.candidates[0].params_sd)}.",
             "",
         ]
-        out += _candidate_rows(s.candidates, unit)
-        out += ["", f"![before and after]({figs[i + 1]})", ""]
+        if i == 0:
+            out.append("Ranked in *Which effect is missing* above.")
+        else:
+            out += [f"Candidates ranked against the model after step {i}:", ""]
+            out += _candidate_rows(s.candidates, unit)
+        out += ["", f"![residuals before and after]({figs[i + 1]})", ""]
+    out += ["## After", ""]
+    if d.steps and len(rounds) > len(d.steps):
+        out += [
+            f"Candidates ranked against the model after step {len(d.steps)} "
+            "(none passes the rule):",
+            "",
+        ]
+        out += _candidate_rows(rounds[len(d.steps)], unit)
+        out.append("")
     out += [
-        "## After",
-        "",
-        f"Effects: {', '.join(d.after.effects) or 'none'}; held-out RMSE "
+        f"Effects: {', '.join(d.after.effects) or 'none'}; held-out RMS error "
         f"{_fmt(d.after.cv_rmse)} {unit}.",
         "",
-        f"Fitted: {_params(d.after.params, d.after.params_sd)}",
+    ]
+    out += _params_table(d.after.params, d.after.params_sd)
+    out += [
         "",
         "## How the numbers were made",
         "",
@@ -186,3 +324,10 @@ def markdown(diagnosis: Diagnosis, *, title: str, inputs: list[str]) -> str:
     ]
     out += [f"* {n}" for n in d.notes]
     return "\n".join(out) + "\n"
+
+
+def rule_head(d: Diagnosis) -> str:
+    """The recommendation rule's first clause ("it lowers the held-out error by
+    ..."), without the confounding rule."""
+    head = d.rule.split(" when ", 1)[-1]
+    return head.split(" (jackknife", 1)[0]

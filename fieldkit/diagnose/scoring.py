@@ -123,3 +123,22 @@ def meaningful(
 ) -> bool:
     """Whether a held-out gain exceeds ``z`` standard errors and ``min_gain``."""
     return gain > min_gain and math.isfinite(se) and gain > z * se
+
+
+def recommendation_rule(z: float = DEFAULT_Z, min_gain: float = MIN_GAIN) -> str:
+    """The rule of :func:`meaningful` in words: a candidate is recommended when ...
+    (the report, ``--help`` and the README state it in these words). The gain is
+    ``1 - cv_rmse(candidate) / cv_rmse(reference)``.
+
+    Examples
+    --------
+    >>> recommendation_rule(min_gain=0.0)
+    'it lowers the held-out error by more than 2 standard errors of that gain'
+    >>> recommendation_rule(z=1.0).split(" error by ")[1]
+    'more than 1 % and by more than 1 standard error of that gain'
+    """
+    floor = f"more than {min_gain * 100:g} % and by " if min_gain > 0 else ""
+    errors = "standard error" if z == 1 else "standard errors"
+    return (
+        f"it lowers the held-out error by {floor}more than {z:g} {errors} of that gain"
+    )

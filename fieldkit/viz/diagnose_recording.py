@@ -2,9 +2,10 @@
 
 Timeline ``step`` (0 = baseline, k = after the k-th accepted effect):
 
-* ``diagnose/cv_rmse`` — the held-out error at each step (a falling line);
+* ``diagnose/cv_rmse`` — the held-out error at each step (a falling line, its
+  series named in words, :mod:`fieldkit.diagnose.labels`);
 * ``diagnose/candidates/<effect>`` — each candidate's held-out error at the
-  steps where it was ranked;
+  steps where it was ranked (series named by the effect in words);
 * ``residuals/<feature>/<component>`` — held-out residuals against each feature
   as 2-D points, so scrubbing the timeline shows the structure disappear;
 * ``report`` — the Markdown report as a text document.
@@ -18,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import rerun as rr
 
+from fieldkit.diagnose import labels
 from fieldkit.diagnose.diagnosis import Diagnosis
 from fieldkit.outputs import OutputSet, write_file
 from fieldkit.viz.rerun_log import open_recording
@@ -66,6 +68,12 @@ def write_diagnosis_recording(
             ranked = [diagnosis.candidates] + [
                 s.candidates for s in diagnosis.steps[1:]
             ]
+            # the plots' series in words (the entity paths keep the JSON names)
+            metric = rr.SeriesLines(names=labels.metric(diagnosis.metric))
+            rec.log("diagnose/cv_rmse", metric, static=True)
+            for name in sorted({c.effect for r in ranked for c in r}):
+                series = rr.SeriesLines(names=labels.effect(name))
+                rec.log(f"diagnose/candidates/{name}", series, static=True)
             for k, error in enumerate(errors):
                 rec.set_time("step", sequence=k)
                 rec.log("diagnose/cv_rmse", rr.Scalars(error))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pandas as pd
@@ -136,3 +137,16 @@ def test_output_model_needs_a_base_model(hidden_csv, tmp_path, cli):
     r = cli("diagnose", hidden_csv, "-o", tmp_path / "m.json")
     assert r.exit_code == 1
     assert "-o needs --model" in r.output
+
+
+def test_report_says_when_a_fitted_value_switches_its_effect_off(diagnosed):
+    """After the angle law, the speed law's K runs off to ~1e5 m/s (its neutral
+    value is infinite): the report says the effect is off instead of printing a
+    bare 1e+05 ± 1e+10."""
+    out, _ = diagnosed
+    text = (out / "rep" / "report.md").read_text()
+    assert re.search(
+        r"\| `velocity_scaled_restitution`: .* \| k_mps = [\d.]+e\+0[4-9] ± [\d.e+]+ "
+        r"m/s \(practically its neutral value ∞: the effect is off\) \|",
+        text,
+    )
