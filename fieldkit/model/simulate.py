@@ -27,6 +27,7 @@ import pandas as pd
 import fieldkit.model.kernel as kernel
 from fieldkit.errors import ArgumentError
 from fieldkit.impact_table import ImpactTable
+from fieldkit.model import compile_cache
 from fieldkit.model.effects import registry
 from fieldkit.model.model_file import Model
 from fieldkit.model.results import AnalysisPoint, SimulationResult
@@ -204,6 +205,8 @@ def simulate(
     progress: Callable[[int, int], None] | None = None,
     envelope_dx_m: float | None = None,
     on_impact_columns: Callable[[dict[str, np.ndarray]], None] | None = None,
+    compile_first: bool = True,
+    on_compile: Callable[[], None] | None = None,
 ) -> SimulationResult:
     """Simulate ``rocks`` rocks of ``model`` with the random numbers of ``rng``.
 
@@ -225,6 +228,12 @@ def simulate(
         arrays (:func:`impact_columns`) instead of an ImpactTable -- for callers that
         need a few columns of many simulations (a path fit), without the table's
         derived columns.
+    compile_first, on_compile
+        When the compiled kernel is neither loaded nor cached
+        (:func:`fieldkit.model.compile_cache.kernel_ready`), call ``on_compile``
+        (to say so) and compile it first on a one-rock model: the result's
+        ``compile_s`` is that time and ``wall_s`` stays simulation time only.
+        ``compile_first=False`` (used by the warm-up itself) skips the check.
 
     Examples
     --------
@@ -249,6 +258,11 @@ def simulate(
             f"impact_chunk_rocks must be >= 1 (got {impact_chunk_rocks})",
             source="impact_chunk_rocks",
         )
+    compile_s = 0.0
+    if compile_first and not compile_cache.kernel_ready():
+        if on_compile is not None:
+            on_compile()
+        compile_s = compile_cache.warm()
     inputs = kernel_inputs(model)
     starts, keys = draw_rocks(model, rocks, rng)
     radius, gyration = body_of(model, starts.mass_kg)
@@ -375,4 +389,5 @@ def simulate(
         envelope_height_m=env,
         trajectories=paths,
         impact_table=table,
+        compile_s=compile_s,
     )
