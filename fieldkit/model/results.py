@@ -80,6 +80,45 @@ class SimulationResult:
         out["x_m"] = (edges[:-1] + edges[1:]) / 2.0 if edges.size > 1 else edges[:0]
         return out
 
+    def percentile_of(self, index: int, quantity: str, value: float) -> dict:
+        """Where a measured ``value`` falls among the rocks crossing analysis point
+        ``index``: its percentile in the simulated distribution of ``quantity``.
+
+        Parameters
+        ----------
+        quantity
+            An :class:`AnalysisPoint` array: ``speed_mps``, ``ke_j`` (translational),
+            ``re_j``, ``total_j`` or ``height_m``.
+
+        Returns
+        -------
+        dict
+            ``measured``, ``percentile`` (percent of crossing rocks with a smaller
+            value, ties counted half; None without crossing rocks), its binomial
+            ``percentile_se`` and ``n`` (crossing rocks).
+
+        Examples
+        --------
+        >>> p = AnalysisPoint(0.0, np.array([True] * 4), np.arange(4.0), *[None] * 4)
+        >>> r = SimulationResult(None, 4, 0, 0.0, 0, None, None, None, [p])
+        >>> r.percentile_of(0, "speed_mps", 2.0)["percentile"]
+        62.5
+        """
+        point = self.analysis[index]
+        crossed = np.asarray(point.crossed, bool)
+        values = np.asarray(getattr(point, quantity), float)[crossed]
+        values = values[np.isfinite(values)]
+        n = int(values.size)
+        out: dict = {"measured": float(value), "n": n}
+        if n == 0:
+            out.update(percentile=None, percentile_se=None)
+            return out
+        below = float((values < value).sum() + 0.5 * (values == value).sum())
+        fraction = below / n
+        out["percentile"] = 100.0 * fraction
+        out["percentile_se"] = 100.0 * float(np.sqrt(fraction * (1 - fraction) / n))
+        return out
+
     def summary(self) -> dict:
         """What a designer reads: the ``summary.json`` contract (architecture §4).
 
