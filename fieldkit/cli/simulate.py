@@ -171,15 +171,17 @@ def simulate(
 
     model = read_model(model_file)
     x_range = (float(model.profile.x_m[0]), float(model.profile.x_m[-1]))
-    if envelope_dx is None and figures is not None:
+    default_dx = envelope_dx is None and figures is not None
+    if default_dx:
         envelope_dx = default_envelope_dx_m(x_range[1] - x_range[0])
+    check_run(rocks, x_range, analysis_x, envelope_dx, trajectories)
+    _check_measured(points, analysis_x)
+    if default_dx:
         note(
             f"--envelope-dx not given: the bounce-height envelope (envelope.png) "
             f"uses {envelope_dx:g} m bins (profile x {x_range[0]:g} to "
             f"{x_range[1]:g} m); pass --envelope-dx to choose"
         )
-    check_run(rocks, x_range, analysis_x, envelope_dx, trajectories)
-    _check_measured(points, analysis_x)
 
     with OutputSet(inputs=[model_file]) as outputs:
         if summary is not None:

@@ -100,7 +100,12 @@ def check_run(
         )
     x0, x1 = x_range_m
     for xa in analysis_x_m:
-        if not math.isfinite(xa) or not x0 <= xa <= x1:
+        if not math.isfinite(xa):
+            raise ArgumentError(
+                f"{xa} is not a finite x (the profile spans x {x0:g} to {x1:g} m)",
+                source="analysis_x_m",
+            )
+        if not x0 <= xa <= x1:
             raise ArgumentError(
                 f"{xa:g} m lies outside the profile (x from {x0:g} to {x1:g} m)",
                 source="analysis_x_m",

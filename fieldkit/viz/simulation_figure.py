@@ -256,8 +256,8 @@ def runout_figure(result: SimulationResult) -> Figure:
         (EXITED_UPSLOPE, "left the profile at its upper end", "tab:purple"),
         (
             MAX_IMPACTS,
-            f"capped: still moving at {int(result.model.core['max_impacts'])} "
-            "impacts (where they were; not a runout)",
+            "capped: still moving at the impact limit, core.max_impacts (where "
+            "they were; not a runout)",
             "tab:red",
         ),
     ]
