@@ -88,10 +88,11 @@ def check_run(
     Examples
     --------
     >>> check_run(1000, (0.0, 700.0), [610.0], 5.0, 20)
-    >>> check_run(1000, (0.0, 700.0), [900.0])
-    Traceback (most recent call last):
-    ...
-    fieldkit.errors.ArgumentError: analysis_x_m: 900 m lies outside the profile (x from 0 to 700 m)
+    >>> try:
+    ...     check_run(1000, (0.0, 700.0), [900.0])
+    ... except ArgumentError as exc:
+    ...     print(exc.message)
+    900 m lies outside the profile (x from 0 to 700 m)
     """
     if not (isinstance(rocks, int | np.integer) and 1 <= rocks <= MAX_ROCKS):
         raise ArgumentError(
