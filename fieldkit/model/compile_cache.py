@@ -64,6 +64,12 @@ def kernel_ready() -> bool:
     return True
 
 
+def kernel_loaded() -> bool:
+    """True when this process already holds the compiled kernel (no load, no
+    compile before the next call)."""
+    return all(getattr(kernel, name).signatures for name in _ENTRY_POINTS)
+
+
 def compiled_now() -> int:
     """Entry-point signatures compiled (not loaded from the cache) in this process."""
     return sum(
