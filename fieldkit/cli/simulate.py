@@ -169,20 +169,6 @@ def simulate(
     if rrd is not None and rrd.suffix.lower() != ".rrd":
         raise ArgumentError(f"must be a .rrd file, got {rrd.name!r}", source="--rrd")
 
-    model = read_model(model_file)
-    x_range = (float(model.profile.x_m[0]), float(model.profile.x_m[-1]))
-    default_dx = envelope_dx is None and figures is not None
-    if default_dx:
-        envelope_dx = default_envelope_dx_m(x_range[1] - x_range[0])
-    check_run(rocks, x_range, analysis_x, envelope_dx, trajectories)
-    _check_measured(points, analysis_x)
-    if default_dx:
-        note(
-            f"--envelope-dx not given: the bounce-height envelope (envelope.png) "
-            f"uses {envelope_dx:g} m bins (profile x {x_range[0]:g} to "
-            f"{x_range[1]:g} m); pass --envelope-dx to choose"
-        )
-
     with OutputSet(inputs=[model_file]) as outputs:
         if summary is not None:
             outputs.plan(summary, argument="--summary")
@@ -193,6 +179,19 @@ def simulate(
 
             for name in point_figure_names(analysis_x):
                 outputs.plan(figures / name, argument="--figures")
+        model = read_model(model_file)
+        x_range = (float(model.profile.x_m[0]), float(model.profile.x_m[-1]))
+        default_dx = envelope_dx is None and figures is not None
+        if default_dx:
+            envelope_dx = default_envelope_dx_m(x_range[1] - x_range[0])
+        check_run(rocks, x_range, analysis_x, envelope_dx, trajectories)
+        _check_measured(points, analysis_x)
+        if default_dx:
+            note(
+                f"--envelope-dx not given: the bounce-height envelope (envelope.png) "
+                f"uses {envelope_dx:g} m bins (profile x {x_range[0]:g} to "
+                f"{x_range[1]:g} m); pass --envelope-dx to choose"
+            )
         if seed is None:
             seed = secrets.randbits(32)
             note(f"`seed` not given: used {seed}; pass --seed {seed} to reproduce")
