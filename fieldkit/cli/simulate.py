@@ -85,10 +85,14 @@ def simulate(
     model_file: Annotated[
         Path, typer.Argument(metavar="MODEL.json", help="The model file (§5).")
     ],
-    rocks: Annotated[int, typer.Option("--rocks", help="Number of rocks.")] = 1000,
+    rocks: Annotated[
+        int, typer.Option("--rocks", help="Number of rocks (1 to 10,000,000).")
+    ] = 1000,
     seed: Annotated[
         int | None,
-        typer.Option("--seed", help="Random seed (drawn and printed when omitted)."),
+        typer.Option(
+            "--seed", help="Random seed >= 0 (drawn and printed when omitted)."
+        ),
     ] = None,
     impacts: Annotated[
         Path | None,
@@ -103,11 +107,17 @@ def simulate(
     ] = None,
     at: Annotated[
         list[float] | None,
-        typer.Option("--at", help="Analysis point x (m); repeatable."),
+        typer.Option(
+            "--at",
+            help="Analysis point x (m), within the profile; repeatable (up to 100).",
+        ),
     ] = None,
     trajectories: Annotated[
         int,
-        typer.Option("--trajectories", help="Keep the paths of the first K rocks."),
+        typer.Option(
+            "--trajectories",
+            help="Keep the paths of the first K rocks (0 to 1,000).",
+        ),
     ] = 20,
     figures: Annotated[
         Path | None, typer.Option("--figures", help="Write PNG figures into DIR.")
@@ -119,14 +129,19 @@ def simulate(
         list[str] | None,
         typer.Option(
             "--measured",
-            help="A measured value drawn on the figures, e.g. "
-            "x=610,speed=18,ke=600e3[,height=1.5]; repeatable.",
+            help="A measured value at an --at point, e.g. "
+            "x=610,speed=18,ke=600e3[,height=1.5] (ke translational, J): its "
+            "percentile among the simulated rocks crossing x is printed, written to "
+            "summary.json and drawn on the figures; repeatable.",
         ),
     ] = None,
     envelope_dx: Annotated[
         float | None,
         typer.Option(
-            "--envelope-dx", help="Bin width of the bounce-height envelope (m)."
+            "--envelope-dx",
+            help="Bin width of the bounce-height envelope (m). With --figures and "
+            "none given: the profile's x extent / 200, rounded up to 1, 2 or 5 x "
+            "10^k m (stated when used).",
         ),
     ] = None,
 ) -> None:
@@ -138,7 +153,14 @@ def simulate(
     the runout distribution, the stopped fraction and, at each analysis point
     (--at), the fraction of rocks passing and percentiles of speed, energy and
     bounce height -- each with its Monte Carlo standard error, so you can see
-    whether --rocks was enough.
+    whether --rocks was enough -- and the percentile of each --measured value.
+
+    Rocks still moving after the model's core.max_impacts impacts (capped) are
+    their own final state: never counted as stopped or run out, left out of the
+    runout statistics (summary.json brackets what counting them would give), with
+    a warning saying how many. The first run after an install compiles the
+    simulator once ("compiling the simulator, first run only"); compile and
+    simulation times are reported apart (compile_s, wall_s in summary.json).
 
     Example (from the repository root; thesis §7.5.4, Tornado Mountain with
     the RocFall inputs of Table 7-1):
