@@ -169,14 +169,18 @@ def simulate(
           --rocks 2000 --seed 1 --at 610 --measured x=610,speed=18,ke=600e3 \\
           --summary out/summary.json --figures out/sim
     """
+    import fieldkit.model.kernel as kernel
     from fieldkit.cli.progress import report_written, step
     from fieldkit.io.impact_stream import (
         ImpactStreamWriter,
         stream_format,
     )
-    from fieldkit.model import compile_cache
     from fieldkit.model.model_file import read_model
-    from fieldkit.model.simulate import check_run, default_envelope_dx_m
+    from fieldkit.model.simulate import (
+        check_run,
+        default_envelope_dx_m,
+        warm_kernel,
+    )
     from fieldkit.model.simulate import simulate as run
 
     if seed is not None and not 0 <= seed < 2**64:
@@ -220,11 +224,11 @@ def simulate(
         rng = np.random.default_rng(seed)
 
         compile_s = 0.0
-        if not compile_cache.kernel_ready():
+        if not kernel.kernel_ready():
             with step("compiling the simulator, first run only"):
-                compile_s = compile_cache.warm()
-        elif not compile_cache.kernel_loaded():
-            compile_cache.warm()  # load from the cache (< 1 s), off the clock
+                compile_s = warm_kernel()
+        elif not kernel.kernel_loaded():
+            warm_kernel()  # load from the cache (< 1 s), off the clock
 
         kept: list = []  # impacts of the trajectory rocks, for the recording
         whole: list = []  # every impact, for an XLSX table

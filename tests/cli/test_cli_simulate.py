@@ -189,16 +189,20 @@ def test_capped_rocks_are_their_own_state_with_a_warning(core, cli, tmp_path):
 def test_compiling_is_announced_and_timed_apart(core, cli, tmp_path, monkeypatch):
     """When the kernel is not cached the command says so and reports the compile
     apart from the simulation (here the compile is a stand-in taking 0.2 s)."""
+    import sys
     import time
 
-    from fieldkit.model import compile_cache
+    import fieldkit.model.kernel as kernel
+
+    simulation = sys.modules["fieldkit.model.simulate"]  # the module, not the function
 
     def slow_warm() -> float:
         time.sleep(0.2)
         return 0.2
 
-    monkeypatch.setattr(compile_cache, "kernel_ready", lambda: False)
-    monkeypatch.setattr(compile_cache, "warm", slow_warm)
+    simulation.warm_kernel()  # the real kernel, loaded before the stand-in
+    monkeypatch.setattr(kernel, "kernel_ready", lambda: False)
+    monkeypatch.setattr(simulation, "warm_kernel", slow_warm)
     r = cli("simulate", MODEL, "--rocks", "20", "--seed", "1", "--summary",
             tmp_path / "s.json")  # fmt: skip
     assert r.exit_code == 0, r.stderr
@@ -209,10 +213,11 @@ def test_compiling_is_announced_and_timed_apart(core, cli, tmp_path, monkeypatch
 
 
 def test_cached_kernel_is_not_announced(core, cli, tmp_path):
-    from fieldkit.model import compile_cache
+    import fieldkit.model.kernel as kernel
+    from fieldkit.model.simulate import warm_kernel
 
-    compile_cache.warm()
-    assert compile_cache.kernel_ready()
+    warm_kernel()
+    assert kernel.kernel_ready() and kernel.kernel_loaded()
     r = cli("simulate", MODEL, "--rocks", "20", "--seed", "1", "--summary",
             tmp_path / "s.json")  # fmt: skip
     assert r.exit_code == 0 and "compiling" not in r.stderr + r.stdout
