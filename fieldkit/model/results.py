@@ -203,6 +203,11 @@ class SimulationResult:
             },
             "analysis_points": points,
             "envelope": {
+                "bin_width_m": (
+                    float(self.envelope_x_m[1] - self.envelope_x_m[0])
+                    if np.size(self.envelope_x_m) > 1
+                    else None
+                ),
                 "x_m": _floats(envelope["x_m"]),
                 "reached": [int(v) for v in envelope["reached"]],
                 "height_p50_m": _floats(envelope["p50"]),

@@ -308,6 +308,7 @@ def test_figures_get_a_stated_envelope_and_measured_percentiles(core, cli, tmp_p
     # envelope.png is not empty: a stated default bin width (90 m / 200 -> 0.5 m)
     assert "0.5 m bins" in r.stderr
     assert len(s["envelope"]["x_m"]) == 180 and s["envelope"]["reached"][0] == 60
+    assert s["envelope"]["bin_width_m"] == 0.5
     # each measured value's percentile among the rocks crossing x = 40 m
     point = simulate(read_model(MODEL), 60, np.random.default_rng(3),
                      analysis_x_m=[40.0]).analysis[0]  # fmt: skip
