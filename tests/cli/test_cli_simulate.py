@@ -258,6 +258,7 @@ def test_a_fresh_copy_compiles_once_then_loads_from_its_cache(tmp_path, repo):
         (["--at", "nan"], ["--at", "nan is not a finite x", "0 to 90 m"]),
         (["--at", "-inf"], ["--at", "-inf is not a finite x"]),
         (["--seed", "-1"], ["--seed", "from 0"]),
+        (["--seed", str(2**64)], ["--seed", "2**64 - 1"]),
         (["--rocks", "1000000000"], ["--rocks", "10,000,000"]),
         (["--trajectories", "100000"], ["--trajectories", "1,000"]),
         (["--envelope-dx", "1e-9"], ["--envelope-dx", "at most 100,000", "0.0009 m"]),
