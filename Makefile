@@ -10,6 +10,7 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	$(BIN)/python -c "from fieldkit.model.compile_cache import main; main()"
 	touch $(STAMP)
 
 ## Reduce the bundled Tornado Mountain survey (thesis Table 2-4) to an ImpactTable and figures.

@@ -448,7 +448,7 @@ class ImpactTable:
         removed (:func:`fieldkit.outputs.unescape_formulas`).
         """
         p = Path(path)
-        fmt = _format_of(p)
+        fmt = table_format(p)
         if not p.is_file():
             raise InputFileError("file not found", source=p)
         if p.stat().st_size == 0:
@@ -487,7 +487,7 @@ class ImpactTable:
         (:mod:`fieldkit.outputs`, "Spreadsheet safety").
         """
         p = Path(path)
-        fmt = _format_of(p)
+        fmt = table_format(p)
         frame = self.frame
         if fmt == "csv":
             safe = escape_formulas(frame)
@@ -531,8 +531,24 @@ def _check_xlsx_text(frame: pd.DataFrame, path: Path) -> None:
             )
 
 
-def _format_of(path: Path) -> str:
+def is_stream_device(path: str | os.PathLike[str]) -> bool:
+    """True for a FIFO or a character device (``/dev/null``, ``/dev/stdout``): a
+    target written in place, whose name need not carry a format extension."""
+    import stat
+
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):
+        return False
+    return stat.S_ISFIFO(mode) or stat.S_ISCHR(mode)
+
+
+def table_format(path: Path) -> str:
+    """The table format of ``path`` from its extension; CSV (the default format) for
+    a FIFO or character device without one (``-o /dev/null``)."""
     fmt = FORMATS.get(path.suffix.lower())
+    if fmt is None and is_stream_device(path):
+        return "csv"
     if fmt is None:
         raise InputFileError(
             f"unknown table format {path.suffix!r}; use one of {', '.join(FORMATS)}",

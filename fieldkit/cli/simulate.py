@@ -4,14 +4,13 @@ from __future__ import annotations
 
 import math
 import secrets
-import sys
 from pathlib import Path
 from typing import Annotated
 
 import numpy as np
 import typer
 
-from fieldkit.cli.common import note, one_line_errors
+from fieldkit.cli.common import note, one_line_errors, warn
 from fieldkit.errors import ArgumentError
 from fieldkit.outputs import OutputSet, write_json
 
@@ -77,10 +76,14 @@ def simulate(
     model_file: Annotated[
         Path, typer.Argument(metavar="MODEL.json", help="The model file (§5).")
     ],
-    rocks: Annotated[int, typer.Option("--rocks", help="Number of rocks.")] = 1000,
+    rocks: Annotated[
+        int, typer.Option("--rocks", help="Number of rocks (1 to 10,000,000).")
+    ] = 1000,
     seed: Annotated[
         int | None,
-        typer.Option("--seed", help="Random seed (drawn and printed when omitted)."),
+        typer.Option(
+            "--seed", help="Random seed >= 0 (drawn and printed when omitted)."
+        ),
     ] = None,
     impacts: Annotated[
         Path | None,
@@ -95,11 +98,17 @@ def simulate(
     ] = None,
     at: Annotated[
         list[float] | None,
-        typer.Option("--at", help="Analysis point x (m); repeatable."),
+        typer.Option(
+            "--at",
+            help="Analysis point x (m), within the profile; repeatable (up to 100).",
+        ),
     ] = None,
     trajectories: Annotated[
         int,
-        typer.Option("--trajectories", help="Keep the paths of the first K rocks."),
+        typer.Option(
+            "--trajectories",
+            help="Keep the paths of the first K rocks (0 to 1,000).",
+        ),
     ] = 20,
     figures: Annotated[
         Path | None, typer.Option("--figures", help="Write PNG figures into DIR.")
@@ -111,14 +120,19 @@ def simulate(
         list[str] | None,
         typer.Option(
             "--measured",
-            help="A measured value drawn on the figures, e.g. "
-            "x=610,speed=18,ke=600e3[,height=1.5]; repeatable.",
+            help="A measured value at an --at point, e.g. "
+            "x=610,speed=18,ke=600e3[,height=1.5] (ke translational, J): its "
+            "percentile among the simulated rocks crossing x is printed, written to "
+            "summary.json and drawn on the figures; repeatable.",
         ),
     ] = None,
     envelope_dx: Annotated[
         float | None,
         typer.Option(
-            "--envelope-dx", help="Bin width of the bounce-height envelope (m)."
+            "--envelope-dx",
+            help="Bin width of the bounce-height envelope (m). With --figures and "
+            "none given: the profile's x extent / 200, rounded up to 1, 2 or 5 x "
+            "10^k m (stated when used).",
         ),
     ] = None,
 ) -> None:
@@ -130,7 +144,14 @@ def simulate(
     the runout distribution, the stopped fraction and, at each analysis point
     (--at), the fraction of rocks passing and percentiles of speed, energy and
     bounce height -- each with its Monte Carlo standard error, so you can see
-    whether --rocks was enough.
+    whether --rocks was enough -- and the percentile of each --measured value.
+
+    Rocks still moving after the model's core.max_impacts impacts (capped) are
+    their own final state: never counted as stopped or run out, left out of the
+    runout statistics (summary.json brackets what counting them would give), with
+    a warning saying how many. The first run after an install compiles the
+    simulator once ("compiling the simulator, first run only"); compile and
+    simulation times are reported apart (compile_s, wall_s in summary.json).
 
     Example (from the repository root; thesis §7.5.4, Tornado Mountain with
     the RocFall inputs of Table 7-1):
@@ -139,33 +160,36 @@ def simulate(
           --rocks 2000 --seed 1 --at 610 --measured x=610,speed=18,ke=600e3 \\
           --summary out/summary.json --figures out/sim
     """
+    import fieldkit.model.kernel as kernel
+    from fieldkit.cli.progress import report_written, step
     from fieldkit.io.impact_stream import (
         ImpactStreamWriter,
         stream_format,
     )
     from fieldkit.model.model_file import read_model
+    from fieldkit.model.simulate import (
+        check_run,
+        default_envelope_dx_m,
+        warm_kernel,
+    )
     from fieldkit.model.simulate import simulate as run
 
-    if rocks < 1:
-        raise ArgumentError(f"rocks must be >= 1 (got {rocks})", source="rocks")
-    if trajectories < 0:
-        raise ArgumentError("trajectories must be >= 0", source="trajectories")
-    if envelope_dx is not None and not envelope_dx > 0:
-        raise ArgumentError("envelope_dx_m must be > 0", source="envelope_dx_m")
+    if seed is not None and not 0 <= seed < 2**64:
+        raise ArgumentError(
+            f"seed must be from 0 to 2**64 - 1 (got {seed})", source="seed"
+        )
     analysis_x = [float(x) for x in (at or [])]
     points = [parse_measured(text) for text in (measured or [])]
     to_xlsx = impacts is not None and impacts.suffix.lower() == ".xlsx"
     if impacts is not None and not to_xlsx:
         stream_format(impacts, "impacts_path")
+    if rrd is not None and rrd.suffix.lower() != ".rrd":
+        raise ArgumentError(f"must be a .rrd file, got {rrd.name!r}", source="--rrd")
 
     with OutputSet(inputs=[model_file]) as outputs:
         if summary is not None:
             outputs.plan(summary, argument="--summary")
         if rrd is not None:
-            if rrd.suffix.lower() != ".rrd":
-                raise ArgumentError(
-                    f"must be a .rrd file, got {rrd.name!r}", source="--rrd"
-                )
             outputs.plan(rrd, argument="--rrd")
         if figures is not None:
             from fieldkit.viz.simulation_figure import point_figure_names
@@ -173,105 +197,176 @@ def simulate(
             for name in point_figure_names(analysis_x):
                 outputs.plan(figures / name, argument="--figures")
         model = read_model(model_file, outputs=outputs)
+        x_range = (float(model.profile.x_m[0]), float(model.profile.x_m[-1]))
+        default_dx = envelope_dx is None and figures is not None
+        if default_dx:
+            envelope_dx = default_envelope_dx_m(x_range[1] - x_range[0])
+        check_run(rocks, x_range, analysis_x, envelope_dx, trajectories)
+        _check_measured(points, analysis_x)
+        if default_dx:
+            note(
+                f"--envelope-dx not given: the bounce-height envelope (envelope.png) "
+                f"uses {envelope_dx:g} m bins (profile x {x_range[0]:g} to "
+                f"{x_range[1]:g} m); pass --envelope-dx to choose"
+            )
         if seed is None:
             seed = secrets.randbits(32)
             note(f"`seed` not given: used {seed}; pass --seed {seed} to reproduce")
         rng = np.random.default_rng(seed)
 
+        compile_s = 0.0
+        if not kernel.kernel_ready():
+            with step("compiling the simulator, first run only"):
+                compile_s = warm_kernel()
+        elif not kernel.kernel_loaded():
+            warm_kernel()  # load from the cache (< 1 s), off the clock
+
         kept: list = []  # impacts of the trajectory rocks, for the recording
+        whole: list = []  # every impact, for an XLSX table
         writer = None
         if impacts is not None and not to_xlsx:
             tmp = outputs.stream(impacts, argument="--impacts")
             writer = ImpactStreamWriter(tmp, stream_format(impacts))
 
         def on_chunk(table) -> None:  # chunks arrive derived (model.simulate)
-            writer.write(table)
+            if writer is not None:
+                writer.write(table)
+            elif to_xlsx:
+                whole.append(table.frame)
             if rrd is not None and trajectories:
                 ids = table.frame["path_id"].astype(int)
                 if (ids < trajectories).any():
                     kept.append(table.frame[ids < trajectories])
 
-        progress, finish = _progress(rocks)
+        doing = f"simulating {rocks:,} rocks"
+        if impacts is not None:
+            doing += f", recording their impacts for {impacts}"
         try:
-            result = run(
-                model,
-                rocks,
-                rng,
-                analysis_x_m=analysis_x,
-                trajectories=trajectories,
-                record_impacts=impacts is not None or rrd is not None,
-                on_impact_chunk=on_chunk if writer is not None else None,
-                progress=progress,
-                envelope_dx_m=envelope_dx,
-            )
+            with step(doing, total=rocks) as advance:
+                result = run(
+                    model,
+                    rocks,
+                    rng,
+                    analysis_x_m=analysis_x,
+                    trajectories=trajectories,
+                    record_impacts=impacts is not None or rrd is not None,
+                    on_impact_chunk=on_chunk,
+                    progress=advance,
+                    envelope_dx_m=envelope_dx,
+                )
         finally:
-            finish()
             if writer is not None:
                 writer.close()
         result.seed = seed
-        recorded = None
-        if result.impact_table is not None:
-            recorded = result.impact_table
-            if recorded.frame["vi_mps"].isna().all():
-                recorded = recorded.derive()
+        result.compile_s = compile_s
         if to_xlsx:
-            if len(recorded) > XLSX_MAX_ROWS:
+            import pandas as pd
+
+            from fieldkit.impact_table import ImpactTable
+
+            rows = sum(len(frame) for frame in whole)
+            if rows > XLSX_MAX_ROWS:
                 raise ArgumentError(
-                    f"{len(recorded):,} impacts do not fit an XLSX sheet "
+                    f"{rows:,} impacts do not fit an XLSX sheet "
                     f"({XLSX_MAX_ROWS:,} rows); write .csv or .parquet",
                     source="--impacts",
                 )
-            recorded.write(impacts, outputs=outputs)
+            ImpactTable(pd.concat(whole, ignore_index=True), source="simulation").write(
+                impacts, outputs=outputs
+            )
         stats = result.summary()
+        stats["measured"] = _measured_percentiles(result, points)
         if summary is not None:
             write_json(summary, stats, outputs)
         if figures is not None:
             from fieldkit.viz.simulation_figure import write_simulation_figures
 
-            write_simulation_figures(figures, result, measured=points, outputs=outputs)
+            with step(f"drawing the figures into {figures}"):
+                write_simulation_figures(
+                    figures, result, measured=points, outputs=outputs
+                )
         if rrd is not None:
             import pandas as pd
 
             from fieldkit.impact_table import ImpactTable
             from fieldkit.viz.rerun_log import write_simulation_recording
 
-            some = None
-            if kept:
-                some = ImpactTable(pd.concat(kept, ignore_index=True))
-            elif recorded is not None:
-                ids = recorded.frame["path_id"].astype(int)
-                some = ImpactTable(recorded.frame[ids < trajectories])
+            some = ImpactTable(pd.concat(kept, ignore_index=True)) if kept else None
             write_simulation_recording(rrd, result, some, outputs=outputs)
-        outputs.commit()
+        with step("writing the outputs", announce=rrd is not None or to_xlsx):
+            written = outputs.commit()
     _print_summary(stats, model)
+    report_written(written)
 
 
-def _progress(total: int):
-    """A rich progress bar on a terminal's stderr; else nothing."""
-    if not sys.stderr.isatty():
-        return None, lambda: None
-    from rich.console import Console
-    from rich.progress import Progress
+def _check_measured(points, analysis_x: list[float]) -> None:
+    """A measured speed or energy is compared at an analysis point: its x must be
+    one of the ``--at`` points (a height alone is drawn on the envelope)."""
+    for m in points:
+        compared = m.speed_mps is not None or m.ke_j is not None
+        if compared and not any(np.isclose(m.x_m, x) for x in analysis_x):
+            raise ArgumentError(
+                f"x={m.x_m:g} is not an analysis point "
+                f"({', '.join(f'--at {x:g}' for x in analysis_x) or 'no --at given'}); "
+                f"its speed and energy are compared with the rocks crossing it: add "
+                f"--at {m.x_m:g}",
+                source="measured",
+            )
 
-    bar = Progress(console=Console(stderr=True), transient=True)
-    task = bar.add_task("simulating", total=total)
-    bar.start()
 
-    def update(done: int, of: int) -> None:
-        bar.update(task, completed=done, total=of)
+#: Measured quantities -> (AnalysisPoint array, label, scale, unit).
+_MEASURED_QUANTITIES = {
+    "speed_mps": ("speed_mps", "speed", 1.0, "m/s"),
+    "ke_j": ("ke_j", "translational KE", 1e-3, "kJ"),
+    "height_m": ("height_m", "bounce height", 1.0, "m"),
+}
 
-    return update, bar.stop
+
+def _measured_percentiles(result, points) -> list[dict]:
+    """Each measured value's percentile among the rocks crossing its point."""
+    out = []
+    for m in points:
+        index = next(
+            (i for i, p in enumerate(result.analysis) if np.isclose(p.x_m, m.x_m)),
+            None,
+        )
+        if index is None:
+            continue
+        entry: dict = {"x_m": float(m.x_m)}
+        for key, (quantity, *_rest) in _MEASURED_QUANTITIES.items():
+            value = getattr(m, key)
+            if value is not None:
+                entry[key] = result.percentile_of(index, quantity, value)
+        entry["over"] = (
+            "rocks crossing x_m (first crossing); percentile = percent of them with a "
+            "smaller value (ties half), percentile_se binomial; ke_j is translational "
+            "(1/2 m v^2), as measured"
+        )
+        out.append(entry)
+    return out
 
 
 def _print_summary(s: dict, model) -> None:
     echo = typer.echo
+    compiled = (
+        f"; compiling the simulator took {s['compile_s']:.2f} s (first run only)"
+        if s.get("compile_s")
+        else ""
+    )
     echo(
-        f"{s['rocks']} rocks, {s['impacts']} impacts in {s['wall_s']:.2f} s "
-        f"(seed {s['seed']})"
+        f"{s['rocks']} rocks, {s['impacts']} impacts in {s['wall_s']:.2f} s of "
+        f"simulation (seed {s['seed']}){compiled}"
     )
     r = s["runout_x_m"]
+    capped = s["capped"]
+    over = (
+        f" (over the {r['n']} rocks that stopped or left; {capped['rocks']} capped "
+        "left out)"
+        if capped["rocks"]
+        else ""
+    )
     echo(
-        "runout x (m): "
+        f"runout x (m){over}: "
         + ", ".join(
             f"{k} {_fmt(r, k)}" for k in ("mean", "p50", "p90", "p95", "p99", "max")
         )
@@ -281,6 +376,27 @@ def _print_summary(s: dict, model) -> None:
         f"± {s['stopped_fraction_se']:.2g}; final states: "
         + ", ".join(f"{k} {v}" for k, v in s["final_state"].items() if v)
     )
+    if capped["rocks"]:
+        lo, hi = s["runout_bounds_x_m"]["lower"], s["runout_bounds_x_m"]["upper"]
+        if lo["p95"] == hi["p95"]:
+            bound = (
+                "counting them anywhere from where they were to the profile's end "
+                f"leaves the runout p95 at {lo['p95']:.4g} m"
+            )
+        else:
+            bound = (
+                f"counting them, the runout p95 lies between {lo['p95']:.4g} m (where "
+                f"they were) and {hi['p95']:.4g} m (the profile's end)"
+            )
+        warn(
+            f"{capped['fraction']:.1%} of the rocks "
+            f"({capped['rocks']} of {s['rocks']}) "
+            f"were still moving after {capped['max_impacts']} impacts (the model's "
+            "core.max_impacts), where the simulation stopped following them: they "
+            f"are neither stopped nor run out and are left out of the runout "
+            f'statistics; {bound}. Raise "core": {{"max_impacts": ...}} in the '
+            "model file (up to 1e6) to follow them to the end."
+        )
     for p in s["analysis_points"]:
         echo(
             f"x = {p['x_m']:g} m: passing {p['passing_fraction']:.3f} "
@@ -288,8 +404,8 @@ def _print_summary(s: dict, model) -> None:
         )
         for key, label, scale, unit in (
             ("speed_mps", "speed", 1.0, " m/s"),
-            ("total_j", "total E", 1e-3, " kJ"),
-            ("ke_j", "KE", 1e-3, " kJ"),
+            ("total_j", "KE+RE", 1e-3, " kJ (total: translational + rotational)"),
+            ("ke_j", "KE", 1e-3, " kJ (translational, 1/2 m v^2)"),
             ("bounce_height_m", "bounce h", 1.0, " m"),
         ):
             d = _scaled(p[key], scale)
@@ -299,6 +415,24 @@ def _print_summary(s: dict, model) -> None:
                     f"{k} {_fmt(d, k)}" for k in ("p50", "p90", "p95", "p99", "max")
                 )
                 + unit
+            )
+    for m in s.get("measured", []):
+        parts = []
+        for key, (_q, label, scale, unit) in _MEASURED_QUANTITIES.items():
+            d = m.get(key)
+            if d is None:
+                continue
+            if d["percentile"] is None:
+                parts.append(f"{label} {d['measured'] * scale:.4g} {unit}: no rocks")
+                continue
+            parts.append(
+                f"{label} {d['measured'] * scale:.4g} {unit} = percentile "
+                f"{d['percentile']:.1f} ± {d['percentile_se']:.1f}"
+            )
+        if parts:
+            echo(
+                f"measured at x = {m['x_m']:g} m, among the simulated rocks crossing "
+                "it: " + "; ".join(parts)
             )
     echo(
         "± = Monte Carlo standard error (percentiles: order-statistic interval; "

@@ -32,7 +32,7 @@ import pyarrow.csv as pa_csv
 import pyarrow.parquet as pq
 
 from fieldkit.errors import ArgumentError
-from fieldkit.impact_table import ImpactTable
+from fieldkit.impact_table import ImpactTable, is_stream_device
 from fieldkit.outputs import escape_formulas
 
 #: Formats a stream can write, by extension.
@@ -40,7 +40,9 @@ STREAM_FORMATS: dict[str, str] = {".csv": "csv", ".parquet": "parquet"}
 
 
 def stream_format(path: str | os.PathLike[str], argument: str = "path") -> str:
-    """``"csv"`` or ``"parquet"`` from the extension of ``path``.
+    """``"csv"`` or ``"parquet"`` from the extension of ``path``; ``"csv"`` (the
+    default table format) for a FIFO or character device without one
+    (``--impacts /dev/null``).
 
     Raises
     ------
@@ -53,6 +55,8 @@ def stream_format(path: str | os.PathLike[str], argument: str = "path") -> str:
     'parquet'
     """
     fmt = STREAM_FORMATS.get(Path(path).suffix.lower())
+    if fmt is None and is_stream_device(path):
+        return "csv"
     if fmt is None:
         raise ArgumentError(
             f"cannot stream impacts to {Path(path).name!r}: use "

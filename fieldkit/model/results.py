@@ -25,7 +25,7 @@ STATE_NAMES = {
     STOPPED: "stopped on the profile",
     EXITED_DOWNSLOPE: "left the profile at its lower end",
     EXITED_UPSLOPE: "left the profile at its upper end",
-    MAX_IMPACTS: "reached the impact limit",
+    MAX_IMPACTS: "still moving at the impact limit (capped)",
 }
 
 
@@ -52,7 +52,7 @@ class SimulationResult:
     model: Model
     rocks: int
     seed: int | None
-    wall_s: float  # kernel time only [s]
+    wall_s: float  # kernel time only [s], without compiling
     impacts: int  # total impacts over all rocks
     runout_x_m: np.ndarray  # (rocks,) x where the rock stopped or left the profile
     state: np.ndarray  # (rocks,) int, one of STATE_NAMES
@@ -64,6 +64,7 @@ class SimulationResult:
     )
     trajectories: list[np.ndarray] = field(default_factory=list)  # (n_i, 2) x, z
     impact_table: ImpactTable | None = None
+    compile_s: float = 0.0  # compiling the kernel in this process [s] (0: cached)
 
     # ------------------------------------------------------------------ statistics
     def envelope(self) -> dict[str, np.ndarray]:
@@ -79,21 +80,75 @@ class SimulationResult:
         out["x_m"] = (edges[:-1] + edges[1:]) / 2.0 if edges.size > 1 else edges[:0]
         return out
 
+    def percentile_of(self, index: int, quantity: str, value: float) -> dict:
+        """Where a measured ``value`` falls among the rocks crossing analysis point
+        ``index``: its percentile in the simulated distribution of ``quantity``.
+
+        Parameters
+        ----------
+        quantity
+            An :class:`AnalysisPoint` array: ``speed_mps``, ``ke_j`` (translational),
+            ``re_j``, ``total_j`` or ``height_m``.
+
+        Returns
+        -------
+        dict
+            ``measured``, ``percentile`` (percent of crossing rocks with a smaller
+            value, ties counted half; None without crossing rocks), its binomial
+            ``percentile_se`` and ``n`` (crossing rocks).
+
+        Examples
+        --------
+        >>> p = AnalysisPoint(0.0, np.array([True] * 4), np.arange(4.0), *[None] * 4)
+        >>> r = SimulationResult(None, 4, 0, 0.0, 0, None, None, None, [p])
+        >>> r.percentile_of(0, "speed_mps", 2.0)["percentile"]
+        62.5
+        """
+        point = self.analysis[index]
+        crossed = np.asarray(point.crossed, bool)
+        values = np.asarray(getattr(point, quantity), float)[crossed]
+        values = values[np.isfinite(values)]
+        n = int(values.size)
+        out: dict = {"measured": float(value), "n": n}
+        if n == 0:
+            out.update(percentile=None, percentile_se=None)
+            return out
+        below = float((values < value).sum() + 0.5 * (values == value).sum())
+        fraction = below / n
+        out["percentile"] = 100.0 * fraction
+        out["percentile_se"] = 100.0 * float(np.sqrt(fraction * (1 - fraction) / n))
+        return out
+
     def summary(self) -> dict:
         """What a designer reads: the ``summary.json`` contract (architecture §4).
 
-        ``rocks``, ``impacts``, ``wall_s`` (simulation only), ``seed``,
-        ``runout_x_m`` and, per analysis point, ``passing_fraction`` and the
+        ``rocks``, ``impacts``, ``wall_s`` (simulation only), ``compile_s``
+        (compiling the simulator, 0 when the compiled kernel came from the cache),
+        ``seed``, ``runout_x_m`` and, per analysis point, ``passing_fraction`` and the
         distributions of ``speed_mps``, ``ke_j``, ``re_j``, ``total_j`` and
         ``bounce_height_m`` over the rocks that crossed it. Every distribution holds
         ``n``, ``mean``, ``p50``, ``p90``, ``p95``, ``p99``, ``max`` and ``se`` (their
         Monte Carlo standard errors; :mod:`fieldkit.model.statistics` says how each
         is computed). Fractions carry ``*_se`` (binomial). Also: the final states,
         the envelope, and the model's source, active effects and core settings.
+
+        Rocks still moving when they reach the model's ``max_impacts`` (*capped*)
+        are their own final state: never counted as stopped or as run out.
+        ``runout_x_m`` is over the rocks that stopped on or left the profile
+        (``runout_over`` says so and how many); ``capped`` gives their number,
+        fraction and where they were; ``runout_bounds_x_m`` brackets each runout
+        percentile of *all* rocks (:func:`_runout_bounds`).
         """
         n = int(self.rocks)
         state = np.asarray(self.state)
         stopped, stopped_se = fraction_se(int((state == STOPPED).sum()), n)
+        capped = state == MAX_IMPACTS
+        runout = np.asarray(self.runout_x_m, float)
+        n_capped = int(capped.sum())
+        capped_fraction, capped_se = fraction_se(n_capped, n)
+        max_impacts = int(
+            dict(getattr(self.model, "core", {}) or {}).get("max_impacts", 0)
+        )
         points = []
         for point in self.analysis:
             crossed = np.asarray(point.crossed, bool)
@@ -121,8 +176,26 @@ class SimulationResult:
             "rocks": n,
             "impacts": int(self.impacts),
             "wall_s": float(self.wall_s),
+            "compile_s": float(self.compile_s),
             "seed": self.seed,
-            "runout_x_m": distribution(np.asarray(self.runout_x_m, float)),
+            "runout_x_m": distribution(runout[~capped]),
+            "runout_over": f"{n - n_capped} of {n} rocks: those that stopped on or "
+            "left the profile (x where they stopped, or the end they left by)"
+            + (
+                f"; the {n_capped} capped rocks are left out (runout_bounds_x_m "
+                "brackets the percentiles of all rocks)"
+                if n_capped
+                else "; no rock was capped"
+            ),
+            "runout_bounds_x_m": _runout_bounds(runout, capped, self.model),
+            "capped": {
+                "rocks": n_capped,
+                "fraction": capped_fraction,
+                "fraction_se": capped_se,
+                "max_impacts": max_impacts,
+                "x_m": distribution(runout[capped]),
+                "meaning": CAPPED_NOTE,
+            },
             "stopped_fraction": stopped,
             "stopped_fraction_se": stopped_se,
             "final_state": {
@@ -130,6 +203,11 @@ class SimulationResult:
             },
             "analysis_points": points,
             "envelope": {
+                "bin_width_m": (
+                    float(self.envelope_x_m[1] - self.envelope_x_m[0])
+                    if np.size(self.envelope_x_m) > 1
+                    else None
+                ),
                 "x_m": _floats(envelope["x_m"]),
                 "reached": [int(v) for v in envelope["reached"]],
                 "height_p50_m": _floats(envelope["p50"]),
@@ -153,8 +231,17 @@ _STATE_KEYS = {
     STOPPED: "stopped",
     EXITED_DOWNSLOPE: "exited_downslope",
     EXITED_UPSLOPE: "exited_upslope",
-    MAX_IMPACTS: "max_impacts",
+    MAX_IMPACTS: "capped",
 }
+
+#: What capped rocks mean for the user, stated in ``summary.json``.
+CAPPED_NOTE = (
+    "capped rocks were still moving when they reached the model's core.max_impacts "
+    "impacts; x_m is where they were then, not where they would stop (their runout "
+    "is at least that). They are neither stopped nor run out: left out of "
+    "runout_x_m; runout_bounds_x_m says how far that can move each percentile. "
+    "Raise core.max_impacts in the model file (up to 1e6) to follow them further."
+)
 
 #: How the standard errors are computed, stated in ``summary.json``.
 STATISTICS_NOTE = (
@@ -165,6 +252,28 @@ STATISTICS_NOTE = (
     "Fractions: sqrt(p (1-p) / n). Analysis-point statistics are over the rocks that "
     "crossed the point."
 )
+
+
+def _runout_bounds(runout: np.ndarray, capped: np.ndarray, model) -> dict:
+    """Bounds on the runout percentiles of all rocks, capped ones included.
+
+    A capped rock's runout is unknown but at least where it was when capped and at
+    most the profile's lower end: the percentiles with every capped rock put there
+    (``lower``) and put at the end (``upper``) bracket the true ones. Equal when no
+    rock was capped.
+    """
+    keys = ("p50", "p90", "p95", "p99", "max")
+    lower = distribution(runout)
+    end = runout.copy()
+    x_end = getattr(getattr(model, "profile", None), "x_m", None)
+    end[capped] = float(np.max(x_end)) if x_end is not None else np.inf
+    upper = distribution(end)
+    return {
+        "lower": {k: lower[k] for k in keys},
+        "upper": {k: upper[k] for k in keys},
+        "over": "all rocks; capped rocks where they were when capped (lower) or at "
+        "the profile's lower end (upper)",
+    }
 
 
 def _floats(values: np.ndarray) -> list[float | None]:

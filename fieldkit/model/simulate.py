@@ -36,6 +36,118 @@ from fieldkit.model.seeder import Starts, draw_starts
 CHUNK_ROCKS = 100_000
 #: Trace points kept per sampled trajectory.
 TRACE_POINTS = 20_000
+#: Largest run accepted (beyond these a run exhausts memory or never ends).
+MAX_ROCKS = 10_000_000
+MAX_ANALYSIS_POINTS = 100
+MAX_ENVELOPE_BINS = 100_000
+MAX_TRAJECTORIES = 1_000
+#: Memory the per-rock arrays may take: starts, outcomes, analysis points, envelope.
+MEMORY_LIMIT_BYTES = 4 * 2**30
+#: Bytes per rock besides analysis points and envelope (12 float64/int64 arrays).
+_BYTES_PER_ROCK = 12 * 8
+#: Envelope bins along the profile when no bin width is given.
+DEFAULT_ENVELOPE_BINS = 200
+
+
+def default_envelope_dx_m(x_extent_m: float) -> float:
+    """The envelope bin width used when none is given: the profile's x extent over
+    :data:`DEFAULT_ENVELOPE_BINS`, rounded up to 1, 2 or 5 x 10^k m.
+
+    Examples
+    --------
+    >>> default_envelope_dx_m(700.0), default_envelope_dx_m(110.0)
+    (5.0, 1.0)
+    """
+    raw = max(float(x_extent_m), 1e-9) / DEFAULT_ENVELOPE_BINS
+    power = 10.0 ** math.floor(math.log10(raw))
+    for step in (1.0, 2.0, 5.0, 10.0):
+        if step * power >= raw * (1 - 1e-12):
+            return step * power
+    return 10.0 * power  # pragma: no cover -- the loop always returns
+
+
+def check_run(
+    rocks: int,
+    x_range_m: tuple[float, float],
+    analysis_x_m: Sequence[float] = (),
+    envelope_dx_m: float | None = None,
+    trajectories: int = 0,
+) -> None:
+    """Refuse a run that is meaningless or would exhaust memory, naming the argument.
+
+    Raises
+    ------
+    ArgumentError
+        ``rocks`` < 1 or > :data:`MAX_ROCKS`; an analysis x not finite or outside
+        the profile's ``x_range_m``; more than :data:`MAX_ANALYSIS_POINTS` of them;
+        ``envelope_dx_m`` not finite and > 0 or making more than
+        :data:`MAX_ENVELOPE_BINS` bins; ``trajectories`` outside [0,
+        :data:`MAX_TRAJECTORIES`]; per-rock arrays above :data:`MEMORY_LIMIT_BYTES`.
+
+    Examples
+    --------
+    >>> check_run(1000, (0.0, 700.0), [610.0], 5.0, 20)
+    >>> try:
+    ...     check_run(1000, (0.0, 700.0), [900.0])
+    ... except ArgumentError as exc:
+    ...     print(exc.message)
+    900 m lies outside the profile (x from 0 to 700 m)
+    """
+    if not (isinstance(rocks, int | np.integer) and 1 <= rocks <= MAX_ROCKS):
+        raise ArgumentError(
+            f"rocks must be an integer from 1 to {MAX_ROCKS:,} (got {rocks})",
+            source="rocks",
+        )
+    x0, x1 = x_range_m
+    for xa in analysis_x_m:
+        if not math.isfinite(xa):
+            raise ArgumentError(
+                f"{xa} is not a finite x (the profile spans x {x0:g} to {x1:g} m)",
+                source="analysis_x_m",
+            )
+        if not x0 <= xa <= x1:
+            raise ArgumentError(
+                f"{xa:g} m lies outside the profile (x from {x0:g} to {x1:g} m)",
+                source="analysis_x_m",
+            )
+    if len(analysis_x_m) > MAX_ANALYSIS_POINTS:
+        raise ArgumentError(
+            f"{len(analysis_x_m)} analysis points; at most {MAX_ANALYSIS_POINTS}",
+            source="analysis_x_m",
+        )
+    bins = 0
+    if envelope_dx_m is not None:
+        if not (math.isfinite(envelope_dx_m) and envelope_dx_m > 0):
+            raise ArgumentError(
+                f"envelope_dx_m must be a finite width > 0 m (got {envelope_dx_m})",
+                source="envelope_dx_m",
+            )
+        bins = max(1, math.ceil((x1 - x0) / envelope_dx_m))
+        if bins > MAX_ENVELOPE_BINS:
+            raise ArgumentError(
+                f"envelope_dx_m {envelope_dx_m:g} m makes {bins:,} bins over the "
+                f"{x1 - x0:g} m profile; at most {MAX_ENVELOPE_BINS:,} (a width of "
+                f"at least {(x1 - x0) / MAX_ENVELOPE_BINS:.3g} m)",
+                source="envelope_dx_m",
+            )
+    if not (
+        isinstance(trajectories, int | np.integer)
+        and 0 <= trajectories <= MAX_TRAJECTORIES
+    ):
+        raise ArgumentError(
+            f"trajectories must be from 0 to {MAX_TRAJECTORIES:,} (got {trajectories})",
+            source="trajectories",
+        )
+    per_rock = _BYTES_PER_ROCK + len(analysis_x_m) * kernel.N_ANALYSIS * 8 + bins * 4
+    need = rocks * per_rock
+    if need > MEMORY_LIMIT_BYTES:
+        raise ArgumentError(
+            f"{rocks:,} rocks with {len(analysis_x_m)} analysis points and {bins:,} "
+            f"envelope bins need {need / 2**30:.1f} GiB for per-rock results; the "
+            f"limit is {MEMORY_LIMIT_BYTES / 2**30:.0f} GiB: at most "
+            f"{MEMORY_LIMIT_BYTES // per_rock:,} rocks here",
+            source="rocks",
+        )
 
 
 @dataclass(frozen=True)
@@ -76,6 +188,37 @@ class KernelInputs:
             self.par,
             self.core,
         )
+
+
+#: A one-segment model that exercises every argument type of the kernel.
+_TINY_MODEL = {
+    "profile": {"x_m": [0.0, 10.0], "z_m": [5.0, 0.0], "material": "rock"},
+    "materials": {"rock": {"e_n": 0.3, "e_t": 0.8, "friction_deg": 30.0}},
+    "body": {"mass_kg": 100.0, "radius_m": 0.2},
+    "seeder": {"x_m": 0.5, "z_m": 6.0},
+}
+
+
+def warm_kernel() -> float:
+    """Compile the kernel (or load it from numba's cache); returns the seconds.
+
+    Runs one rock of a one-segment model with an analysis point, an envelope,
+    recorded impacts and a trajectory: every kernel signature a simulation uses.
+    """
+    from fieldkit.model.model_file import model_from_dict
+
+    tic = time.perf_counter()
+    simulate(
+        model_from_dict(_TINY_MODEL),
+        1,
+        np.random.default_rng(0),
+        analysis_x_m=[5.0],
+        trajectories=1,
+        record_impacts=True,
+        envelope_dx_m=1.0,
+        compile_first=False,
+    )
+    return time.perf_counter() - tic
 
 
 def kernel_inputs(model: Model) -> KernelInputs:
@@ -204,6 +347,8 @@ def simulate(
     progress: Callable[[int, int], None] | None = None,
     envelope_dx_m: float | None = None,
     on_impact_columns: Callable[[dict[str, np.ndarray]], None] | None = None,
+    compile_first: bool = True,
+    on_compile: Callable[[], None] | None = None,
 ) -> SimulationResult:
     """Simulate ``rocks`` rocks of ``model`` with the random numbers of ``rng``.
 
@@ -225,6 +370,13 @@ def simulate(
         arrays (:func:`impact_columns`) instead of an ImpactTable -- for callers that
         need a few columns of many simulations (a path fit), without the table's
         derived columns.
+    compile_first, on_compile
+        Before the clock starts, load the compiled kernel or, when it is not
+        cached (:func:`fieldkit.model.kernel.kernel_ready`), call
+        ``on_compile`` (to say so) and compile it on a one-rock model: the
+        result's ``compile_s`` is the compile time (0 when loaded from the cache)
+        and ``wall_s`` is simulation time only.
+        ``compile_first=False`` (used by the warm-up itself) skips the check.
 
     Examples
     --------
@@ -236,19 +388,26 @@ def simulate(
     >>> simulate(m, 2, np.random.default_rng(0)).state.tolist()
     [1, 1]
     """
-    if not (isinstance(rocks, int | np.integer) and rocks >= 1):
-        raise ArgumentError(
-            f"rocks must be an integer >= 1 (got {rocks})", source="rocks"
-        )
-    if envelope_dx_m is not None and not envelope_dx_m > 0:
-        raise ArgumentError(
-            f"envelope_dx_m must be > 0 (got {envelope_dx_m})", source="envelope_dx_m"
-        )
+    check_run(
+        rocks,
+        (float(model.profile.x_m[0]), float(model.profile.x_m[-1])),
+        [float(x) for x in np.asarray(analysis_x_m, float).reshape(-1)],
+        envelope_dx_m,
+        trajectories,
+    )
     if impact_chunk_rocks < 1:
         raise ArgumentError(
             f"impact_chunk_rocks must be >= 1 (got {impact_chunk_rocks})",
             source="impact_chunk_rocks",
         )
+    compile_s = 0.0
+    if compile_first and not kernel.kernel_loaded():
+        # compile (or load from the cache) before the clock starts
+        compiles = not kernel.kernel_ready()
+        if compiles and on_compile is not None:
+            on_compile()
+        seconds = warm_kernel()
+        compile_s = seconds if compiles else 0.0
     inputs = kernel_inputs(model)
     starts, keys = draw_rocks(model, rocks, rng)
     radius, gyration = body_of(model, starts.mass_kg)
@@ -375,4 +534,5 @@ def simulate(
         envelope_height_m=env,
         trajectories=paths,
         impact_table=table,
+        compile_s=compile_s,
     )

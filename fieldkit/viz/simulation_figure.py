@@ -6,10 +6,12 @@
 * :func:`envelope_figure` -- the bounce-height envelope along the profile: p50, p95
   and max of the rocks' maximum centre height above the ground in each x bin, with a
   measured height as a line when given (Figs. 7.10, 7.13);
-* :func:`point_histograms_figure` -- speed and total energy of the rocks crossing an
-  analysis point, with p50/p90/p95/p99 marked and a measured value drawn on the
-  distribution (Figs. 7.6, 7.8, 7.11, 7.14, 7.16);
-* :func:`runout_figure` -- where the rocks stopped or left the profile.
+* :func:`point_histograms_figure` -- speed, translational and total kinetic energy
+  of the rocks crossing an analysis point, with p50/p90/p95/p99 marked and a
+  measured value drawn on the distribution of the same quantity, with its
+  percentile (Figs. 7.6, 7.8, 7.11, 7.14, 7.16);
+* :func:`runout_figure` -- where the rocks ended, by final state (capped rocks
+  apart).
 """
 
 from __future__ import annotations
@@ -63,7 +65,7 @@ def _draw_section(ax, profile) -> None:
             lw=0,
             label=f"material: {name}" if new else None,
         )
-    ax.plot(x, z, color="0.2", lw=1.2)
+    ax.plot(x, z, color="0.2", lw=1.2, label="ground surface (profile vertices)")
 
 
 def trajectories_figure(
@@ -89,7 +91,9 @@ def trajectories_figure(
             point.x_m,
             color="tab:blue",
             lw=1.0,
-            label="analysis points" if i == 0 else None,
+            label="analysis points (vertical lines where speeds and energies are read)"
+            if i == 0
+            else None,
         )
     ax.set_xlabel("x, horizontal distance (m)")
     ax.set_ylabel("z, elevation (m)")
@@ -106,93 +110,179 @@ def envelope_figure(
     fig, ax = new_figure(9.0, 4.5)
     env = result.envelope()
     x = env["x_m"]
-    ax.plot(x, env["max"], color="tab:red", label="max")
-    ax.plot(x, env["p95"], color="tab:orange", ls="--", label="95th percentile")
-    ax.plot(x, env["p50"], color="tab:blue", label="median")
+    width = float(np.diff(result.envelope_x_m[:2])[0]) if x.size else float("nan")
+    over = f"of each rock's highest point in {width:g} m bins"
+    ax.plot(x, env["max"], color="tab:red", label=f"maximum {over}")
+    ax.plot(x, env["p95"], color="tab:orange", ls="--", label=f"95th percentile {over}")
+    ax.plot(x, env["p50"], color="tab:blue", label=f"median {over}")
     for i, m in enumerate(v for v in measured if v.height_m is not None):
         ax.plot(
             [m.x_m],
             [m.height_m],
             "o",
             color=_MEASURED_COLOUR,
-            label="measured mean height" if i == 0 else None,
+            label="measured mean bounce height, at its x" if i == 0 else None,
         )
-        ax.axhline(m.height_m, color=_MEASURED_COLOUR, lw=0.8, ls=":")
+        ax.axhline(
+            m.height_m,
+            color=_MEASURED_COLOUR,
+            lw=0.8,
+            ls=":",
+            label="measured mean bounce height, level" if i == 0 else None,
+        )
     ax.set_xlabel("x, horizontal distance (m)")
-    ax.set_ylabel("bounce height, centre above ground, vertical (m)")
-    ax.set_title("Bounce-height envelope (over rocks reaching each x)")
+    ax.set_ylabel("bounce height: centre above the ground, vertical (m)")
+    ax.set_title("Bounce-height envelope (over the rocks reaching each x bin)")
+    if not x.size:
+        ax.text(
+            0.5,
+            0.5,
+            "no envelope computed (no bin width given)",
+            transform=ax.transAxes,
+            ha="center",
+        )
     ax.set_ylim(bottom=0.0)
     outside_legend(ax)
     return fig
 
 
+def _measured_percentile(values: np.ndarray, measured: float) -> float:
+    """Percent of ``values`` below ``measured`` (ties half), as summary.json."""
+    below = (values < measured).sum() + 0.5 * (values == measured).sum()
+    return 100.0 * float(below) / values.size
+
+
 def point_histograms_figure(
     result: SimulationResult, index: int, *, measured: Measured | None = None
 ) -> Figure:
-    """Speed and total energy at analysis point ``index``, percentiles marked."""
+    """Speed, translational KE and total energy at analysis point ``index``.
+
+    Percentiles are marked; a measured speed is drawn on the speed panel and a
+    measured (translational) kinetic energy on the translational KE panel -- like
+    with like -- each with its percentile among the simulated rocks. The total
+    energy (translational + rotational) is what a barrier must absorb.
+    """
     point = result.analysis[index]
     crossed = np.asarray(point.crossed, bool)
-    fig = Figure(figsize=(10.0, 4.2), layout="constrained")
-    axes = fig.subplots(1, 2)
+    fig = Figure(figsize=(14.0, 4.4), layout="constrained")
+    axes = fig.subplots(1, 3)
     panels = (
         (
             np.asarray(point.speed_mps, float)[crossed],
-            "speed (m/s)",
+            "speed of the centre (m/s)",
+            "m/s",
             1.0,
             None if measured is None else measured.speed_mps,
             "measured speed",
         ),
         (
-            np.asarray(point.total_j, float)[crossed] / 1e3,
-            "total energy, translational + rotational (kJ)",
+            np.asarray(point.ke_j, float)[crossed] / 1e3,
+            "translational kinetic energy, 1/2 m v² (kJ)",
+            "kJ",
             1e-3,
-            None if measured is None or measured.ke_j is None else measured.ke_j,
-            "measured KE",
+            None if measured is None else measured.ke_j,
+            "measured translational KE",
+        ),
+        (
+            np.asarray(point.total_j, float)[crossed] / 1e3,
+            "total kinetic energy, translational + rotational (kJ)",
+            "kJ",
+            1e-3,
+            None,
+            "",
         ),
     )
-    for ax, (values, label, scale, meas, meas_label) in zip(axes, panels, strict=True):
+    for ax, (values, label, unit, scale, meas, meas_label) in zip(
+        axes, panels, strict=True
+    ):
         ax.grid(True, alpha=0.3)
         values = values[np.isfinite(values)]
         if values.size:
-            ax.hist(values, bins=min(50, max(10, values.size // 20)), color="0.6")
+            ax.hist(
+                values,
+                bins=min(50, max(10, values.size // 20)),
+                color="0.6",
+                label="simulated rocks crossing this x",
+            )
             for q in PERCENTILES:
                 v = float(np.percentile(values, q))
                 ax.axvline(
                     v,
                     color="tab:blue",
                     ls=_PERCENTILE_STYLES[q],
-                    label=f"p{q} = {v:.3g}",
+                    label=f"{q}th percentile = {v:.3g} {unit}",
                 )
         if meas is not None:
+            rank = (
+                f", percentile {_measured_percentile(values, meas * scale):.0f}"
+                if values.size
+                else ""
+            )
             ax.axvline(
                 meas * scale,
                 color=_MEASURED_COLOUR,
                 lw=2.0,
-                label=f"{meas_label} = {meas * scale:.3g}",
+                label=f"{meas_label} = {meas * scale:.3g} {unit}{rank}",
             )
         ax.set_xlabel(label)
-        ax.set_ylabel("rocks")
+        ax.set_ylabel("number of rocks")
         ax.legend(fontsize=7, loc="upper right")
     fig.suptitle(
-        f"x = {point.x_m:g} m: {int(crossed.sum())} of {result.rocks} rocks passed"
+        f"x = {point.x_m:g} m: {int(crossed.sum())} of {result.rocks} rocks passed "
+        "(values at their first crossing)"
     )
     return fig
 
 
 def runout_figure(result: SimulationResult) -> Figure:
-    """Histogram of the runout x (where each rock stopped or left the profile)."""
+    """Where the rocks ended, by final state: stopped on the profile, left it at
+    either end, or still moving at the impact limit (capped, drawn apart: where
+    they were when the simulation stopped following them, not a runout)."""
+    from fieldkit.model.results import (
+        EXITED_DOWNSLOPE,
+        EXITED_UPSLOPE,
+        MAX_IMPACTS,
+        STOPPED,
+    )
+
     fig, ax = new_figure(8.0, 4.0)
     x = np.asarray(result.runout_x_m, float)
-    x = x[np.isfinite(x)]
-    ax.hist(x, bins=min(60, max(10, x.size // 20)), color="0.6")
-    for q in PERCENTILES:
-        v = float(np.percentile(x, q))
-        ax.axvline(
-            v, color="tab:blue", ls=_PERCENTILE_STYLES[q], label=f"p{q} = {v:.4g} m"
-        )
-    ax.set_xlabel("runout x, where the rock stopped or left the profile (m)")
-    ax.set_ylabel("rocks")
-    ax.set_title("Runout distribution")
+    state = np.asarray(result.state)
+    ok = np.isfinite(x)
+    bins = np.histogram_bin_edges(x[ok], bins=min(60, max(10, int(ok.sum()) // 20)))
+    groups = [
+        (STOPPED, "stopped on the profile", "0.55"),
+        (EXITED_DOWNSLOPE, "left the profile at its lower end", "tab:green"),
+        (EXITED_UPSLOPE, "left the profile at its upper end", "tab:purple"),
+        (
+            MAX_IMPACTS,
+            "capped: still moving at the impact limit, core.max_impacts (where "
+            "they were; not a runout)",
+            "tab:red",
+        ),
+    ]
+    data, labels, colours = [], [], []
+    for code, label, colour in groups:
+        sel = ok & (state == code)
+        if sel.any():
+            data.append(x[sel])
+            labels.append(f"{label} ({int(sel.sum())} rocks)")
+            colours.append(colour)
+    if data:
+        ax.hist(data, bins=bins, stacked=True, color=colours, label=labels)
+    ended = ok & (state != MAX_IMPACTS)
+    if ended.any():
+        for q in PERCENTILES:
+            v = float(np.percentile(x[ended], q))
+            ax.axvline(
+                v,
+                color="tab:blue",
+                ls=_PERCENTILE_STYLES[q],
+                label=f"runout {q}th percentile = {v:.4g} m (capped rocks left out)",
+            )
+    ax.set_xlabel("x where the rock ended, horizontal distance (m)")
+    ax.set_ylabel("number of rocks")
+    ax.set_title("Runout distribution, by final state")
     outside_legend(ax)
     return fig
 

@@ -85,10 +85,15 @@ def test_simulate_writes_summary_impacts_figures_and_recording(
         "40",
         "--summary",
         out / "s2.json",
+        "--measured",
+        "x=40,speed=10,ke=1e5",
+        "--envelope-dx",
+        "0.5",  # the default --figures used and stated for this 90 m profile
     )
     s2 = json.loads((out / "s2.json").read_text())
     s.pop("wall_s"), s2.pop("wall_s")
     assert r2.exit_code == 0 and s == s2
+    assert "--envelope-dx not given" in r.stderr and "0.5 m bins" in r.stderr
 
 
 def test_simulate_refuses_bad_options_without_writing(core, cli, tmp_path, fails):
@@ -108,3 +113,215 @@ def test_effects_lists_and_describes(core, cli, fails):
     one = cli("effects", EFFECTS[0].name)
     assert one.exit_code == 0 and EFFECTS[0].parameters[0].name in one.stdout
     fails(cli("effects", "no_such_effect"), "unknown effect", EFFECTS[0].name)
+
+
+# ---------------------------------------------------------------- issue 17 items
+
+#: RocFall's Table 7-1 colluvium (e_n 1.0 +- 0.04, e_t 0.62) on a 45 deg slope that
+#: runs out onto level ground: the case where rocks bounced in place until the cap.
+POGO = {
+    "profile": {"x_m": [0, 30, 130], "z_m": [30, 0, 0], "material": "colluvium"},
+    "materials": {
+        "colluvium": {
+            "e_n": 1.0,
+            "e_t": 0.62,
+            "friction_deg": 20,
+            "e_n_sd": 0.04,
+            "e_t_sd": 0.04,
+        }
+    },
+    "body": {"mass_kg": 3750, "radius_m": 0.725, "gyration_m": 0.46},
+    "seeder": {"x_m": 1, "z_m": 32, "vx_mps": 3.0},
+}
+
+
+def _model(tmp_path, data=POGO, **core) -> Path:
+    model = dict(data, core=core) if core else data
+    path = tmp_path / "model.json"
+    path.write_text(json.dumps(model))
+    return path
+
+
+def test_rocks_with_e_n_near_one_stop_instead_of_bouncing_in_place(core, cli, tmp_path):
+    """e_n drawn around 1 let the normal speed random-walk up at every impact: on
+    level ground the rocks bounced in place (up to 20 m high) until the 500-impact
+    cap -- all 200 here before the fix. An impact now gains no energy, so they
+    stop on the flat."""
+    model = _model(tmp_path)
+    r = cli("simulate", model, "--rocks", "200", "--seed", "5", "--summary",
+            tmp_path / "s.json")  # fmt: skip
+    assert r.exit_code == 0, r.stderr
+    s = json.loads((tmp_path / "s.json").read_text())
+    assert s["final_state"]["capped"] == 0
+    assert s["final_state"]["stopped"] == 200
+    assert 30.0 < s["runout_x_m"]["p50"] < 130.0  # on the level run-out
+    assert "warning" not in r.stderr
+
+
+def test_capped_rocks_are_their_own_state_with_a_warning(core, cli, tmp_path):
+    model = _model(tmp_path, max_impacts=3)  # most rocks need more than 3 impacts
+    r = cli("simulate", model, "--rocks", "200", "--seed", "5", "--summary",
+            tmp_path / "s.json", "--figures", tmp_path / "figs")  # fmt: skip
+    assert r.exit_code == 0, r.stderr
+    s = json.loads((tmp_path / "s.json").read_text())
+    capped = s["final_state"]["capped"]
+    assert capped > 100
+    assert s["capped"]["rocks"] == capped and s["capped"]["max_impacts"] == 3
+    assert s["capped"]["fraction"] == pytest.approx(capped / 200)
+    # never counted as stopped or as run out
+    assert s["final_state"]["stopped"] + s["final_state"]["exited_downslope"] == (
+        200 - capped
+    )
+    assert s["stopped_fraction"] == pytest.approx(s["final_state"]["stopped"] / 200)
+    assert s["runout_x_m"]["n"] == 200 - capped
+    assert "left out" in s["runout_over"]
+    bounds = s["runout_bounds_x_m"]
+    assert bounds["lower"]["p50"] <= bounds["upper"]["p50"]
+    assert bounds["upper"]["max"] == 130.0
+    # one warning line: the fraction, what it means, how to raise the cap
+    warning = [line for line in r.stderr.splitlines() if line.startswith("warning:")]
+    assert len(warning) == 1
+    assert f"({capped} of 200)" in warning[0] and "max_impacts" in warning[0]
+    assert "left out of the runout statistics" in warning[0]
+    assert f"{capped} capped left out" in r.stdout
+
+
+def test_compiling_is_announced_and_timed_apart(core, cli, tmp_path, monkeypatch):
+    """When the kernel is not cached the command says so and reports the compile
+    apart from the simulation (here the compile is a stand-in taking 0.2 s)."""
+    import sys
+    import time
+
+    import fieldkit.model.kernel as kernel
+
+    simulation = sys.modules["fieldkit.model.simulate"]  # the module, not the function
+
+    def slow_warm() -> float:
+        time.sleep(0.2)
+        return 0.2
+
+    simulation.warm_kernel()  # the real kernel, loaded before the stand-in
+    monkeypatch.setattr(kernel, "kernel_ready", lambda: False)
+    monkeypatch.setattr(simulation, "warm_kernel", slow_warm)
+    r = cli("simulate", MODEL, "--rocks", "20", "--seed", "1", "--summary",
+            tmp_path / "s.json")  # fmt: skip
+    assert r.exit_code == 0, r.stderr
+    assert "compiling the simulator, first run only" in r.stderr
+    s = json.loads((tmp_path / "s.json").read_text())
+    assert s["compile_s"] == 0.2 and s["wall_s"] < 0.2
+    assert "compiling the simulator took 0.20 s (first run only)" in r.stdout
+
+
+def test_cached_kernel_is_not_announced(core, cli, tmp_path):
+    import fieldkit.model.kernel as kernel
+    from fieldkit.model.simulate import warm_kernel
+
+    warm_kernel()
+    assert kernel.kernel_ready() and kernel.kernel_loaded()
+    r = cli("simulate", MODEL, "--rocks", "20", "--seed", "1", "--summary",
+            tmp_path / "s.json")  # fmt: skip
+    assert r.exit_code == 0 and "compiling" not in r.stderr + r.stdout
+    assert json.loads((tmp_path / "s.json").read_text())["compile_s"] == 0.0
+
+
+@pytest.mark.slow
+def test_a_fresh_copy_compiles_once_then_loads_from_its_cache(tmp_path, repo):
+    """numba caches by source path: a fresh clone compiles on its first run (or at
+    install, make's warm-up) and every later run loads the cache."""
+    import shutil
+    import subprocess
+    import sys
+
+    shutil.copytree(repo / "fieldkit", tmp_path / "fieldkit",
+                    ignore=shutil.ignore_patterns("__pycache__"))  # fmt: skip
+    env = {"PYTHONPATH": str(tmp_path), "PATH": "/usr/bin:/bin", "HOME": str(tmp_path)}
+
+    def run():
+        return subprocess.run(
+            [sys.executable, "-m", "fieldkit", "simulate", str(MODEL), "--rocks",
+             "50", "--seed", "1", "--summary", str(tmp_path / "s.json")],
+            capture_output=True, text=True, env=env, cwd=tmp_path, check=True,
+        )  # fmt: skip
+
+    first = run()
+    assert "compiling the simulator, first run only" in first.stderr
+    assert json.loads((tmp_path / "s.json").read_text())["compile_s"] > 1.0
+    second = run()
+    assert "compiling" not in second.stderr + second.stdout
+    assert json.loads((tmp_path / "s.json").read_text())["compile_s"] == 0.0
+
+
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (["--at", "900"], ["--at", "900 m lies outside the profile", "0 to 90 m"]),
+        (["--at", "nan"], ["--at", "nan is not a finite x", "0 to 90 m"]),
+        (["--at", "-inf"], ["--at", "-inf is not a finite x"]),
+        (["--seed", "-1"], ["--seed", "from 0"]),
+        (["--seed", str(2**64)], ["--seed", "2**64 - 1"]),
+        (["--rocks", "1000000000"], ["--rocks", "10,000,000"]),
+        (["--trajectories", "100000"], ["--trajectories", "1,000"]),
+        (["--envelope-dx", "1e-9"], ["--envelope-dx", "at most 100,000", "0.0009 m"]),
+        (["--envelope-dx", "inf"], ["--envelope-dx", "finite"]),
+        (["--envelope-dx", "nan"], ["--envelope-dx", "finite"]),
+        ([a for _ in range(101) for a in ("--at", "5")], ["--at", "at most 100"]),
+        (
+            ["--rocks", "9000000", "--at", "5", "--at", "6", "--envelope-dx", "0.01"],
+            ["--rocks", "GiB", "at most"],
+        ),
+        (["--at", "40", "--measured", "x=50,speed=3"], ["--measured", "--at 50"]),
+    ],
+)
+def test_hostile_options_are_one_line_refusals(core, cli, fails, tmp_path, args, words):
+    out = tmp_path / "out"
+    r = cli("simulate", MODEL, "--summary", out / "s.json", "--figures", out / "f",
+            *args)  # fmt: skip
+    fails(r, *words)
+    assert not out.exists()
+
+
+def test_impacts_to_dev_null_and_every_written_file_is_reported(core, cli, tmp_path):
+    r = cli("simulate", MODEL, "--rocks", "20", "--seed", "2", "--impacts",
+            "/dev/null", "--summary", tmp_path / "s.json", "--figures",
+            tmp_path / "f", "--at", "40")  # fmt: skip
+    assert r.exit_code == 0, r.stderr
+    wrote = [line[6:] for line in r.stdout.splitlines() if line.startswith("wrote ")]
+    expected = {"/dev/null", str(tmp_path / "s.json")} | {
+        str(tmp_path / "f" / name)
+        for name in ("trajectories.png", "envelope.png", "runout.png",
+                     "point_1_x40.png")
+    }  # fmt: skip
+    assert set(wrote) == expected and len(wrote) == len(expected)
+    assert "simulating 20 rocks" in r.stderr  # the step is named off a terminal
+
+
+def test_figures_get_a_stated_envelope_and_measured_percentiles(core, cli, tmp_path):
+    import numpy as np
+
+    from fieldkit.model.model_file import read_model
+    from fieldkit.model.simulate import simulate
+
+    r = cli("simulate", MODEL, "--rocks", "60", "--seed", "3", "--at", "40",
+            "--measured", "x=40,speed=10,ke=1e5", "--summary", tmp_path / "s.json",
+            "--figures", tmp_path / "f")  # fmt: skip
+    assert r.exit_code == 0, r.stderr
+    s = json.loads((tmp_path / "s.json").read_text())
+    # envelope.png is not empty: a stated default bin width (90 m / 200 -> 0.5 m)
+    assert "0.5 m bins" in r.stderr
+    assert len(s["envelope"]["x_m"]) == 180 and s["envelope"]["reached"][0] == 60
+    assert s["envelope"]["bin_width_m"] == 0.5
+    # each measured value's percentile among the rocks crossing x = 40 m
+    point = simulate(read_model(MODEL), 60, np.random.default_rng(3),
+                     analysis_x_m=[40.0]).analysis[0]  # fmt: skip
+    speeds = point.speed_mps[point.crossed]
+    ke = point.ke_j[point.crossed]  # translational, as measured
+    m = s["measured"][0]
+    assert m["x_m"] == 40.0
+    assert m["speed_mps"]["percentile"] == pytest.approx(
+        100 * ((speeds < 10).sum() + 0.5 * (speeds == 10).sum()) / speeds.size
+    )
+    assert m["ke_j"]["percentile"] == pytest.approx(100 * (ke < 1e5).sum() / ke.size)
+    assert m["speed_mps"]["n"] == speeds.size
+    line = next(ln for ln in r.stdout.splitlines() if ln.startswith("measured at"))
+    assert f"percentile {m['speed_mps']['percentile']:.1f}" in line
+    assert "translational KE 100 kJ" in line
