@@ -32,7 +32,7 @@ from fieldkit.tracking.flights.net_contacts import NetContact
 from fieldkit.tracking.flights.pipeline import TrackAnalysis
 from fieldkit.viz.figure_files import new_figure, save_png
 from fieldkit.viz.image_projection import project, world_to_image
-from fieldkit.viz.marks import mark_flagged, outside_legend, qa_flagged, velocity_key
+from fieldkit.viz.marks import mark_flagged, outside_legend, qa_column, velocity_key
 
 _CONTACT_SHADE = dict(color="0.85", zorder=0)
 GROUND_COLOUR = "#6b4f2a"
@@ -150,7 +150,7 @@ def plot_track(a: TrackAnalysis, background: np.ndarray | None = None) -> Figure
                 xytext=(4, -10),
                 textcoords="offset points",
             )
-        mark_flagged(ax, pts[:, 0], pts[:, 1], qa_flagged(imp))
+        mark_flagged(ax, pts[:, 0], pts[:, 1], qa_column(imp))
         arrows = _draw_velocities(ax, imp, sx, h, span_m=span_m)
     outside_legend(ax, fontsize=7)
     if arrows is not None:  # after the limits are set: the key goes where nothing is
