@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import functools
 import math
-import sys
 from pathlib import Path
 from typing import Annotated
 
@@ -23,6 +22,7 @@ from fieldkit.cli.common import (
     print_body_notes,
     warn,
 )
+from fieldkit.cli.progress import report_written, step
 from fieldkit.errors import ArgumentError
 from fieldkit.impact_table import FORMATS
 from fieldkit.outputs import OutputSet
@@ -253,12 +253,12 @@ def track(
         )
     written = outputs.commit()
     _summary(video, track_data, detections, analysis, calibration.description)
-    for path in written:
-        typer.echo(f"wrote {path}")
+    report_written(written)
 
 
 def _run_tracking(video, reader, fps, calibration, roi, radius, *, show: bool):
-    """track_video with a rich progress bar on stderr for long videos."""
+    """track_video, shown as a progress step (:func:`fieldkit.cli.progress.step`)
+    for long videos."""
     from fieldkit.tracking.video.pipeline import track_video
 
     run = functools.partial(
@@ -273,27 +273,8 @@ def _run_tracking(video, reader, fps, calibration, roi, radius, *, show: bool):
     total = reader.info.frame_count
     if not show or total < PROGRESS_MIN_FRAMES:
         return run()
-    from rich.console import Console
-    from rich.progress import (
-        BarColumn,
-        MofNCompleteColumn,
-        Progress,
-        TimeRemainingColumn,
-    )
-
-    console = Console(file=sys.stderr)
-    if not console.is_terminal:  # no bar in logs and pipes
-        return run()
-    with Progress(
-        "[progress.description]{task.description}",
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeRemainingColumn(),
-        console=console,
-        transient=True,
-    ) as bar:
-        task = bar.add_task("tracking", total=total)
-        return run(progress=lambda done, n: bar.update(task, completed=done, total=n))
+    with step(f"tracking {total:,} frames", total=total) as advance:
+        return run(progress=advance)
 
 
 def _summary(video, track_data, detections, analysis, calibration_text) -> None:
@@ -306,6 +287,7 @@ def _summary(video, track_data, detections, analysis, calibration_text) -> None:
         f"{len(analysis.flights)} flights, {len(frame)} impacts, "
         f"{len(analysis.contacts)} extended contacts"
     )
+    print_flight_gravity(analysis.flights)
     for _, row in frame.iterrows():
         typer.echo(
             f"  impact {row['point']}: t={row['t_s']:.4f} s  vi={row['vi_mps']:.3f} "
@@ -315,3 +297,18 @@ def _summary(video, track_data, detections, analysis, calibration_text) -> None:
         )
     for contact in analysis.contacts:
         typer.echo(f"  {contact.summary()}")
+
+
+def print_flight_gravity(flights) -> None:
+    """One line per fitted flight: its fitted g with standard error and how far it
+    lies from 9.81 (the check on the capture rate and the scale; flights beyond
+    three standard errors are also warned about, by name)."""
+    from fieldkit.tracking.flights.ballistic_fit import GRAVITY_WARNING_SIGMAS
+
+    if flights:
+        typer.echo(
+            "fitted gravity per flight (free-g fit; warned beyond "
+            f"{GRAVITY_WARNING_SIGMAS:g} standard errors from 9.81):"
+        )
+    for flight in flights:
+        typer.echo(f"  {flight.gravity_summary()}")
