@@ -283,20 +283,20 @@ def _summary(video, track_data, detections, analysis, calibration_text) -> None:
         f"{video}: {len(detections)} frames, body in {len(track_data)}; "
         f"{calibration_text}"
     )
-    typer.echo(
-        f"{len(analysis.flights)} flights, {len(frame)} impacts, "
-        f"{len(analysis.contacts)} extended contacts"
-    )
+    typer.echo(analysis.counts_text())
     print_flight_gravity(analysis.flights)
-    for _, row in frame.iterrows():
+    for (_, row), net in zip(frame.iterrows(), analysis.net_rows, strict=True):
+        what = "net contact at point" if net else "impact"
         typer.echo(
-            f"  impact {row['point']}: t={row['t_s']:.4f} s  vi={row['vi_mps']:.3f} "
+            f"  {what} {row['point']}: t={row['t_s']:.4f} s  vi={row['vi_mps']:.3f} "
             f"vf={row['vf_mps']:.3f} m/s  e_n={row['e_n']:.3f} e_t={row['e_t']:.3f}  "
             f"omega {row['omega_i_radps']:.1f} -> {row['omega_f_radps']:.1f} rad/s  "
             f"slope {row['slope_deg']:.2f} deg"
         )
     for contact in analysis.contacts:
         typer.echo(f"  {contact.summary()}")
+    for line in analysis.net_rows_text():
+        typer.echo(f"  {line}")
 
 
 def print_flight_gravity(flights) -> None:

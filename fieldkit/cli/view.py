@@ -21,6 +21,8 @@ from fieldkit.cli.common import (
     print_body_notes,
     warn,
 )
+from fieldkit.cli.progress import report_written
+from fieldkit.cli.track import print_flight_gravity
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.impact_table import ImpactTable
 from fieldkit.io.track_files import detect_format, read_track
@@ -187,10 +189,11 @@ def view(
     rerun_log.write_recording(out, analysis, outputs=outputs)
     if figures is not None:
         write_track_figures(figures, analysis, outputs=outputs)
-    outputs.commit()
-    typer.echo(
-        f"wrote {out}: {len(analysis.track)} samples, {len(analysis.flights)} flights, "
-        f"{len(analysis.impacts)} impacts, {len(analysis.contacts)} net contacts"
-    )
+    written = outputs.commit()
+    typer.echo(f"{len(analysis.track)} samples, {analysis.counts_text()}")
+    print_flight_gravity(analysis.flights)
     for contact in analysis.contacts:
         typer.echo(f"  {contact.summary()}")
+    for line in analysis.net_rows_text():
+        typer.echo(f"  {line}")
+    report_written(written)

@@ -247,7 +247,7 @@ def _log_world(rec: rr.RecordingStream, analysis: TrackAnalysis) -> None:
     for fl in analysis.flights:
         t = np.linspace(fl.t_start_s, fl.t_end_s, 60)
         strips.append(_xyz(*fl.position(t)))
-        labels.append(f"flight {fl.index}: g = {fl.g_mps2:.2f} ± {fl.g_se_mps2:.2f}")
+        labels.append(f"flight {fl.index}: g = {fl.g_text()} m/s^2")
     if strips:
         rec.log(
             "world/flights",
@@ -256,9 +256,12 @@ def _log_world(rec: rr.RecordingStream, analysis: TrackAnalysis) -> None:
         )
     imp = analysis.impacts.frame
     if len(imp):
+        kinds = ["net contact" if net else "impact" for net in analysis.net_rows]
         labels = [
-            f"{p}: e_n {en:.2f}, e_t {et:.2f}"
-            for p, en, et in zip(imp["point"], imp["e_n"], imp["e_t"], strict=True)
+            f"{kind} {p}: e_n {en:.2f}, e_t {et:.2f}"
+            for kind, p, en, et in zip(
+                kinds, imp["point"], imp["e_n"], imp["e_t"], strict=True
+            )
         ]
         sx = _table_mirror(analysis)
         rec.log(
@@ -271,12 +274,12 @@ def _log_world(rec: rr.RecordingStream, analysis: TrackAnalysis) -> None:
             ),
             static=True,
         )
-        for row in imp.itertuples():
+        for kind, row in zip(kinds, imp.itertuples(), strict=True):
             rec.set_time("t", duration=float(row.t_s))
             rec.log(
                 "events",
                 rr.TextLog(
-                    f"impact {row.point}: v_i {row.vi_mps:.2f} -> "
+                    f"{kind} {row.point}: v_i {row.vi_mps:.2f} -> "
                     f"v_f {row.vf_mps:.2f} m/s, "
                     f"e_n {row.e_n:.2f}, e_t {row.e_t:.2f}, psi {row.slope_deg:.1f} deg"
                 ),

@@ -87,7 +87,7 @@ def test_track_exports_are_detected_and_read(cli, tmp_path, sample, args):
     out = tmp_path / "x.rrd"
     result = cli("view", DATA / sample, "--radius", "0.03", "-o", out, *args)
     assert result.exit_code == 0, result.stderr
-    assert "1 flights" in result.stdout
+    assert "1 flight, " in result.stdout
     assert "g = " not in result.stderr  # exact parabolas: g = 9.81, no warning
     assert out.is_file()
 
@@ -158,3 +158,61 @@ def test_bad_input_one_line_error_and_no_output(
     assert result.stderr.startswith("error: ") and result.stderr.count("\n") == 1
     assert not (tmp_path / "out.rrd").exists()
     assert not (tmp_path / "x.png").exists()
+
+
+def test_net_clip_truth_is_one_net_contact_not_an_impact_too(cli, repo, tmp_path):
+    """Issue 17: `view video/net.truth.csv` reported "1 impacts, 1 net contacts"
+    (the truth has no impact, one contact) and drew the contact as an impact on a
+    "ground" line at -105 deg. The contact is one event: its ImpactTable row is the
+    net contact, on the net's own line (overhanging, docs/architecture.md §2)."""
+    import json
+
+    from matplotlib.figure import Figure
+
+    truth = json.loads((repo / "video" / "net.truth.json").read_text())
+    top, bottom = (
+        np.array(truth["scene_parameters"][k]) for k in ("net_top_m", "net_bottom_m")
+    )
+    dx, dz = bottom - top
+    psi_truth = -np.degrees(np.arctan2(dz, dx)) - 180.0  # N turned to face the ball
+    out, figs = tmp_path / "net.rrd", tmp_path / "net_figs"
+    saved = []
+    original = Figure.savefig
+
+    def keep(self, *args, **kwargs):
+        saved.append(self)
+        return original(self, *args, **kwargs)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(Figure, "savefig", keep)
+        result = cli(
+            "view",
+            repo / "video" / "net.truth.csv",
+            "--radius",
+            "0.0375",
+            "--mass",
+            "0.14",
+            "--gyration",
+            "0.02372",
+            "-o",
+            out,
+            "--figures",
+            figs,
+        )
+    assert result.exit_code == 0, result.stderr
+    assert truth["impacts"] == []
+    assert "482 samples, 2 flights, 0 impacts, 1 net contact" in result.stdout
+    (line,) = [s for s in result.stdout.splitlines() if "the net's line" in s]
+    psi = float(line.split("slope_deg ")[1].split(" deg")[0])
+    assert psi == pytest.approx(psi_truth, abs=0.5)  # -105.1: the net, not ground
+    assert "overhanging" in line
+    (track_fig,) = [f for f in saved if f.axes[0].get_title().startswith("track")]
+    texts = [t.get_text() for t in track_fig.axes[0].get_legend().get_texts()]
+    assert "net's line at the contact (slope_deg)" in texts
+    assert "net contact (start)" in texts
+    assert not [t for t in texts if t.startswith(("impacts", "ground"))]
+    wrote = [s for s in result.stdout.splitlines() if s.startswith("wrote ")]
+    assert wrote == [f"wrote {out}"] + [
+        f"wrote {figs / n}"
+        for n in ("track.png", "speed_spin.png", "residuals.png", "net_contact_0.png")
+    ]

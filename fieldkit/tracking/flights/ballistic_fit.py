@@ -276,7 +276,7 @@ class FlightFit:
         se = self.g_se_mps2
         digits = 2
         if np.isfinite(se) and se > 0:
-            digits = int(min(max(2, 1 - np.floor(np.log10(se))), 6))
+            digits = int(min(max(2, 1 - np.floor(np.log10(se))), 4))
         return f"{self.g_mps2:.{digits}f} +/- {se:.{digits}f}"
 
     def position(self, t_s: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
