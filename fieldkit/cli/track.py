@@ -25,6 +25,7 @@ from fieldkit.cli.common import (
 from fieldkit.cli.progress import report_written, step
 from fieldkit.errors import ArgumentError
 from fieldkit.impact_table import FORMATS
+from fieldkit.io.tracking_export import check_frame_rate
 from fieldkit.outputs import OutputSet
 
 #: show a progress bar for videos longer than this many frames
@@ -156,10 +157,7 @@ def track(
             "playback rate)",
             source="--fps",
         )
-    if not math.isfinite(fps) or fps <= 0:
-        raise ArgumentError(
-            f"must be a positive frame rate, got {fps:g}", source="--fps"
-        )
+    check_frame_rate(fps, "fps")
     body = body_from_options(mass, radius, gyration, shape, dimensions, unit_weight)
     if surface_angle is not None and not (
         math.isfinite(surface_angle) and -90 < surface_angle < 90

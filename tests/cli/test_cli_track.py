@@ -138,6 +138,31 @@ def test_homography_file_gives_the_same_track(cli, clip, tmp_path):
         ((*SCALE,), ("--fps", "required")),
         (("--fps", "0", *SCALE), ("--fps", "positive")),
         (("--fps", "-1205", *SCALE), ("--fps", "positive")),
+        # issue 17: rates and scales no camera has broke the arithmetic (traceback)
+        (("--fps", "1e300", *SCALE), ("--fps", "at most 1e+07 frames/s")),
+        (("--fps", "1e-300", *SCALE), ("--fps", "at least 0.001")),
+        (
+            (
+                "--fps",
+                "1205",
+                "--scale-points",
+                "20,20,300,20",
+                "--scale-length",
+                "1e300",
+            ),
+            ("--scale-length", "m per pixel", "a wrong unit?"),
+        ),
+        (
+            (
+                "--fps",
+                "1205",
+                "--scale-points",
+                "20,20,300,20",
+                "--scale-length",
+                "1e-300",
+            ),
+            ("--scale-length", "m per pixel"),
+        ),
         (
             ("--fps", "1205", "--scale-points", "20,20,20,20", "--scale-length", "1"),
             ("--scale-points", "identical"),

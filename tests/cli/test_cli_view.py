@@ -216,3 +216,75 @@ def test_net_clip_truth_is_one_net_contact_not_an_impact_too(cli, repo, tmp_path
         f"wrote {figs / n}"
         for n in ("track.png", "speed_spin.png", "residuals.png", "net_contact_0.png")
     ]
+
+
+def _track_text(rows: list[tuple[str, str, str]]) -> str:
+    return "t_s,x_m,z_m\n" + "".join(f"{t},{x},{z}\n" for t, x, z in rows)
+
+
+def _throw(n: int = 40) -> list[list[str]]:
+    t = np.arange(n) / 1000.0
+    return [
+        [repr(float(a)), repr(float(b)), repr(float(c))]
+        for a, b, c in zip(t, 1.0 * t, 0.5 + t - 4.905 * t**2, strict=True)
+    ]
+
+
+def _edit(row: int, column: int, value: str) -> str:
+    """A thrown-ball track with file row ``row`` (header = row 1), ``column`` set."""
+    rows = _throw()
+    rows[row - 2][column] = value
+    return _track_text([tuple(r) for r in rows])
+
+
+@pytest.mark.parametrize(
+    ("text", "args", "message"),
+    [
+        # issue 17: times going backwards or repeating used to be sorted silently
+        (
+            _edit(20, 0, "0.005"),
+            (),
+            "back.csv: row 20: times are not increasing: 0.005 s goes back from",
+        ),
+        (
+            _edit(21, 0, "0.018"),
+            (),
+            "row 21: times are not increasing: 0.018 s repeats 0.018 s",
+        ),
+        (_edit(7, 0, "inf"), (), "back.csv: row 7: t_s inf: time is missing"),
+        (_edit(8, 0, ""), (), "back.csv: row 8: t_s nan: time is missing"),
+        (_edit(9, 1, "-inf"), (), "back.csv: row 9: x_m -inf: not finite"),
+        (_edit(10, 2, "1e300"), (), "back.csv: row 10: z_m 1e+300: beyond 100000 m"),
+        (_edit(40, 0, "1e200"), (), "back.csv: row 40: t_s 1e+200: beyond 86400 s"),
+        (
+            _track_text([(f"{i * 1e-12!r}", "0", "0") for i in range(20)]),
+            (),
+            "back.csv: row 3: time step 1e-12 s from the row before is shorter",
+        ),
+        (None, ("--fps", "0", "--file-fps", "30"), "--fps must be a positive frame"),
+        (None, ("--fps", "inf", "--file-fps", "30"), "got inf"),
+        (None, ("--fps", "nan", "--file-fps", "30"), "got nan"),
+        (None, ("--fps", "1e300", "--file-fps", "30"), "at most 1e+07 frames/s"),
+        (None, ("--fps", "1205", "--file-fps", "1e-300"), "--file-fps must be"),
+        (None, ("--fps", "-1"), "--fps must be a positive frame rate"),
+        (None, ("--surface-angle", "nan"), "--surface-angle must be a dip in"),
+        (None, ("--surface-angle", "200"), "(-180, 180] deg"),
+    ],
+)
+def test_hostile_track_input_one_line_error_nothing_written(
+    cli, tmp_path, text, args, message
+):
+    """Issue 17: `view` of a track whose times go backwards succeeded; so did rates
+    and sizes no camera has. Each is now one error line naming the file and row (or
+    the option), exit 1, nothing written, the input unchanged."""
+    path = tmp_path / "back.csv"
+    path.write_text(text or _track_text([tuple(r) for r in _throw()]))
+    before = path.read_bytes()
+    out = tmp_path / "out.rrd"
+    result = cli("view", path, "--radius", "0.03", *args, "-o", out)
+    assert result.exit_code == 1, result.stdout
+    lines = [line for line in result.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
+    assert message in lines[0], lines[0]
+    assert not out.exists() and path.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["back.csv"]

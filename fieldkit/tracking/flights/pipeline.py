@@ -188,6 +188,14 @@ def analyse_track(
         raise ArgumentError(
             f"radius_m must be > 0 (got {radius_m:g})", source="radius_m"
         )
+    if surface_angle_deg is not None and not (
+        np.isfinite(surface_angle_deg) and -180.0 < surface_angle_deg <= 180.0
+    ):
+        raise ArgumentError(
+            "surface_angle_deg must be a dip in (-180, 180] deg "
+            f"(docs/architecture.md §2), got {surface_angle_deg:g}",
+            source="surface_angle_deg",
+        )
     if mass_kg is not None and not mass_kg > 0:
         raise ArgumentError(f"mass_kg must be > 0 (got {mass_kg:g})", source="mass_kg")
     if gyration_m is not None and not gyration_m > 0:

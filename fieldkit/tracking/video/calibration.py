@@ -80,6 +80,12 @@ class Calibration:
         }
 
 
+#: Plausible image scales [m/px]: a microscope's 0.1 um/px to a satellite's 1 km/px;
+#: a scale outside is a unit mistake and breaks the tracking arithmetic.
+MIN_METRES_PER_PIXEL = 1e-7
+MAX_METRES_PER_PIXEL = 1e3
+
+
 def parse_scale_points(scale_points: str) -> tuple[float, float, float, float]:
     """Parse ``"U1,V1,U2,V2"`` (pixels): the ``scale_points`` of
     :func:`two_point_scale`.
@@ -150,6 +156,12 @@ def two_point_scale(
             source="scale_points",
         )
     s = length_m / distance
+    if not MIN_METRES_PER_PIXEL <= s <= MAX_METRES_PER_PIXEL:
+        raise ArgumentError(
+            f"{length_m:g} m over {distance:.4g} px is {s:.3g} m per pixel, outside "
+            f"{MIN_METRES_PER_PIXEL:g}-{MAX_METRES_PER_PIXEL:g} m/px (a wrong unit?)",
+            source="scale_length_m",
+        )
     h = np.array([[s, 0.0, -s * u1], [0.0, -s, s * v1], [0.0, 0.0, 1.0]])
     return Calibration(
         h,
