@@ -249,7 +249,8 @@ def track(
         write_track_figures(
             figures, analysis, background_frame=background, outputs=outputs
         )
-    written = outputs.commit()
+    with step("writing the outputs", announce=rrd is not None or figures is not None):
+        written = outputs.commit()
     _summary(video, track_data, detections, analysis, calibration.description)
     report_written(written)
 

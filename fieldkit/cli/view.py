@@ -21,7 +21,7 @@ from fieldkit.cli.common import (
     print_body_notes,
     warn,
 )
-from fieldkit.cli.progress import report_written
+from fieldkit.cli.progress import report_written, step
 from fieldkit.cli.track import print_flight_gravity
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.impact_table import ImpactTable
@@ -148,9 +148,17 @@ def view(
         table = ImpactTable.read(input_file)
         if len(table) == 0:
             raise InputFileError("table has no rows", source=input_file)
-        rerun_log.write_impact_recording(out, table.derive(), outputs=outputs)
-        outputs.commit()
-        typer.echo(f"wrote {out}: {len(table)} impacts, {len(table.paths())} path(s)")
+        paths = len(table.paths())
+        with step(f"recording {len(table):,} impacts of {paths:,} path(s)"):
+            table = table.derive()
+            rerun_log.write_impact_recording(out, table, outputs=outputs)
+            written = outputs.commit()
+        typer.echo(
+            f"{len(table):,} impacts, {paths:,} path(s): the section shows every path "
+            "(one row of the path timeline each), e_n, e_t and speeds against the "
+            "impact timeline (table row)"
+        )
+        report_written(written)
         return
     if figures is not None:
         from fieldkit.viz.track_figure import TRACK_FIGURE_NAMES, write_track_figures
@@ -189,7 +197,10 @@ def view(
     rerun_log.write_recording(out, analysis, outputs=outputs)
     if figures is not None:
         write_track_figures(figures, analysis, outputs=outputs)
-    written = outputs.commit()
+    with step(
+        "writing the recording and figures", announce=len(analysis.track) > 20_000
+    ):
+        written = outputs.commit()
     typer.echo(f"{len(analysis.track)} samples, {analysis.counts_text()}")
     print_flight_gravity(analysis.flights)
     for contact in analysis.contacts:
