@@ -106,8 +106,8 @@ def plot_track(a: TrackAnalysis, background: np.ndarray | None = None) -> Figure
             background[..., ::-1] if background.ndim == 3 else background, cmap="gray"
         )
         u, v = f["u_px"].to_numpy(float), f["v_px"].to_numpy(float)
-        ax.set_xlabel("u [px]")
-        ax.set_ylabel("v [px]")
+        ax.set_xlabel("u, image column [px]")
+        ax.set_ylabel("v, image row [px]")
         ax.set_title("track over a video frame")
     else:
         u, v = f["x_m"].to_numpy(float), f["z_m"].to_numpy(float)
@@ -300,7 +300,14 @@ def plot_speed_spin(a: TrackAnalysis) -> Figure:
         2, 1, figsize=(8, 6), sharex=True, layout="constrained"
     )
     if ok.any():
-        ax1.plot(t[ok], measured[ok], ".", ms=2, color="0.5", label="measured")
+        ax1.plot(
+            t[ok],
+            measured[ok],
+            ".",
+            ms=2,
+            color="0.5",
+            label="measured (local differentiation)",
+        )
     for fl in a.flights:
         tt = np.linspace(fl.t_start_s, fl.t_end_s, 50)
         ax1.plot(
@@ -313,18 +320,30 @@ def plot_speed_spin(a: TrackAnalysis) -> Figure:
     outside_legend(ax1, fontsize=7)
     omega = f["omega_radps"].to_numpy(float)
     if np.isfinite(omega).any():
-        ax2.plot(t, omega, ".", ms=2, color="0.3", label="omega (track)")
+        ax2.plot(t, omega, ".", ms=2, color="0.3", label="spin from the marker (track)")
     else:
         ax2.text(
             0.5, 0.5, "no spin marker followed", transform=ax2.transAxes, ha="center"
         )
     imp = a.impacts.frame
     if len(imp):
-        ax2.plot(imp["t_s"], imp["omega_i_radps"], "v", color="crimson", label="before")
-        ax2.plot(imp["t_s"], imp["omega_f_radps"], "^", color="green", label="after")
+        ax2.plot(
+            imp["t_s"],
+            imp["omega_i_radps"],
+            "v",
+            color="crimson",
+            label="spin before the impact",
+        )
+        ax2.plot(
+            imp["t_s"],
+            imp["omega_f_radps"],
+            "^",
+            color="green",
+            label="spin after the impact",
+        )
         outside_legend(ax2, fontsize=7)
     ax2.set_ylabel("spin omega [rad/s]")
-    ax2.set_xlabel("t [s]")
+    ax2.set_xlabel("time t [s]")
     for ax in (ax1, ax2):
         ax.grid(True, alpha=0.3)
         _shade_contacts(ax, a)
@@ -354,7 +373,7 @@ def plot_residuals(a: TrackAnalysis) -> Figure:
             label="noise estimate (2-D RMS)",
         )
     _shade_contacts(ax, a)
-    ax.set_xlabel("t [s]")
+    ax.set_xlabel("time t [s]")
     ax.set_ylabel("distance from fitted flight [mm]")
     outside_legend(ax, fontsize=7)
     return fig

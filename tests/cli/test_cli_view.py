@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -262,6 +263,10 @@ def test_net_clip_truth_is_one_net_contact_not_an_impact_too(cli, repo, tmp_path
     assert "net's line at the contact (slope_deg)" in texts
     assert "net contact (start)" in texts
     assert not [t for t in texts if t.startswith(("impacts", "ground"))]
+    for fig in saved:  # every axis in words with a unit
+        for ax in fig.axes:
+            for label in (ax.get_xlabel(), ax.get_ylabel()):
+                assert not label or re.search(r"[a-z]{4,}.*\[[^\]]+\]", label), label
     wrote = [s for s in result.stdout.splitlines() if s.startswith("wrote ")]
     assert wrote == [f"wrote {out}"] + [
         f"wrote {figs / n}"
