@@ -258,6 +258,8 @@ def test_net_clip_truth_is_one_net_contact_not_an_impact_too(cli, repo, tmp_path
     psi = float(line.split("slope_deg ")[1].split(" deg")[0])
     assert psi == pytest.approx(psi_truth, abs=0.5)  # -105.1: the net, not ground
     assert "overhanging" in line
+    # the surface estimate names the same event, as a net contact
+    assert "warning: point 1 (net contact): surface angle -105.13 deg" in result.stderr
     (track_fig,) = [f for f in saved if f.axes[0].get_title().startswith("track")]
     texts = [t.get_text() for t in track_fig.axes[0].get_legend().get_texts()]
     assert "net's line at the contact (slope_deg)" in texts
