@@ -81,6 +81,10 @@ def read_number_columns(
 #: Fastest capture rate accepted [frames/s]: beyond the fastest scientific cameras
 #: (about 1e7 frames/s); a larger number is a typo or a unit mix-up.
 MAX_FPS = 1e7
+#: Plausible image scales [m/px]: a microscope's 0.1 um/px to a satellite's 1 km/px;
+#: a scale outside is a unit mistake and breaks the tracking arithmetic.
+MIN_METRES_PER_PIXEL = 1e-7
+MAX_METRES_PER_PIXEL = 1e3
 #: Slowest frame rate accepted [frames/s] (a frame every ~17 minutes: time-lapse).
 MIN_FPS = 1e-3
 #: Shortest time step between track rows [s]: a tenth of a frame at MAX_FPS.
@@ -198,13 +202,22 @@ class LengthScale:
 
     def metres_per_unit(self, source: object) -> float:
         if self.unit == PIXELS:
-            if self.metres_per_pixel is None or not (
-                np.isfinite(self.metres_per_pixel) and self.metres_per_pixel > 0
-            ):
+            if self.metres_per_pixel is None:
                 raise ArgumentError(
                     "coordinates are in pixels: give the scale in metres per pixel "
                     "(`metres_per_pixel`, e.g. ball diameter in m / diameter in px)",
                     source=str(source),
+                )
+            if not (
+                np.isfinite(self.metres_per_pixel)
+                and MIN_METRES_PER_PIXEL
+                <= self.metres_per_pixel
+                <= MAX_METRES_PER_PIXEL
+            ):
+                raise ArgumentError(
+                    f"metres_per_pixel must lie between {MIN_METRES_PER_PIXEL:g} and "
+                    f"{MAX_METRES_PER_PIXEL:g} m/px, got {self.metres_per_pixel:g}",
+                    source="metres_per_pixel",
                 )
             return float(self.metres_per_pixel)
         if self.unit not in METRES_PER_UNIT:

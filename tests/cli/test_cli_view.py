@@ -346,3 +346,26 @@ def test_hostile_track_input_one_line_error_nothing_written(
     assert message in lines[0], lines[0]
     assert not out.exists() and path.read_bytes() == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["back.csv"]
+
+
+@pytest.mark.parametrize(
+    ("scale", "message"),
+    [
+        (
+            "1e-300",
+            "--metres-per-pixel must lie between 1e-07 and 1000 m/px, got 1e-300",
+        ),
+        ("inf", "--metres-per-pixel must lie between 1e-07 and 1000 m/px, got inf"),
+        ("0", "--metres-per-pixel must lie between 1e-07 and 1000 m/px, got 0"),
+    ],
+)
+def test_absurd_pixel_scale_is_one_line_error(cli, tmp_path, scale, message):
+    """A pixel scale no camera has (1e-300 m/px used to collapse the track to a point
+    and write a recording) is refused naming the option."""
+    out = tmp_path / "x.rrd"
+    args = ("--unit", "px", "--metres-per-pixel", scale)
+    result = cli("view", DATA / "kinovea_raw_semicolon_px.csv", "--radius", "0.03",
+                 *args, "-o", out)  # fmt: skip
+    assert result.exit_code == 1
+    assert result.stderr == f"error: {message}\n"
+    assert not out.exists()

@@ -34,6 +34,7 @@ import numpy as np
 
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.io.csv_table import length_factor, read_csv_table, read_json
+from fieldkit.io.tracking_export import MAX_METRES_PER_PIXEL, MIN_METRES_PER_PIXEL
 
 
 @dataclass(frozen=True)
@@ -78,12 +79,6 @@ class Calibration:
             "residual_m": self.residual_m,
             **self.meta,
         }
-
-
-#: Plausible image scales [m/px]: a microscope's 0.1 um/px to a satellite's 1 km/px;
-#: a scale outside is a unit mistake and breaks the tracking arithmetic.
-MIN_METRES_PER_PIXEL = 1e-7
-MAX_METRES_PER_PIXEL = 1e3
 
 
 def parse_scale_points(scale_points: str) -> tuple[float, float, float, float]:
