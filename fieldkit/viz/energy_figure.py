@@ -104,7 +104,12 @@ def plot_energy_partition(table: ImpactTable) -> Figure:
     impacts = f[np.isfinite(f["dke_j"].to_numpy(float))]
     step = max(1, len(impacts) // 12)
     for k, row in enumerate(impacts.itertuples(index=False)):
-        ax.axhline(row.z_m, color="0.6", lw=0.3)
+        ax.axhline(
+            row.z_m,
+            color="0.6",
+            lw=0.3,
+            label="impact elevation (some labelled with the point)" if k == 0 else None,
+        )
         if k % step == 0:
             ax.text(
                 total * 1.025,

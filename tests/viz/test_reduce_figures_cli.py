@@ -130,3 +130,5 @@ def test_every_line_drawn_is_in_the_legend(reduced):
             assert line.get_label() in texts, (title, line.get_label())
     en_theta = next(f for t, f in figures.items() if "Fig. 5.7" in t)
     assert "$e_N$ = 1: normal speed kept" in legend_texts(en_theta)
+    partition = next(f for t, f in figures.items() if "energy partition" in t)
+    assert "impact elevation (some labelled with the point)" in legend_texts(partition)
