@@ -128,9 +128,11 @@ def track(
 
     The body is found against the static background (median of frames), its
     centre to a fraction of a pixel; a marker spot gives its spin. Flights are
-    fitted with ballistic parabolas (fitted g is checked against 9.81: a wrong
-    --fps or scale shows there); impact and restitution velocities come from
-    the fits at each contact. Net contacts print their energy efficiency.
+    fitted with ballistic parabolas; each flight's fitted g +/- standard error
+    is printed and warned about, naming the flight, beyond 3 standard errors
+    from 9.81 (a wrong --fps or scale shows there). Impact and restitution
+    velocities come from the fits at each contact. A net contact is one event:
+    counted as a net contact, with its energy efficiency.
 
     Example (from the repository root; the first line renders a 0.45 s test
     clip filmed at 1205 frames/s, `make video` renders the longer ones):

@@ -108,12 +108,14 @@ def view(
 ) -> None:
     """Write a rerun recording of an impact table or a track, for the rerun viewer.
 
-    An ImpactTable becomes a section view: impact points labelled with e_n and
-    e_t, impact and restitution velocity arrows, slope ticks, and e_n, e_t and
-    speeds against the impact order. A track (fieldkit's track.csv, or an OSP
+    An ImpactTable becomes a section view of every path (one row of the
+    `path` timeline each): impact points labelled with e_n and e_t, impact and
+    restitution velocity arrows, slope ticks, and e_n, e_t and speeds against
+    the impact order (the `impact` timeline). A track (fieldkit's track.csv, or an OSP
     Tracker or Kinovea export) is first analysed like `fieldkit track` does:
-    flights found and fitted (fitted g checked against 9.81), impacts and net
-    contacts (with their energy efficiency); the recording shows the track,
+    flights found and fitted (each flight's fitted g +/- standard error printed,
+    warned beyond 3 standard errors from 9.81), impacts and net contacts (each
+    counted once, with its energy efficiency); the recording shows the track,
     the fitted flights, velocity vectors, speed, spin and residuals. A track
     needs --radius (or --shape).
 
