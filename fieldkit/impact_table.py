@@ -187,6 +187,23 @@ QA_FLAGS: dict[str, str] = {
     "spin_estimated": "omega is estimated as v/r (eq. 3.17), not measured",
 }
 
+#: Short words for each quality flag, for figure legends (matplotlib mathtext).
+QA_FLAG_LABELS: dict[str, str] = {
+    "energy_gained": "kinetic energy gained",
+    "e_n_negative": "$e_N$ < 0",
+    "e_t_above_1": "$e_T$ > 1",
+    "speed_high": "speed above 60 m/s",
+    "flight_high": "flight more than 10 m high",
+    "slope_from_chord": "slope from the chord to the previous point",
+    "slope_sensitive": "$e_N$ depends on the chord taken as slope",
+    "spin_estimated": "spin estimated as v/r",
+}
+
+#: Quality flags that record how a value was obtained (a method) rather than that a
+#: row is doubtful: a survey reduced without surveyed slopes or measured spin carries
+#: them on (nearly) every row. Figures state them once instead of ringing each row.
+METHOD_QA_FLAGS: frozenset[str] = frozenset({"slope_from_chord", "spin_estimated"})
+
 #: ``energy_gained``: relative KE gain that is more than rounding (KE ~ v^2).
 ENERGY_GAIN_TOLERANCE = 1e-6
 #: ``speed_high`` limit [m/s]: 25 % above the fastest impact the thesis reports (48

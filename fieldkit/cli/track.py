@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import functools
 import math
-import sys
 from pathlib import Path
 from typing import Annotated
 
@@ -23,8 +22,10 @@ from fieldkit.cli.common import (
     print_body_notes,
     warn,
 )
+from fieldkit.cli.progress import report_written, step
 from fieldkit.errors import ArgumentError
 from fieldkit.impact_table import FORMATS
+from fieldkit.io.tracking_export import check_frame_rate
 from fieldkit.outputs import OutputSet
 
 #: show a progress bar for videos longer than this many frames
@@ -127,9 +128,11 @@ def track(
 
     The body is found against the static background (median of frames), its
     centre to a fraction of a pixel; a marker spot gives its spin. Flights are
-    fitted with ballistic parabolas (fitted g is checked against 9.81: a wrong
-    --fps or scale shows there); impact and restitution velocities come from
-    the fits at each contact. Net contacts print their energy efficiency.
+    fitted with ballistic parabolas; each flight's fitted g +/- standard error
+    is printed and warned about, naming the flight, beyond 3 standard errors
+    from 9.81 (a wrong --fps or scale shows there). Impact and restitution
+    velocities come from the fits at each contact. A net contact is one event:
+    counted as a net contact, with its energy efficiency.
 
     Example (from the repository root; the first line renders a 0.45 s test
     clip filmed at 1205 frames/s, `make video` renders the longer ones):
@@ -156,10 +159,7 @@ def track(
             "playback rate)",
             source="--fps",
         )
-    if not math.isfinite(fps) or fps <= 0:
-        raise ArgumentError(
-            f"must be a positive frame rate, got {fps:g}", source="--fps"
-        )
+    check_frame_rate(fps, "fps")
     body = body_from_options(mass, radius, gyration, shape, dimensions, unit_weight)
     if surface_angle is not None and not (
         math.isfinite(surface_angle) and -90 < surface_angle < 90
@@ -251,14 +251,15 @@ def track(
         write_track_figures(
             figures, analysis, background_frame=background, outputs=outputs
         )
-    written = outputs.commit()
+    with step("writing the outputs", announce=rrd is not None or figures is not None):
+        written = outputs.commit()
     _summary(video, track_data, detections, analysis, calibration.description)
-    for path in written:
-        typer.echo(f"wrote {path}")
+    report_written(written)
 
 
 def _run_tracking(video, reader, fps, calibration, roi, radius, *, show: bool):
-    """track_video with a rich progress bar on stderr for long videos."""
+    """track_video, shown as a progress step (:func:`fieldkit.cli.progress.step`)
+    for long videos."""
     from fieldkit.tracking.video.pipeline import track_video
 
     run = functools.partial(
@@ -273,27 +274,8 @@ def _run_tracking(video, reader, fps, calibration, roi, radius, *, show: bool):
     total = reader.info.frame_count
     if not show or total < PROGRESS_MIN_FRAMES:
         return run()
-    from rich.console import Console
-    from rich.progress import (
-        BarColumn,
-        MofNCompleteColumn,
-        Progress,
-        TimeRemainingColumn,
-    )
-
-    console = Console(file=sys.stderr)
-    if not console.is_terminal:  # no bar in logs and pipes
-        return run()
-    with Progress(
-        "[progress.description]{task.description}",
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeRemainingColumn(),
-        console=console,
-        transient=True,
-    ) as bar:
-        task = bar.add_task("tracking", total=total)
-        return run(progress=lambda done, n: bar.update(task, completed=done, total=n))
+    with step(f"tracking {total:,} frames", total=total) as advance:
+        return run(progress=advance)
 
 
 def _summary(video, track_data, detections, analysis, calibration_text) -> None:
@@ -302,16 +284,32 @@ def _summary(video, track_data, detections, analysis, calibration_text) -> None:
         f"{video}: {len(detections)} frames, body in {len(track_data)}; "
         f"{calibration_text}"
     )
-    typer.echo(
-        f"{len(analysis.flights)} flights, {len(frame)} impacts, "
-        f"{len(analysis.contacts)} extended contacts"
-    )
-    for _, row in frame.iterrows():
+    typer.echo(analysis.counts_text())
+    print_flight_gravity(analysis.flights)
+    for (_, row), net in zip(frame.iterrows(), analysis.net_rows, strict=True):
+        what = "net contact at point" if net else "impact"
         typer.echo(
-            f"  impact {row['point']}: t={row['t_s']:.4f} s  vi={row['vi_mps']:.3f} "
+            f"  {what} {row['point']}: t={row['t_s']:.4f} s  vi={row['vi_mps']:.3f} "
             f"vf={row['vf_mps']:.3f} m/s  e_n={row['e_n']:.3f} e_t={row['e_t']:.3f}  "
             f"omega {row['omega_i_radps']:.1f} -> {row['omega_f_radps']:.1f} rad/s  "
             f"slope {row['slope_deg']:.2f} deg"
         )
     for contact in analysis.contacts:
         typer.echo(f"  {contact.summary()}")
+    for line in analysis.net_rows_text():
+        typer.echo(f"  {line}")
+
+
+def print_flight_gravity(flights) -> None:
+    """One line per fitted flight: its fitted g with standard error and how far it
+    lies from 9.81 (the check on the capture rate and the scale; flights beyond
+    three standard errors are also warned about, by name)."""
+    from fieldkit.tracking.flights.ballistic_fit import GRAVITY_WARNING_SIGMAS
+
+    if flights:
+        typer.echo(
+            "fitted gravity per flight (free-g fit; warned beyond "
+            f"{GRAVITY_WARNING_SIGMAS:g} standard errors from 9.81):"
+        )
+    for flight in flights:
+        typer.echo(f"  {flight.gravity_summary()}")

@@ -21,6 +21,8 @@ from fieldkit.cli.common import (
     print_body_notes,
     warn,
 )
+from fieldkit.cli.progress import report_written, step
+from fieldkit.cli.track import print_flight_gravity
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.impact_table import ImpactTable
 from fieldkit.io.track_files import detect_format, read_track
@@ -106,12 +108,14 @@ def view(
 ) -> None:
     """Write a rerun recording of an impact table or a track, for the rerun viewer.
 
-    An ImpactTable becomes a section view: impact points labelled with e_n and
-    e_t, impact and restitution velocity arrows, slope ticks, and e_n, e_t and
-    speeds against the impact order. A track (fieldkit's track.csv, or an OSP
+    An ImpactTable becomes a section view of every path (one row of the
+    `path` timeline each): impact points labelled with e_n and e_t, impact and
+    restitution velocity arrows, slope ticks, and e_n, e_t and speeds against
+    the impact order (the `impact` timeline). A track (fieldkit's track.csv, or an OSP
     Tracker or Kinovea export) is first analysed like `fieldkit track` does:
-    flights found and fitted (fitted g checked against 9.81), impacts and net
-    contacts (with their energy efficiency); the recording shows the track,
+    flights found and fitted (each flight's fitted g +/- standard error printed,
+    warned beyond 3 standard errors from 9.81), impacts and net contacts (each
+    counted once, with its energy efficiency); the recording shows the track,
     the fitted flights, velocity vectors, speed, spin and residuals. A track
     needs --radius (or --shape).
 
@@ -146,9 +150,17 @@ def view(
         table = ImpactTable.read(input_file)
         if len(table) == 0:
             raise InputFileError("table has no rows", source=input_file)
-        rerun_log.write_impact_recording(out, table.derive(), outputs=outputs)
-        outputs.commit()
-        typer.echo(f"wrote {out}: {len(table)} impacts, {len(table.paths())} path(s)")
+        paths = len(table.paths())
+        with step(f"recording {len(table):,} impacts of {paths:,} path(s)"):
+            table = table.derive()
+            rerun_log.write_impact_recording(out, table, outputs=outputs)
+            written = outputs.commit()
+        typer.echo(
+            f"{len(table):,} impacts, {paths:,} path(s): the section shows every path "
+            "(one row of the path timeline each), e_n, e_t and speeds against the "
+            "impact timeline (table row)"
+        )
+        report_written(written)
         return
     if figures is not None:
         from fieldkit.viz.track_figure import TRACK_FIGURE_NAMES, write_track_figures
@@ -187,10 +199,14 @@ def view(
     rerun_log.write_recording(out, analysis, outputs=outputs)
     if figures is not None:
         write_track_figures(figures, analysis, outputs=outputs)
-    outputs.commit()
-    typer.echo(
-        f"wrote {out}: {len(analysis.track)} samples, {len(analysis.flights)} flights, "
-        f"{len(analysis.impacts)} impacts, {len(analysis.contacts)} net contacts"
-    )
+    with step(
+        "writing the recording and figures", announce=len(analysis.track) > 20_000
+    ):
+        written = outputs.commit()
+    typer.echo(f"{len(analysis.track)} samples, {analysis.counts_text()}")
+    print_flight_gravity(analysis.flights)
     for contact in analysis.contacts:
         typer.echo(f"  {contact.summary()}")
+    for line in analysis.net_rows_text():
+        typer.echo(f"  {line}")
+    report_written(written)

@@ -147,6 +147,7 @@ def read_kinovea(
         source=src,
         time_factor=time_factor(file_fps, fps, src),
         fps=fps,
+        row_numbers=row_numbers,
         meta={
             "format": "kinovea",
             "point": name,

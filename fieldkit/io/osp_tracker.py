@@ -120,6 +120,7 @@ def read_osp_tracker(
         source=src,
         time_factor=time_factor(file_fps, fps, src),
         fps=fps,
+        row_numbers=row_numbers,
         meta={
             "format": "osp-tracker",
             "track_name": name,

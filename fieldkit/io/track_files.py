@@ -9,12 +9,23 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from fieldkit.errors import InputFileError
 from fieldkit.impact_table import REQUIRED_COLUMNS
-from fieldkit.io.csv_table import detect_delimiter, read_text, split_row
+from fieldkit.io.csv_table import (
+    detect_delimiter,
+    numbered_lines,
+    read_text,
+    split_row,
+)
 from fieldkit.io.kinovea import read_kinovea
 from fieldkit.io.osp_tracker import read_osp_tracker
-from fieldkit.io.tracking_export import time_factor
+from fieldkit.io.tracking_export import (
+    check_frame_rate,
+    check_track_values,
+    time_factor,
+)
 from fieldkit.track import Track, is_track_header
 
 #: What :func:`detect_format` can answer.
@@ -94,7 +105,18 @@ def read_track(
             fps=fps,
             file_fps=file_fps,
         )
+    if fps is not None and file_fps is None:
+        check_frame_rate(fps, "fps")
     track = Track.read(path, fps=fps)
     if fps is not None or file_fps is not None:
         track.frame["t_s"] = track.frame["t_s"] * time_factor(file_fps, fps, path)
+    # Track.read keeps every data row: they are the file's non-blank lines after the
+    # header, as pandas reads them
+    rows = [n for n, _ in numbered_lines(read_text(path, kind="input"))[1:]]
+    if len(rows) == len(track):
+        check_track_values(track.t, track.x, track.z, np.array(rows), str(path))
+    else:  # a quoted cell over several lines: no exact row numbers
+        check_track_values(
+            track.t, track.x, track.z, np.arange(2, len(track) + 2), str(path)
+        )
     return track

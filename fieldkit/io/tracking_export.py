@@ -78,17 +78,118 @@ def read_number_columns(
     return np.array(row_numbers, int), np.array(data, float)
 
 
+#: Fastest capture rate accepted [frames/s]: beyond the fastest scientific cameras
+#: (about 1e7 frames/s); a larger number is a typo or a unit mix-up.
+MAX_FPS = 1e7
+#: Plausible image scales [m/px]: a microscope's 0.1 um/px to a satellite's 1 km/px;
+#: a scale outside is a unit mistake and breaks the tracking arithmetic.
+MIN_METRES_PER_PIXEL = 1e-7
+MAX_METRES_PER_PIXEL = 1e3
+#: Slowest frame rate accepted [frames/s] (a frame every ~17 minutes: time-lapse).
+MIN_FPS = 1e-3
+#: Shortest time step between track rows [s]: a tenth of a frame at MAX_FPS.
+MIN_TIME_STEP_S = 0.1 / MAX_FPS
+#: Largest time a track may hold [s] (a day): beyond it the times are in another
+#: unit or the export is broken.
+MAX_TRACK_TIME_S = 86_400.0
+#: Largest coordinate a track may hold [m] (100 km): beyond it the length unit or
+#: the scale is wrong.
+MAX_TRACK_COORDINATE_M = 1e5
+
+
 def check_increasing_times(t: np.ndarray, row_numbers: np.ndarray, source: str):
-    """Raise naming the first row whose time is not after the previous time."""
+    """Raise naming the first row whose time is not after the previous time
+    (backwards or repeated)."""
     ok = np.isfinite(t)
     steps = np.diff(t[ok])
     if np.any(steps <= 0):
         j = int(np.flatnonzero(steps <= 0)[0])
+        before, this = t[ok][j], t[ok][j + 1]
+        how = "repeats" if this == before else "goes back from"
         raise InputFileError(
-            "times are not increasing",
+            f"times are not increasing: {this:.9g} s {how} {before:.9g} s of the "
+            "row before",
             source=source,
             where=f"row {row_numbers[ok][j + 1]}",
         )
+
+
+def check_time_steps(t: np.ndarray, row_numbers: np.ndarray, source: str):
+    """Raise naming the first row less than :data:`MIN_TIME_STEP_S` after the row
+    before (faster than any camera: times in a wrong unit)."""
+    ok = np.isfinite(t)
+    steps = np.diff(t[ok])
+    if np.any(steps < MIN_TIME_STEP_S):
+        j = int(np.flatnonzero(steps < MIN_TIME_STEP_S)[0])
+        raise InputFileError(
+            f"time step {steps[j]:.3g} s from the row before is shorter than "
+            f"{MIN_TIME_STEP_S:g} s (faster than any camera: a wrong time unit or "
+            "frame rate?)",
+            source=source,
+            where=f"row {row_numbers[ok][j + 1]}",
+        )
+
+
+def check_track_values(
+    t: np.ndarray,
+    x: np.ndarray,
+    z: np.ndarray,
+    row_numbers: np.ndarray,
+    source: str,
+) -> None:
+    """Raise :class:`InputFileError` naming the first bad row of a track in SI units.
+
+    Every row needs a finite time within +/- :data:`MAX_TRACK_TIME_S`; coordinates
+    may be missing (NaN: body not found) but not infinite nor beyond +/-
+    :data:`MAX_TRACK_COORDINATE_M`; times must increase
+    (:func:`check_increasing_times`).
+    """
+    row_numbers = np.asarray(row_numbers)
+    checks = (
+        (~np.isfinite(t), "t_s", "time is missing or not finite"),
+        (np.abs(t) > MAX_TRACK_TIME_S, "t_s", f"beyond {MAX_TRACK_TIME_S:g} s"),
+        (np.isinf(x), "x_m", "not finite"),
+        (np.isinf(z), "z_m", "not finite"),
+        (
+            np.abs(x) > MAX_TRACK_COORDINATE_M,
+            "x_m",
+            f"beyond {MAX_TRACK_COORDINATE_M:g} m",
+        ),
+        (
+            np.abs(z) > MAX_TRACK_COORDINATE_M,
+            "z_m",
+            f"beyond {MAX_TRACK_COORDINATE_M:g} m",
+        ),
+    )
+    first = None
+    for bad, column, what in checks:
+        with np.errstate(invalid="ignore"):
+            hits = np.flatnonzero(bad)
+        if len(hits) and (first is None or hits[0] < first[0]):
+            first = (int(hits[0]), column, what)
+    if first is not None:
+        i, column, what = first
+        value = {"t_s": t, "x_m": x, "z_m": z}[column][i]
+        hint = "" if "finite" in what else " (a wrong unit or scale?)"
+        raise InputFileError(
+            f"{column} {value:.6g}: {what}{hint}",
+            source=source,
+            where=f"row {row_numbers[i]}",
+        )
+    check_increasing_times(t, row_numbers, source)
+    check_time_steps(t, row_numbers, source)
+
+
+def check_frame_rate(value: float, name: str) -> float:
+    """``value`` as a frame rate in (0, :data:`MAX_FPS`] frames/s, else
+    :class:`ArgumentError` naming the argument ``name``."""
+    if not (np.isfinite(value) and MIN_FPS <= value <= MAX_FPS):
+        raise ArgumentError(
+            f"{name} must be a positive frame rate of at most {MAX_FPS:g} frames/s "
+            f"(and at least {MIN_FPS:g}), got {value:g}",
+            source=name,
+        )
+    return float(value)
 
 
 @dataclass(frozen=True)
@@ -101,11 +202,22 @@ class LengthScale:
 
     def metres_per_unit(self, source: object) -> float:
         if self.unit == PIXELS:
-            if self.metres_per_pixel is None or not self.metres_per_pixel > 0:
+            if self.metres_per_pixel is None:
                 raise ArgumentError(
                     "coordinates are in pixels: give the scale in metres per pixel "
                     "(`metres_per_pixel`, e.g. ball diameter in m / diameter in px)",
                     source=str(source),
+                )
+            if not (
+                np.isfinite(self.metres_per_pixel)
+                and MIN_METRES_PER_PIXEL
+                <= self.metres_per_pixel
+                <= MAX_METRES_PER_PIXEL
+            ):
+                raise ArgumentError(
+                    f"metres_per_pixel must lie between {MIN_METRES_PER_PIXEL:g} and "
+                    f"{MAX_METRES_PER_PIXEL:g} m/px, got {self.metres_per_pixel:g}",
+                    source="metres_per_pixel",
                 )
             return float(self.metres_per_pixel)
         if self.unit not in METRES_PER_UNIT:
@@ -128,8 +240,13 @@ def build_track(
     frames: np.ndarray | None = None,
     fps: float | None = None,
     meta: dict | None = None,
+    row_numbers: np.ndarray | None = None,
 ) -> Track:
-    """A Track in metres (z up) from file columns; rows without time are dropped."""
+    """A Track in metres (z up) from file columns; rows without time are dropped.
+
+    With ``row_numbers`` (the file row of each value) the result is checked by
+    :func:`check_track_values`, naming the file row at fault.
+    """
     k = scale.metres_per_unit(source)
     sign = -1.0 if scale.y_down else 1.0
     keep = np.isfinite(t)
@@ -143,6 +260,14 @@ def build_track(
     )
     if len(frame) == 0:
         raise InputFileError("no data rows", source=source)
+    if row_numbers is not None:
+        check_track_values(
+            frame["t_s"].to_numpy(float),
+            frame["x_m"].to_numpy(float),
+            frame["z_m"].to_numpy(float),
+            np.asarray(row_numbers)[keep],
+            source,
+        )
     return Track(frame, source=source, fps=fps, meta=dict(meta or {}))
 
 
@@ -160,6 +285,4 @@ def time_factor(file_fps: float | None, fps: float | None, source: object) -> fl
             "rate (`fps`) to correct the time base",
             source=str(source),
         )
-    if not (file_fps > 0 and fps > 0):
-        raise ArgumentError("frame rates must be > 0", source=str(source))
-    return file_fps / fps
+    return check_frame_rate(file_fps, "file_fps") / check_frame_rate(fps, "fps")

@@ -25,7 +25,7 @@ from fieldkit.outputs import OutputSet
 from fieldkit.physics.energy import energy_head, kinetic_energy, potential_energy
 from fieldkit.physics.flight import flight_samples
 from fieldkit.viz.figure_files import save_png
-from fieldkit.viz.marks import mark_flagged, outside_legend, qa_flagged
+from fieldkit.viz.marks import mark_flagged, outside_legend, qa_column
 
 
 def energy_profile(table: ImpactTable, n_samples: int = 30) -> dict[str, np.ndarray]:
@@ -104,9 +104,21 @@ def plot_energy_partition(table: ImpactTable) -> Figure:
     impacts = f[np.isfinite(f["dke_j"].to_numpy(float))]
     step = max(1, len(impacts) // 12)
     for k, row in enumerate(impacts.itertuples(index=False)):
-        ax.axhline(row.z_m, color="0.6", lw=0.3)
+        ax.axhline(
+            row.z_m,
+            color="0.6",
+            lw=0.3,
+            label="impact elevation (some labelled with the point)" if k == 0 else None,
+        )
         if k % step == 0:
-            ax.text(total * 1.01, row.z_m, str(row.point), fontsize=7, va="center")
+            ax.text(
+                total * 1.025,
+                row.z_m,
+                str(row.point),
+                fontsize=7,
+                ha="center",
+                va="center",
+            )
     ax.set_xlim(0, total * 1.06)
     ax.set_ylim(z.min(), z.max())
     ax.set_xlabel("energy [kJ]")
@@ -115,9 +127,10 @@ def plot_energy_partition(table: ImpactTable) -> Figure:
         f"{table.paths()[0]}: energy partition (thesis Fig. 6.5), "
         f"m = {f['mass_kg'].iloc[0]:.0f} kg"
     )
-    flags = qa_flagged(impacts)
-    if flags.any():  # ring the impact labels' rows at the right edge
-        mark_flagged(ax, np.full(len(impacts), total), impacts["z_m"], flags)
+    # ring the impact rows at the right edge, around their labels
+    mark_flagged(
+        ax, np.full(len(impacts), total * 1.025), impacts["z_m"], qa_column(impacts)
+    )
     outside_legend(ax)
     return fig
 
@@ -140,8 +153,15 @@ def plot_energy_head(table: ImpactTable) -> Figure:
     )
     ax.plot(p["x_m"], p["z_m"], color="#1f4e9c", lw=0.7, ls="--", label="flight paths")
     head_i = f["energy_head_i_m"].to_numpy(float)
-    ax.plot(x, head_i, "v", color="#c62828", ms=3.5, label="before impact")
-    mark_flagged(ax, x, head_i, qa_flagged(f))
+    ax.plot(
+        x,
+        head_i,
+        "v",
+        color="#c62828",
+        ms=3.5,
+        label="energy head just before an impact",
+    )
+    mark_flagged(ax, x, head_i, qa_column(f))
     ax.set_xlabel("x, horizontal distance along the path [m]")
     ax.set_ylabel("elevation / energy head [m]")
     ax.set_title(f"{table.paths()[0]}: energy head line (thesis §6.4.2)")

@@ -2,9 +2,11 @@
 
 * :func:`outside_legend` -- the legend beside the axes, never over the data or the
   labels annotated on it (``loc="best"`` only avoids data, not annotations);
-* :func:`qa_flagged` / :func:`mark_flagged` -- impacts whose ``qa_flags`` column
-  (docs/architecture.md §3: ``;``-separated flags) is not empty get an open red ring
-  and a "quality flag" legend entry;
+* :func:`qa_flagged` / :func:`mark_flagged` -- impacts with a quality flag
+  (``qa_flags``, docs/architecture.md §3: ``;``-separated) that sets them apart get an
+  open red ring and a "quality flag" legend entry naming the flags; a method flag
+  (slope from the chord, spin estimated) or a flag every impact carries marks no
+  impact and is said once, in one legend line (:func:`flag_summary`);
 * :func:`velocity_key` -- the scale of a quiver of velocity arrows ("10 m/s"), in the
   corner of the axes with the fewest data points (:func:`free_corner`).
 """
@@ -12,6 +14,8 @@
 from __future__ import annotations
 
 import math
+import textwrap
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
@@ -19,8 +23,12 @@ from matplotlib.axes import Axes
 from matplotlib.legend import Legend
 from matplotlib.quiver import Quiver, QuiverKey
 
+from fieldkit.impact_table import METHOD_QA_FLAGS, QA_FLAG_LABELS
+
 QA_COLOUR = "red"
 QA_LABEL = "quality flag"
+#: Legend line for flags not ringed (method flags, flags on every row).
+SHARED_LABEL = "not ringed, said once"
 
 
 def outside_legend(ax: Axes, *, below: bool = False, **kwargs) -> Legend | None:
@@ -43,45 +51,152 @@ def outside_legend(ax: Axes, *, below: bool = False, **kwargs) -> Legend | None:
     return ax.legend(**options)
 
 
+def _flag_names(qa_flags) -> list[list[str]]:
+    """Each row's flags (``;``-separated ``qa_flags`` values; None / NaN = none)."""
+    return [
+        [part.strip() for part in v.split(";") if part.strip()]
+        if isinstance(v, str)
+        else []
+        for v in qa_flags
+    ]
+
+
+@dataclass(frozen=True)
+class FlagSummary:
+    """Which quality flags set rows apart, and which are said once.
+
+    Attributes
+    ----------
+    apart
+        Per row, the flags that set it apart from the other rows: every flag except
+        a method flag (:data:`fieldkit.impact_table.METHOD_QA_FLAGS`) and a flag
+        carried by every row.
+    shared
+        Flags not ringed (method flags and flags on every row) -> rows carrying them.
+    rows
+        Number of rows.
+    """
+
+    apart: list[list[str]]
+    shared: dict[str, int]
+    rows: int
+
+    @property
+    def ringed(self) -> np.ndarray:
+        """True for rows with a flag that sets them apart."""
+        return np.array([bool(names) for names in self.apart], dtype=bool)
+
+
+def flag_summary(qa_flags) -> FlagSummary:
+    """Split the ``qa_flags`` values of a set of rows into flags that set a row apart
+    and flags said once (see :class:`FlagSummary`).
+
+    Examples
+    --------
+    >>> s = flag_summary(["spin_estimated;e_t_above_1", "spin_estimated", None])
+    >>> s.apart, s.shared
+    ([['e_t_above_1'], [], []], {'spin_estimated': 2})
+    >>> flag_summary(["e_t > 1", "e_t > 1"]).shared  # on every row: said once
+    {'e_t > 1': 2}
+    """
+    names = _flag_names(qa_flags)
+    counts: dict[str, int] = {}
+    for row in names:
+        for name in dict.fromkeys(row):
+            counts[name] = counts.get(name, 0) + 1
+    everywhere = {name for name, n in counts.items() if n == len(names) > 1}
+    shared = {
+        name: n
+        for name, n in counts.items()
+        if name in METHOD_QA_FLAGS or name in everywhere
+    }
+    apart = [[name for name in row if name not in shared] for row in names]
+    return FlagSummary(apart=apart, shared=shared, rows=len(names))
+
+
 def qa_flagged(frame: pd.DataFrame) -> np.ndarray:
-    """Rows with at least one quality flag (``qa_flags`` not empty); all False when the
-    table has no ``qa_flags`` column.
+    """Rows with a quality flag that sets them apart (:func:`flag_summary`); all
+    False when the table has no ``qa_flags`` column.
 
     Examples
     --------
     >>> qa_flagged(pd.DataFrame({"qa_flags": ["", "e_t > 1", None, " ; "]})).tolist()
     [False, True, False, False]
+    >>> qa_flagged(pd.DataFrame({"qa_flags": ["spin_estimated", "spin_estimated"]}))
+    array([False, False])
     """
     if "qa_flags" not in frame.columns:
         return np.zeros(len(frame), bool)
-    return np.array(
-        [
-            isinstance(v, str) and any(part.strip() for part in v.split(";"))
-            for v in frame["qa_flags"]
-        ],
-        dtype=bool,
-    )
+    return flag_summary(frame["qa_flags"].tolist()).ringed
 
 
-def mark_flagged(ax: Axes, x, y, flagged) -> None:
-    """Open red rings around the flagged points, with one "quality flag" legend entry.
+def qa_column(frame: pd.DataFrame) -> list | None:
+    """The ``qa_flags`` values of ``frame`` for :func:`mark_flagged`; None without
+    the column."""
+    return frame["qa_flags"].tolist() if "qa_flags" in frame.columns else None
 
-    Draws nothing when no point is flagged.
+
+def flag_words(name: str) -> str:
+    """A flag in words for a legend (:data:`fieldkit.impact_table.QA_FLAG_LABELS`;
+    a producer's own flag as written)."""
+    return QA_FLAG_LABELS.get(name, name)
+
+
+def mark_flagged(ax: Axes, x, y, qa_flags, where=None) -> None:
+    """Open red rings around the rows whose quality flags set them apart, with one
+    legend entry naming those flags and how many rows carry each; flags every row
+    shares (and method flags, :data:`fieldkit.impact_table.METHOD_QA_FLAGS`) get one
+    legend line instead of a ring on every point.
+
+    Parameters
+    ----------
+    ax
+        Axes to draw on.
+    x, y
+        Position of each row's mark (data coordinates).
+    qa_flags
+        Each row's ``qa_flags`` value (``;``-separated; None / NaN = none), or None
+        when the table has no such column (nothing drawn).
+    where
+        Rows that may be ringed (e.g. those drawn at all); default every row with
+        finite ``x`` and ``y``.
     """
-    flagged = np.asarray(flagged, bool)
-    x, y = np.asarray(x, float)[flagged], np.asarray(y, float)[flagged]
-    if not flagged.any():
+    if qa_flags is None:
         return
-    ax.scatter(
-        x,
-        y,
-        s=150,
-        facecolors="none",
-        edgecolors=QA_COLOUR,
-        linewidths=1.5,
-        zorder=7,
-        label=f"{QA_LABEL} ({int(flagged.sum())})",
-    )
+    summary = flag_summary(list(qa_flags))
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    drawn = np.isfinite(x) & np.isfinite(y)
+    if where is not None:
+        drawn &= np.asarray(where, bool)
+    ringed = summary.ringed & drawn
+    if ringed.any():
+        counts: dict[str, int] = {}
+        for names, on in zip(summary.apart, ringed, strict=True):
+            for name in names if on else ():
+                counts[name] = counts.get(name, 0) + 1
+        listed = ", ".join(f"{flag_words(k)} ({v})" for k, v in counts.items())
+        ax.scatter(
+            x[ringed],
+            y[ringed],
+            s=150,
+            facecolors="none",
+            edgecolors=QA_COLOUR,
+            linewidths=1.5,
+            zorder=7,
+            label=textwrap.fill(f"{QA_LABEL} on {int(ringed.sum())}: {listed}", 48),
+        )
+    if summary.shared:
+        listed = ", ".join(
+            f"{flag_words(k)} ({v} of {summary.rows})"
+            for k, v in summary.shared.items()
+        )
+        ax.plot(
+            [],
+            [],
+            " ",
+            label=textwrap.fill(f"{SHARED_LABEL}: {listed}", 48),
+            gid="qa-shared",
+        )
 
 
 def nice_speed(largest_mps: float) -> float:

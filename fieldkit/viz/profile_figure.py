@@ -53,15 +53,16 @@ def _draw_plan(fig, ax_plan, grid: DemGrid, section: Section) -> None:
     image = ax_plan.imshow(
         np.ma.masked_invalid(grid.values), extent=extent, cmap="terrain", origin="upper"
     )
-    fig.colorbar(image, ax=ax_plan, label="elevation (m)", shrink=0.8)
+    fig.colorbar(image, ax=ax_plan, label="elevation [m]", shrink=0.8)
     if np.isfinite(grid.values).sum() > 3:
         ax_plan.contour(grid.x_m, grid.y_m, grid.values, colors="k", linewidths=0.4,
                         alpha=0.5)  # fmt: skip
-    ax_plan.plot(section.plan_x_m, section.plan_y_m, color=LINE_COLOUR, lw=1.5)
+    ax_plan.plot(section.plan_x_m, section.plan_y_m, color=LINE_COLOUR, lw=1.5,
+                 label="section line")  # fmt: skip
     ax_plan.plot(section.plan_x_m[0], section.plan_y_m[0], "o", color=LINE_COLOUR,
                  label="start")  # fmt: skip
-    ax_plan.set_xlabel("x (m)")
-    ax_plan.set_ylabel("y (m)")
+    ax_plan.set_xlabel("x, easting in the DEM's coordinates [m]")
+    ax_plan.set_ylabel("y, northing in the DEM's coordinates [m]")
     ax_plan.set_aspect("equal")
     ax_plan.legend(loc="best", fontsize=8)
     ax_plan.set_title(Path(grid.source).name or "DEM", fontsize=10)
@@ -76,8 +77,8 @@ def _draw_section(ax_section, section: Section, title: str) -> None:
                 color=f"C{i}", lw=2, label=name if j == np.flatnonzero(
                     materials == name)[0] else None,
             )  # fmt: skip
-    ax_section.set_xlabel("chainage (horizontal distance along the line, m)")
-    ax_section.set_ylabel("z (m)")
+    ax_section.set_xlabel("chainage, horizontal distance along the line [m]")
+    ax_section.set_ylabel("z, elevation [m]")
     ax_section.set_aspect("equal", adjustable="datalim")
     ax_section.grid(True, alpha=0.3)
     ax_section.legend(title="material", fontsize=8, loc="upper right")

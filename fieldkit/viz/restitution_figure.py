@@ -30,7 +30,7 @@ from fieldkit.physics.restitution import (
     angle_dependent_restitution,
 )
 from fieldkit.viz.figure_files import save_png
-from fieldkit.viz.marks import mark_flagged, outside_legend, qa_flagged
+from fieldkit.viz.marks import mark_flagged, outside_legend, qa_column
 
 MARKERS = {
     "rock": "s",
@@ -70,7 +70,7 @@ def plot_en_theta(
     law_label: str | None = None,
     title: str | None = None,
     theta0_source: Sequence[str] | None = None,
-    flagged: ArrayLike | None = None,
+    qa_flags: Sequence[str | None] | None = None,
 ) -> Figure:
     """[theta_i - e_N] scatter with a power law ``e_N = a theta_i^-b`` (Fig. 5.7).
 
@@ -94,8 +94,9 @@ def plot_en_theta(
         fixed by a tree strike or measured (:data:`FIXED_SOURCES`) are drawn filled
         (collection gid ``theta0-fixed``), the others open (``theta0-assumed``), each
         group with a legend entry. None: all filled, no such entries.
-    flagged
-        Per point, True for impacts with quality flags: ringed in red.
+    qa_flags
+        Per point, its ``qa_flags`` (``;``-separated): points whose flags set them
+        apart are ringed in red (:func:`fieldkit.viz.marks.mark_flagged`).
 
     Returns
     -------
@@ -159,8 +160,7 @@ def plot_en_theta(
                     label=f"{text} ({(ok & group).sum()})",
                     **style,
                 )
-    if flagged is not None:
-        mark_flagged(ax, theta, en, np.asarray(flagged, bool) & ok)
+    mark_flagged(ax, theta, en, qa_flags)
     if law is not None:
         a, b = law
         t = np.linspace(3.0, 90.0, 300)
@@ -174,9 +174,9 @@ def plot_en_theta(
     top = np.nanmax(en[ok]) if ok.any() else 2.0
     ax.set_xlim(0, 90)
     ax.set_ylim(0, max(2.0, min(top * 1.1, 8.0)))
-    ax.axhline(1.0, color="0.5", lw=0.8, ls=":")
+    ax.axhline(1.0, color="0.5", lw=0.8, ls=":", label="$e_N$ = 1: normal speed kept")
     ax.set_xlabel(r"impact angle $\theta_i$ [deg]")
-    ax.set_ylabel(r"normal coefficient of restitution $e_N$")
+    ax.set_ylabel(r"normal coefficient of restitution $e_N$ [-]")
     ax.set_title(title or r"[$\theta_i$ - $e_N$] relationship (thesis Fig. 5.7)")
     outside_legend(ax)
     return fig
@@ -188,7 +188,7 @@ def plot_et_impacts(
     impact_number: ArrayLike | None = None,
     material: Sequence[str] | None = None,
     title: str | None = None,
-    flagged: ArrayLike | None = None,
+    qa_flags: Sequence[str | None] | None = None,
 ) -> Figure:
     """Tangential coefficient of restitution per impact (thesis Fig. 5.8).
 
@@ -200,8 +200,9 @@ def plot_et_impacts(
         Horizontal axis ("calculation #"); default 1, 2, ...
     material
         Slope material per impact; the legend gives each material's mean e_T.
-    flagged
-        Per impact, True for impacts with quality flags: ringed in red.
+    qa_flags
+        Per impact, its ``qa_flags``: impacts whose flags set them apart are ringed
+        in red (:func:`fieldkit.viz.marks.mark_flagged`).
     """
     et = np.asarray(e_t, float)
     number = (
@@ -226,12 +227,13 @@ def plot_et_impacts(
             mew=0.5,
             label=f"{name}: {sel.sum()} impacts, mean $e_T$ = {mean:.2f}",
         )
-    ax.axhline(1.0, color="0.5", lw=0.8, ls=":")
+    ax.axhline(
+        1.0, color="0.5", lw=0.8, ls=":", label="$e_T$ = 1: tangential speed kept"
+    )
     ax.set_ylim(0, max(1.4, float(np.nanmax(et)) * 1.1 if ok.any() else 1.4))
-    ax.set_xlabel("impact (calculation #)")
-    ax.set_ylabel(r"tangential coefficient of restitution $e_T$")
-    if flagged is not None:
-        mark_flagged(ax, number, et, np.asarray(flagged, bool) & ok)
+    ax.set_xlabel("impact number along the path (thesis: calculation #) [-]")
+    ax.set_ylabel(r"tangential coefficient of restitution $e_T$ [-]")
+    mark_flagged(ax, number, et, qa_flags)
     ax.set_title(title or r"$e_T$ per impact (thesis Fig. 5.8)")
     outside_legend(ax)
     return fig
@@ -256,7 +258,7 @@ def write_restitution_figures(
     )
     mat = None if impacts["material"].isna().all() else material.tolist()
     name = ", ".join(table.paths())
-    flagged = qa_flagged(impacts)
+    qa_flags = qa_column(impacts)
     en_fig = plot_en_theta(
         impacts["theta_i_deg"],
         impacts["e_n"],
@@ -264,13 +266,13 @@ def write_restitution_figures(
         law=law,
         title=f"{name}: [θi - eN] with eq. 5.4 (thesis Fig. 5.7)",
         theta0_source=impacts["theta0_source"].tolist(),
-        flagged=flagged,
+        qa_flags=qa_flags,
     )
     et_fig = plot_et_impacts(
         impacts["e_t"],
         material=mat,
         title=f"{name}: $e_T$ per impact (thesis Fig. 5.8)",
-        flagged=flagged,
+        qa_flags=qa_flags,
     )
     return (
         save_png(en_fig, en_path, outputs=outputs),

@@ -28,7 +28,7 @@ from fieldkit.viz.marks import (
     mark_flagged,
     nice_speed,
     outside_legend,
-    qa_flagged,
+    qa_column,
     velocity_key,
 )
 
@@ -103,7 +103,15 @@ def plot_section(table: ImpactTable, survey: Survey | None = None) -> Figure:
         ax.plot(xs, zs, style, color=FLIGHT_COLOUR, lw=0.9)
     ax.plot([], [], "-", color=FLIGHT_COLOUR, label="flight fixed by a tree strike")
     ax.plot([], [], "--", color=FLIGHT_COLOUR, label="flight with assumed θ0")
-    ax.plot(x, z, "o", ms=3.5, color=IMPACT_COLOUR, label="impact point", zorder=5)
+    ax.plot(
+        x,
+        z,
+        "o",
+        ms=3.5,
+        color=IMPACT_COLOUR,
+        label="impact point (survey name)",
+        zorder=5,
+    )
     vfx, vfz = f["vf_x_mps"].to_numpy(float), f["vf_z_mps"].to_numpy(float)
     ok = np.isfinite(vfx) & np.isfinite(vfz)
     if ok.any():
@@ -122,7 +130,7 @@ def plot_section(table: ImpactTable, survey: Survey | None = None) -> Figure:
             zorder=6,
             label="restitution velocity $v_f$ (∝ speed)",
         )
-    mark_flagged(ax, x, z, qa_flagged(f))
+    mark_flagged(ax, x, z, qa_column(f))
     step = max(1, len(f) // 15)
     for i, row in enumerate(f.itertuples(index=False)):
         if i % step == 0 or i == len(f) - 1:

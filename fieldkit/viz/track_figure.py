@@ -32,7 +32,7 @@ from fieldkit.tracking.flights.net_contacts import NetContact
 from fieldkit.tracking.flights.pipeline import TrackAnalysis
 from fieldkit.viz.figure_files import new_figure, save_png
 from fieldkit.viz.image_projection import project, world_to_image
-from fieldkit.viz.marks import mark_flagged, outside_legend, qa_flagged, velocity_key
+from fieldkit.viz.marks import mark_flagged, outside_legend, qa_column, velocity_key
 
 _CONTACT_SHADE = dict(color="0.85", zorder=0)
 GROUND_COLOUR = "#6b4f2a"
@@ -106,18 +106,25 @@ def plot_track(a: TrackAnalysis, background: np.ndarray | None = None) -> Figure
             background[..., ::-1] if background.ndim == 3 else background, cmap="gray"
         )
         u, v = f["u_px"].to_numpy(float), f["v_px"].to_numpy(float)
-        ax.set_xlabel("u [px]")
-        ax.set_ylabel("v [px]")
+        ax.set_xlabel("u, image column [px]")
+        ax.set_ylabel("v, image row [px]")
         ax.set_title("track over a video frame")
     else:
         u, v = f["x_m"].to_numpy(float), f["z_m"].to_numpy(float)
         ax.set_aspect("equal", adjustable="datalim")
-        ax.set_xlabel("x [m]")
-        ax.set_ylabel("z [m]")
+        ax.set_xlabel("x, horizontal distance [m]")
+        ax.set_ylabel("z, height [m]")
         ax.set_title("track in the section plane")
     label = f["flight"].to_numpy(int)
     off = label < 0
-    ax.plot(u[off], v[off], ".", color="0.5", ms=2, label="contact / unassigned")
+    ax.plot(
+        u[off],
+        v[off],
+        ".",
+        color="0.5",
+        ms=2,
+        label="in contact or outside the flights",
+    )
     for fl in a.flights:
         ax.plot(u[fl.rows], v[fl.rows], ".", ms=2, color=_flight_colour(fl.index))
         t = np.linspace(fl.t_start_s, fl.t_end_s, 100)
@@ -129,7 +136,7 @@ def plot_track(a: TrackAnalysis, background: np.ndarray | None = None) -> Figure
             "-",
             lw=1,
             color=_flight_colour(fl.index),
-            label=f"flight {fl.index}: g = {fl.g_mps2:.2f} ± {fl.g_se_mps2:.2f}",
+            label=f"flight {fl.index}: g = {fl.g_text().replace('+/-', '±')} m/s²",
         )
     imp = a.impacts.frame
     arrows = None
@@ -138,8 +145,22 @@ def plot_track(a: TrackAnalysis, background: np.ndarray | None = None) -> Figure
         span_m = float(np.nanmax(f["x_m"]) - np.nanmin(f["x_m"]))
         x, z = sx * imp["x_m"].to_numpy(float), imp["z_m"].to_numpy(float)
         pts = _plot_points(h, x, z)
-        _draw_ground(ax, imp, sx, h, span_m=span_m)
-        ax.plot(pts[:, 0], pts[:, 1], "x", color="crimson", ms=8, label="impacts")
+        net = a.net_rows
+        _draw_ground(ax, imp, sx, h, span_m=span_m, net=net)
+        for rows, marker, label in (
+            (~net, "x", "impacts"),
+            (net, "D", "net contact (start)"),
+        ):
+            if rows.any():
+                ax.plot(
+                    pts[rows, 0],
+                    pts[rows, 1],
+                    marker,
+                    color="crimson",
+                    ms=8 if marker == "x" else 6,
+                    mfc="none",
+                    label=label,
+                )
         for (px, py), p, en, et in zip(
             pts, imp["point"], imp["e_n"], imp["e_t"], strict=True
         ):
@@ -150,7 +171,7 @@ def plot_track(a: TrackAnalysis, background: np.ndarray | None = None) -> Figure
                 xytext=(4, -10),
                 textcoords="offset points",
             )
-        mark_flagged(ax, pts[:, 0], pts[:, 1], qa_flagged(imp))
+        mark_flagged(ax, pts[:, 0], pts[:, 1], qa_column(imp))
         arrows = _draw_velocities(ax, imp, sx, h, span_m=span_m)
     outside_legend(ax, fontsize=7)
     if arrows is not None:  # after the limits are set: the key goes where nothing is
@@ -165,10 +186,11 @@ def _plot_points(h, x, z) -> np.ndarray:
     return project(h, x, z) if h is not None else np.column_stack([x, z])
 
 
-def _draw_ground(ax, imp, sx: float, h, *, span_m: float) -> None:
+def _draw_ground(ax, imp, sx: float, h, *, span_m: float, net=None) -> None:
     """The surface at each impact: the line of dip ``slope_deg`` through the contact
     point one radius below the centre (along -N), reaching halfway to the neighbouring
-    impacts (a quarter of the track's extent for a single impact)."""
+    impacts (a quarter of the track's extent for a single impact). Rows ``net``
+    (extended contacts) draw the net's line instead of ground, labelled so."""
     psi = np.radians(imp["slope_deg"].to_numpy(float))
     x, z = sx * imp["x_m"].to_numpy(float), imp["z_m"].to_numpy(float)
     radius = np.nan_to_num(imp["radius_m"].to_numpy(float))
@@ -181,14 +203,26 @@ def _draw_ground(ax, imp, sx: float, h, *, span_m: float) -> None:
         left = np.concatenate([[np.inf], gaps])
         right = np.concatenate([gaps, [np.inf]])
         reach = 0.5 * np.minimum(left, right)
-    label = "ground at each impact (slope_deg)"
-    for c, t, r, ok in zip(contact, tangent, reach, np.isfinite(psi), strict=True):
+    net = np.zeros(len(x), bool) if net is None else np.asarray(net, bool)
+    labels = {
+        False: "ground at each impact (slope_deg)",
+        True: "net's line at the contact (slope_deg)",
+    }
+    for c, t, r, ok, is_net in zip(
+        contact, tangent, reach, np.isfinite(psi), net, strict=True
+    ):
         if not ok:
             continue
         ends = np.array([c - r * t, c + r * t])
         line = _plot_points(h, ends[:, 0], ends[:, 1])
-        ax.plot(line[:, 0], line[:, 1], "-", color=GROUND_COLOUR, lw=2.0, label=label)
-        label = None
+        ax.plot(
+            line[:, 0],
+            line[:, 1],
+            "-" if not is_net else "--",
+            color=GROUND_COLOUR,
+            lw=2.0,
+            label=labels.pop(bool(is_net), None),
+        )
 
 
 def _draw_velocities(ax, imp, sx: float, h, *, span_m: float):
@@ -266,7 +300,14 @@ def plot_speed_spin(a: TrackAnalysis) -> Figure:
         2, 1, figsize=(8, 6), sharex=True, layout="constrained"
     )
     if ok.any():
-        ax1.plot(t[ok], measured[ok], ".", ms=2, color="0.5", label="measured")
+        ax1.plot(
+            t[ok],
+            measured[ok],
+            ".",
+            ms=2,
+            color="0.5",
+            label="measured (local differentiation)",
+        )
     for fl in a.flights:
         tt = np.linspace(fl.t_start_s, fl.t_end_s, 50)
         ax1.plot(
@@ -279,18 +320,30 @@ def plot_speed_spin(a: TrackAnalysis) -> Figure:
     outside_legend(ax1, fontsize=7)
     omega = f["omega_radps"].to_numpy(float)
     if np.isfinite(omega).any():
-        ax2.plot(t, omega, ".", ms=2, color="0.3", label="omega (track)")
+        ax2.plot(t, omega, ".", ms=2, color="0.3", label="spin from the marker (track)")
     else:
         ax2.text(
             0.5, 0.5, "no spin marker followed", transform=ax2.transAxes, ha="center"
         )
     imp = a.impacts.frame
     if len(imp):
-        ax2.plot(imp["t_s"], imp["omega_i_radps"], "v", color="crimson", label="before")
-        ax2.plot(imp["t_s"], imp["omega_f_radps"], "^", color="green", label="after")
+        ax2.plot(
+            imp["t_s"],
+            imp["omega_i_radps"],
+            "v",
+            color="crimson",
+            label="spin before the impact",
+        )
+        ax2.plot(
+            imp["t_s"],
+            imp["omega_f_radps"],
+            "^",
+            color="green",
+            label="spin after the impact",
+        )
         outside_legend(ax2, fontsize=7)
     ax2.set_ylabel("spin omega [rad/s]")
-    ax2.set_xlabel("t [s]")
+    ax2.set_xlabel("time t [s]")
     for ax in (ax1, ax2):
         ax.grid(True, alpha=0.3)
         _shade_contacts(ax, a)
@@ -320,7 +373,7 @@ def plot_residuals(a: TrackAnalysis) -> Figure:
             label="noise estimate (2-D RMS)",
         )
     _shade_contacts(ax, a)
-    ax.set_xlabel("t [s]")
+    ax.set_xlabel("time t [s]")
     ax.set_ylabel("distance from fitted flight [mm]")
     outside_legend(ax, fontsize=7)
     return fig

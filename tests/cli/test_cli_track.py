@@ -8,6 +8,7 @@ tests/tracking/test_video_acceptance.py.
 from __future__ import annotations
 
 import importlib.util
+import re
 import sys
 
 import numpy as np
@@ -41,8 +42,10 @@ def _clip(
     codec="MJPG",
     start=(0.05, 0.25),
     velocity=(2.5, 1.0),
+    g=G,
 ):
-    """A ball thrown across a 320x240 scene (2 mm/px); ``hide`` frames lack it."""
+    """A ball thrown across a 320x240 scene (2 mm/px) under gravity ``g``; ``hide``
+    frames lack it."""
     camera = render.Camera(width=320, height=240, origin_u_px=20.0, origin_v_px=220.0)
     rng = np.random.default_rng(4)
     scene = render.BounceScene(plate_point_m=(0.0, -1.0))  # plate out of view
@@ -51,7 +54,7 @@ def _clip(
     poses = np.column_stack(
         [
             start[0] + velocity[0] * t,
-            start[1] + velocity[1] * t - 0.5 * G * t**2,
+            start[1] + velocity[1] * t - 0.5 * g * t**2,
             0.2 - 40.0 * t,
         ]
     )
@@ -135,6 +138,31 @@ def test_homography_file_gives_the_same_track(cli, clip, tmp_path):
         ((*SCALE,), ("--fps", "required")),
         (("--fps", "0", *SCALE), ("--fps", "positive")),
         (("--fps", "-1205", *SCALE), ("--fps", "positive")),
+        # issue 17: rates and scales no camera has broke the arithmetic (traceback)
+        (("--fps", "1e300", *SCALE), ("--fps", "at most 1e+07 frames/s")),
+        (("--fps", "1e-300", *SCALE), ("--fps", "at least 0.001")),
+        (
+            (
+                "--fps",
+                "1205",
+                "--scale-points",
+                "20,20,300,20",
+                "--scale-length",
+                "1e300",
+            ),
+            ("--scale-length", "m per pixel", "a wrong unit?"),
+        ),
+        (
+            (
+                "--fps",
+                "1205",
+                "--scale-points",
+                "20,20,300,20",
+                "--scale-length",
+                "1e-300",
+            ),
+            ("--scale-length", "m per pixel"),
+        ),
         (
             ("--fps", "1205", "--scale-points", "20,20,20,20", "--scale-length", "1"),
             ("--scale-points", "identical"),
@@ -356,3 +384,38 @@ def test_rerun_recording_and_figures(cli, clip, tmp_path):
     assert "track.png" in pngs and len(pngs) >= 2
     for name in pngs:
         assert f"wrote {figures / name}" in result.stdout
+
+
+GRAVITY_LINE = (
+    r"flight 0 \(t = 0\.0000-0\.2\d+ s, \d+ samples\): "
+    r"g = ([\d.]+) \+/- ([\d.]+) m/s\^2"
+)
+
+
+@pytest.mark.parametrize("g", [9.58, G])
+def test_fitted_gravity_is_printed_per_flight_and_warned_beyond_3_se(
+    cli, render, tmp_path, g
+):
+    """Issue 17: `track` said "check the fitted gravity" but never printed it, and a
+    flight 2.3 % (many standard errors) off 9.81 went unwarned (the warning needed
+    5 %). Now every flight's g +/- SE is printed and a flight beyond 3 SE is named."""
+    video, _ = _clip(
+        render, tmp_path / "throw.avi", frames=300, velocity=(1.8, 1.2), g=g
+    )
+    out = tmp_path / "track.csv"
+    result = cli("track", video, "--fps", FPS, *SCALE, "--radius", "0.0375", "-o", out)
+    assert result.exit_code == 0, result.stderr
+    (match,) = re.finditer(GRAVITY_LINE, result.stdout)
+    fitted, se = float(match.group(1)), float(match.group(2))
+    assert fitted == pytest.approx(g, abs=max(4 * se, 0.01))
+    assert 0 < se < 0.05
+    warned = [line for line in result.stderr.splitlines() if "fitted g =" in line]
+    if g == G:
+        assert not warned
+    else:
+        assert (fitted - G) / se < -3
+        (line,) = warned
+        assert line.startswith("warning: flight 0 (t = 0.0000-")
+        assert f"fitted g = {match.group(1)} +/- {match.group(2)} m/s^2" in line
+        assert "standard errors" in line
+    assert f"wrote {out}" in result.stdout.splitlines()

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 from rerun.chunk import RrdReader
 
@@ -68,7 +70,57 @@ def test_impact_table_from_a_track_then_viewed(cli, track_csv, tmp_path):
     result = cli("view", table, "-o", out)
     assert result.exit_code == 0, result.stderr
     assert "3 impacts, 1 path(s)" in result.stdout
-    assert "/section/video/impacts" in summary(out)
+    # one entity per kind, the path on the `path` timeline (columnar recording)
+    assert "/section/impacts" in summary(out)
+    assert f"wrote {out}" in result.stdout.splitlines()
+
+
+def _many_paths(n_paths: int, per_path: int) -> pd.DataFrame:
+    """An ImpactTable of ``n_paths`` straight runs of ``per_path`` impacts each."""
+    rng = np.random.default_rng(3)
+    n = n_paths * per_path
+    step = np.tile(np.arange(per_path, dtype=float), n_paths)
+    return pd.DataFrame(
+        {
+            "path_id": np.repeat([f"rock{i}" for i in range(n_paths)], per_path),
+            "point": np.tile(np.arange(1, per_path + 1), n_paths),
+            "x_m": 5.0 * step + rng.normal(0, 0.5, n),
+            "z_m": 100.0 - 3.0 * step,
+            "slope_deg": np.full(n, 31.0),
+            "vi_x_mps": rng.uniform(5, 10, n),
+            "vi_z_mps": rng.uniform(-8, -4, n),
+            "vf_x_mps": rng.uniform(3, 8, n),
+            "vf_z_mps": rng.uniform(1, 3, n),
+        }
+    )
+
+
+def test_many_impacts_are_recorded_columnar_with_progress(cli, tmp_path):
+    """Issue 17: `view` of 305 k simulated impacts took 26 s and wrote 88 MB
+    silently: one entity tree (about 13 chunks) per path, logged row by row. Now
+    each entity is written once, columnar, the paths on the `path` timeline; the
+    step is named on stderr and every file written is reported."""
+    n_paths, per_path = 400, 25
+    table = tmp_path / "sim.parquet"
+    _many_paths(n_paths, per_path).to_parquet(table)
+    out = tmp_path / "sim.rrd"
+    result = cli("view", table, "-o", out)
+    assert result.exit_code == 0, result.stderr
+    assert f"recording 10,000 impacts of {n_paths} path(s) ..." in result.stderr
+    assert "10,000 impacts, 400 path(s): the section shows every path" in result.stdout
+    assert result.stdout.splitlines()[-1] == f"wrote {out}"
+    lines = summary(out).splitlines()
+    chunks = [line for line in lines if line.startswith("/section")]
+    assert len(chunks) <= 20  # was 13 per path: 5200
+    rows = {
+        line.split(" ", 1)[0]: int(line.split("rows=")[1].split()[0])
+        for line in chunks
+        if "static=True" not in line
+    }
+    for entity in ("impacts", "path", "slope", "vi", "vf"):
+        assert rows[f"/section/{entity}"] == n_paths  # one row per path
+    for col in ("e_n", "e_t", "vi_mps", "vf_mps"):
+        assert rows[f"/section/plots/{col}"] == n_paths * per_path
 
 
 @pytest.mark.parametrize(
@@ -87,7 +139,7 @@ def test_track_exports_are_detected_and_read(cli, tmp_path, sample, args):
     out = tmp_path / "x.rrd"
     result = cli("view", DATA / sample, "--radius", "0.03", "-o", out, *args)
     assert result.exit_code == 0, result.stderr
-    assert "1 flights" in result.stdout
+    assert "1 flight, " in result.stdout
     assert "g = " not in result.stderr  # exact parabolas: g = 9.81, no warning
     assert out.is_file()
 
@@ -158,3 +210,162 @@ def test_bad_input_one_line_error_and_no_output(
     assert result.stderr.startswith("error: ") and result.stderr.count("\n") == 1
     assert not (tmp_path / "out.rrd").exists()
     assert not (tmp_path / "x.png").exists()
+
+
+def test_net_clip_truth_is_one_net_contact_not_an_impact_too(cli, repo, tmp_path):
+    """Issue 17: `view video/net.truth.csv` reported "1 impacts, 1 net contacts"
+    (the truth has no impact, one contact) and drew the contact as an impact on a
+    "ground" line at -105 deg. The contact is one event: its ImpactTable row is the
+    net contact, on the net's own line (overhanging, docs/architecture.md §2)."""
+    import json
+
+    from matplotlib.figure import Figure
+
+    truth = json.loads((repo / "video" / "net.truth.json").read_text())
+    top, bottom = (
+        np.array(truth["scene_parameters"][k]) for k in ("net_top_m", "net_bottom_m")
+    )
+    dx, dz = bottom - top
+    psi_truth = -np.degrees(np.arctan2(dz, dx)) - 180.0  # N turned to face the ball
+    out, figs = tmp_path / "net.rrd", tmp_path / "net_figs"
+    saved = []
+    original = Figure.savefig
+
+    def keep(self, *args, **kwargs):
+        saved.append(self)
+        return original(self, *args, **kwargs)
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(Figure, "savefig", keep)
+        result = cli(
+            "view",
+            repo / "video" / "net.truth.csv",
+            "--radius",
+            "0.0375",
+            "--mass",
+            "0.14",
+            "--gyration",
+            "0.02372",
+            "-o",
+            out,
+            "--figures",
+            figs,
+        )
+    assert result.exit_code == 0, result.stderr
+    assert truth["impacts"] == []
+    assert "482 samples, 2 flights, 0 impacts, 1 net contact" in result.stdout
+    (line,) = [s for s in result.stdout.splitlines() if "the net's line" in s]
+    psi = float(line.split("slope_deg ")[1].split(" deg")[0])
+    assert psi == pytest.approx(psi_truth, abs=0.5)  # -105.1: the net, not ground
+    assert "overhanging" in line
+    # the surface estimate names the same event, as a net contact
+    assert "warning: point 1 (net contact): surface angle -105.13 deg" in result.stderr
+    (track_fig,) = [f for f in saved if f.axes[0].get_title().startswith("track")]
+    texts = [t.get_text() for t in track_fig.axes[0].get_legend().get_texts()]
+    assert "net's line at the contact (slope_deg)" in texts
+    assert "net contact (start)" in texts
+    assert not [t for t in texts if t.startswith(("impacts", "ground"))]
+    for fig in saved:  # every axis in words with a unit
+        for ax in fig.axes:
+            for label in (ax.get_xlabel(), ax.get_ylabel()):
+                assert not label or re.search(r"[a-z]{4,}.*\[[^\]]+\]", label), label
+    wrote = [s for s in result.stdout.splitlines() if s.startswith("wrote ")]
+    assert wrote == [f"wrote {out}"] + [
+        f"wrote {figs / n}"
+        for n in ("track.png", "speed_spin.png", "residuals.png", "net_contact_0.png")
+    ]
+
+
+def _track_text(rows: list[tuple[str, str, str]]) -> str:
+    return "t_s,x_m,z_m\n" + "".join(f"{t},{x},{z}\n" for t, x, z in rows)
+
+
+def _throw(n: int = 40) -> list[list[str]]:
+    t = np.arange(n) / 1000.0
+    return [
+        [repr(float(a)), repr(float(b)), repr(float(c))]
+        for a, b, c in zip(t, 1.0 * t, 0.5 + t - 4.905 * t**2, strict=True)
+    ]
+
+
+def _edit(row: int, column: int, value: str) -> str:
+    """A thrown-ball track with file row ``row`` (header = row 1), ``column`` set."""
+    rows = _throw()
+    rows[row - 2][column] = value
+    return _track_text([tuple(r) for r in rows])
+
+
+@pytest.mark.parametrize(
+    ("text", "args", "message"),
+    [
+        # issue 17: times going backwards or repeating used to be sorted silently
+        (
+            _edit(20, 0, "0.005"),
+            (),
+            "back.csv: row 20: times are not increasing: 0.005 s goes back from",
+        ),
+        (
+            _edit(21, 0, "0.018"),
+            (),
+            "row 21: times are not increasing: 0.018 s repeats 0.018 s",
+        ),
+        (_edit(7, 0, "inf"), (), "back.csv: row 7: t_s inf: time is missing"),
+        (_edit(8, 0, ""), (), "back.csv: row 8: t_s nan: time is missing"),
+        (_edit(9, 1, "-inf"), (), "back.csv: row 9: x_m -inf: not finite"),
+        (_edit(10, 2, "1e300"), (), "back.csv: row 10: z_m 1e+300: beyond 100000 m"),
+        (_edit(40, 0, "1e200"), (), "back.csv: row 40: t_s 1e+200: beyond 86400 s"),
+        (
+            _track_text([(f"{i * 1e-12!r}", "0", "0") for i in range(20)]),
+            (),
+            "back.csv: row 3: time step 1e-12 s from the row before is shorter",
+        ),
+        (None, ("--fps", "0", "--file-fps", "30"), "--fps must be a positive frame"),
+        (None, ("--fps", "inf", "--file-fps", "30"), "got inf"),
+        (None, ("--fps", "nan", "--file-fps", "30"), "got nan"),
+        (None, ("--fps", "1e300", "--file-fps", "30"), "at most 1e+07 frames/s"),
+        (None, ("--fps", "1205", "--file-fps", "1e-300"), "--file-fps must be"),
+        (None, ("--fps", "-1"), "--fps must be a positive frame rate"),
+        (None, ("--surface-angle", "nan"), "--surface-angle must be a dip in"),
+        (None, ("--surface-angle", "200"), "(-180, 180] deg"),
+    ],
+)
+def test_hostile_track_input_one_line_error_nothing_written(
+    cli, tmp_path, text, args, message
+):
+    """Issue 17: `view` of a track whose times go backwards succeeded; so did rates
+    and sizes no camera has. Each is now one error line naming the file and row (or
+    the option), exit 1, nothing written, the input unchanged."""
+    path = tmp_path / "back.csv"
+    path.write_text(text or _track_text([tuple(r) for r in _throw()]))
+    before = path.read_bytes()
+    out = tmp_path / "out.rrd"
+    result = cli("view", path, "--radius", "0.03", *args, "-o", out)
+    assert result.exit_code == 1, result.stdout
+    lines = [line for line in result.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
+    assert message in lines[0], lines[0]
+    assert not out.exists() and path.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["back.csv"]
+
+
+@pytest.mark.parametrize(
+    ("scale", "message"),
+    [
+        (
+            "1e-300",
+            "--metres-per-pixel must lie between 1e-07 and 1000 m/px, got 1e-300",
+        ),
+        ("inf", "--metres-per-pixel must lie between 1e-07 and 1000 m/px, got inf"),
+        ("0", "--metres-per-pixel must lie between 1e-07 and 1000 m/px, got 0"),
+    ],
+)
+def test_absurd_pixel_scale_is_one_line_error(cli, tmp_path, scale, message):
+    """A pixel scale no camera has (1e-300 m/px used to collapse the track to a point
+    and write a recording) is refused naming the option."""
+    out = tmp_path / "x.rrd"
+    args = ("--unit", "px", "--metres-per-pixel", scale)
+    result = cli("view", DATA / "kinovea_raw_semicolon_px.csv", "--radius", "0.03",
+                 *args, "-o", out)  # fmt: skip
+    assert result.exit_code == 1
+    assert result.stderr == f"error: {message}\n"
+    assert not out.exists()

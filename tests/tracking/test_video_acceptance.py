@@ -116,7 +116,8 @@ def test_net_clip_contact_phase(cli, render, tmp_path):
     track, _, truth, result = _run(cli, tmp_path, "net", tmp_path)
     _check_positions(track, tmp_path, "net")
     contact = truth["contact"]
-    assert "1 extended contacts" in result.stdout
+    # one event: a net contact, not also an impact (issue 17)
+    assert "2 flights, 0 impacts, 1 net contact" in result.stdout
     # the body is off its flights throughout the contact (thesis: 61 frames)
     t = track["t_s"].to_numpy()
     during = (t > contact["t_start_s"] + 0.003) & (t < contact["t_end_s"] - 0.012)

@@ -129,7 +129,7 @@ def figures(survey_table, flagged_table, bounces, net):
         "en_theta": plot_en_theta(
             f["theta_i_deg"], f["e_n"], theta0_source=f["theta0_source"].tolist()
         ),
-        "et": plot_et_impacts(f["e_t"], flagged=qa_flagged(f)),
+        "et": plot_et_impacts(f["e_t"], qa_flags=f["qa_flags"]),
         "energy_partition": plot_energy_partition(flagged_table),
         "energy_head": plot_energy_head(flagged_table),
         "fence": plot_fence(11440.0, split=split),
@@ -320,18 +320,20 @@ def test_figures_ring_the_flagged_impacts(flagged_table, survey_table):
     flagged = qa_flagged(f)
     section = plot_section(flagged_table, survey).axes[0]
     head = plot_energy_head(flagged_table).axes[0]
-    et = plot_et_impacts(f["e_t"], flagged=flagged).axes[0]
+    et = plot_et_impacts(f["e_t"], qa_flags=f["qa_flags"]).axes[0]
     for ax, (x, y) in (
         (section, (f["x_m"], f["z_m"])),
         (head, (f["x_m"], f["energy_head_i_m"])),
         (et, (np.arange(1, len(f) + 1), f["e_t"])),
     ):
         (ring,) = rings(ax)
-        assert ring.get_label() == f"{QA_LABEL} (2)"
+        # the legend names each flag that sets a ringed impact apart, with its count
+        label = f"{QA_LABEL} on 2: e_t > 1 (1), energy gained (1), spin estimated (1)"
+        assert " ".join(ring.get_label().split()) == label  # wrapped in the legend
         expected = np.column_stack([x, y])[flagged & np.isfinite(y)]
         np.testing.assert_allclose(ring.get_offsets(), expected)
         assert len(ring.get_facecolors()) == 0  # an open ring
-        assert QA_LABEL + " (2)" in [
+        assert ring.get_label() in [
             t.get_text() for t in legends(ax.figure)[0].get_texts()
         ]
 

@@ -86,11 +86,11 @@ def test_impact_table_recording(tmp_path, bounce_analysis):
     table = bounce_analysis.impacts
     path = write_impact_recording(tmp_path / "impacts.rrd", table)
     e = entities(path)
-    base = "/section/video"
+    # one entity per kind for every path (columnar, the path on the `path` timeline)
     for name in ("impacts", "path", "slope", "vi", "vf"):
-        assert f"{base}/{name}" in e
+        assert e[f"/section/{name}"] == 1  # one path: one row
     for col in ("e_n", "e_t", "vi_mps", "vf_mps"):
-        assert e[f"{base}/plots/{col}"] == len(table)
+        assert e[f"/section/plots/{col}"] == len(table)
 
 
 def test_net_contact_series(tmp_path):

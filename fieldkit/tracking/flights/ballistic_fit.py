@@ -34,8 +34,9 @@ from numpy.typing import ArrayLike
 
 from fieldkit.physics.constants import G
 
-#: Relative difference between fitted and true gravity above which a warning is due.
-GRAVITY_WARNING_FRACTION = 0.05
+#: Standard errors between fitted and true gravity beyond which a flight's gravity
+#: is reported as off (a difference the fit's own noise does not explain).
+GRAVITY_WARNING_SIGMAS = 3.0
 
 
 @dataclass(frozen=True)
@@ -245,6 +246,39 @@ class FlightFit:
         """``(g_fitted - 9.81) / 9.81``."""
         return (self.g_mps2 - G) / G
 
+    @property
+    def g_sigmas(self) -> float:
+        """``(g_fitted - 9.81) / g_se``: standard errors from 9.81 (NaN when the
+        standard error is unknown or zero)."""
+        if not (np.isfinite(self.g_se_mps2) and self.g_se_mps2 > 0):
+            return float("nan")
+        return (self.g_mps2 - G) / self.g_se_mps2
+
+    def gravity_summary(self) -> str:
+        """One line: the flight's time span and fitted g with its standard error.
+
+        Examples
+        --------
+        ``flight 3 (t = 0.5012-0.6910 s, 229 samples): g = 9.58 +/- 0.04 m/s^2,
+        -2.3 %, -5.7 SE from 9.81``
+        """
+        sigmas = self.g_sigmas
+        off = f", {sigmas:+.1f} SE" if np.isfinite(sigmas) else ""
+        return (
+            f"flight {self.index} (t = {self.t_start_s:.4f}-{self.t_end_s:.4f} s, "
+            f"{self.n_samples} samples): g = {self.g_text()} m/s^2, "
+            f"{100 * self.g_relative_error:+.2f} %{off} from 9.81"
+        )
+
+    def g_text(self) -> str:
+        """``g +/- SE`` with the standard error to two significant digits (at least
+        two decimals): ``9.58 +/- 0.04``, ``9.8093 +/- 0.0012``."""
+        se = self.g_se_mps2
+        digits = 2
+        if np.isfinite(se) and se > 0:
+            digits = int(min(max(2, 1 - np.floor(np.log10(se))), 4))
+        return f"{self.g_mps2:.{digits}f} +/- {se:.{digits}f}"
+
     def position(self, t_s: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """Centre position ``(x, z)`` [m] on the fitted parabola at time(s) ``t_s``."""
         tau = np.asarray(t_s, float) - self.t_ref_s
@@ -264,22 +298,22 @@ class FlightFit:
         return np.hypot(*self.velocity(t_s))
 
     def gravity_warning(self) -> str | None:
-        """A warning when the fitted g is > 5 % from 9.81 and the difference is real.
+        """A warning naming the flight when its fitted g is more than
+        :data:`GRAVITY_WARNING_SIGMAS` standard errors from 9.81.
 
-        The difference must exceed both 5 % and three standard errors, so a short,
-        noisy flight does not raise a false alarm. The message gives the capture rate
-        that would make g right (``fps * sqrt(9.81 / g)``) in case the scale is right.
+        A difference the fit's noise does not explain points at the capture rate,
+        the length scale, or a flight disturbed by something else (a contact inside
+        it, drag). The message gives the capture rate that would make g right
+        (``fps * sqrt(9.81 / g)``) in case the scale is right.
         """
-        rel = self.g_relative_error
-        if not np.isfinite(rel) or abs(rel) <= GRAVITY_WARNING_FRACTION:
-            return None
-        if abs(self.g_mps2 - G) <= 3.0 * self.g_se_mps2:
+        sigmas = self.g_sigmas
+        if not np.isfinite(sigmas) or abs(sigmas) <= GRAVITY_WARNING_SIGMAS:
             return None
         factor = np.sqrt(G / self.g_mps2) if self.g_mps2 > 0 else float("nan")
         return (
             f"flight {self.index} (t = {self.t_start_s:.4f}-{self.t_end_s:.4f} s): "
-            f"fitted g = {self.g_mps2:.2f} +/- {self.g_se_mps2:.2f} m/s^2 is "
-            f"{100 * rel:+.1f} % "
+            f"fitted g = {self.g_text()} m/s^2 is "
+            f"{100 * self.g_relative_error:+.1f} % ({sigmas:+.1f} standard errors) "
             f"from 9.81; check the capture rate (`fps`; times {factor:.4g} would fit) "
             "or the length scale"
         )

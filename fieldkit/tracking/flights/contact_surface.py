@@ -216,7 +216,7 @@ def surface_angles(
     if surface_angle_deg is None:
         for i in np.flatnonzero(extended):
             slope[i], note = extended_contact_angle(f.iloc[i], radius_m, gyration_m)
-            warnings.append(f"contact {i + 1} (extended): {note}")
+            warnings.append(f"point {i + 1} (net contact): {note}")
             if not np.isfinite(slope[i]):
                 source[i] = None
     for i in range(n):

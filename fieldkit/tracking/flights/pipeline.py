@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
+import pandas as pd
 
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.impact_table import ImpactTable
@@ -55,9 +56,13 @@ class TrackAnalysis:
     flights
         The fitted flights in time order.
     impacts
-        One row per contact between consecutive flights (empty table when none).
+        One row per contact between consecutive flights (empty table when none):
+        instantaneous impacts and extended contacts alike, the latter with
+        ``contact_duration_s > 0`` and, on an overhanging net, ``slope_deg`` beyond
+        +/-90 deg (docs/architecture.md §2). :attr:`net_rows` tells them apart.
     contacts
-        The extended contacts (nets, rolling phases) with their time series.
+        The extended contacts (nets, rolling phases) with their time series; each
+        is also a row of ``impacts``.
     warnings
         One-line warnings for the user (gravity off, surface angle assumed, ...).
     measured_velocity
@@ -69,6 +74,57 @@ class TrackAnalysis:
     impacts: ImpactTable
     contacts: list[NetContact]
     warnings: list[str]
+
+    @property
+    def net_rows(self) -> np.ndarray:
+        """True for the rows of ``impacts`` that are extended contacts (a net, a
+        rolling phase: ``contact_duration_s > 0``), False for instantaneous impacts.
+
+        An extended contact is one event: it is counted and described as a net
+        contact, not as an impact on a ground line as well.
+        """
+        f = self.impacts.frame
+        if "contact_duration_s" not in f.columns:
+            return np.zeros(len(f), bool)
+        duration = pd.to_numeric(f["contact_duration_s"], errors="coerce")
+        return duration.fillna(0.0).to_numpy(float) > 0.0
+
+    @property
+    def n_impacts(self) -> int:
+        """Instantaneous impacts (rows of ``impacts`` that are not net contacts)."""
+        return int((~self.net_rows).sum())
+
+    def counts_text(self) -> str:
+        """``2 flights, 0 impacts, 1 net contact``: each event counted once."""
+
+        def n(count: int, noun: str) -> str:
+            return f"{count} {noun}{'' if count == 1 else 's'}"
+
+        return (
+            f"{n(len(self.flights), 'flight')}, {n(self.n_impacts, 'impact')}, "
+            f"{n(len(self.contacts), 'net contact')}"
+        )
+
+    def net_rows_text(self) -> list[str]:
+        """One line per net contact row of ``impacts``: the surface it found (the
+        net's line, overhanging when beyond +/-90 deg) and e_n, e_t on it."""
+        f = self.impacts.frame
+        lines = []
+        for i in np.flatnonzero(self.net_rows):
+            row = f.iloc[i]
+            psi = float(row["slope_deg"])
+            side = (
+                "overhanging: N faces the body"
+                if np.isfinite(psi) and abs(psi) > 90
+                else "N faces the body"
+            )
+            lines.append(
+                f"impact table point {row['point']} (the net contact at t "
+                f"{float(row['t_s']):.4f} s): surface slope_deg {psi:.1f} deg (the "
+                f"net's line, {side}); "
+                f"e_n {float(row['e_n']):.3f}, e_t {float(row['e_t']):.3f}"
+            )
+        return lines
 
     @cached_property
     def measured_velocity(self) -> tuple[np.ndarray, np.ndarray]:
@@ -131,6 +187,14 @@ def analyse_track(
     if not np.isfinite(radius_m) or radius_m <= 0:
         raise ArgumentError(
             f"radius_m must be > 0 (got {radius_m:g})", source="radius_m"
+        )
+    if surface_angle_deg is not None and not (
+        np.isfinite(surface_angle_deg) and -180.0 < surface_angle_deg <= 180.0
+    ):
+        raise ArgumentError(
+            "surface_angle_deg must be a dip in (-180, 180] deg "
+            f"(docs/architecture.md §2), got {surface_angle_deg:g}",
+            source="surface_angle_deg",
         )
     if mass_kg is not None and not mass_kg > 0:
         raise ArgumentError(f"mass_kg must be > 0 (got {mass_kg:g})", source="mass_kg")

@@ -34,6 +34,7 @@ import numpy as np
 
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.io.csv_table import length_factor, read_csv_table, read_json
+from fieldkit.io.tracking_export import MAX_METRES_PER_PIXEL, MIN_METRES_PER_PIXEL
 
 
 @dataclass(frozen=True)
@@ -150,6 +151,12 @@ def two_point_scale(
             source="scale_points",
         )
     s = length_m / distance
+    if not MIN_METRES_PER_PIXEL <= s <= MAX_METRES_PER_PIXEL:
+        raise ArgumentError(
+            f"{length_m:g} m over {distance:.4g} px is {s:.3g} m per pixel, outside "
+            f"{MIN_METRES_PER_PIXEL:g}-{MAX_METRES_PER_PIXEL:g} m/px (a wrong unit?)",
+            source="scale_length_m",
+        )
     h = np.array([[s, 0.0, -s * u1], [0.0, -s, s * v1], [0.0, 0.0, 1.0]])
     return Calibration(
         h,
