@@ -13,13 +13,10 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -c "from fieldkit.model.compile_cache import main; main()"
 	touch $(STAMP)
 
-## Reduce the bundled Tornado Mountain survey (thesis Table 2-4) to an ImpactTable and figures.
+## The whole loop on the bundled Tornado Mountain survey in about a minute: reduce ->
+## diagnose -> fit -> simulate -> export; out/demo/index.md links every figure and report.
 demo: $(STAMP)
-	MPLBACKEND=Agg $(BIN)/fieldkit reduce \
-	    --impacts surveys/tornado_mountain/boulder_a_impacts.gpx \
-	    --trees surveys/tornado_mountain/boulder_a_trees.csv \
-	    --theta0 32.6 --mass 3750 --radius 0.725 --gyration 0.46 --path-id boulder_a \
-	    --figures out/demo/figures -o out/demo/boulder_a_impacts.csv
+	MPLBACKEND=Agg $(BIN)/python examples/demo.py out/demo
 
 ## Fast test suite (a few minutes on 2 cores).
 test: $(STAMP)

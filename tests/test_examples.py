@@ -67,6 +67,17 @@ EXPECTED = {
         r"rstone: 6 files",
         r"mismatch: colluvium: rstone has no velocity_scaled_restitution",
     ],
+    # `make demo` (issue 17): the whole loop, one line per step; boulder A has 48
+    # impacts (Table 2-4), boulder A's 18 m/s at 610 m placed in the simulated spread
+    "demo.py": [
+        r"^1\. reduce: 48 impacts of boulder A",
+        r"^2\. diagnose: (recommends \w+|no effect recommended)",
+        r"^3\. fit: colluvium e_n \d\.\d+ ± \d",
+        r"^4\. simulate: runout p50 \d+ m.*18 m/s speed at x = 610 m is at the "
+        r"\d+th percentile",
+        r"^5\. export: 6 RocFall files",
+        r"wrote .*index\.md",
+    ],
     # docs/real-data-diagnosis.md: Tornado Mountain boulder A's 48 impacts, naive
     # eq. 5.4 slope 0.71 (thesis pooled 1.03); the one-impact surveys are refused
     "diagnose_real_data.py": [
@@ -94,7 +105,17 @@ def test_example_runs(script, tmp_path):
     )
     assert done.returncode == 0, done.stderr[-2000:]
     for pattern in EXPECTED.get(script.name, []):
-        assert re.search(pattern, done.stdout), (pattern, done.stdout[-2000:])
+        assert re.search(pattern, done.stdout, re.MULTILINE), (
+            pattern,
+            done.stdout[-2000:],
+        )
+    if script.name == "demo.py":
+        index = tmp_path / "out" / "index.md"
+        links = re.findall(r"\]\(([^)]+)\)", index.read_text(encoding="utf-8"))
+        assert all((index.parent / link).is_file() for link in links), links
+        # the figures and reports of every stage are linked
+        for stage in ("reduce/", "diagnose/", "fit/", "simulate/", "export/"):
+            assert any(link.startswith(stage) for link in links), stage
 
 
 def test_every_example_has_expectations_or_is_new():

@@ -1,0 +1,252 @@
+"""`make demo`: the whole loop on boulder A in about a minute.
+
+Tornado Mountain boulder A (thesis §2.2.2, §7.5.4), surveyed impact by impact, runs
+through every stage a user would run, as the command lines a user types
+(``python -m fieldkit ...``), writing only into OUT_DIR (default ``out/demo``):
+
+1. ``fieldkit reduce`` -- the GPS impacts and tree strikes to an ImpactTable, with the
+   survey's preset (θ0, body, material mapping:
+   ``surveys/tornado_mountain/boulder_a_preset.toml``);
+2. ``fieldkit diagnose`` -- Table 7-1's model against the measured rebounds: held-out
+   error and which effect (if any) the impacts ask for;
+3. ``fieldkit fit --paths`` -- the simulator calibrated on the whole surveyed path
+   (runout, flight heights, impact spacing, impact speeds), from
+   ``surveys/tornado_mountain/model_path_start.json``;
+4. ``fieldkit simulate`` -- the calibrated model, 2,000 rocks, compared with what
+   boulder A did at x = 610 m (18 m/s, 600 kJ; §7.5.4);
+5. ``fieldkit export`` -- the calibrated model as RocFall input blocks.
+
+Each step prints one line; the commands' own output goes to ``OUT_DIR/logs/``, and
+``OUT_DIR/index.md`` links every figure and report. The numbers are a small-sample
+demonstration (few rocks, few bootstrap resamples): the README and
+``examples/calibrate_tornado_mountain.py`` give the measured ones.
+
+Run:  python examples/demo.py [OUT_DIR]
+"""
+
+from __future__ import annotations
+
+import json
+import shlex
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parent
+SURVEY = REPO / "surveys" / "tornado_mountain"
+PRESET = SURVEY / "boulder_a_preset.toml"
+SEED = 1
+#: The path fit of examples/export_tornado_mountain.py, smaller: free parameters and
+#: their search bounds, rocks per evaluation, Sobol screen, bootstrap resamples.
+PATH_FREE = {
+    "materials.colluvium.e_n": (0.2, 2.0),
+    "materials.colluvium.e_t": (0.3, 0.98),
+    "velocity_scaled_restitution.k_mps": (2.0, 30.0),
+    "materials.bench.e_n": (0.05, 1.2),
+    "materials.bench.e_t": (0.1, 0.98),
+}
+PATH_ROCKS, PATH_SCREEN, PATH_BOOTSTRAP = 60, 8, 10
+SIM_ROCKS, X_ANALYSIS_M = 2000, 610.0
+MEASURED = "x=610,speed=18,ke=600e3"  # §7.5.4
+
+
+def relative(path: Path) -> str:
+    """A path as the user would type it from the repository root."""
+    try:
+        return str(path.resolve().relative_to(Path.cwd().resolve()))
+    except ValueError:
+        return str(path)
+
+
+class Demo:
+    """Runs the steps, keeps their logs and the lines of index.md."""
+
+    def __init__(self, out: Path) -> None:
+        self.out = out
+        self.logs = out / "logs"
+        self.logs.mkdir(parents=True, exist_ok=True)
+        self.index: list[str] = []
+        self.step = 0
+
+    def run(self, name: str, *args: object) -> str:
+        """Run ``fieldkit ARGS``; its output goes to logs/NN-name.txt."""
+        self.step += 1
+        words = [relative(a) if isinstance(a, Path) else str(a) for a in args]
+        command = "fieldkit " + shlex.join(words)
+        start = time.perf_counter()
+        done = subprocess.run(
+            [sys.executable, "-m", "fieldkit", *words],
+            capture_output=True,
+            text=True,
+        )
+        seconds = time.perf_counter() - start
+        log = self.logs / f"{self.step:02d}-{name}.txt"
+        log.write_text(
+            f"$ {command}\n\n{done.stdout}\n{done.stderr}", encoding="utf-8"
+        )
+        if done.returncode != 0:
+            sys.exit(
+                f"step {self.step} ({name}) failed: {command}\n{done.stderr.strip()}"
+            )
+        self.index += [f"## {self.step}. {name}", "", "```", command, "```", ""]
+        self.index.append(f"Output: [{log.name}](logs/{log.name}) ({seconds:.0f} s)")
+        self.index.append("")
+        return done.stdout
+
+    def say(self, line: str) -> None:
+        """The one line a step prints (also the step's summary in index.md)."""
+        print(f"{self.step}. {line}", flush=True)
+        self.index.append(line)
+        self.index.append("")
+
+    def link(self, title: str, folder: Path) -> None:
+        """Link every PNG and markdown report in ``folder`` from index.md."""
+        files = sorted(
+            p for p in folder.rglob("*") if p.suffix in (".png", ".md") and p.is_file()
+        )
+        if files:
+            self.index.append(f"{title}:")
+            self.index.append("")
+            for p in files:
+                rel = p.relative_to(self.out).as_posix()
+                self.index.append(f"- [{rel}]({rel})")
+            self.index.append("")
+
+
+def main(out: Path) -> None:
+    out.mkdir(parents=True, exist_ok=True)
+    demo = Demo(out)
+    start = time.perf_counter()
+
+    # 1. survey -> ImpactTable
+    table = out / "boulder_a_impacts.csv"
+    demo.run(
+        "reduce", "reduce", "--preset", PRESET,
+        "--impacts", SURVEY / "boulder_a_impacts.gpx",
+        "--trees", SURVEY / "boulder_a_trees.csv",
+        "-o", table, "--figures", out / "reduce",
+    )  # fmt: skip
+    frame = pd.read_csv(table)
+    impacts = frame["e_n"].notna()
+    demo.say(
+        f"reduce: {impacts.sum()} impacts of boulder A, median e_n "
+        f"{frame.loc[impacts, 'e_n'].median():.2f}, e_t "
+        f"{frame.loc[impacts, 'e_t'].median():.2f} -> {relative(table)}"
+    )
+    demo.link("Figures", out / "reduce")
+
+    # 2. where Table 7-1's model fails on the measured rebounds
+    diagnosis = out / "diagnose" / "diagnosis.json"
+    demo.run(
+        "diagnose", "diagnose", table,
+        "--model", SURVEY / "model_rocfall_table_7_1.json", "--preset", PRESET,
+        "--seed", SEED, "--json", diagnosis, "--report", out / "diagnose",
+    )  # fmt: skip
+    found = json.loads(diagnosis.read_text(encoding="utf-8"))
+    demo.say(f"diagnose: {diagnosis_line(found)}")
+    demo.link("Report and figures", out / "diagnose")
+
+    # 3. calibrate the simulator on the whole path
+    calibrated = out / "calibrated_model.json"
+    fit_json = out / "fit" / "fit.json"
+    bounds = []
+    for name, (lo, hi) in PATH_FREE.items():
+        bounds += ["--free", name, "--bound", f"{name}={lo},{hi}"]
+    demo.run(
+        "fit", "fit", "--paths", table,
+        "--model", SURVEY / "model_path_start.json", "--preset", PRESET, *bounds,
+        "--rocks", PATH_ROCKS, "--screen", PATH_SCREEN,
+        "--bootstrap", PATH_BOOTSTRAP, "--seed", SEED,
+        "-o", calibrated, "--json", fit_json, "--report", out / "fit",
+    )  # fmt: skip
+    fit = json.loads(fit_json.read_text(encoding="utf-8"))
+    demo.say(f"fit: {fit_line(fit)} -> {relative(calibrated)}")
+    demo.link("Report and figures", out / "fit")
+
+    # 4. simulate the calibrated model, compare with boulder A at x = 610 m
+    summary = out / "simulate" / "summary.json"
+    demo.run(
+        "simulate", "simulate", calibrated, "--rocks", SIM_ROCKS, "--seed", SEED,
+        "--at", X_ANALYSIS_M, "--measured", MEASURED,
+        "--summary", summary, "--figures", out / "simulate",
+    )  # fmt: skip
+    stats = json.loads(summary.read_text(encoding="utf-8"))
+    demo.say(f"simulate: {simulate_line(stats)}")
+    demo.link("Figures", out / "simulate")
+
+    # 5. the calibrated model as RocFall input
+    export = out / "export" / "rocfall"
+    demo.run("export", "export", calibrated, "--to", "rocfall", "-o", export, "--force")
+    files = sorted(p.name for p in export.iterdir())
+    demo.say(f"export: {len(files)} RocFall files -> {relative(export)}")
+    demo.link("What was mapped, and what could not be", export)
+
+    seconds = time.perf_counter() - start
+    index = out / "index.md"
+    head = [
+        "# fieldkit demo: Tornado Mountain boulder A, the whole loop",
+        "",
+        "Survey -> ImpactTable -> diagnosis -> path calibration -> simulation -> "
+        f"export, {seconds:.0f} s. Small samples (a demonstration): the README "
+        "gives the measured figures.",
+        "",
+    ]
+    index.write_text("\n".join(head + demo.index) + "\n", encoding="utf-8")
+    print(f"wrote {relative(index)} (every figure and report, {seconds:.0f} s)")
+
+
+def diagnosis_line(found: dict) -> str:
+    """Recommended effects and the held-out error before and after."""
+    before = found["baseline"]["cv_rmse_mps"]
+    added = [step["added"] for step in found["steps"]]
+    if not added:
+        return (
+            f"no effect recommended; held-out error of Table 7-1's model "
+            f"{before:.2f} m/s"
+        )
+    after = found["steps"][-1]["cv_rmse_mps"]
+    return (
+        f"recommends {', '.join(added)}: held-out error of the rebound velocities "
+        f"{before:.2f} -> {after:.2f} m/s ({1 - after / before:.0%} lower)"
+    )
+
+
+def fit_line(fit: dict) -> str:
+    """The fitted values (± bootstrap SE) and the fall of the score."""
+    values = []
+    for p in fit["parameters"]:
+        owner, name = p["name"].split(".")[-2:]
+        se = f" ± {p['stderr']:.2g}" if p.get("stderr") is not None else ""
+        values.append(f"{owner} {name} {p['value']:.3g}{se}")
+    return (
+        f"{', '.join(values)}; score {fit['objective_start']:.2f} -> "
+        f"{fit['objective_optimum']:.2f} (sum over {len(fit['kinds'])} kinds of "
+        "the mean CRPS scaled by its value at the start)"
+    )
+
+
+def simulate_line(stats: dict) -> str:
+    """Runout and where boulder A's measured speed and energy fall at x = 610 m."""
+    runout = stats["runout_x_m"]
+    text = f"runout p50 {runout['p50']:.0f} m, p95 {runout['p95']:.0f} m"
+    for point in stats["measured"]:
+        for key, label, scale, unit in (
+            ("speed_mps", "speed", 1, "m/s"),
+            ("ke_j", "KE", 1e-3, "kJ"),
+        ):
+            if key in point:
+                m = point[key]
+                text += (
+                    f"; boulder A's {m['measured'] * scale:g} {unit} {label} at "
+                    f"x = {point['x_m']:g} m is at the {m['percentile']:.0f}th "
+                    "percentile"
+                )
+    return text
+
+
+if __name__ == "__main__":
+    main(Path(sys.argv[1]) if len(sys.argv) > 1 else Path("out/demo"))
