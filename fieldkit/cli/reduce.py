@@ -23,7 +23,7 @@ from fieldkit.cli.common import (
 )
 from fieldkit.cli.progress import step
 from fieldkit.errors import ArgumentError
-from fieldkit.impact_table import FORMATS
+from fieldkit.impact_table import table_format
 from fieldkit.outputs import OutputSet
 
 #: Body values `reduce` needs: none (columns it cannot fill stay NaN).
@@ -293,11 +293,8 @@ def reduce(
     ).require(*BODY_NEEDS, source="fieldkit reduce")
     if out is None and figures is None:
         note("no -o/--out or --figures given; printing the summary only")
-    if out is not None and out.suffix.lower() not in FORMATS:
-        raise ArgumentError(
-            f"unknown table format {out.suffix!r}; use one of {', '.join(FORMATS)}",
-            source=str(out),
-        )
+    if out is not None:
+        table_format(out)  # CSV for /dev/null or a FIFO, else by its extension
     outputs = OutputSet(inputs=[impacts, fieldbook, stations, trees, preset])
     if out is not None:
         outputs.plan(out, argument="-o")

@@ -24,7 +24,7 @@ from fieldkit.cli.common import (
 )
 from fieldkit.cli.progress import report_written, step
 from fieldkit.errors import ArgumentError
-from fieldkit.impact_table import FORMATS
+from fieldkit.impact_table import table_format
 from fieldkit.io.tracking_export import check_frame_rate
 from fieldkit.outputs import OutputSet
 
@@ -180,11 +180,8 @@ def track(
             "or --homography FILE",
             source=missing,
         )
-    if impacts is not None and impacts.suffix.lower() not in FORMATS:
-        raise ArgumentError(
-            f"unknown table format {impacts.suffix!r}; use one of {', '.join(FORMATS)}",
-            source=str(impacts),
-        )
+    if impacts is not None:
+        table_format(impacts)  # CSV for /dev/null or a FIFO, else by its extension
     outputs = OutputSet(inputs=[video, homography])
     for path, flag in ((out, "-o"), (impacts, "--impacts"), (rrd, "--rrd")):
         if path is not None:

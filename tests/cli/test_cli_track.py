@@ -419,3 +419,12 @@ def test_fitted_gravity_is_printed_per_flight_and_warned_beyond_3_se(
         assert f"fitted g = {match.group(1)} +/- {match.group(2)} m/s^2" in line
         assert "standard errors" in line
     assert f"wrote {out}" in result.stdout.splitlines()
+
+
+def test_impacts_to_dev_null_are_written_through(cli, clip):
+    # issue 17: the README promises -o /dev/null; track had its own extension check
+    video, _ = clip
+    result = cli("track", video, "--fps", FPS, *SCALE, "--radius", "0.0375",
+                 "--impacts", "/dev/null")  # fmt: skip
+    assert result.exit_code == 0, result.stderr
+    assert "wrote /dev/null" in result.stdout
