@@ -88,6 +88,9 @@ DEFAULT_POSITION_SIGMA_M = 0.5
 DEFAULT_ELEVATION_SIGMA_M = 0.5
 #: Standard uncertainty of a tree strike's height above the ground at the tree [m].
 DEFAULT_STRIKE_HEIGHT_SIGMA_M = 0.25
+#: Largest standard uncertainty of a position or height (m): beyond a hand-held GPS's
+#: worst case under canopy (tens of metres) the point no longer locates an impact.
+MAX_SIGMA_M = 100.0
 #: Monte Carlo draws.
 DEFAULT_DRAWS = 100
 #: Seed of ``numpy.random.default_rng`` (fixed: the same survey gives the same sd).
@@ -150,6 +153,12 @@ class PositionError:
                 raise ArgumentError(f"{name} must be a finite number", source=name)
             if value < 0:
                 raise ArgumentError(f"{name} must be >= 0 (got {value:g})", source=name)
+            if value > MAX_SIGMA_M:
+                raise ArgumentError(
+                    f"{name} must be <= {MAX_SIGMA_M:g} m (got {value:g}): a point "
+                    "known no better than that does not locate an impact on a slope",
+                    source=name,
+                )
         if int(self.draws) != self.draws or self.draws < 10:
             raise ArgumentError(
                 f"draws must be a whole number >= 10 (got {self.draws})",

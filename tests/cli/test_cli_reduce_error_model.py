@@ -94,7 +94,13 @@ def test_tree_strike_height_error_moves_only_its_flight(cli, path, tmp_path):
 
 @pytest.mark.parametrize("flag", ["--position-sigma", "--height-sigma"])
 @pytest.mark.parametrize(
-    ("value", "words"), [("-0.5", ">= 0"), ("nan", "finite"), ("inf", "finite")]
+    ("value", "words"),
+    [
+        ("-0.5", ">= 0"),
+        ("nan", "finite"),
+        ("inf", "finite"),
+        ("1e300", "<= 100 m"),  # issue 17: accepted, then overflowed in the draws
+    ],
 )
 def test_bad_sigma_one_line_nothing_written(
     cli, fails, path, tmp_path, flag, value, words
