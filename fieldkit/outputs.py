@@ -47,8 +47,9 @@ replaced and the link stays a link; a link to an input is refused like the input
 
 Outputs confined to a folder
 ----------------------------
-A command that writes a set of files *into* a folder (``export -o DIR``) plans each
-with ``within=DIR``: the file must then be written inside DIR. A path under DIR that
+A command that writes a set of files *into* a folder (``export -o DIR``,
+``--figures DIR``, ``--report DIR``) declares it with :meth:`OutputSet.confine`: every
+output planned under DIR must then be written inside DIR. A path under DIR that
 resolves outside it -- a symbolic link in DIR (or a linked sub-folder) pointing
 elsewhere -- is **refused**, naming the link (``DIR/slope.csv: is a symbolic link to
 /etc/x, outside DIR; remove it or write elsewhere``): following it would replace a
@@ -241,6 +242,14 @@ class OutputSet:
         self._outputs: list[_Output] = []
         self._committed = False
         self._created: list[Path] = []  # folders made before commit (stream)
+        self._folders: list[Path] = []  # outputs under these stay inside them
+
+    def confine(self, folder: PathArg | None) -> None:
+        """Declare ``folder`` a folder of outputs (``None`` skipped): every output
+        planned under it must be written inside it (module docstring, "Outputs
+        confined to a folder"); a symbolic link there that leads out is refused."""
+        if folder is not None:
+            self._folders.append(Path(folder))
 
     def __enter__(self) -> OutputSet:
         return self
@@ -275,13 +284,7 @@ class OutputSet:
                         source=out.path,
                     )
 
-    def plan(
-        self,
-        path: PathArg,
-        *,
-        argument: str | None = None,
-        within: PathArg | None = None,
-    ) -> Path:
+    def plan(self, path: PathArg, *, argument: str | None = None) -> Path:
         """Reserve ``path`` for an output; its writer is added later.
 
         Parameters
@@ -291,10 +294,6 @@ class OutputSet:
         argument
             What named it, for messages: the command line passes its option
             (``"--json"``); without it the path is named.
-        within
-            A folder the file must be written in (module docstring, "Outputs
-            confined to a folder"): a path that a symbolic link takes outside it
-            is refused.
 
         Returns
         -------
@@ -305,12 +304,14 @@ class OutputSet:
         ------
         OutputFileError
             ``path`` is an input or another output, or cannot be written (a folder,
-            below a file, a name too long, a socket or block device, no permission).
+            below a file, a name too long, a socket or block device, no permission),
+            or a symbolic link takes it out of its :meth:`confine` folder.
         """
         target = Path(path)
         identity = _identity(target)
-        if within is not None:
-            _refuse_outside(target, Path(within))
+        for folder in self._folders:
+            if folder in target.parents:
+                _refuse_outside(target, folder)
         self._refuse_inputs(target, identity)
         through = _check_target(target, identity[0])
         for other in self._outputs:

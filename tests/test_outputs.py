@@ -194,11 +194,14 @@ def test_add_inputs_checks_outputs_planned_before(tmp_path):
         outputs.add_inputs([read_late])
 
 
-def test_within_refuses_a_link_out_but_not_a_file_in(tmp_path):
+def test_confine_refuses_a_link_out_but_not_a_file_in(tmp_path):
     folder = tmp_path / "out"
     folder.mkdir()
     (folder / "link.txt").symlink_to(tmp_path / "elsewhere.txt")
+    (tmp_path / "beside.txt").symlink_to(tmp_path / "elsewhere.txt")
     outputs = OutputSet()
-    outputs.plan(folder / "plain.txt", within=folder)
+    outputs.confine(folder)
+    outputs.plan(folder / "plain.txt")
+    outputs.plan(tmp_path / "beside.txt")  # not in the folder: a link is followed
     with pytest.raises(OutputFileError, match="symbolic link .* outside"):
-        outputs.plan(folder / "link.txt", within=folder)
+        outputs.plan(folder / "link.txt")

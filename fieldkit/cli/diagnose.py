@@ -232,6 +232,7 @@ def diagnose(
         )
     inputs = [input_file] + ([model] if model is not None else [])
     with OutputSet(inputs=[*inputs, preset]) as outputs:
+        outputs.confine(report_dir)
         if json_file is not None:
             outputs.plan(json_file, argument="--json")
         if report_dir is not None:

@@ -115,6 +115,7 @@ def export(
     _refuse_full_folder(output, force)
     inputs = [model_file] + ([dem] if dem is not None else [])
     with OutputSet(inputs=inputs) as outputs:
+        outputs.confine(output)
         model = read_model(model_file, outputs=outputs)
         site = None
         with step(f"exporting to {chosen.name}", announce=False):
@@ -131,7 +132,7 @@ def export(
             result.notes.insert(0, f"grid: {site.description}")
         files["README.md"] = result.readme(str(model_file))
         for name in files:
-            outputs.plan(output / name, argument="-o", within=output)
+            outputs.plan(output / name, argument="-o")
         for name, content in files.items():
             write_file(output / name, _writer(content), outputs)
         with step(f"writing {len(files)} files", announce=False):

@@ -255,6 +255,7 @@ def fit(
     from fieldkit.model.model_file import read_model, write_model
 
     with OutputSet(inputs=[table_file, model_file, preset]) as outputs:
+        outputs.confine(report)
         outputs.plan(output, argument="-o")
         if report is not None:
             outputs.plan(report / "report.md", argument="--report")

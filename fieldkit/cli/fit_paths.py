@@ -207,6 +207,7 @@ def fit_paths_command(
     if holdout:
         inputs += [holdout_releases, holdout_deposits]
     with OutputSet(inputs=[*inputs, preset]) as outputs:
+        outputs.confine(report)
         # plan exactly what will be written, before any long step
         outputs.plan(output, argument="-o")
         if json_file is not None:

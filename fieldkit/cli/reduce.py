@@ -296,6 +296,7 @@ def reduce(
     if out is not None:
         table_format(out)  # CSV for /dev/null or a FIFO, else by its extension
     outputs = OutputSet(inputs=[impacts, fieldbook, stations, trees, preset])
+    outputs.confine(figures)
     if out is not None:
         outputs.plan(out, argument="-o")
     for name in FIGURE_NAMES if figures is not None else ():

@@ -187,6 +187,7 @@ def simulate(
         raise ArgumentError(f"must be a .rrd file, got {rrd.name!r}", source="--rrd")
 
     with OutputSet(inputs=[model_file]) as outputs:
+        outputs.confine(figures)
         if summary is not None:
             outputs.plan(summary, argument="--summary")
         if rrd is not None:

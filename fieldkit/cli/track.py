@@ -183,6 +183,7 @@ def track(
     if impacts is not None:
         table_format(impacts)  # CSV for /dev/null or a FIFO, else by its extension
     outputs = OutputSet(inputs=[video, homography])
+    outputs.confine(figures)
     for path, flag in ((out, "-o"), (impacts, "--impacts"), (rrd, "--rrd")):
         if path is not None:
             outputs.plan(path, argument=flag)

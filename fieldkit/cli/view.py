@@ -135,6 +135,7 @@ def view(
     Then open a recording with `rerun out/boulder_a.rrd`.
     """
     outputs = OutputSet(inputs=[input_file])
+    outputs.confine(figures)
     outputs.plan(out, argument="-o")
     if out.suffix.lower() != ".rrd":
         raise ArgumentError(
