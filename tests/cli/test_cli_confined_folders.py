@@ -62,10 +62,11 @@ def test_a_link_in_a_report_folder_is_refused_not_followed(cli, fails, repo, tmp
     assert outside.read_text() == "mine\n"
 
 
-def test_a_link_inside_the_folder_to_the_folder_is_fine(cli, repo, tmp_path):
+def test_a_link_that_stays_inside_the_folder_is_followed(cli, repo, tmp_path):
     folder = tmp_path / "figs"
-    (folder / "sub").mkdir(parents=True)
+    (folder / "kept").mkdir(parents=True)
     argv, name = _commands(repo, folder)["reduce --figures"]
+    (folder / name).symlink_to(folder / "kept" / name)
     result = cli(*argv)
     assert result.exit_code == 0, result.stderr
-    assert (folder / name).is_file()
+    assert (folder / name).is_symlink() and (folder / "kept" / name).is_file()
