@@ -6,14 +6,15 @@ Each command module defines a single function decorated with
 
 Termination
 -----------
-``SIGTERM`` (a timeout, a CI job cancelled, ``docker stop``, ``kill``) and ``SIGHUP``
-(the terminal closed) end a command the way Ctrl-C does: :func:`main` turns them into
-a :class:`Terminated` exception, so every :class:`~fieldkit.outputs.OutputSet`
-unwinds -- a streamed temporary file and the folders made for it are removed, files
-already there are left as they were -- then prints ``error: terminated by SIGTERM``
-and exits with ``128 + signal`` (143 for SIGTERM, 129 for SIGHUP), as a shell
-reports a process killed by that signal. A second signal while unwinding is ignored
-so the cleanup finishes. ``kill -9`` cannot be caught (see :mod:`fieldkit.outputs`).
+``SIGTERM`` (a timeout, a CI job cancelled, ``docker stop``, ``kill``), ``SIGHUP``
+(the terminal closed) and ``SIGINT`` (Ctrl-C) end a command one way: :func:`main`
+turns them into a :class:`Terminated` exception, so every
+:class:`~fieldkit.outputs.OutputSet` unwinds -- a streamed temporary file and the
+folders made for it are removed, files already there are left as they were -- then
+prints ``error: terminated by SIGTERM`` (``interrupted by SIGINT``) and exits with
+``128 + signal`` (143, 129, 130), as a shell reports a process killed by that signal.
+A second signal while unwinding is ignored so the cleanup finishes. ``kill -9``
+cannot be caught (see :mod:`fieldkit.outputs`).
 """
 
 from __future__ import annotations
@@ -93,7 +94,7 @@ _USAGE_ERRORS = next(
 
 
 #: Signals that end a command like Ctrl-C (module docstring, "Termination").
-TERMINATING_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
+TERMINATING_SIGNALS = (signal.SIGTERM, signal.SIGHUP, signal.SIGINT)
 
 
 class Terminated(BaseException):  # noqa: N818 -- named for what happened, as SystemExit
@@ -141,9 +142,8 @@ def _run(args: list[str]) -> None:
         code = app(args=args, prog_name="fieldkit", standalone_mode=False)
     except Terminated as exc:
         name = signal.Signals(exc.signum).name
-        typer.echo(
-            f"error: terminated by {name}; unfinished outputs were removed", err=True
-        )
+        how = "interrupted" if exc.signum == signal.SIGINT else "terminated"
+        typer.echo(f"error: {how} by {name}; unfinished outputs were removed", err=True)
         sys.exit(128 + exc.signum)
     except _USAGE_ERRORS as exc:
         command = " ".join(["fieldkit", *args[:1]]) if args[:1] else "fieldkit"

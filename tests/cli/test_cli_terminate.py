@@ -25,6 +25,7 @@ def _temporaries(folder: Path) -> list[Path]:
     [
         (signal.SIGTERM, 0),
         (signal.SIGHUP, 0),
+        (signal.SIGINT, 0),
         # tens of MB streamed first (after the numba compile on a cold cache)
         pytest.param(signal.SIGTERM, 10_000_000, marks=pytest.mark.slow),
     ],
@@ -60,8 +61,9 @@ def test_a_terminated_streamed_simulation_leaves_nothing(
             process.wait()
     assert process.returncode == 128 + signum
     lines = [line for line in stderr.splitlines() if line.startswith("error")]
+    how = "interrupted" if signum == signal.SIGINT else "terminated"
     assert lines == [
-        f"error: terminated by {signal.Signals(signum).name}; unfinished outputs "
+        f"error: {how} by {signal.Signals(signum).name}; unfinished outputs "
         "were removed"
     ], stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["mine.txt"]
