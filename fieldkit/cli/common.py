@@ -2,7 +2,12 @@
 
 Library code names the arguments of its functions (``mass_kg``), never command-line
 flags (see :mod:`fieldkit.errors`); :data:`FLAGS` maps those names to the flags, and
-:func:`one_line_errors`, :func:`warn` and :func:`note` show the flags instead.
+:func:`one_line_errors`, :func:`warn` and :func:`note` show the flags instead -- but
+only flags the running command has (:func:`command_flags`): an error raised while
+``simulate`` reads a model file's DEM profile names the file and field, not
+``profile --step``. :func:`one_line_errors` also refuses a non-finite number given to
+any float option (``inf``, ``nan``) before the command runs, unless the option's own
+default is infinite (``--friction``, default inf).
 """
 
 from __future__ import annotations
@@ -84,6 +89,70 @@ FLAGS: dict[str, str] = {
 _QUOTED = re.compile(r"`(\w+)`")
 
 
+def _current_context():
+    """The click context of the running command, or None outside one."""
+    try:  # typer bundles its own click (typer >= 0.20)
+        from typer._click.globals import get_current_context
+    except ImportError:  # pragma: no cover - typer on the installed click
+        from click import get_current_context
+    return get_current_context(silent=True)
+
+
+def _command_options(ctx) -> frozenset[str]:
+    """Every option string (``--step``, ``-o``) of the context's command."""
+    names: set[str] = set()
+    for param in ctx.command.params:
+        names.update(param.opts)
+        names.update(getattr(param, "secondary_opts", ()))
+    return frozenset(names)
+
+
+def command_flags(mapping: Mapping[str, str] = FLAGS) -> dict[str, str]:
+    """The part of ``mapping`` whose flags the running command has.
+
+    An argument name maps to a flag only when the command being run has that flag
+    (``"--from/--to"``: both); an error about any other name keeps its own source
+    (the file and field the value came from). Outside a command line (a library
+    call, a doctest) the whole mapping.
+
+    Examples
+    --------
+    >>> command_flags({"step_m": "--step"})
+    {'step_m': '--step'}
+    """
+    ctx = _current_context()
+    if ctx is None:
+        return dict(mapping)
+    options = _command_options(ctx)
+    return {
+        name: flag
+        for name, flag in mapping.items()
+        if all(part in options for part in flag.split("/"))
+    }
+
+
+def _non_finite_option(ctx, values: Mapping[str, object]) -> str | None:
+    """The first float option given a non-finite value, as a one-line message.
+
+    An option may be infinite only when its default is (``--friction``: inf means
+    slip always stops); NaN is never a value.
+    """
+    for param in ctx.command.params:
+        if not param.opts or param.opts[0][:1] != "-" or param.name not in values:
+            continue
+        value = values[param.name]
+        items = value if isinstance(value, (list, tuple)) else [value]
+        default = param.default if isinstance(param.default, float) else 0.0
+        for item in items:
+            if not isinstance(item, float) or math.isfinite(item):
+                continue
+            if math.isinf(item) and item == default:
+                continue
+            flag = max(param.opts, key=len)
+            return f"{flag} must be a finite number (got {item:g})"
+    return None
+
+
 def with_flags(text: str, flags: Mapping[str, str] = FLAGS) -> str:
     """Replace every argument name in backticks by its flag.
 
@@ -120,7 +189,10 @@ def error_line(exc: FieldkitError, flags: Mapping[str, str] = FLAGS) -> str:
     message = with_flags(exc.message, flags)
     name = _argument(exc, flags)
     if name is None:
-        parts = [exc.source, exc.where]
+        source = exc.source
+        if source and (message + " ").startswith(source + " "):
+            source = None  # "step_m must be > 0", not "step_m: step_m must be > 0"
+        parts = [source, exc.where]
     else:
         # about an argument: bare argument names (with an underscore, so never prose)
         # are flags too, and the message may begin with the argument's own name
@@ -149,17 +221,28 @@ def one_line_errors(func=None, *, flags=None):
     """Turn :class:`FieldkitError` into ``error: <one line>`` on stderr, exit 1.
 
     Argument names in the error become flags (:func:`error_line`), through
-    :data:`FLAGS` updated with ``flags`` (a command whose flags differ).
+    :data:`FLAGS` updated with ``flags`` (a command whose flags differ), restricted
+    to the flags the running command has (:func:`command_flags`). Before the
+    command runs, a non-finite value of a float option (``--mass inf``,
+    ``--step nan``) is a usage error (exit 2), unless the option's default is
+    infinite.
     """
     mapping = {**FLAGS, **(flags or {})}
 
     def decorate(command: Callable[P, R]) -> Callable[P, R]:
         @functools.wraps(command)
         def wrapper(*args: P.args, **kwargs: P.kwargs) -> R:
+            ctx = _current_context()
+            if ctx is not None:
+                problem = _non_finite_option(ctx, kwargs)
+                if problem is not None:
+                    typer.echo(f"error: {problem}", err=True)
+                    raise typer.Exit(2)
             try:
                 return command(*args, **kwargs)
             except FieldkitError as exc:
-                typer.echo(f"error: {error_line(exc, mapping)}", err=True)
+                line = error_line(exc, command_flags(mapping))
+                typer.echo(f"error: {line}", err=True)
                 raise typer.Exit(1) from None
 
         return wrapper
@@ -169,12 +252,14 @@ def one_line_errors(func=None, *, flags=None):
 
 def warn(message: str) -> None:
     """Print a one-line warning to stderr (argument names in backticks as flags)."""
-    typer.echo(f"warning: {' '.join(with_flags(message).split())}", err=True)
+    text = with_flags(message, command_flags())
+    typer.echo(f"warning: {' '.join(text.split())}", err=True)
 
 
 def note(message: str) -> None:
     """Print a one-line note to stderr (argument names in backticks as flags)."""
-    typer.echo(f"note: {' '.join(with_flags(message).split())}", err=True)
+    text = with_flags(message, command_flags())
+    typer.echo(f"note: {' '.join(text.split())}", err=True)
 
 
 def body_from_options(

@@ -33,7 +33,11 @@ Fixed-step normalised gradient descent on the bilinear surface, with step halvin
 5. the line also stops after ``max_length_m`` of plan length.
 
 ``step_m`` may be at most half the cell size, so every cell the line crosses gets at
-least two gradient evaluations. z decreases strictly along the line by construction.
+least two gradient evaluations, and at least :data:`MIN_STEP_CELLS` of it: the
+bilinear surface is smooth inside a cell, so a shorter step resolves nothing more, it
+only multiplies the vertices (a step of 1e-9 m never ends). No section has more than
+:data:`MAX_SECTION_VERTICES` vertices; a step and length that would need more are
+refused before any work. z decreases strictly along the line by construction.
 On a tilted plane the line is the straight fall line; on a cone or a bowl it is radial
 (tests/model/test_dem_profile.py checks both).
 """
@@ -58,6 +62,22 @@ FLAT_SLOPE = 1e-3
 
 #: Step halvings before a point counts as a local minimum (h down to step_m / 64).
 _HALVINGS = 6
+
+#: Shortest steepest-descent step, as a fraction of the cell size: the bilinear
+#: surface is smooth inside a cell, so shorter steps add vertices, not accuracy.
+MIN_STEP_CELLS = 0.01
+
+#: Most vertices in a section: 100,000 vertices is 100 km at 1 m, two orders of
+#: magnitude beyond any rockfall slope, and still a few MB of CSV and a run of seconds.
+MAX_SECTION_VERTICES = 100_000
+
+#: Fields of a model file's ``"dem"`` profile entry -> the argument each one sets.
+ENTRY_FIELDS = {
+    "from": "start_xy",
+    "line": "vertices_xy",
+    "step_m": "step_m",
+    "max_length_m": "max_length_m",
+}
 
 #: How a steepest-descent line may end (:attr:`Section.ending`).
 ENDINGS = ("local minimum", "flat area", "grid edge", "nodata", "maximum length")
@@ -312,7 +332,26 @@ def section_from_vertices(
     )
 
 
+def _number(value: object, name: str) -> float:
+    """``value`` as a float; an :class:`ArgumentError` naming ``name`` for anything
+    but a real number (text, a list, an object, true/false)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
+        raise ArgumentError(
+            f"{name} must be a number (got {_shown(value)})", source=name
+        )
+    return float(value)
+
+
+def _shown(value: object) -> str:
+    """``value`` as a short one-line text for a message."""
+    text = " ".join(repr(value).split())
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
 def _check_step(value: float, name: str, grid: DemGrid | None = None) -> float:
+    """A step > 0; with ``grid`` (steepest descent) between :data:`MIN_STEP_CELLS`
+    of the cell size and half of it."""
+    value = _number(value, name)
     if not (math.isfinite(value) and value > 0):
         raise ArgumentError(f"{name} must be > 0 (got {value:g})", source=name)
     if grid is not None and value > grid.cellsize_m / 2 + 1e-12:
@@ -321,11 +360,44 @@ def _check_step(value: float, name: str, grid: DemGrid | None = None) -> float:
             f"(got {value:g})",
             source=name,
         )
-    return float(value)
+    if grid is not None and value < MIN_STEP_CELLS * grid.cellsize_m * (1 - 1e-9):
+        raise ArgumentError(
+            f"{name} must be >= {MIN_STEP_CELLS:g} of the cell size, "
+            f"{MIN_STEP_CELLS * grid.cellsize_m:g} m (got {value:g}): a shorter step "
+            "adds vertices, not accuracy, on the bilinear surface of a cell",
+            source=name,
+        )
+    return value
+
+
+def _check_vertex_count(count: float, name: str, step: float, over: str = "") -> None:
+    """Refuse a section of more than :data:`MAX_SECTION_VERTICES` vertices
+    (``over``: the length they cover, for the message)."""
+    if count > MAX_SECTION_VERTICES:
+        raise ArgumentError(
+            f"{name} {step:g} m{over} would make about {count:.3g} section vertices, "
+            f"more than the limit of {MAX_SECTION_VERTICES:,}: give a longer step or a "
+            "shorter line",
+            source=name,
+        )
 
 
 def _check_points(points, name: str, minimum: int) -> np.ndarray:
-    xy = np.asarray(points, dtype=float).reshape(-1, 2)
+    """``points`` as ``(k, 2)`` finite plan coordinates, k >= ``minimum``."""
+    wanted = "[x, y]" if minimum == 1 else "a list of [x, y] points"
+    try:
+        if isinstance(points, (str, bytes, dict)):
+            raise TypeError
+        xy = np.asarray(points, dtype=float)
+        pair = xy.shape == (2,)
+        pairs = xy.ndim == 2 and xy.shape[1:] == (2,)
+        if not (pair if minimum == 1 else pairs):
+            raise ValueError
+    except (TypeError, ValueError):
+        raise ArgumentError(
+            f"{name} must be {wanted} in metres (got {_shown(points)})", source=name
+        ) from None
+    xy = xy.reshape(-1, 2)
     if len(xy) < minimum:
         raise ArgumentError(
             f"{name} needs at least {minimum} plan points (got {len(xy)})", source=name
@@ -333,6 +405,63 @@ def _check_points(points, name: str, minimum: int) -> np.ndarray:
     if not np.isfinite(xy).all():
         raise ArgumentError(f"{name} must be finite numbers", source=name)
     return xy
+
+
+def section_from_entry(grid: DemGrid, entry: dict, *, source: str) -> Section:
+    """The section a model file's DEM profile entry describes.
+
+    Parameters
+    ----------
+    grid
+        The DEM of ``entry["dem"]``.
+    entry
+        ``{"from": [x, y]}`` (steepest descent) or ``{"line": [[x, y], ...]}`` (a
+        polyline), with optional ``"step_m"`` (default half the cell size) and
+        ``"max_length_m"``; other keys are the caller's.
+    source
+        The model file.
+
+    Raises
+    ------
+    InputFileError
+        Any bad field, naming ``source`` and the field (``profile.step_m``), or
+        the DEM file for a line leaving the grid.
+
+    Examples
+    --------
+    >>> g = DemGrid.from_corner(np.array([[10.0, 10.0], [0.0, 0.0]]), x_left_m=0,
+    ...                         y_top_m=2, cellsize_m=1)
+    >>> section_from_entry(g, {"from": "abc"}, source="m.json")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    fieldkit.errors.InputFileError: m.json: profile.from: must be [x, y] in metres ...
+    """
+    if ("from" in entry) == ("line" in entry):
+        raise InputFileError(
+            "give either `from` [x, y] (steepest descent) or `line` [[x, y], ...]",
+            source=source,
+            where="profile.dem",
+        )
+    fields = {argument: key for key, argument in ENTRY_FIELDS.items()}
+    fields["spacing_m"] = "step_m"  # the polyline's name for the step
+    try:
+        step = entry.get("step_m")
+        step = 0.5 * grid.cellsize_m if step is None else _number(step, "step_m")
+        if "line" in entry:
+            return profile_along_polyline(grid, entry["line"], step)
+        return steepest_descent_line(
+            grid, entry["from"], step, max_length_m=entry.get("max_length_m")
+        )
+    except ArgumentError as exc:
+        if exc.source not in fields:
+            raise
+        name, field = exc.source, fields[exc.source]
+        message = exc.message
+        if (message + " ").startswith(name + " "):
+            message = message[len(name) + 1 :]
+        raise InputFileError(
+            message.replace(name, field), source=source, where=f"profile.{field}"
+        ) from None
 
 
 def profile_along_polyline(
@@ -376,6 +505,7 @@ def profile_along_polyline(
     xy = _check_points(vertices_xy, "vertices_xy", 2)
     step = _check_step(spacing_m, "spacing_m")
     legs = np.hypot(*np.diff(xy, axis=0).T)
+    _check_vertex_count(1 + float(np.ceil(legs / step).sum()), "spacing_m", step)
     if (legs <= 0).any():
         i = int(np.flatnonzero(legs <= 0)[0])
         raise ArgumentError(
@@ -443,7 +573,8 @@ def steepest_descent_line(
     start_xy
         Release point (x, y) [m]; must lie on data inside the grid.
     step_m
-        Plan step [m], 0 < step_m <= half the cell size.
+        Plan step [m], between :data:`MIN_STEP_CELLS` of the cell size and half
+        of it.
     max_length_m
         Stop after this plan length [m] (None: the grid's width plus height).
     flat_slope
@@ -475,10 +606,15 @@ def steepest_descent_line(
     nrows, ncols = grid.shape
     if max_length_m is None:
         max_length_m = (ncols - 1) * grid.dx_m + (nrows - 1) * grid.dy_m
+    max_length_m = _number(max_length_m, "max_length_m")
     if not (math.isfinite(max_length_m) and max_length_m > 0):
         raise ArgumentError(
             f"max_length_m must be > 0 (got {max_length_m:g})", source="max_length_m"
         )
+    _check_vertex_count(
+        1 + math.ceil(max_length_m / h), "step_m", h,
+        f" over max_length_m {max_length_m:g} m",
+    )  # fmt: skip
     if not (math.isfinite(flat_slope) and flat_slope >= 0):
         raise ArgumentError(
             f"flat_slope must be >= 0 (got {flat_slope:g})", source="flat_slope"
@@ -494,6 +630,8 @@ def steepest_descent_line(
     x, y, z = [float(start[0])], [float(start[1])], [float(z0[0])]
     length, ending = 0.0, "maximum length"
     while length < max_length_m - 1e-9:
+        if len(x) >= MAX_SECTION_VERTICES:  # halved steps: shorter than step_m
+            _check_vertex_count(len(x) + 1, "step_m", h)
         here = _direction(grid, x[-1], y[-1])
         assert here is not None  # every kept point is on data
         dx0, dy0, slope = here
