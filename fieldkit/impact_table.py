@@ -458,6 +458,14 @@ class ImpactTable:
             for c in CONTRACT_COLUMNS + EXTENSION_COLUMNS
             if c.kind == "str"
         }
+        if fmt == "csv":  # NUL bytes: binary, UTF-16 or UTF-32, not a UTF-8 CSV
+            with p.open("rb") as handle:
+                if b"\x00" in handle.read(4096):
+                    raise InputFileError(
+                        "not a UTF-8 text CSV file (NUL bytes: binary, UTF-16 or "
+                        "UTF-32 content)",
+                        source=p,
+                    )
         try:
             if fmt == "csv":
                 frame = pd.read_csv(p, dtype=text_cols)
@@ -465,9 +473,14 @@ class ImpactTable:
                 frame = pd.read_parquet(p)
             else:
                 frame = pd.read_excel(p, dtype=text_cols)
-        except (ValueError, OSError, pd.errors.ParserError) as exc:
+        except MemoryError:
+            raise
+        except Exception as exc:  # noqa: BLE001 - any parser failure is the file's
+            # pandas, pyarrow and openpyxl raise their own types for a file that
+            # is not what its extension says (BadZipFile, KeyError, ArrowInvalid)
+            reason = " ".join(str(exc).split())[:160] or type(exc).__name__
             raise InputFileError(
-                f"cannot read {fmt.upper()}: {exc}", source=p
+                f"not a readable {fmt.upper()} file ({reason})", source=p
             ) from None
         if frame.empty:
             raise InputFileError("table has no rows", source=p)
