@@ -15,9 +15,11 @@ from __future__ import annotations
 import functools
 import math
 import re
+import secrets
 from collections.abc import Callable, Mapping
 from typing import Annotated, ParamSpec, TypeVar, overload
 
+import numpy as np
 import typer
 
 from fieldkit.errors import ArgumentError, FieldkitError
@@ -83,6 +85,7 @@ FLAGS: dict[str, str] = {
     # synthetic tables and fits (fieldkit.fit)
     "noise_fraction": "--noise",
     "paths": "--paths",
+    "seed": "--seed",
     "report_dir": "--report",
 }
 
@@ -332,6 +335,27 @@ UnitWeightOpt = Annotated[
         help=f"Rock unit weight for --shape, kN/m3 (default {UNIT_WEIGHT_KN_M3:g}).",
     ),
 ]
+
+
+#: Largest seed: numpy's generators take any non-negative integer; 2**128 - 1 is
+#: the entropy of their seed sequence (more digits change nothing).
+MAX_SEED = 2**128 - 1
+
+
+def random_generator(seed: int | None) -> tuple[np.random.Generator, int]:
+    """The generator of a command's ``--seed``, and the seed used.
+
+    None draws a seed and says so (a note with the ``--seed`` that reproduces the
+    run); a negative seed, or one above :data:`MAX_SEED`, is refused.
+    """
+    if seed is None:
+        seed = secrets.randbits(32)
+        note(f"`seed` not given: used {seed}; pass --seed {seed} to reproduce")
+    elif not 0 <= seed <= MAX_SEED:
+        raise ArgumentError(
+            f"seed must be an integer from 0 to 2**128 - 1 (got {seed})", source="seed"
+        )
+    return np.random.default_rng(seed), seed
 
 
 def parse_point(text: str, flag: str) -> tuple[float, float]:

@@ -27,6 +27,55 @@ from fieldkit.track import Track
 #: RK4 step while looking for the landing [s] (then refined by bisection).
 _LANDING_STEP_S = 1e-3
 
+#: Most flights in one synthetic track (a filmed sequence has a handful).
+MAX_FLIGHTS = 1_000
+
+#: Fastest capture rate [1/s]: the top of high-speed video at useful resolution.
+MAX_FPS = 100_000.0
+
+#: Fastest launch speed [m/s]: free fall from 500 m reaches 99 m/s; rockfall
+#: rebounds are tens of m/s.
+MAX_LAUNCH_SPEED_MPS = 100.0
+
+#: Largest position noise SD [m]: beyond a metre a video track measures nothing.
+MAX_NOISE_M = 1.0
+
+#: Most samples in one track (8 flights of 1 s at 200 frames/s are 1,600): a
+#: million samples is about 70 MB of CSV.
+MAX_TRACK_SAMPLES = 1_000_000
+
+
+def check_track_options(
+    *,
+    flights: int,
+    launch_speed_mps: float,
+    launch_angle_deg: float,
+    fps: float,
+    noise_m: float,
+) -> None:
+    """Refuse options of a synthetic track outside their physical range.
+
+    ``flights`` 1 .. :data:`MAX_FLIGHTS`, launch speed in (0,
+    :data:`MAX_LAUNCH_SPEED_MPS`] m/s, launch angle above the plane in (0, 90) deg,
+    ``fps`` in (0, :data:`MAX_FPS`], ``noise_m`` in [0, :data:`MAX_NOISE_M`] m.
+    """
+    checks = (
+        ("flights", flights, 1 <= flights <= MAX_FLIGHTS, f"from 1 to {MAX_FLIGHTS:,}"),
+        ("launch_speed_mps", launch_speed_mps,
+         0 < launch_speed_mps <= MAX_LAUNCH_SPEED_MPS,
+         f"in (0, {MAX_LAUNCH_SPEED_MPS:g}] m/s (free fall from 500 m reaches 99 m/s)"),
+        ("launch_angle_deg", launch_angle_deg, 0 < launch_angle_deg < 90,
+         "in (0, 90) deg above the plane"),
+        ("fps", fps, 0 < fps <= MAX_FPS,
+         f"in (0, {MAX_FPS:,.0f}] frames/s (high-speed video)"),
+        ("noise_m", noise_m, 0 <= noise_m <= MAX_NOISE_M,
+         f"in [0, {MAX_NOISE_M:g}] m (a noisier track measures nothing)"),
+    )  # fmt: skip
+    for name, value, ok, bound in checks:
+        if not (math.isfinite(value) and ok):
+            got = value if isinstance(value, int) else f"{value:g}"
+            raise ArgumentError(f"{name} must be {bound} (got {got})", source=name)
+
 
 def _landing(state: np.ndarray, k: float, tan_psi: float, x0: float, z0: float):
     """Time of flight and landing state of a flight leaving the plane at ``state``."""
@@ -131,7 +180,15 @@ def synthetic_track(
         durations.append(duration)
         t += duration
         pos = end[:2]
-    times = np.arange(0, int(math.floor(t * fps)) + 1) / fps
+    samples = math.floor(t * fps) + 1
+    if samples > MAX_TRACK_SAMPLES:
+        raise ArgumentError(
+            f"{len(speeds)} flights lasting {t:.1f} s at fps {fps:g} would make "
+            f"{samples:,} samples, more than the limit of {MAX_TRACK_SAMPLES:,}: "
+            "fewer flights or a lower fps",
+            source="fps",
+        )
+    times = np.arange(0, samples) / fps
     x_true, z_true = np.empty(times.size), np.empty(times.size)
     flight = np.searchsorted(np.array(starts), times, side="right") - 1
     for i, (s, st) in enumerate(zip(starts, states, strict=True)):
