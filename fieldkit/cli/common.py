@@ -114,8 +114,9 @@ def command_flags(mapping: Mapping[str, str] = FLAGS) -> dict[str, str]:
     """The part of ``mapping`` whose flags the running command has.
 
     An argument name maps to a flag only when the command being run has that flag
-    (``"--from/--to"``: both); an error about any other name keeps its own source
-    (the file and field the value came from). Outside a command line (a library
+    (``"--from/--to"``: both; a description that is not a flag is kept); an error
+    about any other name keeps its own source (the file and field the value came
+    from). Outside a command line (a library
     call, a doctest) the whole mapping.
 
     Examples
@@ -130,7 +131,8 @@ def command_flags(mapping: Mapping[str, str] = FLAGS) -> dict[str, str]:
     return {
         name: flag
         for name, flag in mapping.items()
-        if all(part in options for part in flag.split("/"))
+        if not flag.startswith("-")  # a description ("the impact angle (--angle)")
+        or all(part in options for part in flag.split("/"))
     }
 
 
@@ -335,6 +337,50 @@ UnitWeightOpt = Annotated[
         help=f"Rock unit weight for --shape, kN/m3 (default {UNIT_WEIGHT_KN_M3:g}).",
     ),
 ]
+
+
+#: Largest size of the quantities the impact and fence calculators take from the
+#: command line: (limit, units, why). A value beyond is a typo or a unit slip (e_N
+#: 1e308 for 0.8), refused rather than computed with; the sign and the lower end
+#: are each calculator's own checks. An infinite friction is accepted (the
+#: option's default: slip always stops).
+PHYSICAL_LIMITS: dict[str, tuple[float, str, str]] = {
+    "speed_mps": (
+        100.0, "m/s", "free fall from 500 m reaches 99 m/s; rockfall impacts are "
+        "tens of m/s",
+    ),
+    "spin_radps": (
+        1000.0, "rad/s", "a 0.1 m rock rolling at 100 m/s spins at 1000 rad/s",
+    ),
+    "e_n": (
+        10.0, "", "measured e_N reach 1.5 at shallow impacts (thesis Table 2-4)",
+    ),
+    "friction": (
+        100.0, "", "mu = 100 is a friction angle of 89.4 deg; give inf for slip "
+        "that always stops",
+    ),
+}  # fmt: skip
+
+
+def check_physical(value: float | None, flag: str, quantity: str) -> None:
+    """Refuse ``value`` of ``flag`` larger in size than :data:`PHYSICAL_LIMITS`
+    [quantity] (None: not given; an infinite friction passes, see there).
+
+    Examples
+    --------
+    >>> check_physical(1e308, "--en", "e_n")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    fieldkit.errors.ArgumentError: --en must be at most 10 in size (got 1e+308): ...
+    """
+    if value is None or (quantity == "friction" and value == math.inf):
+        return
+    limit, units, why = PHYSICAL_LIMITS[quantity]
+    if not (math.isfinite(value) and abs(value) <= limit):
+        raise ArgumentError(
+            f"{flag} must be at most {limit:g}{' ' + units if units else ''} in size "
+            f"(got {value:g}): {why}"
+        )
 
 
 #: Largest seed: numpy's generators take any non-negative integer; 2**128 - 1 is

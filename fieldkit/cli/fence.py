@@ -22,9 +22,11 @@ from fieldkit.cli.common import (
     ShapeOpt,
     UnitWeightOpt,
     body_from_options,
+    check_physical,
     one_line_errors,
     print_body_notes,
 )
+from fieldkit.cli.progress import report_written
 from fieldkit.errors import ArgumentError
 from fieldkit.physics.fence_impact import FenceImpact
 from fieldkit.physics.structure_forces import StructureLaw
@@ -163,6 +165,15 @@ def fence(
     ).require(*BODY_NEEDS, source="fieldkit fence")
     if speed_in is None:
         raise ArgumentError("the impact speed is required", source="--speed-in")
+    for value, flag, quantity in (
+        (speed_in, "--speed-in", "speed_mps"),
+        (speed_out, "--speed-out", "speed_mps"),
+        (spin_in, "--spin-in", "spin_radps"),
+        (spin_out, "--spin-out", "spin_radps"),
+        (e_n, "--e-n", "e_n"),
+        (friction, "--friction", "friction"),
+    ):
+        check_physical(value, flag, quantity)
     laws = [
         _law("rigid", rigid, "--rigid"),
         _law("flexible", flexible, "--flexible"),
@@ -199,13 +210,12 @@ def fence(
         write_fence_figure(
             figure, result.impulse_ns, laws, result.split, outputs=outputs
         )
-        lines.append(f"figure: {figure}")
     if out is not None:
         write_text(out, json.dumps(_results(result), indent=2) + "\n", outputs)
-        lines.append(f"results: {out}")
-    outputs.commit()
+    written = outputs.commit()
     typer.echo("\n".join(lines))
     print_body_notes(rock)
+    report_written(written)
 
 
 def _report(f: FenceImpact) -> list[str]:

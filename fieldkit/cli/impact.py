@@ -18,6 +18,7 @@ from fieldkit.cli.common import (
     ShapeOpt,
     UnitWeightOpt,
     body_from_options,
+    check_physical,
     one_line_errors,
     print_body_notes,
     warn,
@@ -68,6 +69,7 @@ def _impact_velocity(
         if speed is None or angle is None:
             raise ArgumentError("--speed and --angle go together (give both)")
         _positive("--speed", speed)
+        check_physical(speed, "--speed", "speed_mps")
         if not (math.isfinite(angle) and 0.0 < angle < 180.0):
             raise ArgumentError(
                 f"--angle must be between 0 and 180 deg, exclusive (got {angle:g})"
@@ -84,6 +86,8 @@ def _impact_velocity(
         raise ArgumentError(
             f"--vn must be < 0, i.e. moving into the ground (got {vn:g})"
         )
+    check_physical(vt, "--vt", "speed_mps")
+    check_physical(vn, "--vn", "speed_mps")
     return vt, vn
 
 
@@ -308,6 +312,9 @@ def impact(
     v_it, v_in = _impact_velocity(speed, angle, vt, vn)
     if not math.isfinite(spin):
         raise ArgumentError(f"--spin must be finite (got {spin:g})")
+    check_physical(spin, "--spin", "spin_radps")
+    check_physical(en, "--en", "e_n")
+    check_physical(friction, "--friction", "friction")
     body = body_from_options(
         mass, radius, gyration, shape, dimensions, unit_weight
     ).require(*BODY_NEEDS, source="fieldkit impact")

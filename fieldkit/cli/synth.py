@@ -201,7 +201,11 @@ def _synth_track(
 ) -> None:
     """`synth --track`: the model's body bouncing down a plane (see :func:`synth`)."""
     from fieldkit.fit.synthetic import with_effects
-    from fieldkit.fit.synthetic_track import check_track_options, synthetic_track
+    from fieldkit.fit.synthetic_track import (
+        LAUNCH_JITTER_DEG,
+        check_track_options,
+        synthetic_track,
+    )
     from fieldkit.model.model_file import read_model
 
     check_track_options(
@@ -232,7 +236,8 @@ def _synth_track(
             cd=float(drag["cd"]),
             air_density_kg_m3=float(drag["air_density_kg_m3"]),
             launch_speed_mps=speed * rng.uniform(0.8, 1.2, flights),
-            launch_angle_deg=angle + rng.uniform(-5.0, 5.0, flights),
+            launch_angle_deg=angle
+            + rng.uniform(-LAUNCH_JITTER_DEG, LAUNCH_JITTER_DEG, flights),
             surface_angle_deg=dip,
             fps=fps,
             noise_m=noise_m,

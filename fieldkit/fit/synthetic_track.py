@@ -27,6 +27,9 @@ from fieldkit.track import Track
 #: RK4 step while looking for the landing [s] (then refined by bisection).
 _LANDING_STEP_S = 1e-3
 
+#: Half-width of the uniform spread of each flight's launch angle [deg].
+LAUNCH_JITTER_DEG = 5.0
+
 #: Most flights in one synthetic track (a filmed sequence has a handful).
 MAX_FLIGHTS = 1_000
 
@@ -56,7 +59,8 @@ def check_track_options(
     """Refuse options of a synthetic track outside their physical range.
 
     ``flights`` 1 .. :data:`MAX_FLIGHTS`, launch speed in (0,
-    :data:`MAX_LAUNCH_SPEED_MPS`] m/s, launch angle above the plane in (0, 90) deg,
+    :data:`MAX_LAUNCH_SPEED_MPS`] m/s, mean launch angle above the plane within
+    (0, 90) deg by :data:`LAUNCH_JITTER_DEG` (the angle each flight is drawn from),
     ``fps`` in (0, :data:`MAX_FPS`], ``noise_m`` in [0, :data:`MAX_NOISE_M`] m.
     """
     checks = (
@@ -64,8 +68,11 @@ def check_track_options(
         ("launch_speed_mps", launch_speed_mps,
          0 < launch_speed_mps <= MAX_LAUNCH_SPEED_MPS,
          f"in (0, {MAX_LAUNCH_SPEED_MPS:g}] m/s (free fall from 500 m reaches 99 m/s)"),
-        ("launch_angle_deg", launch_angle_deg, 0 < launch_angle_deg < 90,
-         "in (0, 90) deg above the plane"),
+        ("launch_angle_deg", launch_angle_deg,
+         LAUNCH_JITTER_DEG < launch_angle_deg < 90 - LAUNCH_JITTER_DEG,
+         f"in ({LAUNCH_JITTER_DEG:g}, {90 - LAUNCH_JITTER_DEG:g}) deg: each flight's "
+         f"angle is drawn within +-{LAUNCH_JITTER_DEG:g} deg and must stay above the "
+         "plane and ahead, down-slope"),
         ("fps", fps, 0 < fps <= MAX_FPS,
          f"in (0, {MAX_FPS:,.0f}] frames/s (high-speed video)"),
         ("noise_m", noise_m, 0 <= noise_m <= MAX_NOISE_M,
@@ -122,7 +129,8 @@ def synthetic_track(
     cd, air_density_kg_m3
         ``air_drag`` parameters; ``cd = 0`` gives exact parabolas.
     launch_speed_mps, launch_angle_deg
-        Per flight: launch speed [m/s] and angle above the plane [deg], > 0.
+        Per flight: launch speed [m/s] > 0 and angle above the plane [deg] in
+        (0, 90), measured from the down-slope direction (the direction of travel).
     surface_angle_deg
         Dip of the plane psi [deg], positive descending toward +x.
     fps
@@ -157,9 +165,12 @@ def synthetic_track(
             "launch_speed_mps and launch_angle_deg need one value per flight",
             source="launch_speed_mps",
         )
-    if not (np.all(speeds > 0) and np.all((angles > 0) & (angles < 180))):
+    if not (np.all(speeds > 0) and np.all((angles > 0) & (angles < 90))):
+        # above 90 deg a flight leaves the plane backwards, up-slope: x must
+        # increase in the direction of travel (ARCHITECTURE §2)
         raise ArgumentError(
-            "launch speeds must be > 0 and angles in (0, 180) deg",
+            "launch speeds must be > 0 and angles above the plane in (0, 90) deg "
+            "(ahead, down-slope)",
             source="launch_speed_mps",
         )
     if not fps > 0 or not noise_m >= 0 or not cd >= 0:
