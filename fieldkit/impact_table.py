@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import os
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -165,6 +166,9 @@ REQUIRED_COLUMNS: tuple[str, ...] = tuple(
     c.name for c in CONTRACT_COLUMNS if c.required
 )
 THETA0_SOURCES: frozenset[str] = frozenset({"tree", "assumed", "video", "given"})
+#: Key of the frame's attrs holding the columns the table's source had.
+_GIVEN = "fieldkit_given_columns"
+
 FORMATS: dict[str, str] = {".csv": "csv", ".parquet": "parquet", ".xlsx": "xlsx"}
 
 _EPS = 1e-12
@@ -335,6 +339,10 @@ class ImpactTable:
                 source=self.source,
             )
         out = frame.copy()
+        # the columns the source had, before the contract's are added as NaN (kept
+        # in the frame's attrs, which copies and row selections carry along)
+        given = out.attrs.get(_GIVEN, out.columns)
+        out.attrs[_GIVEN] = tuple(c for c in given if c in out.columns)
         for col in CONTRACT_COLUMNS:
             if col.name not in out.columns:
                 out[col.name] = pd.NA if col.kind in ("str", "bool") else np.nan
@@ -434,6 +442,37 @@ class ImpactTable:
     def paths(self) -> list[str]:
         """Path identifiers in order of first appearance."""
         return list(dict.fromkeys(self.frame["path_id"].tolist()))
+
+    def unusable_columns(self, names: Sequence[str]) -> str | None:
+        """Which of ``names`` cannot be used, in words, or None when all can.
+
+        A column the table does not have is *missing*; one it has with no value
+        in any row is *empty* (an export that left it blank), and the two are
+        told apart.
+
+        Examples
+        --------
+        >>> t = ImpactTable(pd.DataFrame({"path_id": ["A"], "point": ["1"],
+        ...     "x_m": [0.0], "z_m": [0.0], "slope_deg": [0.0], "vi_x_mps": [np.nan],
+        ...     "vi_z_mps": [-4.0], "vf_x_mps": [3.0], "vf_z_mps": [2.0]}))
+        >>> print(t.unusable_columns(["vi_x_mps", "vi_z_mps", "material"]))
+        ... # doctest: +NORMALIZE_WHITESPACE
+        missing column(s) material; column(s) vi_x_mps present but empty (no value in
+        any row)
+        """
+        frame = self.frame
+        given = set(frame.attrs.get(_GIVEN, frame.columns))
+        unusable = [c for c in names if c not in frame.columns or frame[c].isna().all()]
+        missing = [c for c in unusable if c not in given]
+        empty = [c for c in unusable if c in given]
+        parts = []
+        if missing:
+            parts.append(f"missing column(s) {', '.join(missing)}")
+        if empty:
+            parts.append(
+                f"column(s) {', '.join(empty)} present but empty (no value in any row)"
+            )
+        return "; ".join(parts) or None
 
     def column(self, name: str) -> np.ndarray:
         """A float column as a numpy array (NaN where missing)."""

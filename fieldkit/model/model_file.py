@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fieldkit.errors import FieldkitError, InputFileError
+from fieldkit.errors import ArgumentError, FieldkitError, InputFileError
 from fieldkit.io.dem import read_dem
 from fieldkit.io.profile_csv import read_profile_csv
 from fieldkit.model.dem_profile import section_from_entry, section_from_vertices
@@ -267,7 +267,15 @@ def _profile(prof: dict, source: str, *, base_dir) -> Profile:
         _unknown(prof, allowed, "profile", source)
         path = base / str(prof[kind])
         if kind == "csv":
-            vertices = read_profile_csv(path, units=prof.get("units"))
+            try:
+                vertices = read_profile_csv(path, units=prof.get("units"))
+            except ArgumentError as exc:  # the entry's "units", not a flag
+                if exc.source != "units":
+                    raise
+                message = exc.message.removeprefix("units ")
+                raise InputFileError(
+                    message, source=source, where="profile.units"
+                ) from None
             section = section_from_vertices(
                 vertices.x_m, vertices.z_m, vertices.material, source=str(path)
             )
