@@ -356,6 +356,15 @@ class ImpactTable:
                 out[name] = out[name].astype("string")
             elif spec.kind == "bool":
                 out[name] = out[name].astype("boolean")
+        slope = out["slope_deg"].to_numpy(float)
+        outside = ~np.isnan(slope) & ~((slope > -180.0) & (slope <= 180.0))
+        if outside.any():  # a dip, beyond +-90 deg an overhang (§2)
+            i = int(np.flatnonzero(outside)[0])
+            raise InputFileError(
+                f"slope_deg {slope[i]:g} is outside (-180, 180] deg",
+                source=self.source,
+                where=f"row {i + 1}",
+            )
         for key in ("path_id", "point"):
             bad = out.index[out[key].isna()]
             if len(bad):

@@ -70,6 +70,18 @@ def site(tmp_path) -> Path:
         z.writestr("a.txt", "not a workbook")
     (tmp_path / "text.parquet").write_text("path_id,x_m\n1,2\n")
     (tmp_path / "binary.csv").write_bytes(b"\x00\x01\x02\x03" * 64)
+    tornado = REPO / "surveys" / "tornado_mountain"
+    book = (tornado / "boulder_a_fieldbook.csv").read_text().splitlines()
+    book[0] += ",slope_deg"
+    book[1:] = [line + (",200" if i == 2 else ",30") for i, line in enumerate(book[1:])]
+    (tmp_path / "book.csv").write_text("\n".join(book) + "\n")
+    shutil.copy(tornado / "boulder_a_stations.gpx", tmp_path / "stations.gpx")
+    table = pd.DataFrame({"path_id": ["1", "1"], "point": ["A", "B"],
+                          "x_m": [0.0, 5.0], "z_m": [10.0, 7.0],
+                          "slope_deg": [30.0, 400.0], "vi_x_mps": [5.0, 5.0],
+                          "vi_z_mps": [-3.0, -3.0], "vf_x_mps": [4.0, 4.0],
+                          "vf_z_mps": [1.0, 1.0]})  # fmt: skip
+    table.to_csv(tmp_path / "slope400.csv", index=False)
     return tmp_path
 
 
@@ -196,6 +208,14 @@ CASES = [
      ["--e-n must be at most 10 in size"], []),
     ("fence-spin-inf", (*_FENCE[:8], "inf", *_FENCE[9:]), 2,
      ["--spin-in must be a finite number (got inf)"], []),
+    # slopes outside (-180, 180] (a dip; beyond +-90 deg an overhang)
+    ("table-slope-400", ("diagnose", "{d}/slope400.csv", "--model", "{d}/smoke.json",
+                         "--seed", "1"), 1,
+     ["slope400.csv: row 2: slope_deg 400 is outside (-180, 180] deg"], []),
+    ("fieldbook-slope-200", ("reduce", "--fieldbook", "{d}/book.csv", "--stations",
+                             "{d}/stations.gpx", "--declination", "14.2", "--theta0",
+                             "30", "-o", "{d}/out/r.csv"), 1,
+     ["book.csv: row 4: column 'slope_deg': 200° is not a ground dip"], []),
     # ImpactTables that are not what their extension says
     ("table-corrupt-xlsx", ("diagnose", "{d}/corrupt.xlsx", "--model",
                             "{d}/smoke.json", "--seed", "1"), 1,
