@@ -118,9 +118,9 @@ CASES = [
     ("profile-step-tiny", _profile("--step", "1e-9"), 1,
      ["--step must be >= 0.01 of the cell size, 0.05 m"], []),
     ("profile-line-step-tiny", _profile("--to", "102.22,151.49", "--step", "1e-9"), 1,
-     ["--step 1e-09 m", "more than the limit of 100,000"], []),
+     ["--step 1e-09 m", "more than the limit of 20,000"], []),
     ("profile-max-length-huge", _profile("--step", "0.06", "--max-length", "1e9"), 1,
-     ["--max-length 1e+09 m", "limit of 100,000"], []),
+     ["--max-length 1e+09 m", "limit of 20,000"], []),
     ("profile-step-inf", _profile("--step", "inf"), 2,
      ["--step must be a finite number (got inf)"], []),
     ("profile-step-nan", _profile("--step", "nan"), 2,
@@ -136,7 +136,7 @@ CASES = [
     ("model-step-tiny", _simulate("step_tiny"), 1,
      ["step_tiny.json: profile.step_m: must be >= 0.01 of the cell size"], ["--step"]),
     ("model-line-step-tiny", _simulate("line_step_tiny"), 1,
-     ["line_step_tiny.json: profile.step_m:", "limit of 100,000"], ["--step"]),
+     ["line_step_tiny.json: profile.step_m:", "limit of 20,000"], ["--step"]),
     ("model-from-text", _simulate("from_text"), 1,
      ["from_text.json: profile.from: must be [x, y] in metres (got 'abc')"],
      ["--from"]),
@@ -303,3 +303,17 @@ def test_profile_and_fence_report_every_file_written(cli, site):
     assert result.exit_code == 0, result.stderr
     written = [line for line in result.stdout.splitlines() if line.startswith("wrote")]
     assert sorted(written) == sorted([f"wrote {fence_json}", f"wrote {fence_png}"])
+
+
+def test_a_descent_reaching_the_vertex_limit_says_so(cli, site, monkeypatch):
+    """The default length (the grid's width plus height) is not refused up front;
+    a line that reaches the vertex limit stops there and the output says why."""
+    import fieldkit.model.dem_profile as dem_profile
+
+    monkeypatch.setattr(dem_profile, "MAX_SECTION_VERTICES", 50)
+    out = site / "p.csv"
+    result = cli("profile", site / "terrain.asc", "--from", START, "--step", "0.05",
+                 "-o", out)  # fmt: skip
+    assert result.exit_code == 0, result.stderr
+    assert "ended: reached the limit of 50 vertices" in result.stdout
+    assert len(out.read_text().splitlines()) == 1 + 50
