@@ -280,7 +280,7 @@ def body_from_options(
     arguments of :func:`fieldkit.physics.bodies.resolve_body` for every command)."""
     from fieldkit.physics.bodies import resolve_body
 
-    return resolve_body(
+    body = resolve_body(
         mass_kg=mass,
         radius_m=radius,
         gyration_m=gyration,
@@ -289,6 +289,15 @@ def body_from_options(
         dimensions_m=dimensions,
         unit_weight_kn_m3=unit_weight,
     )
+    derived = "the body's {} (from --shape and --dimensions)"
+    for value, given, flag, name, quantity in (
+        (body.mass_kg, mass, "--mass", "mass", "mass_kg"),
+        (body.radius_m, radius, "--radius", "radius", "length_m"),
+        (body.gyration_m, gyration, "--gyration", "radius of gyration", "length_m"),
+    ):
+        check_physical(value, flag if given is not None else derived.format(name),
+                       quantity)  # fmt: skip
+    return body
 
 
 def print_body_notes(body: ResolvedBody) -> None:
@@ -359,6 +368,16 @@ PHYSICAL_LIMITS: dict[str, tuple[float, str, str]] = {
         100.0, "", "mu = 100 is a friction angle of 89.4 deg; give inf for slip "
         "that always stops",
     ),
+    "mass_kg": (
+        1e7, "kg", "10,000 t (3,700 m3 of rock): beyond it a fall is a rock "
+        "avalanche, not a rockfall",
+    ),
+    "length_m": (10.0, "m", "rockfall blocks are at most a few metres across"),
+    "angle_deg": (180.0, "deg", "an angle between two directions"),
+    "impulse_ns": (1e9, "N s", "10,000 t at 100 m/s"),
+    "angle_law_a": (1000.0, "", "eq. 5.4's a is 19.5 in the thesis"),
+    "angle_law_b": (10.0, "", "eq. 5.4's b is 1.03 in the thesis"),
+    "velocity_scale_mps": (1000.0, "m/s", "eq. 7.1's K is 9.144 m/s in the thesis"),
 }  # fmt: skip
 
 

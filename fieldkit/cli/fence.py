@@ -172,6 +172,9 @@ def fence(
         (spin_out, "--spin-out", "spin_radps"),
         (e_n, "--e-n", "e_n"),
         (friction, "--friction", "friction"),
+        (angle_in, "--angle-in", "angle_deg"),
+        (angle_out, "--angle-out", "angle_deg"),
+        (impulse, "--impulse", "impulse_ns"),
     ):
         check_physical(value, flag, quantity)
     laws = [
@@ -338,5 +341,12 @@ def _law(name: str, text: str, option: str) -> StructureLaw:
     ):
         raise ArgumentError(
             f"coefficient and exponent must be positive, got {text!r}", source=option
+        )
+    if not (1.0 <= coefficient <= 1e12 and exponent <= 10.0):
+        raise ArgumentError(
+            f"coefficient must be in [1, 1e12] N/s^x and exponent at most 10, got "
+            f"{text!r} (the thesis laws are 1e6,1; 4e4,2 and 3e4,0.6: beyond these "
+            "bounds a contact lasts beyond any impact or no time at all)",
+            source=option,
         )
     return StructureLaw(name, coefficient, exponent)

@@ -312,9 +312,16 @@ def impact(
     v_it, v_in = _impact_velocity(speed, angle, vt, vn)
     if not math.isfinite(spin):
         raise ArgumentError(f"--spin must be finite (got {spin:g})")
-    check_physical(spin, "--spin", "spin_radps")
-    check_physical(en, "--en", "e_n")
-    check_physical(friction, "--friction", "friction")
+    for value, flag, quantity in (
+        (spin, "--spin", "spin_radps"),
+        (en, "--en", "e_n"),
+        (friction, "--friction", "friction"),
+        (offset, "--offset", "length_m"),
+        (a, "--a", "angle_law_a"),
+        (b, "--b", "angle_law_b"),
+        (scale_velocity, "--scale-velocity", "velocity_scale_mps"),
+    ):
+        check_physical(value, flag, quantity)
     body = body_from_options(
         mass, radius, gyration, shape, dimensions, unit_weight
     ).require(*BODY_NEEDS, source="fieldkit impact")
@@ -325,6 +332,7 @@ def impact(
     mass_known = body.mass_kg is not None
     theta_i = math.degrees(math.atan2(-v_in, v_it))
     e_n, e_source = _restitution(law, en, a, b, scale_velocity, theta_i, v_in)
+    check_physical(e_n, f"e_N by {e_source} at theta_i {theta_i:.3g} deg", "e_n")
     common = {
         "radius_m": body.radius_m,
         "gyration_m": body.gyration_m,
