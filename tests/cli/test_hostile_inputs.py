@@ -76,6 +76,7 @@ def site(tmp_path) -> Path:
     book[1:] = [line + (",200" if i == 2 else ",30") for i, line in enumerate(book[1:])]
     (tmp_path / "book.csv").write_text("\n".join(book) + "\n")
     shutil.copy(tornado / "boulder_a_stations.gpx", tmp_path / "stations.gpx")
+    _sparse_geotiff(tmp_path / "bomb.tif", 20_000)
     table = pd.DataFrame({"path_id": ["1", "1"], "point": ["A", "B"],
                           "x_m": [0.0, 5.0], "z_m": [10.0, 7.0],
                           "slope_deg": [30.0, 400.0], "vi_x_mps": [5.0, 5.0],
@@ -83,6 +84,19 @@ def site(tmp_path) -> Path:
                           "vf_z_mps": [1.0, 1.0]})  # fmt: skip
     table.to_csv(tmp_path / "slope400.csv", index=False)
     return tmp_path
+
+
+def _sparse_geotiff(path: Path, size: int) -> None:
+    """A GeoTIFF declaring ``size`` x ``size`` cells in a few kB (tiles left out)."""
+    import rasterio
+    from rasterio.transform import Affine
+    from rasterio.windows import Window
+
+    profile = dict(driver="GTiff", width=size, height=size, count=1, dtype="float32",
+                   crs="EPSG:2056", transform=Affine(1, 0, 0, 0, -1, size), tiled=True,
+                   compress="deflate", sparse_ok=True)  # fmt: skip
+    with rasterio.open(path, "w", **profile) as grid:
+        grid.write(np.ones((256, 256), "float32"), 1, window=Window(0, 0, 256, 256))
 
 
 def _state(folder: Path) -> dict[str, str]:
@@ -127,6 +141,10 @@ CASES = [
      ["--step must be a finite number (got nan)"], []),
     ("profile-max-length-minus-inf", _profile("--max-length", "-inf"), 2,
      ["--max-length must be a finite number"], []),
+    ("profile-dem-too-many-cells", ("profile", "{d}/bomb.tif", "--from", "5,5", "-o",
+                                    "{d}/out/p.csv"), 1,
+     ["bomb.tif: grid of 20,000 x 20,000 cells, more than the limit of 50,000,000"],
+     []),
     # a model file's DEM profile read by simulate: the file and field, never a flag
     # simulate does not have
     ("model-step-negative", _simulate("step_negative"), 1,
