@@ -77,6 +77,9 @@ def site(tmp_path) -> Path:
     (tmp_path / "book.csv").write_text("\n".join(book) + "\n")
     shutil.copy(tornado / "boulder_a_stations.gpx", tmp_path / "stations.gpx")
     _sparse_geotiff(tmp_path / "bomb.tif", 20_000)
+    (tmp_path / "z_huge.csv").write_text("x_m,z_m\n0,1e308\n10,-1e308\n")
+    (tmp_path / "x_huge.csv").write_text("x_m,z_m\n0,100\n1e308,0\n")
+    (tmp_path / "x_tiny.csv").write_text("x_m,z_m\n0,100\n1e-300,0\n")
     table = pd.DataFrame({"path_id": ["1", "1"], "point": ["A", "B"],
                           "x_m": [0.0, 5.0], "z_m": [10.0, 7.0],
                           "slope_deg": [30.0, 400.0], "vi_x_mps": [5.0, 5.0],
@@ -145,6 +148,12 @@ CASES = [
                                     "{d}/out/p.csv"), 1,
      ["bomb.tif: grid of 20,000 x 20,000 cells, more than the limit of 50,000,000"],
      []),
+    ("profile-csv-z-huge", ("profile", "{d}/z_huge.csv", "-o", "{d}/out/p.csv"), 1,
+     ["z_huge.csv: row 2: column 'z_m': 1e+308 m is not an elevation on Earth"], []),
+    ("profile-csv-x-huge", ("profile", "{d}/x_huge.csv", "-o", "{d}/out/p.csv"), 1,
+     ["x_huge.csv: row 3: column 'x_m': 1e+308 m is not a chainage"], []),
+    ("profile-csv-x-tiny-step", ("profile", "{d}/x_tiny.csv", "-o", "{d}/out/p.csv"),
+     1, ["x_tiny.csv: row 3: column 'x_m': vertices 1e-300 m apart"], []),
     # a model file's DEM profile read by simulate: the file and field, never a flag
     # simulate does not have
     ("model-step-negative", _simulate("step_negative"), 1,
