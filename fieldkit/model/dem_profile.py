@@ -74,14 +74,6 @@ MIN_STEP_CELLS = 0.01
 #: vertices took 110 s), so the limit also bounds a run to about 20 s.
 MAX_SECTION_VERTICES = 20_000
 
-#: Fields of a model file's ``"dem"`` profile entry -> the argument each one sets.
-ENTRY_FIELDS = {
-    "from": "start_xy",
-    "line": "vertices_xy",
-    "step_m": "step_m",
-    "max_length_m": "max_length_m",
-}
-
 #: How a steepest-descent line may end (:attr:`Section.ending`).
 ENDINGS = (
     "local minimum", "flat area", "grid edge", "nodata", "maximum length",
@@ -411,63 +403,6 @@ def _check_points(points, name: str, minimum: int) -> np.ndarray:
     if not np.isfinite(xy).all():
         raise ArgumentError(f"{name} must be finite numbers", source=name)
     return xy
-
-
-def section_from_entry(grid: DemGrid, entry: dict, *, source: str) -> Section:
-    """The section a model file's DEM profile entry describes.
-
-    Parameters
-    ----------
-    grid
-        The DEM of ``entry["dem"]``.
-    entry
-        ``{"from": [x, y]}`` (steepest descent) or ``{"line": [[x, y], ...]}`` (a
-        polyline), with optional ``"step_m"`` (default half the cell size) and
-        ``"max_length_m"``; other keys are the caller's.
-    source
-        The model file.
-
-    Raises
-    ------
-    InputFileError
-        Any bad field, naming ``source`` and the field (``profile.step_m``), or
-        the DEM file for a line leaving the grid.
-
-    Examples
-    --------
-    >>> g = DemGrid.from_corner(np.array([[10.0, 10.0], [0.0, 0.0]]), x_left_m=0,
-    ...                         y_top_m=2, cellsize_m=1)
-    >>> section_from_entry(g, {"from": "abc"}, source="m.json")  # doctest: +ELLIPSIS
-    Traceback (most recent call last):
-    ...
-    fieldkit.errors.InputFileError: m.json: profile.from: must be [x, y] in metres ...
-    """
-    if ("from" in entry) == ("line" in entry):
-        raise InputFileError(
-            "give either `from` [x, y] (steepest descent) or `line` [[x, y], ...]",
-            source=source,
-            where="profile.dem",
-        )
-    fields = {argument: key for key, argument in ENTRY_FIELDS.items()}
-    fields["spacing_m"] = "step_m"  # the polyline's name for the step
-    try:
-        step = entry.get("step_m")
-        step = 0.5 * grid.cellsize_m if step is None else _number(step, "step_m")
-        if "line" in entry:
-            return profile_along_polyline(grid, entry["line"], step)
-        return steepest_descent_line(
-            grid, entry["from"], step, max_length_m=entry.get("max_length_m")
-        )
-    except ArgumentError as exc:
-        if exc.source not in fields:
-            raise
-        name, field = exc.source, fields[exc.source]
-        message = exc.message
-        if (message + " ").startswith(name + " "):
-            message = message[len(name) + 1 :]
-        raise InputFileError(
-            message.replace(name, field), source=source, where=f"profile.{field}"
-        ) from None
 
 
 def profile_along_polyline(

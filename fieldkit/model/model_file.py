@@ -24,10 +24,14 @@ from pathlib import Path
 
 import numpy as np
 
-from fieldkit.errors import ArgumentError, FieldkitError, InputFileError
+from fieldkit.errors import FieldkitError, InputFileError
 from fieldkit.io.dem import read_dem
 from fieldkit.io.profile_csv import read_profile_csv
-from fieldkit.model.dem_profile import section_from_entry, section_from_vertices
+from fieldkit.model.dem_profile import (
+    profile_along_polyline,
+    section_from_vertices,
+    steepest_descent_line,
+)
 from fieldkit.model.effects import registry
 from fieldkit.model.materials import Material, check_number
 from fieldkit.model.profile import Profile
@@ -267,15 +271,7 @@ def _profile(prof: dict, source: str, *, base_dir) -> Profile:
         _unknown(prof, allowed, "profile", source)
         path = base / str(prof[kind])
         if kind == "csv":
-            try:
-                vertices = read_profile_csv(path, units=prof.get("units"))
-            except ArgumentError as exc:  # the entry's "units", not a flag
-                if exc.source != "units":
-                    raise
-                message = exc.message.removeprefix("units ")
-                raise InputFileError(
-                    message, source=source, where="profile.units"
-                ) from None
+            vertices = read_profile_csv(path, units=prof.get("units"))
             section = section_from_vertices(
                 vertices.x_m, vertices.z_m, vertices.material, source=str(path)
             )
@@ -297,7 +293,20 @@ def _profile(prof: dict, source: str, *, base_dir) -> Profile:
 
 def _dem_section(prof: dict, path: Path, source: str):
     """The section of a ``"dem"`` profile entry (steepest descent or polyline)."""
-    return section_from_entry(read_dem(path), prof, source=source)
+    grid = read_dem(path)
+    step = prof.get("step_m")
+    step = 0.5 * grid.cellsize_m if step is None else float(step)
+    if ("from" in prof) == ("line" in prof):
+        raise InputFileError(
+            "give either `from` [x, y] (steepest descent) or `line` [[x, y], ...]",
+            source=source,
+            where="profile.dem",
+        )
+    if "line" in prof:
+        return profile_along_polyline(grid, prof["line"], step)
+    return steepest_descent_line(
+        grid, prof["from"], step, max_length_m=prof.get("max_length_m")
+    )
 
 
 def _seeder(data: dict, profile: Profile, source: str) -> Seeder:
