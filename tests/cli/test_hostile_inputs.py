@@ -198,7 +198,7 @@ CASES = [
      ["effects.air_drag.cd: must be in [0, 3]"], []),
     ("synth-effect-inf", _synth("--paths", "2", "--seed", "1", "--effects",
                                 "angle_dependent_restitution=b=inf"), 1,
-     ["effects.angle_dependent_restitution.b: must be in [0, 3]"], []),
+     ["effects.angle_dependent_restitution.b: must be", "(got inf)"], []),
     ("synth-noise-nan", _synth("--paths", "2", "--seed", "1", "--noise", "nan"), 2,
      ["--noise must be a finite number (got nan)"], []),
     # impact and fence: non-finite and absurd numbers
