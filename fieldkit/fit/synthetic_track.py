@@ -43,6 +43,10 @@ MAX_LAUNCH_SPEED_MPS = 100.0
 #: Largest position noise SD [m]: beyond a metre a video track measures nothing.
 MAX_NOISE_M = 1.0
 
+#: Longest track [s]: ten minutes of video (a filmed rockfall lasts seconds); the
+#: flights are integrated in 1 ms steps, so this also bounds the work.
+MAX_TRACK_S = 600.0
+
 #: Most samples in one track (8 flights of 1 s at 200 frames/s are 1,600): a
 #: million samples is about 70 MB of CSV.
 MAX_TRACK_SAMPLES = 1_000_000
@@ -180,7 +184,15 @@ def synthetic_track(
     x0, z0 = start_xz_m
     starts, states, durations = [], [], []
     t, pos = 0.0, np.array(start_xz_m, float)
-    for speed, angle in zip(speeds, angles, strict=True):
+    for i, (speed, angle) in enumerate(zip(speeds, angles, strict=True)):
+        if t > MAX_TRACK_S or t * fps >= MAX_TRACK_SAMPLES:  # before more work
+            raise ArgumentError(
+                f"the first {i} of {len(speeds)} flights already last {t:.1f} s, "
+                f"{math.floor(t * fps) + 1:,} samples at fps {fps:g}: a track holds "
+                f"at most {MAX_TRACK_S:g} s and {MAX_TRACK_SAMPLES:,} samples (fewer "
+                "flights, a lower fps or slower launches)",
+                source="fps" if t <= MAX_TRACK_S else "flights",
+            )
         theta = math.radians(angle - surface_angle_deg)
         state = np.array(
             [pos[0], pos[1], speed * math.cos(theta), speed * math.sin(theta)]
@@ -192,12 +204,13 @@ def synthetic_track(
         t += duration
         pos = end[:2]
     samples = math.floor(t * fps) + 1
-    if samples > MAX_TRACK_SAMPLES:
+    if t > MAX_TRACK_S or samples > MAX_TRACK_SAMPLES:
         raise ArgumentError(
             f"{len(speeds)} flights lasting {t:.1f} s at fps {fps:g} would make "
-            f"{samples:,} samples, more than the limit of {MAX_TRACK_SAMPLES:,}: "
-            "fewer flights or a lower fps",
-            source="fps",
+            f"{samples:,} samples: a track holds at most {MAX_TRACK_S:g} s and "
+            f"{MAX_TRACK_SAMPLES:,} samples (fewer flights, a lower fps or slower "
+            "launches)",
+            source="fps" if t <= MAX_TRACK_S else "flights",
         )
     times = np.arange(0, samples) / fps
     x_true, z_true = np.empty(times.size), np.empty(times.size)
