@@ -295,8 +295,14 @@ def body_from_options(
         (body.radius_m, radius, "--radius", "radius", "length_m"),
         (body.gyration_m, gyration, "--gyration", "radius of gyration", "length_m"),
     ):
-        check_physical(value, flag if given is not None else derived.format(name),
-                       quantity)  # fmt: skip
+        flag = flag if given is not None else derived.format(name)
+        check_physical(value, flag, quantity)
+        minimum, units = BODY_MINIMA[quantity]
+        if value is not None and value < minimum:
+            raise ArgumentError(
+                f"{flag} must be at least {minimum:g} {units} (got {value:g}): a "
+                "smaller body is sand, not a rock"
+            )
     return body
 
 
@@ -379,6 +385,14 @@ PHYSICAL_LIMITS: dict[str, tuple[float, str, str]] = {
     "angle_law_b": (10.0, "", "eq. 5.4's b is 1.03 in the thesis"),
     "velocity_scale_mps": (1000.0, "m/s", "eq. 7.1's K is 9.144 m/s in the thesis"),
 }  # fmt: skip
+
+
+#: Smallest body the calculators take: (minimum, units). Below a gram or a
+#: millimetre a "rock" is sand, and k^2 of 1e-300 m underflows to zero.
+BODY_MINIMA: dict[str, tuple[float, str]] = {
+    "mass_kg": (1e-3, "kg"),
+    "length_m": (1e-3, "m"),
+}
 
 
 def check_physical(value: float | None, flag: str, quantity: str) -> None:

@@ -170,7 +170,9 @@ def _report(
         f"{'slip v_T + r omega [m/s]':26s}{f['slip_velocity_i_mps']:10.2f}"
         f"{f['slip_velocity_f_mps']:10.2f}",
         f"{'e_N = -v_fN/v_iN':26s}{'':10s}{f['e_n']:10.3f}",
-        f"{'e_T = v_fT/v_iT':26s}{'':10s}{f['e_t']:10.3f}",
+        f"{'e_T = v_fT/v_iT':26s}{'':10s}"
+        + (f"{f['e_t']:10.3f}" if math.isfinite(f["e_t"])
+           else "  not defined (v_iT = 0)"),
         "",
     ]  # fmt: skip
     unit = "N s" if mass_known else "N s/kg"

@@ -229,6 +229,9 @@ CASES = [
                            "--shape", "cube", "--dimensions", "1000"), 1,
      ["the body's mass (from --shape and --dimensions) must be at most 1e+07 kg"],
      []),
+    ("impact-gyration-tiny", ("impact", "--vt", "3", "--vn", "-5", "--en", "0.5",
+                              "--radius", "0.2", "--gyration", "1e-300"), 1,
+     ["--gyration must be at least 0.001 m (got 1e-300)"], []),
     ("impact-offset-huge", (*_IMPACT, "--en", "0.5", "--friction", "0.5",
                             "--offset", "1e300"), 1,
      ["--offset must be at most 10 m in size"], []),
@@ -354,3 +357,12 @@ def test_a_descent_reaching_the_vertex_limit_says_so(cli, site, monkeypatch):
     assert result.exit_code == 0, result.stderr
     assert "ended: reached the limit of 50 vertices" in result.stdout
     assert len(out.read_text().splitlines()) == 1 + 50
+
+
+def test_an_undefined_e_t_is_said_not_printed_as_nan(cli):
+    """v_iT = 0: e_T = v_fT/v_iT has no value; the report says so instead of 'nan'."""
+    result = cli("impact", "--vt", "0", "--vn", "-5", "--en", "0.5", "--radius", "0.2",
+                 "--gyration", "0.1", "--mass", "10")  # fmt: skip
+    assert result.exit_code == 0, result.stderr
+    assert "not defined (v_iT = 0)" in result.stdout
+    assert "nan" not in result.stdout
