@@ -280,6 +280,12 @@ def body_from_options(
     arguments of :func:`fieldkit.physics.bodies.resolve_body` for every command)."""
     from fieldkit.physics.bodies import resolve_body
 
+    for part in re.split(r"[,xX]", dimensions or ""):
+        try:
+            size = float(part)
+        except ValueError:
+            continue  # resolve_body says what is wrong with the text
+        check_physical(size, "--dimensions", "dimensions_m")
     body = resolve_body(
         mass_kg=mass,
         radius_m=radius,
@@ -379,6 +385,7 @@ PHYSICAL_LIMITS: dict[str, tuple[float, str, str]] = {
         "avalanche, not a rockfall",
     ),
     "length_m": (10.0, "m", "rockfall blocks are at most a few metres across"),
+    "dimensions_m": (20.0, "m", "rockfall blocks are at most a few metres across"),
     "angle_deg": (180.0, "deg", "an angle between two directions"),
     "impulse_ns": (1e9, "N s", "10,000 t at 100 m/s"),
     "angle_law_a": (1000.0, "", "eq. 5.4's a is 19.5 in the thesis"),

@@ -11,6 +11,7 @@ import math
 from pathlib import Path
 from typing import Annotated
 
+import numpy as np
 import typer
 
 from fieldkit.cli.common import (
@@ -29,6 +30,7 @@ from fieldkit.cli.common import (
 from fieldkit.cli.progress import report_written
 from fieldkit.errors import ArgumentError
 from fieldkit.physics.fence_impact import FenceImpact
+from fieldkit.physics.restitution import angle_dependent_restitution
 from fieldkit.physics.structure_forces import StructureLaw
 
 #: Body values `fence` always needs (a rebound also needs k, a computed one also r).
@@ -191,6 +193,10 @@ def fence(
     # a typed --radius or an --angle-in asks for the computed rebound; a shape's
     # radius alone does not
     computed = radius is not None or angle_in is not None
+    if computed and e_n is None and angle_in is not None and 0 < angle_in <= 90:
+        with np.errstate(over="ignore", divide="ignore"):
+            law = float(angle_dependent_restitution(angle_in))
+        check_physical(law, f"e_N by eq. 5.4 at --angle-in {angle_in:g} deg", "e_n")
     result = fence_impact(
         rock.mass_kg,
         speed_in,

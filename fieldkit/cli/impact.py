@@ -333,7 +333,8 @@ def impact(
             outputs.plan(path, argument=flag)
     mass_known = body.mass_kg is not None
     theta_i = math.degrees(math.atan2(-v_in, v_it))
-    e_n, e_source = _restitution(law, en, a, b, scale_velocity, theta_i, v_in)
+    with np.errstate(over="ignore", divide="ignore"):  # refused just below
+        e_n, e_source = _restitution(law, en, a, b, scale_velocity, theta_i, v_in)
     check_physical(e_n, f"e_N by {e_source} at theta_i {theta_i:.3g} deg", "e_n")
     common = {
         "radius_m": body.radius_m,
