@@ -357,8 +357,10 @@ class ImpactTable:
             elif spec.kind == "bool":
                 out[name] = out[name].astype("boolean")
         slope = out["slope_deg"].to_numpy(float)
-        outside = ~np.isnan(slope) & ~((slope > -180.0) & (slope <= 180.0))
-        if outside.any():  # a dip, beyond +-90 deg an overhang (§2)
+        # a dip, beyond +-90 deg an overhang (§2); a non-finite value is left to
+        # the check of each use ("not finite", with every row named)
+        outside = np.isfinite(slope) & ~((slope > -180.0) & (slope <= 180.0))
+        if outside.any():
             i = int(np.flatnonzero(outside)[0])
             raise InputFileError(
                 f"slope_deg {slope[i]:g} is outside (-180, 180] deg",
