@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import os
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -165,6 +166,9 @@ REQUIRED_COLUMNS: tuple[str, ...] = tuple(
     c.name for c in CONTRACT_COLUMNS if c.required
 )
 THETA0_SOURCES: frozenset[str] = frozenset({"tree", "assumed", "video", "given"})
+#: Key of the frame's attrs holding the columns the table's source had.
+_GIVEN = "fieldkit_given_columns"
+
 FORMATS: dict[str, str] = {".csv": "csv", ".parquet": "parquet", ".xlsx": "xlsx"}
 
 _EPS = 1e-12
@@ -352,6 +356,10 @@ class ImpactTable:
                 source=self.source,
             )
         out = frame.copy()
+        # the columns the source had, before the contract's are added as NaN (kept
+        # in the frame's attrs, which copies and row selections carry along)
+        given = out.attrs.get(_GIVEN, out.columns)
+        out.attrs[_GIVEN] = tuple(c for c in given if c in out.columns)
         for col in CONTRACT_COLUMNS:
             if col.name not in out.columns:
                 out[col.name] = pd.NA if col.kind in ("str", "bool") else np.nan
@@ -365,6 +373,17 @@ class ImpactTable:
                 out[name] = out[name].astype("string")
             elif spec.kind == "bool":
                 out[name] = out[name].astype("boolean")
+        slope = out["slope_deg"].to_numpy(float)
+        # a dip, beyond +-90 deg an overhang (§2); a non-finite value is left to
+        # the check of each use ("not finite", with every row named)
+        outside = np.isfinite(slope) & ~((slope > -180.0) & (slope <= 180.0))
+        if outside.any():
+            i = int(np.flatnonzero(outside)[0])
+            raise InputFileError(
+                f"slope_deg {slope[i]:g} is outside (-180, 180] deg",
+                source=self.source,
+                where=f"row {i + 1}",
+            )
         for key in ("path_id", "point"):
             bad = out.index[out[key].isna()]
             if len(bad):
@@ -452,6 +471,37 @@ class ImpactTable:
         """Path identifiers in order of first appearance."""
         return list(dict.fromkeys(self.frame["path_id"].tolist()))
 
+    def unusable_columns(self, names: Sequence[str]) -> str | None:
+        """Which of ``names`` cannot be used, in words, or None when all can.
+
+        A column the table does not have is *missing*; one it has with no value
+        in any row is *empty* (an export that left it blank), and the two are
+        told apart.
+
+        Examples
+        --------
+        >>> t = ImpactTable(pd.DataFrame({"path_id": ["A"], "point": ["1"],
+        ...     "x_m": [0.0], "z_m": [0.0], "slope_deg": [0.0], "vi_x_mps": [np.nan],
+        ...     "vi_z_mps": [-4.0], "vf_x_mps": [3.0], "vf_z_mps": [2.0]}))
+        >>> print(t.unusable_columns(["vi_x_mps", "vi_z_mps", "material"]))
+        ... # doctest: +NORMALIZE_WHITESPACE
+        missing column(s) material; column(s) vi_x_mps present but empty (no value in
+        any row)
+        """
+        frame = self.frame
+        given = set(frame.attrs.get(_GIVEN, frame.columns))
+        unusable = [c for c in names if c not in frame.columns or frame[c].isna().all()]
+        missing = [c for c in unusable if c not in given]
+        empty = [c for c in unusable if c in given]
+        parts = []
+        if missing:
+            parts.append(f"missing column(s) {', '.join(missing)}")
+        if empty:
+            parts.append(
+                f"column(s) {', '.join(empty)} present but empty (no value in any row)"
+            )
+        return "; ".join(parts) or None
+
     def column(self, name: str) -> np.ndarray:
         """A float column as a numpy array (NaN where missing)."""
         return self.frame[name].to_numpy(dtype=float, na_value=np.nan)
@@ -475,6 +525,14 @@ class ImpactTable:
             for c in CONTRACT_COLUMNS + EXTENSION_COLUMNS
             if c.kind == "str"
         }
+        if fmt == "csv":  # NUL bytes: binary, UTF-16 or UTF-32, not a UTF-8 CSV
+            with p.open("rb") as handle:
+                if b"\x00" in handle.read(4096):
+                    raise InputFileError(
+                        "not a UTF-8 text CSV file (NUL bytes: binary, UTF-16 or "
+                        "UTF-32 content)",
+                        source=p,
+                    )
         try:
             if fmt == "csv":
                 frame = pd.read_csv(p, dtype=text_cols)
@@ -482,9 +540,14 @@ class ImpactTable:
                 frame = pd.read_parquet(p)
             else:
                 frame = pd.read_excel(p, dtype=text_cols)
-        except (ValueError, OSError, pd.errors.ParserError) as exc:
+        except MemoryError:
+            raise
+        except Exception as exc:  # noqa: BLE001 - any parser failure is the file's
+            # pandas, pyarrow and openpyxl raise their own types for a file that
+            # is not what its extension says (BadZipFile, KeyError, ArrowInvalid)
+            reason = " ".join(str(exc).split())[:160] or type(exc).__name__
             raise InputFileError(
-                f"cannot read {fmt.upper()}: {exc}", source=p
+                f"not a readable {fmt.upper()} file ({reason})", source=p
             ) from None
         if frame.empty:
             raise InputFileError("table has no rows", source=p)

@@ -2,7 +2,12 @@
 
 Library code names the arguments of its functions (``mass_kg``), never command-line
 flags (see :mod:`fieldkit.errors`); :data:`FLAGS` maps those names to the flags, and
-:func:`one_line_errors`, :func:`warn` and :func:`note` show the flags instead.
+:func:`one_line_errors`, :func:`warn` and :func:`note` show the flags instead -- but
+only flags the running command has (:func:`command_flags`): an error raised while
+``simulate`` reads a model file's DEM profile names the file and field, not
+``profile --step``. :func:`one_line_errors` also refuses a non-finite number given to
+any float option (``inf``, ``nan``) before the command runs, unless the option's own
+default is infinite (``--friction``, default inf).
 """
 
 from __future__ import annotations
@@ -10,9 +15,11 @@ from __future__ import annotations
 import functools
 import math
 import re
+import secrets
 from collections.abc import Callable, Mapping
 from typing import Annotated, ParamSpec, TypeVar, overload
 
+import numpy as np
 import typer
 
 from fieldkit.errors import ArgumentError, FieldkitError
@@ -78,10 +85,77 @@ FLAGS: dict[str, str] = {
     # synthetic tables and fits (fieldkit.fit)
     "noise_fraction": "--noise",
     "paths": "--paths",
+    "seed": "--seed",
     "report_dir": "--report",
 }
 
 _QUOTED = re.compile(r"`(\w+)`")
+
+
+def _current_context():
+    """The click context of the running command, or None outside one."""
+    try:  # typer bundles its own click (typer >= 0.20)
+        from typer._click.globals import get_current_context
+    except ImportError:  # pragma: no cover - typer on the installed click
+        from click import get_current_context
+    return get_current_context(silent=True)
+
+
+def _command_options(ctx) -> frozenset[str]:
+    """Every option string (``--step``, ``-o``) of the context's command."""
+    names: set[str] = set()
+    for param in ctx.command.params:
+        names.update(param.opts)
+        names.update(getattr(param, "secondary_opts", ()))
+    return frozenset(names)
+
+
+def command_flags(mapping: Mapping[str, str] = FLAGS) -> dict[str, str]:
+    """The part of ``mapping`` whose flags the running command has.
+
+    An argument name maps to a flag only when the command being run has that flag
+    (``"--from/--to"``: both; a description that is not a flag is kept); an error
+    about any other name keeps its own source (the file and field the value came
+    from). Outside a command line (a library
+    call, a doctest) the whole mapping.
+
+    Examples
+    --------
+    >>> command_flags({"step_m": "--step"})
+    {'step_m': '--step'}
+    """
+    ctx = _current_context()
+    if ctx is None:
+        return dict(mapping)
+    options = _command_options(ctx)
+    return {
+        name: flag
+        for name, flag in mapping.items()
+        if not flag.startswith("-")  # a description ("the impact angle (--angle)")
+        or all(part in options for part in flag.split("/"))
+    }
+
+
+def _non_finite_option(ctx, values: Mapping[str, object]) -> str | None:
+    """The first float option given a non-finite value, as a one-line message.
+
+    An option may be infinite only when its default is (``--friction``: inf means
+    slip always stops); NaN is never a value.
+    """
+    for param in ctx.command.params:
+        if not param.opts or param.opts[0][:1] != "-" or param.name not in values:
+            continue
+        value = values[param.name]
+        items = value if isinstance(value, (list, tuple)) else [value]
+        default = param.default if isinstance(param.default, float) else 0.0
+        for item in items:
+            if not isinstance(item, float) or math.isfinite(item):
+                continue
+            if math.isinf(item) and item == default:
+                continue
+            flag = max(param.opts, key=len)
+            return f"{flag} must be a finite number (got {item:g})"
+    return None
 
 
 def with_flags(text: str, flags: Mapping[str, str] = FLAGS) -> str:
@@ -120,7 +194,10 @@ def error_line(exc: FieldkitError, flags: Mapping[str, str] = FLAGS) -> str:
     message = with_flags(exc.message, flags)
     name = _argument(exc, flags)
     if name is None:
-        parts = [exc.source, exc.where]
+        source = exc.source
+        if source and (message + " ").startswith(source + " "):
+            source = None  # "step_m must be > 0", not "step_m: step_m must be > 0"
+        parts = [source, exc.where]
     else:
         # about an argument: bare argument names (with an underscore, so never prose)
         # are flags too, and the message may begin with the argument's own name
@@ -149,17 +226,28 @@ def one_line_errors(func=None, *, flags=None):
     """Turn :class:`FieldkitError` into ``error: <one line>`` on stderr, exit 1.
 
     Argument names in the error become flags (:func:`error_line`), through
-    :data:`FLAGS` updated with ``flags`` (a command whose flags differ).
+    :data:`FLAGS` updated with ``flags`` (a command whose flags differ), restricted
+    to the flags the running command has (:func:`command_flags`). Before the
+    command runs, a non-finite value of a float option (``--mass inf``,
+    ``--step nan``) is a usage error (exit 2), unless the option's default is
+    infinite.
     """
     mapping = {**FLAGS, **(flags or {})}
 
     def decorate(command: Callable[P, R]) -> Callable[P, R]:
         @functools.wraps(command)
         def wrapper(*args: P.args, **kwargs: P.kwargs) -> R:
+            ctx = _current_context()
+            if ctx is not None:
+                problem = _non_finite_option(ctx, kwargs)
+                if problem is not None:
+                    typer.echo(f"error: {problem}", err=True)
+                    raise typer.Exit(2)
             try:
                 return command(*args, **kwargs)
             except FieldkitError as exc:
-                typer.echo(f"error: {error_line(exc, mapping)}", err=True)
+                line = error_line(exc, command_flags(mapping))
+                typer.echo(f"error: {line}", err=True)
                 raise typer.Exit(1) from None
 
         return wrapper
@@ -169,12 +257,14 @@ def one_line_errors(func=None, *, flags=None):
 
 def warn(message: str) -> None:
     """Print a one-line warning to stderr (argument names in backticks as flags)."""
-    typer.echo(f"warning: {' '.join(with_flags(message).split())}", err=True)
+    text = with_flags(message, command_flags())
+    typer.echo(f"warning: {' '.join(text.split())}", err=True)
 
 
 def note(message: str) -> None:
     """Print a one-line note to stderr (argument names in backticks as flags)."""
-    typer.echo(f"note: {' '.join(with_flags(message).split())}", err=True)
+    text = with_flags(message, command_flags())
+    typer.echo(f"note: {' '.join(text.split())}", err=True)
 
 
 def body_from_options(
@@ -190,7 +280,13 @@ def body_from_options(
     arguments of :func:`fieldkit.physics.bodies.resolve_body` for every command)."""
     from fieldkit.physics.bodies import resolve_body
 
-    return resolve_body(
+    for part in re.split(r"[,xX]", dimensions or ""):
+        try:
+            size = float(part)
+        except ValueError:
+            continue  # resolve_body says what is wrong with the text
+        check_physical(size, "--dimensions", "dimensions_m")
+    body = resolve_body(
         mass_kg=mass,
         radius_m=radius,
         gyration_m=gyration,
@@ -199,6 +295,21 @@ def body_from_options(
         dimensions_m=dimensions,
         unit_weight_kn_m3=unit_weight,
     )
+    derived = "the body's {} (from --shape and --dimensions)"
+    for value, given, flag, name, quantity in (
+        (body.mass_kg, mass, "--mass", "mass", "mass_kg"),
+        (body.radius_m, radius, "--radius", "radius", "length_m"),
+        (body.gyration_m, gyration, "--gyration", "radius of gyration", "length_m"),
+    ):
+        flag = flag if given is not None else derived.format(name)
+        check_physical(value, flag, quantity)
+        minimum, units = BODY_MINIMA[quantity]
+        if value is not None and value < minimum:
+            raise ArgumentError(
+                f"{flag} must be at least {minimum:g} {units} (got {value:g}): a "
+                "smaller body is sand, not a rock"
+            )
+    return body
 
 
 def print_body_notes(body: ResolvedBody) -> None:
@@ -247,6 +358,90 @@ UnitWeightOpt = Annotated[
         help=f"Rock unit weight for --shape, kN/m3 (default {UNIT_WEIGHT_KN_M3:g}).",
     ),
 ]
+
+
+#: Largest size of the quantities the impact and fence calculators take from the
+#: command line: (limit, units, why). A value beyond is a typo or a unit slip (e_N
+#: 1e308 for 0.8), refused rather than computed with; the sign and the lower end
+#: are each calculator's own checks. An infinite friction is accepted (the
+#: option's default: slip always stops).
+PHYSICAL_LIMITS: dict[str, tuple[float, str, str]] = {
+    "speed_mps": (
+        100.0, "m/s", "free fall from 500 m reaches 99 m/s; rockfall impacts are "
+        "tens of m/s",
+    ),
+    "spin_radps": (
+        1000.0, "rad/s", "a 0.1 m rock rolling at 100 m/s spins at 1000 rad/s",
+    ),
+    "e_n": (
+        10.0, "", "measured e_N reach 1.5 at shallow impacts (thesis Table 2-4)",
+    ),
+    "friction": (
+        100.0, "", "mu = 100 is a friction angle of 89.4 deg; give inf for slip "
+        "that always stops",
+    ),
+    "mass_kg": (
+        1e7, "kg", "10,000 t (3,700 m3 of rock): beyond it a fall is a rock "
+        "avalanche, not a rockfall",
+    ),
+    "length_m": (10.0, "m", "rockfall blocks are at most a few metres across"),
+    "dimensions_m": (20.0, "m", "rockfall blocks are at most a few metres across"),
+    "angle_deg": (180.0, "deg", "an angle between two directions"),
+    "impulse_ns": (1e9, "N s", "10,000 t at 100 m/s"),
+    "angle_law_a": (1000.0, "", "eq. 5.4's a is 19.5 in the thesis"),
+    "angle_law_b": (10.0, "", "eq. 5.4's b is 1.03 in the thesis"),
+    "velocity_scale_mps": (1000.0, "m/s", "eq. 7.1's K is 9.144 m/s in the thesis"),
+}  # fmt: skip
+
+
+#: Smallest body the calculators take: (minimum, units). Below a gram or a
+#: millimetre a "rock" is sand, and k^2 of 1e-300 m underflows to zero.
+BODY_MINIMA: dict[str, tuple[float, str]] = {
+    "mass_kg": (1e-3, "kg"),
+    "length_m": (1e-3, "m"),
+}
+
+
+def check_physical(value: float | None, flag: str, quantity: str) -> None:
+    """Refuse ``value`` of ``flag`` larger in size than :data:`PHYSICAL_LIMITS`
+    [quantity] (None: not given; an infinite friction passes, see there).
+
+    Examples
+    --------
+    >>> check_physical(1e308, "--en", "e_n")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    fieldkit.errors.ArgumentError: --en must be at most 10 in size (got 1e+308): ...
+    """
+    if value is None or (quantity == "friction" and value == math.inf):
+        return
+    limit, units, why = PHYSICAL_LIMITS[quantity]
+    if not (math.isfinite(value) and abs(value) <= limit):
+        raise ArgumentError(
+            f"{flag} must be at most {limit:g}{' ' + units if units else ''} in size "
+            f"(got {value:g}): {why}"
+        )
+
+
+#: Largest seed: numpy's generators take any non-negative integer; 2**128 - 1 is
+#: the entropy of their seed sequence (more digits change nothing).
+MAX_SEED = 2**128 - 1
+
+
+def random_generator(seed: int | None) -> tuple[np.random.Generator, int]:
+    """The generator of a command's ``--seed``, and the seed used.
+
+    None draws a seed and says so (a note with the ``--seed`` that reproduces the
+    run); a negative seed, or one above :data:`MAX_SEED`, is refused.
+    """
+    if seed is None:
+        seed = secrets.randbits(32)
+        note(f"`seed` not given: used {seed}; pass --seed {seed} to reproduce")
+    elif not 0 <= seed <= MAX_SEED:
+        raise ArgumentError(
+            f"seed must be an integer from 0 to 2**128 - 1 (got {seed})", source="seed"
+        )
+    return np.random.default_rng(seed), seed
 
 
 def parse_point(text: str, flag: str) -> tuple[float, float]:

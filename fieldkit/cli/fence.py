@@ -10,6 +10,7 @@ import math
 from pathlib import Path
 from typing import Annotated
 
+import numpy as np
 import typer
 
 from fieldkit.cli.common import (
@@ -21,11 +22,14 @@ from fieldkit.cli.common import (
     ShapeOpt,
     UnitWeightOpt,
     body_from_options,
+    check_physical,
     one_line_errors,
     print_body_notes,
 )
+from fieldkit.cli.progress import report_written
 from fieldkit.errors import ArgumentError
 from fieldkit.physics.fence_impact import FenceImpact
+from fieldkit.physics.restitution import angle_dependent_restitution
 from fieldkit.physics.structure_forces import StructureLaw
 
 #: Body values `fence` always needs (a rebound also needs k, a computed one also r).
@@ -162,6 +166,18 @@ def fence(
     ).require(*BODY_NEEDS, source="fieldkit fence")
     if speed_in is None:
         raise ArgumentError("the impact speed is required", source="--speed-in")
+    for value, flag, quantity in (
+        (speed_in, "--speed-in", "speed_mps"),
+        (speed_out, "--speed-out", "speed_mps"),
+        (spin_in, "--spin-in", "spin_radps"),
+        (spin_out, "--spin-out", "spin_radps"),
+        (e_n, "--e-n", "e_n"),
+        (friction, "--friction", "friction"),
+        (angle_in, "--angle-in", "angle_deg"),
+        (angle_out, "--angle-out", "angle_deg"),
+        (impulse, "--impulse", "impulse_ns"),
+    ):
+        check_physical(value, flag, quantity)
     laws = [
         _law("rigid", rigid, "--rigid"),
         _law("flexible", flexible, "--flexible"),
@@ -176,6 +192,10 @@ def fence(
     # a typed --radius or an --angle-in asks for the computed rebound; a shape's
     # radius alone does not
     computed = radius is not None or angle_in is not None
+    if computed and e_n is None and angle_in is not None and 0 < angle_in <= 90:
+        with np.errstate(over="ignore", divide="ignore"):
+            law = float(angle_dependent_restitution(angle_in))
+        check_physical(law, f"e_N by eq. 5.4 at --angle-in {angle_in:g} deg", "e_n")
     result = fence_impact(
         rock.mass_kg,
         speed_in,
@@ -198,13 +218,12 @@ def fence(
         write_fence_figure(
             figure, result.impulse_ns, laws, result.split, outputs=outputs
         )
-        lines.append(f"figure: {figure}")
     if out is not None:
         write_json(out, _results(result), outputs)
-        lines.append(f"results: {out}")
-    outputs.commit()
+    written = outputs.commit()
     typer.echo("\n".join(lines))
     print_body_notes(rock)
+    report_written(written)
 
 
 def _report(f: FenceImpact) -> list[str]:
@@ -327,5 +346,12 @@ def _law(name: str, text: str, option: str) -> StructureLaw:
     ):
         raise ArgumentError(
             f"coefficient and exponent must be positive, got {text!r}", source=option
+        )
+    if not (1.0 <= coefficient <= 1e12 and exponent <= 10.0):
+        raise ArgumentError(
+            f"coefficient must be in [1, 1e12] N/s^x and exponent at most 10, got "
+            f"{text!r} (the thesis laws are 1e6,1; 4e4,2 and 3e4,0.6: beyond these "
+            "bounds a contact lasts beyond any impact or no time at all)",
+            source=option,
         )
     return StructureLaw(name, coefficient, exponent)

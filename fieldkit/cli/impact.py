@@ -17,6 +17,7 @@ from fieldkit.cli.common import (
     ShapeOpt,
     UnitWeightOpt,
     body_from_options,
+    check_physical,
     one_line_errors,
     print_body_notes,
     warn,
@@ -67,6 +68,7 @@ def _impact_velocity(
         if speed is None or angle is None:
             raise ArgumentError("--speed and --angle go together (give both)")
         _positive("--speed", speed)
+        check_physical(speed, "--speed", "speed_mps")
         if not (math.isfinite(angle) and 0.0 < angle < 180.0):
             raise ArgumentError(
                 f"--angle must be between 0 and 180 deg, exclusive (got {angle:g})"
@@ -83,6 +85,8 @@ def _impact_velocity(
         raise ArgumentError(
             f"--vn must be < 0, i.e. moving into the ground (got {vn:g})"
         )
+    check_physical(vt, "--vt", "speed_mps")
+    check_physical(vn, "--vn", "speed_mps")
     return vt, vn
 
 
@@ -165,7 +169,9 @@ def _report(
         f"{'slip v_T + r omega [m/s]':26s}{f['slip_velocity_i_mps']:10.2f}"
         f"{f['slip_velocity_f_mps']:10.2f}",
         f"{'e_N = -v_fN/v_iN':26s}{'':10s}{f['e_n']:10.3f}",
-        f"{'e_T = v_fT/v_iT':26s}{'':10s}{f['e_t']:10.3f}",
+        f"{'e_T = v_fT/v_iT':26s}{'':10s}"
+        + (f"{f['e_t']:10.3f}" if math.isfinite(f["e_t"])
+           else "  not defined (v_iT = 0)"),
         "",
     ]  # fmt: skip
     unit = "N s" if mass_known else "N s/kg"
@@ -307,6 +313,16 @@ def impact(
     v_it, v_in = _impact_velocity(speed, angle, vt, vn)
     if not math.isfinite(spin):
         raise ArgumentError(f"--spin must be finite (got {spin:g})")
+    for value, flag, quantity in (
+        (spin, "--spin", "spin_radps"),
+        (en, "--en", "e_n"),
+        (friction, "--friction", "friction"),
+        (offset, "--offset", "length_m"),
+        (a, "--a", "angle_law_a"),
+        (b, "--b", "angle_law_b"),
+        (scale_velocity, "--scale-velocity", "velocity_scale_mps"),
+    ):
+        check_physical(value, flag, quantity)
     body = body_from_options(
         mass, radius, gyration, shape, dimensions, unit_weight
     ).require(*BODY_NEEDS, source="fieldkit impact")
@@ -316,7 +332,9 @@ def impact(
             outputs.plan(path, argument=flag)
     mass_known = body.mass_kg is not None
     theta_i = math.degrees(math.atan2(-v_in, v_it))
-    e_n, e_source = _restitution(law, en, a, b, scale_velocity, theta_i, v_in)
+    with np.errstate(over="ignore", divide="ignore"):  # refused just below
+        e_n, e_source = _restitution(law, en, a, b, scale_velocity, theta_i, v_in)
+    check_physical(e_n, f"e_N by {e_source} at theta_i {theta_i:.3g} deg", "e_n")
     common = {
         "radius_m": body.radius_m,
         "gyration_m": body.gyration_m,

@@ -18,6 +18,7 @@ from typing import Annotated
 
 import typer
 
+from fieldkit.cli import progress
 from fieldkit.cli.common import note, one_line_errors, parse_point
 from fieldkit.errors import ArgumentError
 from fieldkit.io.dem import DemGrid, read_dem
@@ -25,11 +26,16 @@ from fieldkit.io.profile_csv import read_profile_csv
 from fieldkit.model.dem_profile import (
     DEFAULT_MATERIAL,
     Section,
+    descent_steps,
+    parse_material_ranges,
     profile_along_polyline,
     section_from_vertices,
     steepest_descent_line,
 )
 from fieldkit.outputs import OutputSet, csv_text, write_text
+
+#: Steepest descent takes about 1 ms a vertex: announce a line that may pass 5 s.
+_ANNOUNCE_VERTICES = 5_000
 
 #: Columns of the profile CSV, in order.
 COLUMNS = ("x_m", "z_m", "plan_x_m", "plan_y_m", "material")
@@ -69,6 +75,8 @@ def _ending(section: Section) -> str:
         "grid edge": "reached the grid edge",
         "nodata": "reached nodata cells",
         "maximum length": "reached --max-length",
+        "vertex limit": f"reached the limit of {len(section.chainage_m):,} vertices (a "
+        "longer --step or a --max-length ends it sooner)",
         "end of polyline": "the last --to point",
         "end of the CSV": "the last row of the CSV",
     }
@@ -96,9 +104,12 @@ def _cut(
         section = profile_along_polyline(grid, vertices, spacing)
         lines.append(f"polyline through {len(vertices)} points; {step_text}")
     else:
-        section = steepest_descent_line(
-            grid, start_xy, spacing, max_length_m=max_length
-        )
+        steps = descent_steps(grid, spacing, max_length)[2]  # checked before work
+        description = "following the line of steepest descent"
+        with progress.step(description, announce=steps > _ANNOUNCE_VERTICES) as advance:
+            section = steepest_descent_line(
+                grid, start_xy, spacing, max_length_m=max_length, progress=advance
+            )
         lines.append(
             f"steepest descent from ({start_xy[0]:g}, {start_xy[1]:g}), z "
             f"{section.z_m[0]:.2f} m; {step_text}"
@@ -205,6 +216,8 @@ def profile(
     outputs.plan(out, argument="-o")
     if figure is not None:
         outputs.plan(figure, argument="--figure")
+    if materials is not None:
+        parse_material_ranges(materials)  # before any work
     grid: DemGrid | None = None
     vertices_csv = None
     if dem.suffix.lower() == ".csv":
@@ -255,5 +268,4 @@ def profile(
     typer.echo("\n".join(lines))
     for text in grid.notes if grid is not None else ():
         note(text)
-    for path in outputs.commit():
-        typer.echo(f"wrote {path}")
+    progress.report_written(outputs.commit())

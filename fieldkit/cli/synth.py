@@ -2,15 +2,15 @@
 
 from __future__ import annotations
 
-import secrets
 from pathlib import Path
 from typing import Annotated
 
 import numpy as np
 import typer
 
-from fieldkit.cli.common import note, one_line_errors
-from fieldkit.errors import ArgumentError
+from fieldkit.cli.common import one_line_errors, random_generator
+from fieldkit.cli.progress import report_written, step
+from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.outputs import OutputSet
 
 FLAGS = {
@@ -150,7 +150,7 @@ def synth(
           --track --fps 200 --noise-m 0.005 --flights 8 --seed 1 \\
           --effects air_drag=cd=0.8 -o out/track.csv
     """
-    from fieldkit.fit.synthetic import synthetic_table
+    from fieldkit.fit.synthetic import check_paths, synthetic_table, with_effects
     from fieldkit.model.model_file import read_model
 
     hidden = dict(parse_effect(text) for text in (effects or []))
@@ -167,26 +167,25 @@ def synth(
             angle=launch_angle,
         )
         return
+    check_paths(paths)
     with OutputSet(inputs=[model_file]) as outputs:
         outputs.plan(output, argument="-o")
-        model = read_model(model_file, outputs=outputs)
-        if seed is None:
-            seed = secrets.randbits(32)
-            note(f"`seed` not given: used {seed}; pass --seed {seed} to reproduce")
-        table = synthetic_table(
-            model,
-            effects=hidden,
-            noise_fraction=noise,
-            paths=paths,
-            rng=np.random.default_rng(seed),
-        )
-        table.write(output, outputs=outputs)
-        outputs.commit()
-    active = {**model.effects, **hidden}
+        # the hidden effects are checked before any work
+        model = with_effects(read_model(model_file, outputs=outputs), hidden)
+        rng, seed = random_generator(seed)
+        with step(f"simulating {paths:,} rocks"):
+            table = synthetic_table(
+                model, effects={}, noise_fraction=noise, paths=paths, rng=rng
+            )
+        with step(f"writing {len(table):,} impacts", announce=len(table) > 100_000):
+            table.write(output, outputs=outputs)
+            written = outputs.commit()
+    active = model.effects
     typer.echo(
         f"{len(table)} impacts of {paths} rocks (seed {seed}), noise F = {noise:g} "
-        f"on vf; effects: {', '.join(active) or 'none (base model)'} -> {output}"
+        f"on vf; effects: {', '.join(active) or 'none (base model)'}"
     )
+    report_written(written)
 
 
 def _synth_track(
@@ -203,48 +202,53 @@ def _synth_track(
 ) -> None:
     """`synth --track`: the model's body bouncing down a plane (see :func:`synth`)."""
     from fieldkit.fit.synthetic import with_effects
-    from fieldkit.fit.synthetic_track import synthetic_track
+    from fieldkit.fit.synthetic_track import (
+        LAUNCH_JITTER_DEG,
+        check_track_options,
+        synthetic_track,
+    )
     from fieldkit.model.model_file import read_model
 
-    if flights < 1:
-        raise ArgumentError(f"flights must be >= 1 (got {flights})", source="flights")
-    if not (speed > 0 and 0 < angle < 90):
-        raise ArgumentError(
-            f"launch_speed_mps must be > 0 and launch_angle_deg in (0, 90) "
-            f"(got {speed:g}, {angle:g})",
-            source="launch_speed_mps",
-        )
-    if not (fps > 0 and noise_m >= 0):
-        raise ArgumentError(
-            f"fps must be > 0 and noise_m >= 0 (got {fps:g}, {noise_m:g})",
-            source="fps",
-        )
+    check_track_options(
+        flights=flights, launch_speed_mps=speed, launch_angle_deg=angle, fps=fps,
+        noise_m=noise_m,
+    )  # fmt: skip
     with OutputSet(inputs=[model_file]) as outputs:
         outputs.plan(output, argument="-o")
         model = with_effects(read_model(model_file, outputs=outputs), hidden)
-        if seed is None:
-            seed = secrets.randbits(32)
-            note(f"`seed` not given: used {seed}; pass --seed {seed} to reproduce")
-        rng = np.random.default_rng(seed)
         drag = model.effects.get("air_drag", {"cd": 0.0, "air_density_kg_m3": 1.225})
         px, pz = model.profile.x_m, model.profile.z_m
+        # x increases in the direction of travel and the dip is positive when the
+        # ground descends that way (ARCHITECTURE §2): a profile rising toward +x
+        # would launch the block up a slope it cannot climb
         dip = float(np.degrees(np.arctan2(pz[0] - pz[-1], px[-1] - px[0])))
+        if not dip > 0:
+            raise InputFileError(
+                f"the profile rises {pz[-1] - pz[0]:.1f} m from x = {px[0]:g} to "
+                f"{px[-1]:g} m (mean dip {dip:.1f} deg): a synthetic track runs in "
+                "the direction of travel, +x, down a plane that descends that way",
+                source=model_file,
+                where="profile",
+            )
+        rng, seed = random_generator(seed)
         result = synthetic_track(
             radius_m=model.body.radius_m,
             mass_kg=model.body.mass_kg,
             cd=float(drag["cd"]),
             air_density_kg_m3=float(drag["air_density_kg_m3"]),
             launch_speed_mps=speed * rng.uniform(0.8, 1.2, flights),
-            launch_angle_deg=angle + rng.uniform(-5.0, 5.0, flights),
+            launch_angle_deg=angle
+            + rng.uniform(-LAUNCH_JITTER_DEG, LAUNCH_JITTER_DEG, flights),
             surface_angle_deg=dip,
             fps=fps,
             noise_m=noise_m,
             rng=rng,
         )
         result.write(output, outputs=outputs)
-        outputs.commit()
+        written = outputs.commit()
     typer.echo(
         f"track of {flights} flights, {len(result)} samples at {fps:g} frames/s "
         f"(seed {seed}), plane dip {dip:.1f} deg, noise {noise_m:g} m, "
-        f"air_drag cd = {float(drag['cd']):g} -> {output}"
+        f"air_drag cd = {float(drag['cd']):g}"
     )
+    report_written(written)

@@ -96,14 +96,9 @@ def check_table(
     needed = ["material", "radius_m"]
     if "rotation_friction" in model.effects:
         needed.append("gyration_m")
-    missing = [
-        c for c in (*needed, *FINITE_COLUMNS) if c not in frame or frame[c].isna().all()
-    ]
-    if missing:
-        raise InputFileError(
-            f"missing column(s) {', '.join(missing)} (needed to fit impacts)",
-            source=table.source,
-        )
+    problem = table.unusable_columns((*needed, *FINITE_COLUMNS))
+    if problem:
+        raise InputFileError(f"{problem} (needed to fit impacts)", source=table.source)
     for name in (*FINITE_COLUMNS, *needed[1:]):
         bad = ~np.isfinite(table.column(name)) & keep
         if bad.any():

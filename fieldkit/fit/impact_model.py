@@ -50,13 +50,10 @@ def impact_inputs(table: ImpactTable, model: Model) -> ImpactInputs:
         in the model (named).
     """
     frame = table.frame
-    missing = [
-        c for c in INPUT_COLUMNS if c not in frame.columns or frame[c].isna().all()
-    ]
-    if missing:
+    problem = table.unusable_columns(INPUT_COLUMNS)
+    if problem:
         raise InputFileError(
-            f"missing column(s) {', '.join(missing)} needed to predict impacts",
-            source=table.source,
+            f"{problem}: needed to predict impacts", source=table.source
         )
     names = tuple(model.materials)
     labels = frame["material"].astype("string")

@@ -33,6 +33,12 @@ from fieldkit.model.effects import registry
 from fieldkit.model.model_file import Model, model_from_dict, model_to_dict
 from fieldkit.model.simulate import simulate
 
+#: Most rocks in one synthetic table. Each rock makes up to the simulator's impact
+#: cap (500) rows and a row holds about 2.6 kB in memory while the table is built
+#: (2,000 rocks of the Table 7-1 model: 305k impacts, 1.2 GB); 5,000 rocks is
+#: about 3 GB, and a fit recovers its parameters from a few hundred.
+MAX_PATHS = 5_000
+
 #: Clean copies kept next to the noisy columns.
 TRUE_COLUMNS = ("vf_x_mps", "vf_z_mps", "vfn_mps", "vft_mps", "omega_f_radps")
 
@@ -45,6 +51,16 @@ def with_effects(model: Model, effects: dict[str, dict[str, float]]) -> Model:
         data["effects"][name] = registry.validate(name, merged, source="effects")
     out = model_from_dict(data, source=model.source)
     return replace(out, provenance=dict(model.provenance))
+
+
+def check_paths(paths: int) -> None:
+    """Refuse a number of rocks outside 1 .. :data:`MAX_PATHS` (memory, see there)."""
+    if not (isinstance(paths, int | np.integer) and 1 <= paths <= MAX_PATHS):
+        raise ArgumentError(
+            f"paths must be from 1 to {MAX_PATHS:,} (got {paths}): each rock adds up "
+            "to 500 impact rows of about 2.6 kB in memory",
+            source="paths",
+        )
 
 
 def synthetic_table(
@@ -73,8 +89,7 @@ def synthetic_table(
             f"noise_fraction must be in [0, 1] (got {noise_fraction})",
             source="noise_fraction",
         )
-    if not (isinstance(paths, int | np.integer) and paths >= 1):
-        raise ArgumentError(f"paths must be >= 1 (got {paths})", source="paths")
+    check_paths(paths)
     hidden = with_effects(model, effects)
     table = simulate(hidden, int(paths), rng, record_impacts=True).impact_table
     if table is None or len(table) == 0:

@@ -27,6 +27,66 @@ from fieldkit.track import Track
 #: RK4 step while looking for the landing [s] (then refined by bisection).
 _LANDING_STEP_S = 1e-3
 
+#: Half-width of the uniform spread of each flight's launch angle [deg].
+LAUNCH_JITTER_DEG = 5.0
+
+#: Most flights in one synthetic track (a filmed sequence has a handful).
+MAX_FLIGHTS = 1_000
+
+#: Fastest capture rate [1/s]: the top of high-speed video at useful resolution.
+MAX_FPS = 100_000.0
+
+#: Fastest launch speed [m/s]: free fall from 500 m reaches 99 m/s; rockfall
+#: rebounds are tens of m/s.
+MAX_LAUNCH_SPEED_MPS = 100.0
+
+#: Largest position noise SD [m]: beyond a metre a video track measures nothing.
+MAX_NOISE_M = 1.0
+
+#: Longest track [s]: ten minutes of video (a filmed rockfall lasts seconds); the
+#: flights are integrated in 1 ms steps, so this also bounds the work.
+MAX_TRACK_S = 600.0
+
+#: Most samples in one track (8 flights of 1 s at 200 frames/s are 1,600): a
+#: million samples is about 70 MB of CSV.
+MAX_TRACK_SAMPLES = 1_000_000
+
+
+def check_track_options(
+    *,
+    flights: int,
+    launch_speed_mps: float,
+    launch_angle_deg: float,
+    fps: float,
+    noise_m: float,
+) -> None:
+    """Refuse options of a synthetic track outside their physical range.
+
+    ``flights`` 1 .. :data:`MAX_FLIGHTS`, launch speed in (0,
+    :data:`MAX_LAUNCH_SPEED_MPS`] m/s, mean launch angle above the plane within
+    (0, 90) deg by :data:`LAUNCH_JITTER_DEG` (the angle each flight is drawn from),
+    ``fps`` in (0, :data:`MAX_FPS`], ``noise_m`` in [0, :data:`MAX_NOISE_M`] m.
+    """
+    checks = (
+        ("flights", flights, 1 <= flights <= MAX_FLIGHTS, f"from 1 to {MAX_FLIGHTS:,}"),
+        ("launch_speed_mps", launch_speed_mps,
+         0 < launch_speed_mps <= MAX_LAUNCH_SPEED_MPS,
+         f"in (0, {MAX_LAUNCH_SPEED_MPS:g}] m/s (free fall from 500 m reaches 99 m/s)"),
+        ("launch_angle_deg", launch_angle_deg,
+         LAUNCH_JITTER_DEG < launch_angle_deg < 90 - LAUNCH_JITTER_DEG,
+         f"in ({LAUNCH_JITTER_DEG:g}, {90 - LAUNCH_JITTER_DEG:g}) deg: each flight's "
+         f"angle is drawn within +-{LAUNCH_JITTER_DEG:g} deg and must stay above the "
+         "plane and ahead, down-slope"),
+        ("fps", fps, 0 < fps <= MAX_FPS,
+         f"in (0, {MAX_FPS:,.0f}] frames/s (high-speed video)"),
+        ("noise_m", noise_m, 0 <= noise_m <= MAX_NOISE_M,
+         f"in [0, {MAX_NOISE_M:g}] m (a noisier track measures nothing)"),
+    )  # fmt: skip
+    for name, value, ok, bound in checks:
+        if not (math.isfinite(value) and ok):
+            got = value if isinstance(value, int) else f"{value:g}"
+            raise ArgumentError(f"{name} must be {bound} (got {got})", source=name)
+
 
 def _landing(state: np.ndarray, k: float, tan_psi: float, x0: float, z0: float):
     """Time of flight and landing state of a flight leaving the plane at ``state``."""
@@ -73,7 +133,8 @@ def synthetic_track(
     cd, air_density_kg_m3
         ``air_drag`` parameters; ``cd = 0`` gives exact parabolas.
     launch_speed_mps, launch_angle_deg
-        Per flight: launch speed [m/s] and angle above the plane [deg], > 0.
+        Per flight: launch speed [m/s] > 0 and angle above the plane [deg] in
+        (0, 90), measured from the down-slope direction (the direction of travel).
     surface_angle_deg
         Dip of the plane psi [deg], positive descending toward +x.
     fps
@@ -108,9 +169,12 @@ def synthetic_track(
             "launch_speed_mps and launch_angle_deg need one value per flight",
             source="launch_speed_mps",
         )
-    if not (np.all(speeds > 0) and np.all((angles > 0) & (angles < 180))):
+    if not (np.all(speeds > 0) and np.all((angles > 0) & (angles < 90))):
+        # above 90 deg a flight leaves the plane backwards, up-slope: x must
+        # increase in the direction of travel (ARCHITECTURE §2)
         raise ArgumentError(
-            "launch speeds must be > 0 and angles in (0, 180) deg",
+            "launch speeds must be > 0 and angles above the plane in (0, 90) deg "
+            "(ahead, down-slope)",
             source="launch_speed_mps",
         )
     if not fps > 0 or not noise_m >= 0 or not cd >= 0:
@@ -120,7 +184,15 @@ def synthetic_track(
     x0, z0 = start_xz_m
     starts, states, durations = [], [], []
     t, pos = 0.0, np.array(start_xz_m, float)
-    for speed, angle in zip(speeds, angles, strict=True):
+    for i, (speed, angle) in enumerate(zip(speeds, angles, strict=True)):
+        if t > MAX_TRACK_S or t * fps >= MAX_TRACK_SAMPLES:  # before more work
+            raise ArgumentError(
+                f"the first {i} of {len(speeds)} flights already last {t:.1f} s, "
+                f"{math.floor(t * fps) + 1:,} samples at fps {fps:g}: a track holds "
+                f"at most {MAX_TRACK_S:g} s and {MAX_TRACK_SAMPLES:,} samples (fewer "
+                "flights, a lower fps or slower launches)",
+                source="fps" if t <= MAX_TRACK_S else "flights",
+            )
         theta = math.radians(angle - surface_angle_deg)
         state = np.array(
             [pos[0], pos[1], speed * math.cos(theta), speed * math.sin(theta)]
@@ -131,7 +203,16 @@ def synthetic_track(
         durations.append(duration)
         t += duration
         pos = end[:2]
-    times = np.arange(0, int(math.floor(t * fps)) + 1) / fps
+    samples = math.floor(t * fps) + 1
+    if t > MAX_TRACK_S or samples > MAX_TRACK_SAMPLES:
+        raise ArgumentError(
+            f"{len(speeds)} flights lasting {t:.1f} s at fps {fps:g} would make "
+            f"{samples:,} samples: a track holds at most {MAX_TRACK_S:g} s and "
+            f"{MAX_TRACK_SAMPLES:,} samples (fewer flights, a lower fps or slower "
+            "launches)",
+            source="fps" if t <= MAX_TRACK_S else "flights",
+        )
+    times = np.arange(0, samples) / fps
     x_true, z_true = np.empty(times.size), np.empty(times.size)
     flight = np.searchsorted(np.array(starts), times, side="right") - 1
     for i, (s, st) in enumerate(zip(starts, states, strict=True)):

@@ -327,6 +327,23 @@ def _header_number(text: str, key: str, source: str, line: int) -> float:
     return value
 
 
+#: Most cells a DEM may have: 50 million (a 7 km square at 1 m) is 400 MB as
+#: floats, and a rockfall section needs a slope, not a region. A compressed
+#: GeoTIFF declaring more (a few kB on disk) would otherwise exhaust memory.
+MAX_DEM_CELLS = 50_000_000
+
+
+def check_cell_count(nrows: int, ncols: int, source: str) -> None:
+    """Refuse a grid of more than :data:`MAX_DEM_CELLS` cells, before reading it."""
+    if nrows * ncols > MAX_DEM_CELLS:
+        raise InputFileError(
+            f"grid of {nrows:,} x {ncols:,} cells, more than the limit of "
+            f"{MAX_DEM_CELLS:,} (400 MB of elevations): crop it to the slope "
+            "(gdal_translate -projwin) or coarsen it (gdalwarp -tr)",
+            source=source,
+        )
+
+
 def _read_esri_ascii(file: Path) -> DemGrid:
     """An ESRI ASCII grid, strictly (module docstring)."""
     source = str(file)
@@ -386,6 +403,7 @@ def _read_esri_ascii(file: Path) -> DemGrid:
                 where=f"line {line}",
             )
         counts[key] = int(value)
+    check_cell_count(counts["nrows"], counts["ncols"], source)
     if "cellsize" in header:
         if "dx" in header or "dy" in header:
             need("cellsize", "dx")  # raises: given twice
@@ -516,6 +534,7 @@ def _read_geotiff(file: Path) -> DemGrid:
                     "grid in metres: reproject it (gdalwarp -t_srs EPSG:...)",
                     source=source,
                 )
+            check_cell_count(src.height, src.width, source)
             band = src.read(1, masked=True).astype(float)
             values = band.filled(np.nan)
             crs = src.crs.to_string() if src.crs is not None else None

@@ -45,7 +45,12 @@ from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.io import geodesy
 from fieldkit.io.csv_table import CsvTable, length_factor, read_csv_table
 from fieldkit.io.point_sets import check_unique_points, point_set_from_geographic
-from fieldkit.io.points_csv import MATERIAL_ALIASES, NAME_ALIASES, SLOPE_ALIASES
+from fieldkit.io.points_csv import (
+    MATERIAL_ALIASES,
+    NAME_ALIASES,
+    SLOPE_ALIASES,
+    check_angles,
+)
 from fieldkit.io.stations import read_stations
 from fieldkit.io.trupulse import parse_trupulse
 from fieldkit.survey import PointSet
@@ -279,6 +284,7 @@ def read_fieldbook(
     if material_column is not None:
         extra["material"] = materials
     if slope_column is not None:
+        check_angles(table, slope_column, slopes, -90.0, 90.0, "a ground dip")
         extra["slope_deg"] = slopes
     reference = (
         f"station heights ({stations.height_reference}) + instrument height + "

@@ -282,7 +282,7 @@ def _elevations(table: CsvTable, units: str) -> tuple[np.ndarray, str]:
     return values, f"column '{column.header.strip()}' {reference}"
 
 
-def _check_angles(
+def check_angles(
     table: CsvTable,
     column: Column,
     values: list[float],
@@ -290,7 +290,8 @@ def _check_angles(
     high: float,
     what: str,
 ) -> None:
-    """Angles strictly inside (low, high) [deg] (empty cells pass)."""
+    """Angles strictly inside (low, high) [deg] (empty cells pass); one reader's
+    rule for every surveyed angle column (points CSV, field book)."""
     for (number, _), value in zip(table.rows, values, strict=True):
         if not np.isnan(value) and not low < value < high:
             raise InputFileError(
@@ -309,12 +310,12 @@ def _optional_columns(table: CsvTable, units: str) -> dict[str, object]:
     slope = table.find(SLOPE_ALIASES)
     if slope is not None:
         values = [table.number(n, row, slope, required=False) for n, row in table.rows]
-        _check_angles(table, slope, values, -90.0, 90.0, "a ground dip")
+        check_angles(table, slope, values, -90.0, 90.0, "a ground dip")
         extra["slope_deg"] = values
     theta0 = table.find(THETA0_ALIASES)
     if theta0 is not None:
         values = [table.number(n, row, theta0, required=False) for n, row in table.rows]
-        _check_angles(table, theta0, values, 0.0, 180.0, "a restitution angle")
+        check_angles(table, theta0, values, 0.0, 180.0, "a restitution angle")
         extra["theta0_deg"] = values
     time = table.find(TIME_ALIASES)
     if time is not None:

@@ -30,6 +30,17 @@ import numpy as np
 from fieldkit.errors import InputFileError
 from fieldkit.io.csv_table import length_factor, read_csv_table
 
+#: Largest chainage [m]: 100 km, beyond any slope section.
+MAX_CHAINAGE_M = 100_000.0
+
+#: Largest elevation size [m]: the Earth's surface lies between -10,994 m (the
+#: Challenger Deep) and 8,849 m (Everest).
+MAX_ELEVATION_M = 11_000.0
+
+#: Shortest segment [m]: the profile CSV is written to 0.1 mm, and a surveyed
+#: section has no vertices a millimetre apart.
+MIN_SEGMENT_M = 1e-3
+
 X_ALIASES = ("x", "chainage", "distance", "station")
 Z_ALIASES = ("z", "elevation", "elev", "height", "ground_z")
 MATERIAL_ALIASES = ("material", "materials", "surface")
@@ -98,7 +109,30 @@ def read_profile_csv(
         )
     x = np.array([table.number(n, row, x_column) for n, row in rows]) * x_factor
     z = np.array([table.number(n, row, z_column) for n, row in rows]) * z_factor
+    for values, column, limit, what in (
+        (x, x_column, MAX_CHAINAGE_M, "a chainage (100 km, beyond any slope section)"),
+        (z, z_column, MAX_ELEVATION_M, "an elevation on Earth (-10,994 to 8,849 m)"),
+    ):
+        beyond = np.flatnonzero(np.abs(values) > limit)
+        if beyond.size:
+            i = int(beyond[0])
+            raise InputFileError(
+                f"column '{column.header.strip()}': {values[i]:g} m is not {what}: "
+                f"at most {limit:,.0f} m in size",
+                source=source,
+                where=f"row {rows[i][0]}",
+            )
     steps = np.diff(x)
+    short = np.flatnonzero((steps > 0) & (steps < MIN_SEGMENT_M))
+    if short.size:
+        i = int(short[0])
+        raise InputFileError(
+            f"column '{x_column.header.strip()}': vertices {steps[i]:.3g} m apart; "
+            f"segments must be at least {MIN_SEGMENT_M * 1e3:g} mm long (the profile "
+            "CSV is written to 0.1 mm)",
+            source=source,
+            where=f"row {rows[i + 1][0]}",
+        )
     if (steps <= 0).any():
         i = int(np.flatnonzero(steps <= 0)[0])
         header = x_column.header.strip()

@@ -33,7 +33,13 @@ Fixed-step normalised gradient descent on the bilinear surface, with step halvin
 5. the line also stops after ``max_length_m`` of plan length.
 
 ``step_m`` may be at most half the cell size, so every cell the line crosses gets at
-least two gradient evaluations. z decreases strictly along the line by construction.
+least two gradient evaluations, and at least :data:`MIN_STEP_CELLS` of it: the
+bilinear surface is smooth inside a cell, so a shorter step resolves nothing more, it
+only multiplies the vertices (a step of 1e-9 m never ends). No section has more than
+:data:`MAX_SECTION_VERTICES` vertices: a polyline or a ``max_length_m`` that would
+need more is refused before any work; the default length (the grid's width plus
+height) is not, and a line reaching the limit stops there ("vertex limit"). z
+decreases strictly along the line by construction.
 On a tilted plane the line is the straight fall line; on a cone or a bowl it is radial
 (tests/model/test_dem_profile.py checks both).
 """
@@ -42,7 +48,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -60,8 +66,20 @@ FLAT_SLOPE = 1e-3
 #: Step halvings before a point counts as a local minimum (h down to step_m / 64).
 _HALVINGS = 6
 
+#: Shortest steepest-descent step, as a fraction of the cell size: the bilinear
+#: surface is smooth inside a cell, so shorter steps add vertices, not accuracy.
+MIN_STEP_CELLS = 0.01
+
+#: Most vertices in a section: 20 km at 1 m, ten times the longest rockfall slope.
+#: Steepest descent takes about 1 ms a vertex (a loaded 2-core machine: 100,000
+#: vertices took 110 s), so the limit also bounds a run to about 20 s.
+MAX_SECTION_VERTICES = 20_000
+
 #: How a steepest-descent line may end (:attr:`Section.ending`).
-ENDINGS = ("local minimum", "flat area", "grid edge", "nodata", "maximum length")
+ENDINGS = (
+    "local minimum", "flat area", "grid edge", "nodata", "maximum length",
+    "vertex limit",
+)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -314,7 +332,26 @@ def section_from_vertices(
     )
 
 
+def _number(value: object, name: str) -> float:
+    """``value`` as a float; an :class:`ArgumentError` naming ``name`` for anything
+    but a real number (text, a list, an object, true/false)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
+        raise ArgumentError(
+            f"{name} must be a number (got {_shown(value)})", source=name
+        )
+    return float(value)
+
+
+def _shown(value: object) -> str:
+    """``value`` as a short one-line text for a message."""
+    text = " ".join(repr(value).split())
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
 def _check_step(value: float, name: str, grid: DemGrid | None = None) -> float:
+    """A step > 0; with ``grid`` (steepest descent) between :data:`MIN_STEP_CELLS`
+    of the cell size and half of it."""
+    value = _number(value, name)
     if not (math.isfinite(value) and value > 0):
         raise ArgumentError(f"{name} must be > 0 (got {value:g})", source=name)
     if grid is not None and value > grid.cellsize_m / 2 + 1e-12:
@@ -323,11 +360,44 @@ def _check_step(value: float, name: str, grid: DemGrid | None = None) -> float:
             f"(got {value:g})",
             source=name,
         )
-    return float(value)
+    if grid is not None and value < MIN_STEP_CELLS * grid.cellsize_m * (1 - 1e-9):
+        raise ArgumentError(
+            f"{name} must be >= {MIN_STEP_CELLS:g} of the cell size, "
+            f"{MIN_STEP_CELLS * grid.cellsize_m:g} m (got {value:g}): a shorter step "
+            "adds vertices, not accuracy, on the bilinear surface of a cell",
+            source=name,
+        )
+    return value
+
+
+def _check_vertex_count(count: float, name: str, step: float, over: str = "") -> None:
+    """Refuse a section of more than :data:`MAX_SECTION_VERTICES` vertices
+    (``over``: the length they cover, for the message)."""
+    if count > MAX_SECTION_VERTICES:
+        raise ArgumentError(
+            f"{name} {step:g} m{over} would make about {count:.3g} section vertices, "
+            f"more than the limit of {MAX_SECTION_VERTICES:,}: give a longer step or a "
+            "shorter line",
+            source=name,
+        )
 
 
 def _check_points(points, name: str, minimum: int) -> np.ndarray:
-    xy = np.asarray(points, dtype=float).reshape(-1, 2)
+    """``points`` as ``(k, 2)`` finite plan coordinates, k >= ``minimum``."""
+    wanted = "[x, y]" if minimum == 1 else "a list of [x, y] points"
+    try:
+        if isinstance(points, (str, bytes, dict)):
+            raise TypeError
+        xy = np.asarray(points, dtype=float)
+        pair = xy.shape == (2,)
+        pairs = xy.ndim == 2 and xy.shape[1:] == (2,)
+        if not (pair if minimum == 1 else pairs):
+            raise ValueError
+    except (TypeError, ValueError):
+        raise ArgumentError(
+            f"{name} must be {wanted} in metres (got {_shown(points)})", source=name
+        ) from None
+    xy = xy.reshape(-1, 2)
     if len(xy) < minimum:
         raise ArgumentError(
             f"{name} needs at least {minimum} plan points (got {len(xy)})", source=name
@@ -378,6 +448,7 @@ def profile_along_polyline(
     xy = _check_points(vertices_xy, "vertices_xy", 2)
     step = _check_step(spacing_m, "spacing_m")
     legs = np.hypot(*np.diff(xy, axis=0).T)
+    _check_vertex_count(1 + float(np.ceil(legs / step).sum()), "spacing_m", step)
     if (legs <= 0).any():
         i = int(np.flatnonzero(legs <= 0)[0])
         raise ArgumentError(
@@ -428,6 +499,41 @@ def _direction(grid: DemGrid, x: float, y: float) -> tuple[float, float, float] 
     return -gx[0] / norm, -gy[0] / norm, norm
 
 
+def descent_steps(
+    grid: DemGrid, step_m: float, max_length_m: float | None = None
+) -> tuple[float, float, int]:
+    """Check a steepest descent's step and length before any work.
+
+    Returns
+    -------
+    step_m, max_length_m, steps
+        The step, the length (None: the grid's width plus height) and the most
+        steps the line can take (below :data:`MAX_SECTION_VERTICES`).
+
+    Raises
+    ------
+    ArgumentError
+        A step outside :data:`MIN_STEP_CELLS` .. half the cell size; a
+        ``max_length_m`` <= 0, or one needing more than :data:`MAX_SECTION_VERTICES`
+        vertices at this step.
+    """
+    h = _check_step(step_m, "step_m", grid)
+    given = max_length_m is not None
+    if max_length_m is None:
+        nrows, ncols = grid.shape
+        max_length_m = (ncols - 1) * grid.dx_m + (nrows - 1) * grid.dy_m
+    length = _number(max_length_m, "max_length_m")
+    if not (math.isfinite(length) and length > 0):
+        raise ArgumentError(
+            f"max_length_m must be > 0 (got {length:g})", source="max_length_m"
+        )
+    if given:
+        _check_vertex_count(
+            1 + math.ceil(length / h), "step_m", h, f" over max_length_m {length:g} m"
+        )
+    return h, length, min(math.ceil(length / h), MAX_SECTION_VERTICES - 1)
+
+
 def steepest_descent_line(
     grid: DemGrid,
     start_xy: Sequence[float],
@@ -435,6 +541,7 @@ def steepest_descent_line(
     *,
     max_length_m: float | None = None,
     flat_slope: float = FLAT_SLOPE,
+    progress: Callable[[int, int], None] | None = None,
 ) -> Section:
     """The line of steepest descent from a release point (method: module docstring).
 
@@ -445,11 +552,14 @@ def steepest_descent_line(
     start_xy
         Release point (x, y) [m]; must lie on data inside the grid.
     step_m
-        Plan step [m], 0 < step_m <= half the cell size.
+        Plan step [m], between :data:`MIN_STEP_CELLS` of the cell size and half
+        of it.
     max_length_m
         Stop after this plan length [m] (None: the grid's width plus height).
     flat_slope
         Stop where the slope (tan of the dip) is below this (default 0.001).
+    progress
+        Called as ``progress(steps_done, steps_at_most)`` every 100 vertices.
 
     Returns
     -------
@@ -473,14 +583,7 @@ def steepest_descent_line(
     >>> s.ending, s.length_m, s.drop_m, set(s.plan_y_m.round(9).tolist())
     ('grid edge', 3.5, 3.5, {2.5})
     """
-    h = _check_step(step_m, "step_m", grid)
-    nrows, ncols = grid.shape
-    if max_length_m is None:
-        max_length_m = (ncols - 1) * grid.dx_m + (nrows - 1) * grid.dy_m
-    if not (math.isfinite(max_length_m) and max_length_m > 0):
-        raise ArgumentError(
-            f"max_length_m must be > 0 (got {max_length_m:g})", source="max_length_m"
-        )
+    h, max_length_m, at_most = descent_steps(grid, step_m, max_length_m)
     if not (math.isfinite(flat_slope) and flat_slope >= 0):
         raise ArgumentError(
             f"flat_slope must be >= 0 (got {flat_slope:g})", source="flat_slope"
@@ -496,6 +599,11 @@ def steepest_descent_line(
     x, y, z = [float(start[0])], [float(start[1])], [float(z0[0])]
     length, ending = 0.0, "maximum length"
     while length < max_length_m - 1e-9:
+        if len(x) >= MAX_SECTION_VERTICES:  # the default length, or halved steps
+            ending = "vertex limit"
+            break
+        if progress is not None and len(x) % 100 == 0:
+            progress(min(len(x), at_most), at_most)
         here = _direction(grid, x[-1], y[-1])
         assert here is not None  # every kept point is on data
         dx0, dy0, slope = here
