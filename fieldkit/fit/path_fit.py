@@ -675,11 +675,8 @@ def fit_paths(
     n_units = sum(s.size for s in objective.strata)
     weights = np.ones(n_units)
 
-    def f(u):
-        units = objective.units(to_x(u))
-        if objective.evaluations % 25 == 0:
-            say(f"  {objective.evaluations} evaluations")
-        return float(np.dot(weights, units))
+    def f(u):  # progress is the stage's (a bar on a terminal), not a line per 25
+        return float(np.dot(weights, objective.units(to_x(u))))
 
     u0 = (x0 - lower) / span
     start_scores = objective.observation_scores(x0)
@@ -752,8 +749,6 @@ def fit_paths(
             ub, _, _ = _minimise(f, u_best, 0.05, short)
             boot[b] = to_x(ub)
             advance(b + 1, bootstrap)
-            if (b + 1) % 10 == 0:
-                say(f"bootstrap {b + 1}/{bootstrap}")
     objective.seed = seed
     weights = np.ones(n_units)
     if bootstrap >= MIN_BOOTSTRAP_SE:
