@@ -18,8 +18,9 @@ from typing import Annotated
 
 import typer
 
-from fieldkit.cli import progress
 from fieldkit.cli.common import note, one_line_errors, parse_point
+from fieldkit.cli.progress import report_written
+from fieldkit.cli.progress import step as progress_step
 from fieldkit.errors import ArgumentError
 from fieldkit.io.dem import DemGrid, read_dem
 from fieldkit.io.profile_csv import read_profile_csv
@@ -106,7 +107,9 @@ def _cut(
     else:
         steps = descent_steps(grid, spacing, max_length)[2]  # checked before work
         description = "following the line of steepest descent"
-        with progress.step(description, announce=steps > _ANNOUNCE_VERTICES) as advance:
+        with progress_step(
+            description, announce=steps > _ANNOUNCE_VERTICES
+        ) as advance:
             section = steepest_descent_line(
                 grid, start_xy, spacing, max_length_m=max_length, progress=advance
             )
@@ -268,4 +271,4 @@ def profile(
     typer.echo("\n".join(lines))
     for text in grid.notes if grid is not None else ():
         note(text)
-    progress.report_written(outputs.commit())
+    report_written(outputs.commit())

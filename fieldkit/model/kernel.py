@@ -659,7 +659,12 @@ def run_rock(
                         c2 = math.cos(rad)
                         s2 = math.sin(rad)
                         if vx * s2 + vz * c2 < 0.0 or trial == 2:
-                            c, s, psi = c2, s2, math.degrees(rad)
+                            # the dip as the ImpactTable keeps it, in (-180, 180]
+                            # (a steep face tilted further reads as an overhang)
+                            psi = math.degrees(math.atan2(s2, c2))
+                            if psi <= -180.0:
+                                psi += 360.0
+                            c, s = c2, s2
                             break
                     vit = vx * c - vz * s
                     vin = vx * s + vz * c

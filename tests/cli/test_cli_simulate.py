@@ -255,8 +255,8 @@ def test_a_fresh_copy_compiles_once_then_loads_from_its_cache(tmp_path, repo):
     ("args", "words"),
     [
         (["--at", "900"], ["--at", "900 m lies outside the profile", "0 to 90 m"]),
-        (["--at", "nan"], ["--at", "nan is not a finite x", "0 to 90 m"]),
-        (["--at", "-inf"], ["--at", "-inf is not a finite x"]),
+        (["--at", "nan"], ["--at must be a finite number (got nan)"]),
+        (["--at", "-inf"], ["--at must be a finite number (got -inf)"]),
         (["--seed", "-1"], ["--seed", "from 0"]),
         (["--seed", str(2**64)], ["--seed", "2**64 - 1"]),
         (["--rocks", "1000000000"], ["--rocks", "10,000,000"]),

@@ -66,6 +66,29 @@ def test_roughness_raises_bounce_heights():
     assert rough > smooth + 4 * math.hypot(se0, se1)
 
 
+def test_rough_steep_faces_give_dips_the_impact_table_accepts():
+    # issue 17: a 70 deg face with a roughness SD of ~60 deg drew local dips past
+    # 180 deg, which the ImpactTable (ARCHITECTURE §2: (-180, 180]) refused mid-run
+    model = model_from_dict(
+        {
+            "profile": {"x_m": [0, 10, 60], "z_m": [60, 32.5, 0],
+                        "material": ["face", "soil"]},
+            "materials": {
+                "face": {"e_n": 0.5, "e_t": 0.8, "friction_deg": 30,
+                         "roughness_m": 0.5, "roughness_deg_sd": 30.0},
+                "soil": {"e_n": 0.3, "e_t": 0.7, "friction_deg": 35},
+            },
+            "body": {"mass_kg": 100.0, "radius_m": 0.3, "gyration_m": 0.19},
+            "seeder": {"x_m": 0.5, "z_m": 60, "vx_mps": 1.0},
+            "effects": {"slope_roughness": {"scale": 1.0}},
+        }
+    )  # fmt: skip
+    res = simulate(model, 2000, np.random.default_rng(7), record_impacts=True)
+    dip = res.impact_table.frame["slope_deg"].to_numpy(float)
+    assert dip.size > 2000 and np.all((dip > -180.0) & (dip <= 180.0))
+    assert np.any(np.abs(dip) > 90.0)  # local overhangs drawn, and kept as such
+
+
 def test_smaller_blocks_feel_rougher_ground():
     from fieldkit.model.effects.slope_roughness import dip_sd_rad
 

@@ -325,7 +325,7 @@ def _nothing_found(
             "moves)"
         )
     looked = (
-        f"no body of radius {expected:.4g} px found in any frame (`radius_m` "
+        f"no body of radius {expected:.1f} px found in any frame (`radius_m` "
         f"{radius_m:g} m at {metres_per_pixel * 1000:.3g} mm/px)"
     )
     seen = np.asarray(detector.off_size_radii, dtype=float)
