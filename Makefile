@@ -13,7 +13,7 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -c "from fieldkit.model.compile_cache import main; main()"
 	touch $(STAMP)
 
-## The whole loop on the bundled Tornado Mountain survey in about a minute: reduce ->
+## The whole loop on the bundled Tornado Mountain survey in under a minute: reduce ->
 ## diagnose -> fit -> simulate -> export; out/demo/index.md links every figure and report.
 demo: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python examples/demo.py out/demo

@@ -147,7 +147,8 @@ def fence(
     example 8A). For the impulse m v_i, the rigid, flexible and stiff
     time-force laws (eqs. 8.2-8.7) give the contact time and peak force.
 
-    Example (thesis worked example 8B: the net absorbs 97.4 kJ, 72 %):
+    Example (thesis worked example 8B: the net absorbs 97.5 kJ, 72 %; the
+    thesis prints 97.4, subtracting rounded totals):
 
         fieldkit fence --mass 520 --gyration 0.35 --speed-in 22 \\
           --spin-in 18 --speed-out 11.5 --spin-out=-11.6 \\

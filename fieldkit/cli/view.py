@@ -123,7 +123,9 @@ def view(
     the rendered net clip, an OSP Tracker export in centimetres:
 
         fieldkit reduce --impacts surveys/tornado_mountain/boulder_a_impacts.gpx \\
-          --theta0 32.6 -o out/boulder_a.csv
+          --trees surveys/tornado_mountain/boulder_a_trees.csv \\
+          --preset surveys/tornado_mountain/boulder_a_preset.toml \\
+          -o out/boulder_a.csv
         fieldkit view out/boulder_a.csv -o out/boulder_a.rrd
 
         fieldkit view video/net.truth.csv --radius 0.0375 --mass 0.14 \\
