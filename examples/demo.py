@@ -103,13 +103,18 @@ class Demo:
         self.index.append(line)
         self.index.append("")
 
-    def link(self, title: str, folder: Path) -> None:
+    def link(self, folder: Path, about: str = "") -> None:
         """Link every PNG and markdown report in ``folder`` from index.md."""
         files = sorted(
             p for p in folder.rglob("*") if p.suffix in (".png", ".md") and p.is_file()
         )
+        kinds = {p.suffix for p in files}
+        title = {
+            frozenset({".png"}): "Figures",
+            frozenset({".md"}): "Report",
+        }.get(frozenset(kinds), "Report and figures")
         if files:
-            self.index.append(f"{title}:")
+            self.index.append(f"{title}{about}:")
             self.index.append("")
             for p in files:
                 rel = p.relative_to(self.out).as_posix()
@@ -132,12 +137,20 @@ def main(out: Path) -> None:
     )  # fmt: skip
     frame = pd.read_csv(table)
     impacts = frame["e_n"].notna()
+    sensitive = int(frame["qa_flags"].fillna("").str.contains("slope_sensitive").sum())
     demo.say(
         f"reduce: {impacts.sum()} impacts of boulder A, median e_n "
         f"{frame.loc[impacts, 'e_n'].median():.2f}, e_t "
-        f"{frame.loc[impacts, 'e_t'].median():.2f} -> {relative(table)}"
+        f"{frame.loc[impacts, 'e_t'].median():.2f} ({sensitive} e_n rest on the "
+        f"slope assumed) -> {relative(table)}"
     )
-    demo.link("Figures", out / "reduce")
+    demo.index.append(
+        f"At {sensitive} of the {impacts.sum()} impacts e_n rests more on the slope "
+        "assumed (the chord from the previous point) than on the survey (quality flag "
+        "`slope_sensitive`): the medians are of surveyed points, not surveyed slopes."
+    )
+    demo.index.append("")
+    demo.link(out / "reduce")
 
     # 2. where Table 7-1's model fails on the measured rebounds
     diagnosis = out / "diagnose" / "diagnosis.json"
@@ -148,7 +161,15 @@ def main(out: Path) -> None:
     )  # fmt: skip
     found = json.loads(diagnosis.read_text(encoding="utf-8"))
     demo.say(f"diagnose: {diagnosis_line(found)}")
-    demo.link("Report and figures", out / "diagnose")
+    demo.index += [
+        "The diagnosis scores impact laws on the measured *rebounds* (held out in "
+        "blocks of consecutive impacts); the fit below calibrates the simulator on "
+        "the whole *path* (runout, flight heights, spacing, speeds) from another "
+        "start model. A velocity scale K from one is not the other's: they answer "
+        "different questions with different data.",
+        "",
+    ]
+    demo.link(out / "diagnose")
 
     # 3. calibrate the simulator on the whole path
     calibrated = out / "calibrated_model.json"
@@ -165,7 +186,13 @@ def main(out: Path) -> None:
     )  # fmt: skip
     fit = json.loads(fit_json.read_text(encoding="utf-8"))
     demo.say(f"fit: {fit_line(fit)} -> {relative(calibrated)}")
-    demo.link("Report and figures", out / "fit")
+    demo.index += [
+        "One surveyed path: the ± are bootstrap standard errors over its surveyed "
+        "points, a lower bound on the uncertainty (the points of one path are not "
+        "independent).",
+        "",
+    ]
+    demo.link(out / "fit")
 
     # 4. simulate the calibrated model, compare with boulder A at x = 610 m
     summary = out / "simulate" / "summary.json"
@@ -176,14 +203,14 @@ def main(out: Path) -> None:
     )  # fmt: skip
     stats = json.loads(summary.read_text(encoding="utf-8"))
     demo.say(f"simulate: {simulate_line(stats)}")
-    demo.link("Figures", out / "simulate")
+    demo.link(out / "simulate")
 
     # 5. the calibrated model as RocFall input
     export = out / "export" / "rocfall"
     demo.run("export", "export", calibrated, "--to", "rocfall", "-o", export, "--force")
     files = sorted(p.name for p in export.iterdir())
     demo.say(f"export: {len(files)} RocFall files -> {relative(export)}")
-    demo.link("What was mapped, and what could not be", export)
+    demo.link(export, " (what was mapped, and what could not be)")
 
     seconds = time.perf_counter() - start
     index = out / "index.md"
@@ -221,9 +248,13 @@ def fit_line(fit: dict) -> str:
     for p in fit["parameters"]:
         owner, name = p["name"].split(".")[-2:]
         se = f" ± {p['stderr']:.2g}" if p.get("stderr") is not None else ""
+        se += "*" if se and fit["n_runs"] == 1 else ""
         values.append(f"{owner} {name} {p['value']:.3g}{se}")
+    lower_bound = (
+        " (*one path: SE a lower bound)" if fit["n_runs"] == 1 and values else ""
+    )
     return (
-        f"{', '.join(values)}; score {fit['objective_start']:.2f} -> "
+        f"{', '.join(values)}{lower_bound}; score {fit['objective_start']:.2f} -> "
         f"{fit['objective_optimum']:.2f} (sum over {len(fit['kinds'])} kinds of "
         "the mean CRPS scaled by its value at the start)"
     )
