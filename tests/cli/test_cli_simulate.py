@@ -302,7 +302,7 @@ def test_figures_get_a_stated_envelope_and_measured_percentiles(core, cli, tmp_p
     from fieldkit.model.simulate import simulate
 
     r = cli("simulate", MODEL, "--rocks", "60", "--seed", "3", "--at", "40",
-            "--measured", "x=40,speed=10,ke=1e5", "--summary", tmp_path / "s.json",
+            "--measured", "x=40,speed=17,ke=72e3", "--summary", tmp_path / "s.json",
             "--figures", tmp_path / "f")  # fmt: skip
     assert r.exit_code == 0, r.stderr
     s = json.loads((tmp_path / "s.json").read_text())
@@ -318,10 +318,67 @@ def test_figures_get_a_stated_envelope_and_measured_percentiles(core, cli, tmp_p
     m = s["measured"][0]
     assert m["x_m"] == 40.0
     assert m["speed_mps"]["percentile"] == pytest.approx(
-        100 * ((speeds < 10).sum() + 0.5 * (speeds == 10).sum()) / speeds.size
+        100 * ((speeds < 17).sum() + 0.5 * (speeds == 17).sum()) / speeds.size
     )
-    assert m["ke_j"]["percentile"] == pytest.approx(100 * (ke < 1e5).sum() / ke.size)
+    assert m["ke_j"]["percentile"] == pytest.approx(100 * (ke < 72e3).sum() / ke.size)
+    assert 0 < m["ke_j"]["percentile"] < 100 and m["ke_j"]["beyond"] is None
     assert m["speed_mps"]["n"] == speeds.size
     line = next(ln for ln in r.stdout.splitlines() if ln.startswith("measured at"))
     assert f"percentile {m['speed_mps']['percentile']:.1f}" in line
-    assert "translational KE 100 kJ" in line
+    assert "translational KE 72 kJ" in line
+
+
+def test_runout_beyond_the_profile_end_is_a_lower_bound(core, cli, tmp_path):
+    """Rocks that leave the profile at its lower end ran out at least that far: a
+    runout statistic that uses them is a lower bound, printed '≥ 100 m (end of
+    profile; 14 % of rocks left it)' and flagged per statistic in summary.json
+    (it printed 'p90 100 ± 0' as if measured)."""
+    cut = dict(POGO, profile=dict(POGO["profile"], x_m=[0, 30, 100]))
+    model = _model(tmp_path, cut)
+    r = cli("simulate", model, "--rocks", "200", "--seed", "5", "--summary",
+            tmp_path / "s.json")  # fmt: skip
+    assert r.exit_code == 0, r.stderr
+    s = json.loads((tmp_path / "s.json").read_text())
+    left = s["final_state"]["exited_downslope"]
+    assert left == 29 and s["runout_censored"]["rocks"] == left
+    assert s["runout_censored"]["fraction"] == pytest.approx(29 / 200)
+    assert s["runout_censored"]["end_x_m"] == 100.0
+    runout = s["runout_x_m"]
+    assert runout["censored"] == 29 and runout["p90"] == 100.0  # keys kept
+    # 171 stopped before x = 100 m: the median is theirs, p90 and up use left rocks
+    assert runout["lower_bound"] == {
+        "mean": True, "p50": False, "p90": True, "p95": True, "p99": True, "max": True
+    }  # fmt: skip
+    line = next(ln for ln in r.stdout.splitlines() if ln.startswith("runout x"))
+    assert "p90, p95, p99, max ≥ 100 m (end of profile; 14 % of rocks left it)" in line
+    assert f"p50 {runout['p50']:.4g} ± " in line and "mean ≥ " in line
+    assert "100 ± 0" not in line
+    # the same rocks on the 130 m profile: the bound holds (p90 101.6 >= 100 m)
+    r = cli("simulate", _model(tmp_path), "--rocks", "200", "--seed", "5",
+            "--summary", tmp_path / "whole.json")  # fmt: skip
+    whole = json.loads((tmp_path / "whole.json").read_text())["runout_x_m"]
+    assert whole["p50"] == runout["p50"] and whole["p90"] > 100.0
+    assert not any(whole["lower_bound"].values())
+
+
+def test_a_measured_value_beyond_every_rock_has_no_percentile(core, cli, tmp_path):
+    """A measured speed above every crossing rock said '100th percentile ± 0.0'; the
+    sample only says it lies above all of them."""
+    r = cli("simulate", MODEL, "--rocks", "60", "--seed", "3", "--at", "40",
+            "--measured", "x=40,speed=500,ke=1", "--summary", tmp_path / "s.json",
+            "--figures", tmp_path / "f")  # fmt: skip
+    assert r.exit_code == 0, r.stderr
+    m = json.loads((tmp_path / "s.json").read_text())["measured"][0]
+    speed, ke = m["speed_mps"], m["ke_j"]
+    assert speed["beyond"] == "above" and speed["percentile"] is None
+    assert speed["percentile_se"] is None and speed["simulated_max"] < 500
+    assert ke["beyond"] == "below" and ke["percentile"] is None
+    assert ke["simulated_min"] > 1
+    line = next(ln for ln in r.stdout.splitlines() if ln.startswith("measured at"))
+    n = speed["n"]
+    assert (
+        f"speed 500 m/s: above all {n} simulated rocks (their maximum "
+        f"{speed['simulated_max']:.3g} m/s)" in line
+    )
+    assert f"below all {n} simulated rocks (their minimum" in line
+    assert "percentile" not in line
