@@ -282,7 +282,7 @@ def point_histograms_figure(
                 meas * scale,
                 color=_MEASURED_COLOUR,
                 lw=2.0,
-                label=f"{meas_label} = {readable(meas * scale)} {unit}: "
+                label=f"{meas_label} = {meas * scale:.4g} {unit}: "
                 + rank_words(rank, 1.0, unit, decimals=0),
             )
         ax.set_xlabel(label)
