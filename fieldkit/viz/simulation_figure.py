@@ -205,7 +205,7 @@ def envelope_figure(
             ha="center",
         )
     ax.set_ylim(bottom=0.0)
-    outside_legend(ax)
+    outside_legend(ax, below=True, ncols=2)
     return fig
 
 
