@@ -168,7 +168,14 @@ def simulate(
     the runout distribution, the stopped fraction and, at each analysis point
     (--at), the fraction of rocks passing and percentiles of speed, energy and
     bounce height -- each with its Monte Carlo standard error, so you can see
-    whether --rocks was enough -- and the percentile of each --measured value.
+    whether --rocks was enough -- and the percentile of each --measured value
+    (a value above or below every crossing rock has none: "above all N simulated
+    rocks", with their maximum).
+
+    A rock that leaves the profile at its lower end ran out at least that far: a
+    runout statistic that uses such rocks is a lower bound, printed "≥ 700 m (end
+    of profile; 71 % of rocks left it)" and flagged in summary.json
+    (runout_x_m.lower_bound); extend the profile to measure it.
 
     Rocks still moving after the model's core.max_impacts impacts (capped) are
     their own final state: never counted as stopped or run out, left out of the
