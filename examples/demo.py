@@ -261,9 +261,19 @@ def fit_line(fit: dict) -> str:
 
 
 def simulate_line(stats: dict) -> str:
-    """Runout and where boulder A's measured speed and energy fall at x = 610 m."""
+    """Runout and where boulder A's measured speed and energy fall at x = 610 m
+    (a runout percentile that uses rocks which left the profile is a lower bound,
+    "≥"; a measured value beyond every simulated rock has no percentile)."""
     runout = stats["runout_x_m"]
-    text = f"runout p50 {runout['p50']:.0f} m, p95 {runout['p95']:.0f} m"
+    bound = runout.get("lower_bound", {})
+
+    def at(key: str) -> str:
+        return ("≥ " if bound.get(key) else "") + f"{runout[key]:.0f} m"
+
+    text = f"runout p50 {at('p50')}, p95 {at('p95')}"
+    if bound.get("p95"):
+        left = stats["runout_censored"]["fraction"]
+        text += f" (end of profile; {100 * left:.0f} % of rocks left it)"
     for point in stats["measured"]:
         for key, label, scale, unit in (
             ("speed_mps", "speed", 1, "m/s"),
@@ -271,10 +281,14 @@ def simulate_line(stats: dict) -> str:
         ):
             if key in point:
                 m = point[key]
+                where = (
+                    f"{m['beyond']} all {m['n']:,} simulated rocks"
+                    if m.get("beyond")
+                    else f"at the {m['percentile']:.0f}th percentile"
+                )
                 text += (
                     f"; boulder A's {m['measured'] * scale:g} {unit} {label} at "
-                    f"x = {point['x_m']:g} m is at the {m['percentile']:.0f}th "
-                    "percentile"
+                    f"x = {point['x_m']:g} m is {where}"
                 )
     return text
 

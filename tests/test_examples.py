@@ -73,8 +73,8 @@ EXPECTED = {
         r"^1\. reduce: 48 impacts of boulder A",
         r"^2\. diagnose: (recommends \w+|no effect recommended)",
         r"^3\. fit: colluvium e_n \d\.\d+ ± \d",
-        r"^4\. simulate: runout p50 \d+ m.*18 m/s speed at x = 610 m is at the "
-        r"\d+th percentile",
+        r"^4\. simulate: runout p50 (≥ )?\d+ m.*18 m/s speed at x = 610 m is (at the "
+        r"\d+th percentile|above all [\d,]+ simulated rocks)",
         r"^5\. export: 6 RocFall files",
         r"wrote .*index\.md",
     ],

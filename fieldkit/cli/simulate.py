@@ -65,10 +65,34 @@ def parse_measured(text: str):
 
 
 def _fmt(d: dict, key: str, unit: str = "") -> str:
+    from fieldkit.model.results import readable
+
     v, se = d.get(key), d.get("se", {}).get(key)
     if v is None:
         return "-"
-    return f"{v:.4g}" + (f" ± {se:.2g}" if se is not None else "") + unit
+    if d.get("lower_bound", {}).get(key):  # uses censored values: at least v
+        return f"≥ {readable(v, 4)}{unit}"
+    return readable(v, 4) + (f" ± {readable(se, 2)}" if se is not None else "") + unit
+
+
+def _runout_values(r: dict, censored: dict) -> str:
+    """The runout statistics, each lower bound as "≥": a run of them at the
+    profile's end said once, "p50, p90, p95, p99, max ≥ 700 m (end of profile;
+    71 % of rocks left it)"."""
+    from fieldkit.model.results import censored_words
+
+    keys = ("mean", "p50", "p90", "p95", "p99", "max")
+    end = censored.get("end_x_m")
+    at_end = [
+        k for k in keys
+        if k != "mean" and r.get("lower_bound", {}).get(k) and r.get(k) == end
+    ]  # fmt: skip
+    parts = [f"{k} {_fmt(r, k)}" for k in keys if k not in at_end]
+    if at_end:
+        parts.append(
+            f"{', '.join(at_end)} ≥ {end:g} m ({censored_words(censored['fraction'])})"
+        )
+    return ", ".join(parts)
 
 
 @one_line_errors(flags=FLAGS)
@@ -144,7 +168,14 @@ def simulate(
     the runout distribution, the stopped fraction and, at each analysis point
     (--at), the fraction of rocks passing and percentiles of speed, energy and
     bounce height -- each with its Monte Carlo standard error, so you can see
-    whether --rocks was enough -- and the percentile of each --measured value.
+    whether --rocks was enough -- and the percentile of each --measured value
+    (a value above or below every crossing rock has none: "above all N simulated
+    rocks", with their maximum).
+
+    A rock that leaves the profile at its lower end ran out at least that far: a
+    runout statistic that uses such rocks is a lower bound, printed "≥ 700 m (end
+    of profile; 71 % of rocks left it)" and flagged in summary.json
+    (runout_x_m.lower_bound); extend the profile to measure it.
 
     Rocks still moving after the model's core.max_impacts impacts (capped) are
     their own final state: never counted as stopped or run out, left out of the
@@ -340,7 +371,9 @@ def _measured_percentiles(result, points) -> list[dict]:
                 entry[key] = result.percentile_of(index, quantity, value)
         entry["over"] = (
             "rocks crossing x_m (first crossing); percentile = percent of them with a "
-            "smaller value (ties half), percentile_se binomial; ke_j is translational "
+            "smaller value (ties half), percentile_se binomial; a value above (below) "
+            "every crossing rock has no percentile (null) but beyond = above (below) "
+            "and the simulated_max (simulated_min) it exceeds; ke_j is translational "
             "(1/2 m v^2), as measured"
         )
         out.append(entry)
@@ -348,6 +381,8 @@ def _measured_percentiles(result, points) -> list[dict]:
 
 
 def _print_summary(s: dict, model) -> None:
+    from fieldkit.model.results import rank_words
+
     echo = typer.echo
     compiled = (
         f"; compiling the simulator took {s['compile_s']:.2f} s (first run only)"
@@ -366,12 +401,14 @@ def _print_summary(s: dict, model) -> None:
         if capped["rocks"]
         else ""
     )
-    echo(
-        f"runout x (m){over}: "
-        + ", ".join(
-            f"{k} {_fmt(r, k)}" for k in ("mean", "p50", "p90", "p95", "p99", "max")
+    echo(f"runout x (m){over}: {_runout_values(r, s['runout_censored'])}")
+    if any(r.get("lower_bound", {}).values()):
+        censored = s["runout_censored"]
+        echo(
+            f"  ≥: a lower bound, the statistic uses the {censored['rocks']:,} rocks "
+            f"that left the profile at its lower end (x = {censored['end_x_m']:g} m), "
+            "whose runout is at least that; extend the profile to place it"
         )
-    )
     echo(
         f"stopped on the profile: {s['stopped_fraction']:.3f} "
         f"± {s['stopped_fraction_se']:.2g}; final states: "
@@ -379,15 +416,19 @@ def _print_summary(s: dict, model) -> None:
     )
     if capped["rocks"]:
         lo, hi = s["runout_bounds_x_m"]["lower"], s["runout_bounds_x_m"]["upper"]
+
+        def p95(d: dict) -> str:
+            return ("≥ " if d["lower_bound"]["p95"] else "") + f"{d['p95']:.4g} m"
+
         if lo["p95"] == hi["p95"]:
             bound = (
                 "counting them anywhere from where they were to the profile's end "
-                f"leaves the runout p95 at {lo['p95']:.4g} m"
+                f"leaves the runout p95 at {p95(lo)}"
             )
         else:
             bound = (
-                f"counting them, the runout p95 lies between {lo['p95']:.4g} m (where "
-                f"they were) and {hi['p95']:.4g} m (the profile's end)"
+                f"counting them, the runout p95 lies between {p95(lo)} (where "
+                f"they were) and {p95(hi)} (the profile's end)"
             )
         warn(
             f"{capped['fraction']:.1%} of the rocks "
@@ -423,13 +464,9 @@ def _print_summary(s: dict, model) -> None:
             d = m.get(key)
             if d is None:
                 continue
-            if d["percentile"] is None:
-                parts.append(f"{label} {d['measured'] * scale:.4g} {unit}: no rocks")
-                continue
-            parts.append(
-                f"{label} {d['measured'] * scale:.4g} {unit} = percentile "
-                f"{d['percentile']:.1f} ± {d['percentile_se']:.1f}"
-            )
+            words = rank_words(d, scale, unit)
+            sep = " = " if d["percentile"] is not None else ": "
+            parts.append(f"{label} {d['measured'] * scale:.4g} {unit}{sep}{words}")
         if parts:
             echo(
                 f"measured at x = {m['x_m']:g} m, among the simulated rocks crossing "

@@ -14,7 +14,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from fieldkit.impact_table import ImpactTable
-from fieldkit.model.statistics import distribution, envelope_percentiles, fraction_se
+from fieldkit.model.statistics import (
+    distribution,
+    envelope_percentiles,
+    fraction_se,
+    rank_of,
+)
 
 if TYPE_CHECKING:  # the Model type is only named in annotations
     from fieldkit.model.model_file import Model
@@ -93,9 +98,11 @@ class SimulationResult:
         Returns
         -------
         dict
-            ``measured``, ``percentile`` (percent of crossing rocks with a smaller
-            value, ties counted half; None without crossing rocks), its binomial
-            ``percentile_se`` and ``n`` (crossing rocks).
+            :func:`fieldkit.model.statistics.rank_of`: ``measured``, ``n`` (crossing
+            rocks), ``percentile`` (percent of them with a smaller value, ties counted
+            half) and its binomial ``percentile_se``; no percentile but ``beyond``
+            (``"above"``, ``"below"``) when the value lies beyond every crossing rock;
+            ``simulated_min``, ``simulated_max``.
 
         Examples
         --------
@@ -103,21 +110,12 @@ class SimulationResult:
         >>> r = SimulationResult(None, 4, 0, 0.0, 0, None, None, None, [p])
         >>> r.percentile_of(0, "speed_mps", 2.0)["percentile"]
         62.5
+        >>> r.percentile_of(0, "speed_mps", 7.0)["beyond"]
+        'above'
         """
         point = self.analysis[index]
         crossed = np.asarray(point.crossed, bool)
-        values = np.asarray(getattr(point, quantity), float)[crossed]
-        values = values[np.isfinite(values)]
-        n = int(values.size)
-        out: dict = {"measured": float(value), "n": n}
-        if n == 0:
-            out.update(percentile=None, percentile_se=None)
-            return out
-        below = float((values < value).sum() + 0.5 * (values == value).sum())
-        fraction = below / n
-        out["percentile"] = 100.0 * fraction
-        out["percentile_se"] = 100.0 * float(np.sqrt(fraction * (1 - fraction) / n))
-        return out
+        return rank_of(np.asarray(getattr(point, quantity), float)[crossed], value)
 
     def summary(self) -> dict:
         """What a designer reads: the ``summary.json`` contract (architecture §4).
@@ -135,16 +133,21 @@ class SimulationResult:
         Rocks still moving when they reach the model's ``max_impacts`` (*capped*)
         are their own final state: never counted as stopped or as run out.
         ``runout_x_m`` is over the rocks that stopped on or left the profile
-        (``runout_over`` says so and how many); ``capped`` gives their number,
-        fraction and where they were; ``runout_bounds_x_m`` brackets each runout
-        percentile of *all* rocks (:func:`_runout_bounds`).
+        (``runout_over`` says so and how many); a rock that left the profile at its
+        lower end ran out at least that far, so each runout statistic that uses one
+        is flagged a lower bound (``runout_x_m["lower_bound"]``, ``runout_censored``);
+        ``capped`` gives their number, fraction and where they were;
+        ``runout_bounds_x_m`` brackets each runout percentile of *all* rocks
+        (:func:`_runout_bounds`).
         """
         n = int(self.rocks)
         state = np.asarray(self.state)
         stopped, stopped_se = fraction_se(int((state == STOPPED).sum()), n)
         capped = state == MAX_IMPACTS
+        left = state == EXITED_DOWNSLOPE  # ran out at least to the profile's end
         runout = np.asarray(self.runout_x_m, float)
         n_capped = int(capped.sum())
+        n_left = int(left.sum())
         capped_fraction, capped_se = fraction_se(n_capped, n)
         max_impacts = int(
             dict(getattr(self.model, "core", {}) or {}).get("max_impacts", 0)
@@ -178,7 +181,13 @@ class SimulationResult:
             "wall_s": float(self.wall_s),
             "compile_s": float(self.compile_s),
             "seed": self.seed,
-            "runout_x_m": distribution(runout[~capped]),
+            "runout_x_m": distribution(runout[~capped], at_least=left[~capped]),
+            "runout_censored": {
+                "rocks": n_left,
+                "fraction": n_left / (n - n_capped) if n > n_capped else None,
+                "end_x_m": _profile_end(model),
+                "meaning": CENSORED_NOTE,
+            },
             "runout_over": f"{n - n_capped} of {n} rocks: those that stopped on or "
             "left the profile (x where they stopped, or the end they left by)"
             + (
@@ -187,7 +196,7 @@ class SimulationResult:
                 if n_capped
                 else "; no rock was capped"
             ),
-            "runout_bounds_x_m": _runout_bounds(runout, capped, self.model),
+            "runout_bounds_x_m": _runout_bounds(runout, capped, left, self.model),
             "capped": {
                 "rocks": n_capped,
                 "fraction": capped_fraction,
@@ -243,6 +252,15 @@ CAPPED_NOTE = (
     "Raise core.max_impacts in the model file (up to 1e6) to follow them further."
 )
 
+#: What the rocks that left the profile mean for the runout, in ``summary.json``.
+CENSORED_NOTE = (
+    "rocks that left the profile at its lower end (end_x_m) ran out at least that "
+    "far; where they would stop is unknown. fraction is over the rocks in "
+    "runout_x_m. runout_x_m.lower_bound flags each statistic that uses them: it is "
+    "only a lower bound (read p95 = 700 with lower_bound.p95 true as p95 >= 700 m). "
+    "Extend the profile past where the rocks stop to measure those percentiles."
+)
+
 #: How the standard errors are computed, stated in ``summary.json``.
 STATISTICS_NOTE = (
     "se = Monte Carlo standard error. Percentiles: numpy linear interpolation; SE = "
@@ -254,27 +272,97 @@ STATISTICS_NOTE = (
 )
 
 
-def _runout_bounds(runout: np.ndarray, capped: np.ndarray, model) -> dict:
+def _runout_bounds(
+    runout: np.ndarray, capped: np.ndarray, left: np.ndarray, model
+) -> dict:
     """Bounds on the runout percentiles of all rocks, capped ones included.
 
     A capped rock's runout is unknown but at least where it was when capped and at
     most the profile's lower end: the percentiles with every capped rock put there
     (``lower``) and put at the end (``upper``) bracket the true ones. Equal when no
-    rock was capped.
+    rock was capped. A rock that left the profile (``left``), and in ``upper`` a
+    capped rock put at the end, ran out at least that far: ``lower_bound`` flags the
+    percentiles that use one (:func:`fieldkit.model.statistics.lower_bounds`).
     """
     keys = ("p50", "p90", "p95", "p99", "max")
-    lower = distribution(runout)
+    lower = distribution(runout, at_least=left)
     end = runout.copy()
-    x_end = getattr(getattr(model, "profile", None), "x_m", None)
-    end[capped] = float(np.max(x_end)) if x_end is not None else np.inf
-    upper = distribution(end)
+    x_end = _profile_end(model)
+    end[capped] = x_end if x_end is not None else np.inf
+    upper = distribution(end, at_least=left | capped)
+
+    def part(d: dict) -> dict:
+        out = {k: d[k] for k in keys}
+        out["lower_bound"] = {k: d["lower_bound"][k] for k in keys}
+        return out
+
     return {
-        "lower": {k: lower[k] for k in keys},
-        "upper": {k: upper[k] for k in keys},
+        "lower": part(lower),
+        "upper": part(upper),
         "over": "all rocks; capped rocks where they were when capped (lower) or at "
-        "the profile's lower end (upper)",
+        "the profile's lower end (upper); lower_bound: the percentile uses rocks "
+        "that left the profile, so it is at least that",
     }
+
+
+def _profile_end(model) -> float | None:
+    """The profile's lower end x [m] (None for a model without a profile)."""
+    x = getattr(getattr(model, "profile", None), "x_m", None)
+    return float(np.max(x)) if x is not None and np.size(x) else None
 
 
 def _floats(values: np.ndarray) -> list[float | None]:
     return [float(v) if np.isfinite(v) else None for v in np.asarray(values, float)]
+
+
+def readable(value: float, digits: int = 3) -> str:
+    """``value`` to ``digits`` significant digits but every integer digit kept, in
+    plain notation with thousands separators (``1,768``, never ``1.8e+03``).
+
+    Examples
+    --------
+    >>> readable(1768.4), readable(46.48), readable(160.0, 2), readable(0.0037, 2)
+    ('1,768', '46.5', '160', '0.0037')
+    """
+    if not np.isfinite(value) or value == 0:
+        return f"{value:g}"
+    rounded = float(f"{value:.{digits}g}")  # 9.996 -> 10.0: one decimal fewer
+    decimals = max(digits - 1 - int(np.floor(np.log10(abs(rounded)))), 0)
+    return f"{value:,.{decimals}f}"
+
+
+def rank_words(
+    rank: dict, scale: float = 1.0, unit: str = "", decimals: int = 1
+) -> str:
+    """A measured value's place among the simulated rocks, in words.
+
+    ``rank`` is :func:`fieldkit.model.statistics.rank_of`'s answer (values times
+    ``scale`` are in ``unit``): "percentile 26.4 ± 1.0", or beyond every rock "above
+    all 1,999 simulated rocks (their maximum 61.4 m/s)", or "no simulated rocks".
+
+    Examples
+    --------
+    >>> rank_words({"n": 1999, "percentile": None, "beyond": "above",
+    ...             "simulated_max": 61.41, "simulated_min": 0.3}, 1.0, "m/s")
+    'above all 1,999 simulated rocks (their maximum 61.4 m/s)'
+    """
+    if not rank.get("n"):
+        return "no simulated rocks"
+    beyond = rank.get("beyond")
+    if beyond is not None:
+        extreme = "maximum" if beyond == "above" else "minimum"
+        value = rank["simulated_max" if beyond == "above" else "simulated_min"]
+        return (
+            f"{beyond} all {rank['n']:,} simulated rocks (their {extreme} "
+            f"{readable(value * scale)} {unit})".replace(" )", ")")
+        )
+    return (
+        f"percentile {rank['percentile']:.{decimals}f} ± "
+        f"{rank['percentile_se']:.{decimals}f}"
+    )
+
+
+def censored_words(fraction: float) -> str:
+    """Why a runout statistic is a lower bound: "end of profile; 71 % of rocks left
+    it" (``fraction`` of the rocks in the runout statistics left the profile)."""
+    return f"end of profile; {100.0 * fraction:.0f} % of rocks left it"

@@ -23,6 +23,15 @@ half a metre from 1,000 rocks is not a design value; from 100,000 rocks it may b
   the sample maximum is a biased, heavy-tailed estimate of the true one -- so read
   this SE as a lower bound.)
 * **Fractions** (passing, stopped) -- the binomial ``sqrt(p (1 - p) / n)``.
+* **Censored values** -- a rock that left the profile at its lower end ran out *at
+  least* to the profile's end: its runout is right-censored there. A statistic that
+  uses a censored value (the mean, a percentile whose interpolation reaches one, the
+  maximum) is only a lower bound; :func:`distribution` flags each one
+  (``lower_bound``) when told which values are censored.
+* **A measured value among simulated ones** -- :func:`rank_of`: its percentile (percent
+  of the values below it, ties counted half) with the binomial SE, or, above (below)
+  every simulated value, no percentile but ``beyond`` and the simulated extreme: the
+  sample says only that the value lies beyond all of them, not how far.
 """
 
 from __future__ import annotations
@@ -134,21 +143,42 @@ def fraction_se(count: int, n: int) -> tuple[float, float]:
 
 
 def distribution(
-    values: np.ndarray, percentiles: Sequence[int] = PERCENTILES
+    values: np.ndarray,
+    percentiles: Sequence[int] = PERCENTILES,
+    *,
+    at_least: np.ndarray | None = None,
 ) -> dict[str, object]:
     """Mean, percentiles and max of ``values`` (NaN ignored), each with its SE.
+
+    Parameters
+    ----------
+    values
+        Samples (NaN are ignored).
+    percentiles
+        Percentiles to report.
+    at_least
+        Optional bool mask, one per value: True where the value is right-censored
+        (the true value is at least this, e.g. the runout of a rock that left the
+        profile). Adds ``lower_bound``.
 
     Returns
     -------
     dict
         ``{"n": count, "mean": ..., "p50": ..., ..., "max": ..., "se": {"mean": ...,
-        "p50": ..., "max": ...}}``; values are None (JSON null) where undefined.
+        "p50": ..., "max": ...}}``; values are None (JSON null) where undefined. With
+        ``at_least``: ``lower_bound`` (per statistic, True when it uses a censored
+        value and is only a lower bound, :func:`lower_bounds`) and ``censored`` (how
+        many values are censored).
 
     Examples
     --------
     >>> d = distribution(np.array([1.0, 2.0, 3.0, 4.0, 5.0]), percentiles=(50,))
     >>> d["n"], d["mean"], d["p50"], d["max"], round(d["se"]["p50"], 4)
     (5, 3.0, 3.0, 5.0, 0.8944)
+    >>> d = distribution(np.array([1.0, 2.0, 5.0, 5.0]), percentiles=(50, 90),
+    ...                  at_least=np.array([False, False, True, True]))
+    >>> d["lower_bound"], d["censored"]
+    ({'mean': True, 'p50': True, 'p90': True, 'max': True}, 2)
     """
     out: dict[str, object] = {"n": int(_finite(values).size)}
     se: dict[str, float | None] = {}
@@ -160,6 +190,91 @@ def distribution(
         out[name] = _json(value)
         se[name] = _json(error)
     out["se"] = se
+    if at_least is not None:
+        flags = lower_bounds(values, at_least, percentiles)
+        out["lower_bound"] = flags
+        finite = np.isfinite(np.asarray(values, dtype=float).ravel())
+        out["censored"] = int(np.asarray(at_least, bool).ravel()[finite].sum())
+    return out
+
+
+def lower_bounds(
+    values: np.ndarray, at_least: np.ndarray, percentiles: Sequence[int] = PERCENTILES
+) -> dict[str, bool]:
+    """Which statistics of :func:`distribution` are only lower bounds.
+
+    A statistic is a lower bound when it uses a right-censored value (``at_least``
+    True): the mean when any value is censored; a percentile when either order
+    statistic its linear interpolation (type 7) uses is censored, ties sorted with the
+    censored values last; the maximum when it is censored.
+
+    Examples
+    --------
+    >>> x = np.array([1.0, 2.0, 3.0, 4.0, 10.0])
+    >>> lower_bounds(x, x == 10.0, (50, 90))
+    {'mean': True, 'p50': False, 'p90': True, 'max': True}
+    """
+    x = np.asarray(values, dtype=float).ravel()
+    c = np.asarray(at_least, dtype=bool).ravel()
+    keep = np.isfinite(x)
+    x, c = x[keep], c[keep]
+    n = x.size
+    ordered = c[np.lexsort((c, x))]  # by value, censored last among ties
+    out = {"mean": bool(c.any())}
+    for q in percentiles:
+        if n == 0:
+            out[f"p{q}"] = False
+            continue
+        h = (n - 1) * q / 100.0
+        lo, hi = math.floor(h), min(math.ceil(h), n - 1)
+        out[f"p{q}"] = bool(ordered[lo] or (hi != lo and ordered[hi]))
+    out["max"] = bool(n and ordered[-1])
+    return out
+
+
+def rank_of(values: np.ndarray, value: float) -> dict[str, object]:
+    """Where a measured ``value`` falls among simulated ``values`` (NaN ignored).
+
+    Returns
+    -------
+    dict
+        ``measured``; ``n`` (simulated values); ``percentile`` (percent of the values
+        below ``value``, ties counted half) and its binomial ``percentile_se`` --
+        both None without values, or when ``value`` lies above or below every one of
+        them (then the sample gives no percentile, only that it is beyond all:
+        ``beyond`` is ``"above"`` or ``"below"``, else None); ``simulated_min`` and
+        ``simulated_max``.
+
+    Examples
+    --------
+    >>> rank_of(np.array([1.0, 2.0, 3.0, 4.0]), 3.0)["percentile"]
+    62.5
+    >>> r = rank_of(np.array([1.0, 2.0, 3.0, 4.0]), 9.0)
+    >>> r["beyond"], r["percentile"], r["simulated_max"]
+    ('above', None, 4.0)
+    """
+    x = _finite(values)
+    n = int(x.size)
+    out: dict[str, object] = {
+        "measured": float(value),
+        "n": n,
+        "percentile": None,
+        "percentile_se": None,
+        "beyond": None,
+        "simulated_min": float(x.min()) if n else None,
+        "simulated_max": float(x.max()) if n else None,
+    }
+    if n == 0:
+        return out
+    if value > x.max():
+        out["beyond"] = "above"
+        return out
+    if value < x.min():
+        out["beyond"] = "below"
+        return out
+    fraction = float((x < value).sum() + 0.5 * (x == value).sum()) / n
+    out["percentile"] = 100.0 * fraction
+    out["percentile_se"] = 100.0 * math.sqrt(fraction * (1.0 - fraction) / n)
     return out
 
 

@@ -302,7 +302,7 @@ def test_figures_get_a_stated_envelope_and_measured_percentiles(core, cli, tmp_p
     from fieldkit.model.simulate import simulate
 
     r = cli("simulate", MODEL, "--rocks", "60", "--seed", "3", "--at", "40",
-            "--measured", "x=40,speed=10,ke=1e5", "--summary", tmp_path / "s.json",
+            "--measured", "x=40,speed=17,ke=72e3", "--summary", tmp_path / "s.json",
             "--figures", tmp_path / "f")  # fmt: skip
     assert r.exit_code == 0, r.stderr
     s = json.loads((tmp_path / "s.json").read_text())
@@ -318,10 +318,167 @@ def test_figures_get_a_stated_envelope_and_measured_percentiles(core, cli, tmp_p
     m = s["measured"][0]
     assert m["x_m"] == 40.0
     assert m["speed_mps"]["percentile"] == pytest.approx(
-        100 * ((speeds < 10).sum() + 0.5 * (speeds == 10).sum()) / speeds.size
+        100 * ((speeds < 17).sum() + 0.5 * (speeds == 17).sum()) / speeds.size
     )
-    assert m["ke_j"]["percentile"] == pytest.approx(100 * (ke < 1e5).sum() / ke.size)
+    assert m["ke_j"]["percentile"] == pytest.approx(100 * (ke < 72e3).sum() / ke.size)
+    assert 0 < m["ke_j"]["percentile"] < 100 and m["ke_j"]["beyond"] is None
     assert m["speed_mps"]["n"] == speeds.size
     line = next(ln for ln in r.stdout.splitlines() if ln.startswith("measured at"))
     assert f"percentile {m['speed_mps']['percentile']:.1f}" in line
-    assert "translational KE 100 kJ" in line
+    assert "translational KE 72 kJ" in line
+
+
+def test_runout_beyond_the_profile_end_is_a_lower_bound(core, cli, tmp_path):
+    """Rocks that leave the profile at its lower end ran out at least that far: a
+    runout statistic that uses them is a lower bound, printed '≥ 100 m (end of
+    profile; 14 % of rocks left it)' and flagged per statistic in summary.json
+    (it printed 'p90 100 ± 0' as if measured)."""
+    cut = dict(POGO, profile=dict(POGO["profile"], x_m=[0, 30, 100]))
+    model = _model(tmp_path, cut)
+    r = cli("simulate", model, "--rocks", "200", "--seed", "5", "--summary",
+            tmp_path / "s.json")  # fmt: skip
+    assert r.exit_code == 0, r.stderr
+    s = json.loads((tmp_path / "s.json").read_text())
+    left = s["final_state"]["exited_downslope"]
+    assert left == 29 and s["runout_censored"]["rocks"] == left
+    assert s["runout_censored"]["fraction"] == pytest.approx(29 / 200)
+    assert s["runout_censored"]["end_x_m"] == 100.0
+    runout = s["runout_x_m"]
+    assert runout["censored"] == 29 and runout["p90"] == 100.0  # keys kept
+    # 171 stopped before x = 100 m: the median is theirs, p90 and up use left rocks
+    assert runout["lower_bound"] == {
+        "mean": True, "p50": False, "p90": True, "p95": True, "p99": True, "max": True
+    }  # fmt: skip
+    line = next(ln for ln in r.stdout.splitlines() if ln.startswith("runout x"))
+    assert "p90, p95, p99, max ≥ 100 m (end of profile; 14 % of rocks left it)" in line
+    assert f"p50 {runout['p50']:.4g} ± " in line and "mean ≥ " in line
+    assert "100 ± 0" not in line
+    # the same rocks on the 130 m profile: the bound holds (p90 101.6 >= 100 m)
+    r = cli("simulate", _model(tmp_path), "--rocks", "200", "--seed", "5",
+            "--summary", tmp_path / "whole.json")  # fmt: skip
+    whole = json.loads((tmp_path / "whole.json").read_text())["runout_x_m"]
+    assert whole["p50"] == runout["p50"] and whole["p90"] > 100.0
+    assert not any(whole["lower_bound"].values())
+
+
+def test_a_measured_value_beyond_every_rock_has_no_percentile(core, cli, tmp_path):
+    """A measured speed above every crossing rock said '100th percentile ± 0.0'; the
+    sample only says it lies above all of them."""
+    r = cli("simulate", MODEL, "--rocks", "60", "--seed", "3", "--at", "40",
+            "--measured", "x=40,speed=500,ke=1", "--summary", tmp_path / "s.json",
+            "--figures", tmp_path / "f")  # fmt: skip
+    assert r.exit_code == 0, r.stderr
+    m = json.loads((tmp_path / "s.json").read_text())["measured"][0]
+    speed, ke = m["speed_mps"], m["ke_j"]
+    assert speed["beyond"] == "above" and speed["percentile"] is None
+    assert speed["percentile_se"] is None and speed["simulated_max"] < 500
+    assert ke["beyond"] == "below" and ke["percentile"] is None
+    assert ke["simulated_min"] > 1
+    line = next(ln for ln in r.stdout.splitlines() if ln.startswith("measured at"))
+    n = speed["n"]
+    assert (
+        f"speed 500 m/s: above all {n} simulated rocks (their maximum "
+        f"{speed['simulated_max']:.3g} m/s)" in line
+    )
+    assert f"below all {n} simulated rocks (their minimum" in line
+    assert "percentile" not in line
+
+
+@pytest.fixture()
+def drawn(monkeypatch):
+    """The figures `simulate --figures` saves, by file name (then saved as usual)."""
+    import fieldkit.viz.simulation_figure as figures
+
+    kept: dict = {}
+    save = figures.save_png
+
+    def keep(fig, path, **kwargs):
+        kept[Path(path).name] = fig
+        return save(fig, path, **kwargs)
+
+    monkeypatch.setattr(figures, "save_png", keep)
+    return kept
+
+
+def _inside(fig, artist) -> bool:
+    """True when ``artist`` is drawn wholly inside ``fig`` (not clipped)."""
+    fig.draw_without_rendering()
+    box, page = artist.get_window_extent(), fig.bbox
+    return box.x0 >= page.x0 - 1 and box.x1 <= page.x1 + 1 and box.y1 <= page.y1 + 1
+
+
+def test_readme_run_figures_say_what_the_profile_end_hides(core, cli, tmp_path, drawn):
+    """The README's run: 71 % of the rocks leave the 700 m profile. runout.png was
+    squashed to ~170 px by its legend (title and x label clipped), its bar of rocks
+    that left hidden behind four percentile lines at 700 m, each '(capped rocks left
+    out)'; the point figure's legends sat on the bars ('1.8e+03 kJ'); trajectories
+    at 1:1 left 60 % of the plot empty."""
+    from matplotlib.patches import Rectangle
+
+    model = Path(__file__).resolve().parents[2] / "surveys" / "tornado_mountain"
+    r = cli("simulate", model / "model_rocfall_table_7_1.json", "--rocks", "2000",
+            "--seed", "1", "--at", "610", "--measured", "x=610,speed=18,ke=600e3",
+            "--summary", tmp_path / "s.json", "--figures", tmp_path / "f")  # fmt: skip
+    assert r.exit_code == 0, r.stderr
+    s = json.loads((tmp_path / "s.json").read_text())
+    left = s["final_state"]["exited_downslope"]
+    share = f"{100 * left / s['runout_x_m']['n']:.0f} %"
+    assert share == "71 %"
+    line = next(ln for ln in r.stdout.splitlines() if ln.startswith("runout x"))
+    assert (
+        "p50, p90, p95, p99, max ≥ 700 m (end of profile; 71 % of rocks left it)"
+        in line
+    )
+    assert all(s["runout_x_m"]["lower_bound"].values())
+
+    fig = drawn["runout.png"]
+    ax = fig.axes[0]
+    labels = ax.get_legend_handles_labels()[1]
+    assert ax.get_position().width > 0.6  # the axes, not the legend, fill the width
+    assert _inside(fig, ax.title) and _inside(fig, ax.xaxis.label)
+    assert ax.title.get_text().startswith("Runout")
+    # no percentile line stands on the profile's end; one '≥' entry says why
+    lines = {ln.get_label() for ln in ax.get_lines()}
+    assert not any(lab.startswith("runout") and "=" in lab for lab in lines)
+    bound = [lab for lab in labels if lab.startswith("runout")]
+    assert bound == [
+        "runout 50th, 90th, 95th, 99th percentiles ≥ 700 m (end of profile; 71 % of "
+        "rocks left it)"
+    ]
+    # the rocks that left: their own bar beyond x = 700 m, with their count
+    bars = [p for p in ax.patches if isinstance(p, Rectangle) and p.get_x() > 700]
+    assert [p.get_height() for p in bars] == [left]
+    assert f"{left:,}\n↑" in [t.get_text() for t in ax.texts]
+    capped = s["final_state"]["capped"]
+    assert sum("left out" in lab for lab in labels) == (1 if capped else 0)
+
+    fig = drawn["point_1_x610.png"]
+    for ax in fig.axes[:3]:  # the histograms: no legend on them, none over them
+        assert ax.get_legend() is None
+    for key, ax in zip(fig.axes[3:], fig.axes[:3], strict=True):
+        fig.draw_without_rendering()
+        legend = key.get_legend().get_window_extent()
+        assert legend.y1 < ax.get_window_extent().y0 and _inside(fig, key.get_legend())
+    texts = [t.get_text() for t in fig.axes[4].get_legend().get_texts()]
+    p50 = s["analysis_points"][0]["ke_j"]["p50"] / 1e3
+    assert f"50th percentile = {p50:,.0f} kJ" in texts
+    assert not any("e+" in t for t in texts)
+    measured = next(t for t in texts if t.startswith("measured translational KE"))
+    assert measured.startswith("measured translational KE = 600 kJ: percentile 26 ± 1")
+
+    fig = drawn["trajectories.png"]
+    section, heights = fig.axes[:2]
+    z0, z1 = section.get_ylim()
+    paths = [ln for ln in section.get_lines() if ln.get_linewidth() == 0.9]
+    ground = next(
+        ln for ln in section.get_lines() if ln.get_label().startswith("ground")
+    )
+    top, low = max(max(ln.get_ydata()) for ln in paths), min(ground.get_ydata())
+    assert len(paths) == 20 and low > z0 and top < z1  # nothing cut off
+    assert (z1 - z0) < 1.15 * (top - low)  # and nothing empty above or below
+    assert section.get_position().height > 0.5  # the section fills its panel
+    assert section.get_ylabel().endswith(("true scale", "x"))  # its scale stated
+    # below: the same paths as height above the ground, off the ground line
+    above = [ln for ln in heights.get_lines() if ln.get_linewidth() == 0.9]
+    assert len(above) == 20 and heights.get_ylabel().startswith("centre above")
+    assert max(max(ln.get_ydata()) for ln in above) > 20.0

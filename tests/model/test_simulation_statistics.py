@@ -125,3 +125,40 @@ def test_summary_contract(synthetic_simulation):
         assert point[key]["n"] == point["passing"]
     assert s["model"]["effects"] == {"air_drag": {"cd": 0.5}}
     assert len(s["envelope"]["x_m"]) == 10
+
+
+def test_lower_bounds_follow_the_interpolation_into_censored_values():
+    from fieldkit.model.statistics import lower_bounds
+
+    x = np.arange(1.0, 11.0)  # 1..10, the last two censored (left the profile)
+    censored = x >= 9.0
+    flags = lower_bounds(x, censored, (50, 80, 85, 90))
+    # type 7: p80 -> position 7.2 between 8 and 9 (9 censored): a lower bound
+    assert flags == {
+        "mean": True, "p50": False, "p80": True, "p85": True, "p90": True, "max": True
+    }  # fmt: skip
+    # exactly at an uncensored order statistic: position 7.0 -> 8, measured
+    assert lower_bounds(x, censored, (70,))["p70"] is False
+    assert lower_bounds(x, censored, (100 * 7 / 9,))[f"p{100 * 7 / 9}"] is False
+    # ties with a censored value: sorted after the uncensored, the bound shows
+    tie = np.array([1.0, 2.0, 2.0])
+    assert lower_bounds(tie, np.array([False, True, False]), (50,))["p50"] is False
+    assert lower_bounds(tie, np.array([False, True, False]), (100,))["p100"] is True
+    assert not any(lower_bounds(x, np.zeros(10, bool)).values())
+
+
+def test_rank_of_a_value_beyond_the_sample_has_no_percentile():
+    from fieldkit.model.statistics import rank_of
+
+    x = np.array([3.0, 1.0, 2.0, np.nan])
+    inside = rank_of(x, 2.0)
+    assert inside["percentile"] == 50.0 and inside["beyond"] is None
+    assert inside["percentile_se"] == pytest.approx(100 * math.sqrt(0.25 / 3))
+    assert rank_of(x, 3.0)["percentile"] == pytest.approx(100 * 2.5 / 3)  # a tie
+    above, below = rank_of(x, 3.5), rank_of(x, 0.5)
+    assert (above["beyond"], above["percentile"], above["simulated_max"]) == (
+        "above", None, 3.0
+    )  # fmt: skip
+    assert (below["beyond"], below["simulated_min"], below["n"]) == ("below", 1.0, 3)
+    assert rank_of(np.array([np.nan]), 1.0)["percentile"] is None
+    json.dumps(above)
