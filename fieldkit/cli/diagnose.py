@@ -273,7 +273,7 @@ def diagnose(
                     "--radius and --mass apply to a track only (an ImpactTable "
                     "gives the body on every row)"
                 )
-            from fieldkit.diagnose.impacts import diagnose_impacts
+            from fieldkit.diagnose.impacts import diagnose_impacts, impact_count
             from fieldkit.impact_table import ImpactTable
             from fieldkit.model.model_file import read_model
 
@@ -281,7 +281,7 @@ def diagnose(
             mapping = mapped_table(ImpactTable.read(input_file), base, material, preset)
             table = mapping.table
             with _step_once_checked(
-                f"diagnosing {len(table)} impacts: scoring the baseline and each "
+                f"diagnosing {impact_count(table)}: scoring the baseline and each "
                 f"candidate effect by {folds}-fold cross-validation"
             ) as progress:
                 diagnosis = diagnose_impacts(

@@ -182,7 +182,7 @@ def markdown(diagnosis: Diagnosis, *, title: str, inputs: list[str]) -> str:
     out = [f"# Diagnosis: {title}", ""]
     out += [f"* input: `{name}`" for name in inputs]
     out += [
-        f"* {d.n_rows} rows, {d.n_data} data; held out: {d.groups}",
+        f"* {d.size or f'{d.n_rows} rows'}, {d.n_data} data; held out: {d.groups}",
         f"* error measure: the {error} ({unit}), the weighted root-mean-square of "
         "the residuals (measured − model) of data held out of the fit "
         f"(`{d.metric}` in the JSON)",

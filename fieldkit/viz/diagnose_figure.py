@@ -50,22 +50,40 @@ def _order(features: dict, flagged: set[str]) -> list[str]:
     ]
 
 
+def _category_axis(ax, values: np.ndarray, residual: np.ndarray):
+    """Place a categorical feature on the x axis: one strip per category, each
+    ticked with its name and how many points it holds (``rock (n = 2)``), the axis
+    wide enough for every strip. Returns ``(x, jitter)``: each point's category
+    position and, per residual column, its offset within the strip."""
+    names = sorted(set(values) - {""})
+    pos = {c: i for i, c in enumerate(names)}
+    x = np.array([pos.get(v, np.nan) for v in values], float)
+    drawn = np.isfinite(residual).any(axis=1)
+    counts = [int((drawn & (values == c)).sum()) for c in names]
+    ax.set_xticks(range(len(names)), [f"{c}\n(n = {n})" for c, n in
+                                      zip(names, counts, strict=True)])  # fmt: skip
+    ax.set_xlim(-0.5, len(names) - 0.5)
+    jitter = np.zeros(residual.shape)
+    for j in range(residual.shape[1]):
+        for c in names:
+            sel = np.flatnonzero((values == c) & np.isfinite(residual[:, j]))
+            spread = np.linspace(-0.15, 0.15, sel.size) if sel.size > 1 else 0.0
+            jitter[sel, j] = spread + 0.1 * (j - 1)
+    return x, jitter
+
+
 def _panel(ax, values, residual, components) -> None:
     cats = values.dtype == object
     if cats:
-        names = sorted(set(values) - {""})
-        pos = {c: i for i, c in enumerate(names)}
-        x = np.array([pos.get(v, np.nan) for v in values], float)
-        ax.set_xticks(range(len(names)), names)
+        x, jitter = _category_axis(ax, values, residual)
     else:
-        x = values
+        x, jitter = values, np.zeros(residual.shape)
     for j, _ in enumerate(components):
         r = residual[:, j]
         ok = np.isfinite(r) & np.isfinite(x)
         if not ok.any():
             continue
-        jitter = (np.linspace(-0.15, 0.15, ok.sum()) + 0.1 * (j - 1)) if cats else 0
-        ax.scatter(x[ok] + jitter, r[ok], s=6, alpha=0.45, c=_COLOURS[j % 3])
+        ax.scatter(x[ok] + jitter[ok, j], r[ok], s=6, alpha=0.45, c=_COLOURS[j % 3])
         if not cats and ok.sum() >= 20:
             edges = np.quantile(x[ok], np.linspace(0, 1, MEDIAN_BINS + 1))
             mid, med = [], []

@@ -1,0 +1,109 @@
+"""`fieldkit diagnose` on the README's boulder A, as a reviewer read it.
+
+Boulder A is reduced and diagnosed through the command line once (about 8 s); the
+figures are captured as the command saves them. What is checked is what a person
+reads: every material strip ticked with its name and count, one number of impacts
+everywhere, titles in words, notes that sit in the panel they describe.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+SURVEY = REPO / "surveys" / "tornado_mountain"
+
+
+@pytest.fixture(scope="module")
+def boulder_a(tmp_path_factory):
+    """``(out folder, diagnose result, [(png name, figure)])``."""
+    from typer.testing import CliRunner
+
+    import fieldkit.viz.diagnose_figure as module
+    from fieldkit.cli import app
+
+    out = tmp_path_factory.mktemp("boulder_a")
+    preset = str(SURVEY / "boulder_a_preset.toml")
+    runner = CliRunner()
+    r = runner.invoke(
+        app,
+        [
+            "reduce", "--impacts", str(SURVEY / "boulder_a_impacts.gpx"),
+            "--trees", str(SURVEY / "boulder_a_trees.csv"), "--preset", preset,
+            "-o", str(out / "b.csv"),
+        ],
+    )  # fmt: skip
+    assert r.exit_code == 0, r.output
+    saved = []
+    original = module.save_png
+
+    def capture(fig, path, **kwargs):
+        saved.append((Path(path).name, fig))
+        return original(fig, path, **kwargs)
+
+    patch = pytest.MonkeyPatch()
+    patch.setattr(module, "save_png", capture)
+    try:
+        r = runner.invoke(
+            app,
+            [
+                "diagnose", str(out / "b.csv"), "--model",
+                str(SURVEY / "model_rocfall_table_7_1.json"), "--preset", preset,
+                "--seed", "1", "--json", str(out / "d.json"), "--report",
+                str(out / "rep"),
+            ],
+        )  # fmt: skip
+    finally:
+        patch.undo()
+    assert r.exit_code == 0, r.output
+    return out, r, saved
+
+
+def _material_axes(figures):
+    return [
+        ax
+        for _, fig in figures
+        for ax in fig.get_axes()
+        if ax.get_xlabel().startswith("slope material")
+    ]
+
+
+def test_every_material_strip_is_ticked_with_its_count(boulder_a):
+    """The two rock impacts sat right of the axis' last tick (the axis was scaled
+    to the jittered points, not to the categories): every category is ticked,
+    with how many impacts it holds, and every point lies inside its strip."""
+    _, _, figures = boulder_a
+    axes = _material_axes(figures)
+    assert len(axes) == 3  # baseline; step 1 before and after
+    for ax in axes:
+        ticks = [t.get_text() for t in ax.get_xticklabels()]
+        assert ticks == ["colluvium\n(n = 46)", "rock\n(n = 2)"]
+        low, high = ax.get_xlim()
+        assert low <= -0.5 and high >= 1.5
+        for points in ax.collections:
+            x = points.get_offsets()[:, 0]
+            near = x.round()
+            assert (abs(x - near) <= 0.3).all()
+            assert sorted(near.tolist()).count(1.0) == 2  # the two rock impacts
+
+
+def test_one_number_of_impacts_everywhere(boulder_a):
+    """50 rows, of which the first is the release and the last the stop point:
+    the progress line, the report and the JSON all say 48 impacts."""
+    out, r, _ = boulder_a
+    said = (
+        "48 impacts (of 50 rows; not impacts: row 1, a release point; row 50, a "
+        "stop point)"
+    )
+    assert f"diagnosing {said}: scoring the baseline" in r.stderr
+    assert "diagnosing 50 impacts" not in r.stderr
+    text = (out / "rep" / "report.md").read_text()
+    assert f"* {said}, 96 data; held out:" in text
+    assert "48 rows" not in text
+    assert json.loads((out / "d.json").read_text())["n_rows"] == 48
+    materials = re.findall(r"^\| (rock|colluvium) \| (\d+) \|", text, flags=re.M)
+    assert sum(int(n) for _, n in materials) == 48
