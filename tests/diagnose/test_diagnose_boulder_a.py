@@ -107,3 +107,64 @@ def test_one_number_of_impacts_everywhere(boulder_a):
     assert json.loads((out / "d.json").read_text())["n_rows"] == 48
     materials = re.findall(r"^\| (rock|colluvium) \| (\d+) \|", text, flags=re.M)
     assert sum(int(n) for _, n in materials) == 48
+
+
+def test_titles_and_report_name_effects_in_words(boulder_a):
+    """The baseline's slope roughness was shown by its code name in the figure
+    titles, the report and the printed summary."""
+    out, r, figures = boulder_a
+    text = (out / "rep" / "report.md").read_text()
+    words = "constant e_n, e_t per material + slope roughness (thesis eq. 7.4)"
+    assert f"Model: {words}; held-out RMS error" in text
+    assert f"baseline, {words}: held-out RMS error" in r.stdout
+    assert re.search(
+        r"^Effects: slope roughness \(thesis eq. 7.4\), velocity-scaled restitution "
+        r"\(thesis eq. 7.1\); held-out RMS error",
+        text,
+        flags=re.M,
+    )
+    for _, fig in figures:
+        title = fig.texts[0].get_text()
+        assert "slope_roughness" not in title and "_restitution" not in title
+    assert figures[0][1].texts[0].get_text().startswith(f"Baseline, {words}")
+
+
+def test_features_shown_tested_and_not_tested_add_up(boulder_a):
+    """The figure said "6 of 7 features shown" beside "Features tested" listing
+    6: the figure names the feature it leaves out, the report the one it could not
+    test."""
+    out, _, figures = boulder_a
+    for _, fig in figures:
+        title = " ".join(fig.texts[0].get_text().split())
+        assert (
+            "6 of 7 features shown (those the residuals depend on first); not shown: "
+            "flight before the impact struck a tree; the report lists every test"
+        ) in title
+    text = (out / "rep" / "report.md").read_text()
+    tested = re.search(r"^Features tested: (.*)\.$", text, flags=re.M).group(1)
+    assert len(tested.split("; ")) == 6 and "slope material" not in tested
+    assert (
+        "Not tested (drawn in the figure all the same): slope material: the test "
+        "needs two categories of at least 5 impacts (colluvium 46, rock 2)."
+    ) in text
+
+
+def test_dependence_note_sits_inside_its_own_panel(boulder_a):
+    """The note "residuals depend on it: v_fn" sat under the v_in axis, where it
+    read as the heading of the θi panel below: it is a boxed note inside the v_in
+    panel, with room above the points so it hides none."""
+    _, _, figures = boulder_a
+    axes = figures[0][1].get_axes()
+    for ax in axes:
+        assert "depend" not in ax.get_xlabel()
+    noted = [ax for ax in axes if ax.texts]
+    assert [ax.get_xlabel() for ax in noted] == ["normal impact speed v_in (m/s)"]
+    ax = noted[0]
+    (note,) = ax.texts
+    assert note.get_text() == (
+        "residuals depend on this feature (Holm p ≤ 0.01): v_fn (Holm p = 0.0002)"
+    )
+    assert note.get_transform() == ax.transAxes and note.get_position()[1] > 0.9
+    top = max(float(c.get_offsets()[:, 1].max()) for c in ax.collections)
+    low, high = ax.get_ylim()
+    assert (top - low) / (high - low) < 0.85  # the note's box starts above it
