@@ -87,7 +87,7 @@ def _summary(diagnosis) -> list[str]:
                 )
             )
     lines += [f"confounded: {a}" for a in d.advice]
-    lines.append(f"recommended: {d.recommended or 'nothing'} ({d.stopped})")
+    lines.append(f"recommended: {d.recommended or 'nothing'}; stopped: {d.stopped}")
     lines += [
         f"residuals still: {dependence_sentence(x)}"
         for x in sorted(d.dependence_after, key=lambda x: x.p_value)

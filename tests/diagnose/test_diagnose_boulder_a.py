@@ -168,3 +168,14 @@ def test_dependence_note_sits_inside_its_own_panel(boulder_a):
     top = max(float(c.get_offsets()[:, 1].max()) for c in ax.collections)
     low, high = ax.get_ylim()
     assert (top - low) / (high - low) < 0.85  # the note's box starts above it
+
+
+def test_summary_nests_no_parentheses(boulder_a):
+    """The line "recommended: X (no remaining candidate ... (best: ...))" nested one
+    parenthesis in another: the reason follows after "stopped:"."""
+    _, r, _ = boulder_a
+    assert (
+        "recommended: velocity_scaled_restitution; stopped: no remaining candidate "
+        "passes the rule (best: angle_dependent_restitution, gain -0.6% ± 3.8%)\n"
+    ) in r.stdout
+    assert "))" not in r.stdout
