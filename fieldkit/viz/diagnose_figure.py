@@ -175,7 +175,13 @@ def residual_figure(
     notes = [_depends(tests) for _, _, tests in columns]
     names = _order(features, set().union(*notes))
     if len(names) < len(features):
-        hidden = "; ".join(labels.feature(f) for f in features if f not in names)
+        flagged = set().union(*notes)
+        hidden = "; ".join(
+            labels.feature(f) + (" (the residuals depend on it too)" if f in flagged
+                                 else "")
+            for f in features
+            if f not in names
+        )  # fmt: skip
         title += (
             f"\n{len(names)} of {len(features)} features shown (those the residuals "
             f"depend on first); not shown: {hidden}; the report lists every test"

@@ -151,3 +151,33 @@ def test_report_says_when_a_fitted_value_switches_its_effect_off(diagnosed):
         text,
     )
     assert not re.search(r"k_mps = [\d.]+e\+0[4-9] ±", text)
+
+
+def test_figure_names_a_feature_left_out_and_its_dependence(
+    hidden_csv, tmp_path, cli, monkeypatch
+):
+    """The README's hidden case: the v_fn residuals depend on seven features, six
+    fit a figure. The title named none of those left out ("6 of 7 features
+    shown"): it names the material, and that the residuals depend on it too."""
+    import fieldkit.viz.diagnose_figure as module
+
+    titles = []
+    original = module.save_png
+
+    def capture(fig, path, **kwargs):
+        titles.append(" ".join(fig.texts[0].get_text().split()))
+        return original(fig, path, **kwargs)
+
+    monkeypatch.setattr(module, "save_png", capture)
+    r = cli("diagnose", hidden_csv, "--model", TORNADO, "--seed", "1",
+            "--report", tmp_path / "rep")  # fmt: skip
+    assert r.exit_code == 0, r.output
+    text = (tmp_path / "rep" / "report.md").read_text()
+    assert "| normal rebound velocity v_fn | slope material | Kruskal-Wallis" in text
+    assert len(titles) == 2
+    for title in titles:
+        assert (
+            "6 of 7 features shown (those the residuals depend on first); not shown: "
+            "slope material (the residuals depend on it too); the report lists "
+            "every test"
+        ) in title
