@@ -87,7 +87,7 @@ def _summary(diagnosis) -> list[str]:
                 )
             )
     lines += [f"confounded: {a}" for a in d.advice]
-    lines.append(f"recommended: {d.recommended or 'nothing'} ({d.stopped})")
+    lines.append(f"recommended: {d.recommended or 'nothing'}; stopped: {d.stopped}")
     lines += [
         f"residuals still: {dependence_sentence(x)}"
         for x in sorted(d.dependence_after, key=lambda x: x.p_value)
@@ -194,8 +194,9 @@ def diagnose(
     The baseline (constant e_n, e_t per material, or --model) is scored by its
     held-out error: k-fold cross-validation over paths (or blocks of consecutive
     impacts on a single-path survey). Residuals are tested against every feature
-    the table carries (Holm-adjusted p-values). Each candidate effect the data
-    can inform is added, refitted and scored on the held-out data; one is
+    the table carries; a residual depends on a feature when its Holm-adjusted p
+    <= 0.01. Each candidate effect the data can inform is added, refitted and
+    scored on the held-out data; one is
     recommended only when it lowers the held-out error by more than 1 % and by
     more than 2 standard errors of that gain (jackknife over the held-out
     groups). Two candidates that both pass, neither of which lowers the other's
@@ -203,7 +204,10 @@ def diagnose(
     neither is added. Accepted effects are added stepwise. A track CSV is
     diagnosed at flight level, on the positions of its flights: air_drag is
     recommended when it lowers the held-out error by more than 2 standard
-    errors of that gain.
+    errors of that gain. Its x and z residuals are tested against the time from
+    mid-flight and the speed (4 tests; a residual depends on a feature when its
+    Holm-adjusted p <= 0.05). The dependence tests only describe the
+    residuals: no recommendation rests on them.
 
     Example (from the repository root):
 
@@ -273,7 +277,7 @@ def diagnose(
                     "--radius and --mass apply to a track only (an ImpactTable "
                     "gives the body on every row)"
                 )
-            from fieldkit.diagnose.impacts import diagnose_impacts
+            from fieldkit.diagnose.impacts import diagnose_impacts, impact_count
             from fieldkit.impact_table import ImpactTable
             from fieldkit.model.model_file import read_model
 
@@ -281,7 +285,7 @@ def diagnose(
             mapping = mapped_table(ImpactTable.read(input_file), base, material, preset)
             table = mapping.table
             with _step_once_checked(
-                f"diagnosing {len(table)} impacts: scoring the baseline and each "
+                f"diagnosing {impact_count(table)}: scoring the baseline and each "
                 f"candidate effect by {folds}-fold cross-validation"
             ) as progress:
                 diagnosis = diagnose_impacts(

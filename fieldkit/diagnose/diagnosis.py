@@ -137,6 +137,10 @@ class Diagnosis:
     notes: list[str] = field(default_factory=list)
     n_data: int = 0
     n_rows: int = 0
+    #: ``n_rows`` in words, as the printed summary and the report say it ("48
+    #: impacts (of 50 rows; not impacts: row 1, a release point; ...)"); not in
+    #: the JSON (empty: "``n_rows`` rows").
+    size: str = ""
     #: Arrays for figures and recordings (not in the JSON): ``features``,
     #: ``baseline``/``after``/``steps`` held-out residuals, ``weight``, ``path_id``,
     #: ``dependence`` (tests of the baseline and of each step), ``after_model``,

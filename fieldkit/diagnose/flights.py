@@ -481,6 +481,7 @@ def diagnose_flights(
         notes=notes,
         n_data=n_obs,
         n_rows=int(data.t.size),
+        size=f"{int(data.t.size)} samples of {data.n_flights} flights",
         arrays={
             "features": _features(data, base),
             "baseline": base.residual,

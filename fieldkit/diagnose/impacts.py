@@ -58,6 +58,7 @@ from fieldkit.fit.impact_fit import (
     fit_result,
     free_parameters,
     impact_problem,
+    no_flight_rows,
     too_few,
 )
 from fieldkit.fit.synthetic import with_effects
@@ -69,6 +70,61 @@ METRIC = "cv_rmse_mps"
 MIN_GROUPS = 3
 #: Worst impacts named in the report.
 N_WORST = 5
+#: Most rows that are not impacts named one by one in :func:`impact_count`.
+N_NAMED_ROWS = 5
+
+
+def not_impacts(table: ImpactTable) -> list[tuple[int, str]]:
+    """The rows of ``table`` that are not impacts: ``(row, what)``, row 1-based.
+
+    These are the rows every fit leaves out
+    (:func:`~fieldkit.fit.impact_fit.no_flight_rows`): a reduced path's release
+    point (no arriving flight) and stop point (no leaving flight).
+    """
+    frame = table.frame
+    skip = no_flight_rows(table)
+    arrives = np.ones(len(frame), bool)
+    if {"vi_x_mps", "vi_z_mps"} <= set(frame):
+        arrives = ~(frame["vi_x_mps"].isna() & frame["vi_z_mps"].isna()).to_numpy()
+    leaves = np.ones(len(frame), bool)
+    if {"vf_x_mps", "vf_z_mps"} <= set(frame):
+        leaves = ~(frame["vf_x_mps"].isna() & frame["vf_z_mps"].isna()).to_numpy()
+    out = []
+    for i in np.flatnonzero(skip):
+        if not arrives[i] and not leaves[i]:
+            what = "a point with no flight on either side"
+        elif not arrives[i]:
+            what = "a release point"
+        else:
+            what = "a stop point"
+        out.append((int(i) + 1, what))
+    return out
+
+
+def impact_count(table: ImpactTable) -> str:
+    """How many impacts of ``table`` a diagnosis uses, in words, with the rows left
+    out named (the number the summary, the report and the JSON's ``n_rows`` give).
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> frame = pd.DataFrame({
+    ...     "path_id": ["A"] * 3, "point": ["1", "2", "3"], "x_m": [0.0, 5, 10],
+    ...     "z_m": [9.0, 5, 0], "slope_deg": [-40.0] * 3,
+    ...     "vi_x_mps": [None, 1.0, 2.0], "vi_z_mps": [None, -1, -2],
+    ...     "vf_x_mps": [1.0, 2.0, None], "vf_z_mps": [1, 1, None]})
+    >>> impact_count(ImpactTable(frame))
+    '1 impact (of 3 rows; not impacts: row 1, a release point; row 3, a stop point)'
+    """
+    left = not_impacts(table)
+    n = len(table) - len(left)
+    head = f"{n} impact" + ("" if n == 1 else "s")
+    if not left:
+        return head
+    named = [f"row {row}, {what}" for row, what in left[:N_NAMED_ROWS]]
+    if len(left) > N_NAMED_ROWS:
+        named.append(f"{len(left) - N_NAMED_ROWS} more release or stop points")
+    return f"{head} (of {len(table)} rows; not impacts: {'; '.join(named)})"
 
 
 @dataclass
@@ -372,6 +428,7 @@ def diagnose_impacts(
         notes=notes,
         n_data=int(problem.use.sum()),
         n_rows=len(problem.table),
+        size=impact_count(table),
         arrays={
             "features": features,
             "baseline": baseline.residual,

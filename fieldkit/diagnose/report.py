@@ -53,8 +53,7 @@ def _params_table(params: dict, sds: dict) -> list[str]:
     rows = ["| parameter | value ± standard error |", "|---|---|"]
     for k, v in params.items():
         words, unit = labels.parameter(k)
-        text = labels.value_with_se(v, sds.get(k), unit=unit) + labels.remark(k, v)
-        rows.append(_row(words, text))
+        rows.append(_row(words, labels.value_text(k, v, sds.get(k))))
     return rows
 
 
@@ -119,7 +118,32 @@ def dependence_sentence(d: Dependence) -> str:
     )
 
 
-def _dependence_section(tests: list[Dependence]) -> list[str]:
+def levels(alpha: float) -> str:
+    """Which diagnosis tests at ``alpha`` and the level of the other kind: an
+    ImpactTable's tests at :data:`~fieldkit.diagnose.residual_tests.ALPHA`, a
+    track's flight tests at :data:`~fieldkit.diagnose.flights.DEPENDENCE_ALPHA`.
+
+    Examples
+    --------
+    >>> levels(0.05)
+    "the level of a track's flight tests; an ImpactTable's tests use 0.01"
+    """
+    from fieldkit.diagnose.flights import DEPENDENCE_ALPHA
+
+    impacts, track = residual_tests.ALPHA, DEPENDENCE_ALPHA
+    if alpha == track != impacts:
+        return (
+            "the level of a track's flight tests; an ImpactTable's tests use "
+            f"{impacts:g}"
+        )
+    if alpha == impacts != track:
+        return (
+            f"the level of an ImpactTable's tests; a track's flight tests use {track:g}"
+        )
+    return "the level of every diagnosis"
+
+
+def _dependence_section(tests: list[Dependence], features: dict) -> list[str]:
     if not tests:
         return ["No residual could be tested against a feature.", ""]
     alpha = tests[0].alpha
@@ -129,7 +153,9 @@ def _dependence_section(tests: list[Dependence]) -> list[str]:
         f"{len(tests)} tests, each residual against each feature. *p* is a test's "
         f"own p-value ({methods or 'the test alone'}); *Holm p* is *p* adjusted by "
         f"Holm's method over all {len(tests)} tests. A residual depends on a "
-        f"feature when its Holm p ≤ {alpha:g}.",
+        f"feature when its Holm p ≤ {alpha:g} ({levels(alpha)}). These tests "
+        "describe the residuals only: no recommendation rests on them (a "
+        "candidate is recommended by its held-out gain alone).",
         "",
     ]
     if hits:
@@ -158,8 +184,18 @@ def _dependence_section(tests: list[Dependence]) -> list[str]:
     out += [
         "",
         "Features tested: " + "; ".join(labels.feature(f) for f in tested) + ".",
-        "",
     ]
+    untested = [f for f in features if f not in tested]
+    if untested:
+        out.append(
+            "Not tested (drawn in the figure all the same): "
+            + "; ".join(
+                f"{labels.feature(f)}: {residual_tests.why_untested(features[f])}"
+                for f in untested
+            )
+            + "."
+        )
+    out.append("")
     return out
 
 
@@ -169,7 +205,7 @@ def baseline_label(d: Diagnosis) -> str:
         base = "ballistic flights (g = 9.81 m/s², no drag)"
     else:
         base = "constant e_n, e_t per material"
-    return base + "".join(f" + {e}" for e in d.baseline.effects)
+    return base + "".join(f" + {labels.effect(e)}" for e in d.baseline.effects)
 
 
 def markdown(diagnosis: Diagnosis, *, title: str, inputs: list[str]) -> str:
@@ -182,7 +218,7 @@ def markdown(diagnosis: Diagnosis, *, title: str, inputs: list[str]) -> str:
     out = [f"# Diagnosis: {title}", ""]
     out += [f"* input: `{name}`" for name in inputs]
     out += [
-        f"* {d.n_rows} rows, {d.n_data} data; held out: {d.groups}",
+        f"* {d.size or f'{d.n_rows} rows'}, {d.n_data} data; held out: {d.groups}",
         f"* error measure: the {error} ({unit}), the weighted root-mean-square of "
         "the residuals (measured − model) of data held out of the fit "
         f"(`{d.metric}` in the JSON)",
@@ -264,9 +300,10 @@ def markdown(diagnosis: Diagnosis, *, title: str, inputs: list[str]) -> str:
         out += [_worst_line(w, unit) for w in d.worst]
         out.append("")
     out += ["### Do the residuals depend on a feature?", ""]
-    out += _dependence_section(d.dependence_before)
+    out += _dependence_section(d.dependence_before, d.arrays.get("features", {}))
     kind = d.arrays.get("residual_kind", "held-out")
-    out += [f"![baseline residuals ({kind}) against each feature]({figs[0]})", ""]
+    out += [f"![baseline residuals against each feature; residuals {kind}]({figs[0]})",
+            ""]  # fmt: skip
     rounds = rankings(d)
     out += [
         "## Which effect is missing",
@@ -310,7 +347,9 @@ def markdown(diagnosis: Diagnosis, *, title: str, inputs: list[str]) -> str:
         out += _candidate_rows(rounds[len(d.steps)], unit)
         out.append("")
     out += [
-        f"Effects: {', '.join(d.after.effects) or 'none'}; held-out RMS error "
+        "Effects: "
+        + (", ".join(labels.effect(e) for e in d.after.effects) or "none")
+        + "; held-out RMS error "
         f"{_fmt(d.after.cv_rmse)} {unit}.",
         "",
     ]

@@ -73,6 +73,24 @@ def impact_features(frame: pd.DataFrame, spin_measured: np.ndarray) -> dict:
     return out
 
 
+def why_untested(values: np.ndarray) -> str:
+    """Why a feature of :func:`impact_features` entered no test (in words).
+
+    Examples
+    --------
+    >>> why_untested(np.array(["rock", "rock", "till"] + ["colluvium"] * 9, object))
+    'the test needs two categories of at least 5 impacts (colluvium 9, rock 2, till 1)'
+    """
+    if values.dtype == object:
+        names = sorted(set(values) - {""})
+        counts = ", ".join(f"{c} {int((values == c).sum())}" for c in names)
+        return (
+            f"the test needs two categories of at least {MIN_PER_GROUP} impacts "
+            f"({counts})"
+        )
+    return f"fewer than {2 * MIN_PER_GROUP} impacts with a value and a residual"
+
+
 def dependence_tests(
     residuals: np.ndarray, features: dict[str, np.ndarray]
 ) -> list[Dependence]:

@@ -4,8 +4,8 @@ One row per feature the residuals were tested against (continuous features as
 scatter with a binned median; categories as strips), one column per model: the
 baseline alone, or the model before a step and after it. Axes, legend and titles
 use the words of :mod:`fieldkit.diagnose.labels` (the report's words); a feature
-the residuals were found to depend on says so under its axis, with the residual
-and the Holm-adjusted p-value of the test. A legend under the panels explains
+the residuals were found to depend on says so in a box inside its panel, with the
+residual and the Holm-adjusted p-value of the test. A legend under the panels explains
 every mark: one colour per residual, its binned median, the zero line.
 """
 
@@ -30,17 +30,45 @@ MAX_FEATURES = 6
 #: Quantile bins of the binned median drawn over a continuous feature.
 MEDIAN_BINS = 8
 _COLOURS = ("C0", "C1", "C2")
+#: Head room added above a panel's points for its note (fraction of the y range).
+NOTE_ROOM = 0.22
 
 
 def _depends(tests: list[Dependence]) -> dict[str, str]:
-    """Feature -> the note under its axis when residuals depend on it."""
+    """Feature -> the note inside its panel when residuals depend on it."""
     notes: dict[str, list[str]] = {}
+    alpha = {d.alpha for d in tests}
     for d in sorted(tests, key=lambda d: d.p_value):
         if d.significant:
             notes.setdefault(d.feature, []).append(
                 f"{labels.symbol(d.component)} (Holm p = {d.p_holm:.1g})"
             )
-    return {f: "residuals depend on it: " + ", ".join(n) for f, n in notes.items()}
+    level = f" (Holm p ≤ {alpha.pop():g})" if len(alpha) == 1 else ""
+    return {
+        f: f"residuals depend on this feature{level}: " + ", ".join(n)
+        for f, n in notes.items()
+    }
+
+
+def _wrap(text: str, chars: int) -> str:
+    """``text`` in lines of at most ``chars``, broken before its last parenthesis
+    when that is enough (a unit or a scale stays whole on its own line)."""
+    if len(text) <= chars:
+        return text
+    head, _, tail = text.rpartition(" (")
+    if head and len(head) <= chars and len(tail) < chars:
+        return f"{head}\n({tail}"
+    return textwrap.fill(text, chars)
+
+
+def _note(ax, text: str) -> None:
+    """``text`` inside the top left corner of ``ax``, boxed: it belongs to this
+    panel (under the axis it read as the heading of the panel below)."""
+    ax.text(
+        0.01, 0.97, text, transform=ax.transAxes, ha="left", va="top", fontsize=8,
+        bbox={"boxstyle": "round,pad=0.25", "fc": "white", "ec": "0.5", "alpha": 0.9},
+        zorder=5,
+    )  # fmt: skip
 
 
 def _order(features: dict, flagged: set[str]) -> list[str]:
@@ -50,22 +78,40 @@ def _order(features: dict, flagged: set[str]) -> list[str]:
     ]
 
 
+def _category_axis(ax, values: np.ndarray, residual: np.ndarray):
+    """Place a categorical feature on the x axis: one strip per category, each
+    ticked with its name and how many points it holds (``rock (n = 2)``), the axis
+    wide enough for every strip. Returns ``(x, jitter)``: each point's category
+    position and, per residual column, its offset within the strip."""
+    names = sorted(set(values) - {""})
+    pos = {c: i for i, c in enumerate(names)}
+    x = np.array([pos.get(v, np.nan) for v in values], float)
+    drawn = np.isfinite(residual).any(axis=1)
+    counts = [int((drawn & (values == c)).sum()) for c in names]
+    ax.set_xticks(range(len(names)), [f"{c}\n(n = {n})" for c, n in
+                                      zip(names, counts, strict=True)])  # fmt: skip
+    ax.set_xlim(-0.5, len(names) - 0.5)
+    jitter = np.zeros(residual.shape)
+    for j in range(residual.shape[1]):
+        for c in names:
+            sel = np.flatnonzero((values == c) & np.isfinite(residual[:, j]))
+            spread = np.linspace(-0.15, 0.15, sel.size) if sel.size > 1 else 0.0
+            jitter[sel, j] = spread + 0.1 * (j - 1)
+    return x, jitter
+
+
 def _panel(ax, values, residual, components) -> None:
     cats = values.dtype == object
     if cats:
-        names = sorted(set(values) - {""})
-        pos = {c: i for i, c in enumerate(names)}
-        x = np.array([pos.get(v, np.nan) for v in values], float)
-        ax.set_xticks(range(len(names)), names)
+        x, jitter = _category_axis(ax, values, residual)
     else:
-        x = values
+        x, jitter = values, np.zeros(residual.shape)
     for j, _ in enumerate(components):
         r = residual[:, j]
         ok = np.isfinite(r) & np.isfinite(x)
         if not ok.any():
             continue
-        jitter = (np.linspace(-0.15, 0.15, ok.sum()) + 0.1 * (j - 1)) if cats else 0
-        ax.scatter(x[ok] + jitter, r[ok], s=6, alpha=0.45, c=_COLOURS[j % 3])
+        ax.scatter(x[ok] + jitter[ok, j], r[ok], s=6, alpha=0.45, c=_COLOURS[j % 3])
         if not cats and ok.sum() >= 20:
             edges = np.quantile(x[ok], np.linspace(0, 1, MEDIAN_BINS + 1))
             mid, med = [], []
@@ -122,32 +168,45 @@ def residual_figure(
     """Rows of features, one column per ``(label, residual (n, k), tests)``.
 
     ``tests`` are the dependence tests of the column's residuals: a feature they
-    found is noted under its axis. Rows share their y axis so the fall is seen at
-    scale; ``what`` one point stands for (impact, sample).
+    found is noted in a box inside its panel. Rows share their y axis so the fall
+    is seen at scale; ``what`` one point stands for (impact, sample).
     """
     title += f"\nresiduals: {residual_kind}"
     notes = [_depends(tests) for _, _, tests in columns]
     names = _order(features, set().union(*notes))
     if len(names) < len(features):
+        flagged = set().union(*notes)
+        hidden = "; ".join(
+            labels.feature(f) + (" (the residuals depend on it too)" if f in flagged
+                                 else "")
+            for f in features
+            if f not in names
+        )  # fmt: skip
         title += (
             f"\n{len(names)} of {len(features)} features shown (those the residuals "
-            "depend on first); the report lists every test"
+            f"depend on first); not shown: {hidden}; the report lists every test"
         )
     rows = max(1, len(names))
     width = max(8.0, 5.6 * len(columns))
     fig = Figure(figsize=(width, 2.8 * rows + 1.2), layout="constrained")
     axes = np.atleast_2d(fig.subplots(rows, len(columns), squeeze=False, sharey="row"))
+    chars = int(11 * width / len(columns))  # characters a column's line holds
     for c, (label, residual, _) in enumerate(columns):
         for r, name in enumerate(names):
             ax = axes[r, c]
             _panel(ax, features[name], residual, components)
             note = notes[c].get(name)
-            ax.set_xlabel(labels.feature(name) + (f"\n{note}" if note else ""))
+            ax.set_xlabel(_wrap(labels.feature(name), chars))
+            if note:
+                _note(ax, note)
             if c == 0:
                 ax.set_ylabel(f"residual, measured − model ({unit})")
             if r == 0:
-                ax.set_title(textwrap.fill(label, int(11 * width / len(columns))),
-                             fontsize=10)  # fmt: skip
+                ax.set_title(textwrap.fill(label, chars), fontsize=10)
+    for r, name in enumerate(names):
+        if any(name in n for n in notes):  # room for the note above the points
+            low, high = axes[r, 0].get_ylim()
+            axes[r, 0].set_ylim(low, high + NOTE_ROOM * (high - low))
     present = [
         any(np.isfinite(residual[:, j]).any() for _, residual, _ in columns)
         for j in range(len(components))

@@ -157,9 +157,14 @@ def test_figures_label_axes_in_words_and_explain_every_mark(two_effects):
     for name, fig in figures:
         axes = fig.get_axes()
         for ax in axes:
-            first, *note = ax.get_xlabel().split("\n")
-            assert first in labels.FEATURES.values(), (name, first)
-            assert not note or note[0].startswith("residuals depend on it: "), note
+            # the axis names its feature only (wrapped to the column's width)
+            label = ax.get_xlabel().replace("\n", " ")
+            assert label in labels.FEATURES.values(), (name, label)
+            notes = [t.get_text() for t in ax.texts]
+            assert all(
+                n.startswith("residuals depend on this feature (Holm p ≤ 0.01): ")
+                for n in notes
+            ), notes
             assert ax.get_ylabel() in ("", "residual, measured − model (m/s)")
         legend = fig.legends[0]
         texts = [t.get_text() for t in legend.get_texts()]
@@ -170,14 +175,14 @@ def test_figures_label_axes_in_words_and_explain_every_mark(two_effects):
         assert "held-out RMS error" in titles
         for code in CODE_NAMES:
             assert code not in fig.texts[0].get_text() + titles
-    # the baseline's angle dependence is noted under its axis, with its Holm p
+    # the baseline's angle dependence is noted inside the angle's own panel (under
+    # the axis it read as the heading of the panel below), with its Holm p
     baseline = figures[0][1].get_axes()
-    noted = [ax.get_xlabel() for ax in baseline if "depend" in ax.get_xlabel()]
-    angle = [x for x in noted if x.startswith("impact angle to the ground θi (deg)\n")]
+    noted = {ax.get_xlabel(): [t.get_text() for t in ax.texts] for ax in baseline}
+    angle = noted["impact angle to the ground θi (deg)"]
     assert len(angle) == 1, noted
-    assert re.search(
-        r"\nresiduals depend on it: .*v_fn \(Holm p = [\de.+-]+\)", angle[0]
-    )
+    assert re.search(r": .*v_fn \(Holm p = [\de.+-]+\)", angle[0])
+    assert not any("depend" in x for x in noted)
 
 
 def test_residual_structure_left_is_said_in_words(tmp_path, cli):
@@ -244,7 +249,7 @@ def test_track_report_names_flights_once_and_says_what_is_fixed(
         texts = [t.get_text() for t in fig.legends[0].get_texts()]
         assert texts[0] == "horizontal position x (m), one point per sample of a flight"
         for ax in fig.get_axes():
-            assert ax.get_xlabel().split("\n")[0] in labels.FEATURES.values()
+            assert ax.get_xlabel().replace("\n", " ") in labels.FEATURES.values()
 
 
 def test_legend_leaves_out_a_residual_without_data(tmp_path, cli, figures):
@@ -285,3 +290,61 @@ def test_confounded_structure_is_not_called_unexplained(tmp_path, cli):
     assert "**Residual structure left**: the confounded candidates" in text
     assert "no candidate explains" not in text
     assert "|v_in| = |v_i| sin θi rises with the impact angle θi" in text
+
+
+def test_track_time_axis_and_level_say_what_they_are(track_csv, tmp_path, cli, figures):
+    """The time feature is |t - t_mid| / half the flight (0 to 1): its axis says
+    absolute and what 0 and 1 are; the track's tests use Holm p ≤ 0.05 (an
+    ImpactTable's 0.01): the report, the figure's note and --help say which; the
+    figure's residual kind is not nested in a second parenthesis."""
+    from fieldkit.diagnose import flights, residual_tests
+
+    figures.clear()
+    r = cli("diagnose", track_csv, "--radius", "0.2", "--seed", "0",
+            "--report", tmp_path / "rep")  # fmt: skip
+    assert r.exit_code == 0, r.output
+    assert (residual_tests.ALPHA, flights.DEPENDENCE_ALPHA) == (0.01, 0.05)
+    axis = (
+        "absolute time from mid-flight / half the flight's duration\n"
+        "(0 mid-flight, 1 take-off or landing)"
+    )
+    time_axes = [ax for _, fig in figures for ax in fig.get_axes()
+                 if ax.get_xlabel() == axis]  # fmt: skip
+    assert len(time_axes) == 3, [ax.get_xlabel() for _, f in figures
+                                 for ax in f.get_axes()]  # fmt: skip
+    assert time_axes[0].get_xticks().min() >= -0.2
+    notes = [t.get_text() for ax in time_axes for t in ax.texts]
+    assert notes and all(
+        n.startswith("residuals depend on this feature (Holm p ≤ 0.05): x (Holm p")
+        for n in notes
+    ), notes
+    text = (tmp_path / "rep" / "report.md").read_text()
+    assert "((" not in text and "))" not in text.replace("(s))", "")
+    assert (
+        "![baseline residuals against each feature; residuals in-sample (each "
+        "flight's own fit)](baseline.png)"
+    ) in text
+    assert (
+        "A residual depends on a feature when its Holm p ≤ 0.05 (the level of a "
+        "track's flight tests; an ImpactTable's tests use 0.01). These tests "
+        "describe the residuals only: no recommendation rests on them"
+    ) in text
+    help_text = " ".join(cli("diagnose", "--help").stdout.split())
+    assert "a residual depends on a feature when its Holm-adjusted p <= 0.01." in (
+        help_text
+    )
+    assert (
+        "(4 tests; a residual depends on a feature when its Holm-adjusted p <= 0.05). "
+        "The dependence tests only describe the residuals: no recommendation rests "
+        "on them."
+    ) in help_text
+
+
+def test_impact_report_states_its_level_and_the_tracks(two_effects):
+    out, _, _ = two_effects
+    text = (out / "rep" / "report.md").read_text()
+    assert (
+        "A residual depends on a feature when its Holm p ≤ 0.01 (the level of an "
+        "ImpactTable's tests; a track's flight tests use 0.05). These tests "
+        "describe the residuals only: no recommendation rests on them"
+    ) in text
