@@ -81,7 +81,7 @@ def plural(count: int, noun: str) -> str:
 
 def parameter_words(name: str) -> str:
     """A fitted parameter in words with its unit (``materials.colluvium.e_n`` ->
-    ``colluvium: normal restitution e_n (-)``)."""
+    ``colluvium: normal restitution e_n``; units where it has one)."""
     from fieldkit.diagnose.labels import parameter
     from fieldkit.model.model_file import CORE_DEFAULTS
 
@@ -89,7 +89,9 @@ def parameter_words(name: str) -> str:
     if parts[0] == "core" and len(parts) == 2 and parts[1] in CORE_DEFAULTS:
         return f"simulator setting {parts[1]} ({CORE_DEFAULTS[parts[1]][3]})"
     words, unit = parameter(name)
-    return f"{words} ({unit or '-'})" if words != name else name
+    if words == name:
+        return name
+    return words if unit in ("", "-") else f"{words} ({unit})"
 
 
 def _value(p: dict) -> str:
