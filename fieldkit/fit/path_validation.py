@@ -33,7 +33,9 @@ def validate(
     """Scores of the three forecasts on ``holdout`` (``fitted``: calibrated values).
 
     Returns ``{"forecasts": {name: scores}, "ensembles": {name: [arrays]},
-    "observed": array, "path_ids": [...]}``; each ``scores`` as
+    "observed": array, "path_ids": [...], "section_end_m": [...]}`` (the last
+    chainage of each run's section from its release: a rock simulated that far left
+    the section, its runout censored); each ``scores`` as
     :func:`holdout_scores` with the climatology as reference (``crps_skill``), plus
     ``mean_error_m`` = mean predicted - mean observed runout.
     """
@@ -57,4 +59,7 @@ def validate(
         "ensembles": ensembles,
         "observed": observed,
         "path_ids": [r.path_id for r in objective.runs],
+        "section_end_m": [
+            float(r.model.profile.x_m[-1] - r.model.seeder.x_m) for r in objective.runs
+        ],
     }
