@@ -29,6 +29,11 @@ def test_tschamut_fit_writes_model_json_and_holdout_scores(cli, tmp_path):
     fit = json.loads((tmp_path / "fit.json").read_text())
     assert fit["n_runs"] == 18
     assert fit["objective_optimum"] <= fit["objective_start"]
+    # the slice's ends are bisected: two-sided ranges (the 9-point grid alone ended
+    # every one at the fitted value), so each parameter has evidence either way
+    for p in fit["parameters"]:
+        lo, hi = p["interval90"]
+        assert lo < p["value"] < hi and p["range_resolved"], p
     h = fit["holdout"]
     assert set(h) == {"calibrated", "uncalibrated", "climatology"}
     assert all(v["n_runs"] == 18 for v in h.values())
