@@ -125,8 +125,8 @@ def uncertainty_lines(summary: dict) -> list[str]:
     boot, n_runs = summary["bootstrap_size"], summary["n_runs"]
     if boot < MIN_BOOTSTRAP_SE:
         return [
-            f"no standard errors or correlations: {boot} bootstrap resamples are "
-            f"fewer than the {MIN_BOOTSTRAP_SE} a standard error needs; the range is "
+            f"no standard errors or correlations: --bootstrap {boot} is fewer than "
+            f"the {MIN_BOOTSTRAP_SE} resamples a standard error needs; the range is "
             "the values the runs cannot tell from the optimum (the objective's slice)"
         ]
     t, dof = summary["t_quantile"], summary["t_dof"]
