@@ -107,8 +107,12 @@ def _value(p: dict) -> str:
             )
         return f"{p['value']:.4g} (no standard error{span}; start {p['start']:.4g})"
     bound = ", a lower bound" if p.get("stderr_is_lower_bound") else ""
+    span = (
+        f"90 % {lo:.4g} to {hi:.4g}" if p.get("range_resolved", True)
+        else f"no 90 % range resolved: narrower than {p['slice_resolution']:.2g}"
+    )  # fmt: skip
     return (
-        f"{p['value']:.4g} ± {p['stderr']:.2g}{bound} (90 % {lo:.4g} to {hi:.4g}; "
+        f"{p['value']:.4g} ± {p['stderr']:.2g}{bound} ({span}; "
         f"start {p['start']:.4g})"
     )
 
@@ -205,13 +209,12 @@ def report_markdown(
             f"± is the standard error: the SD of the fitted values over {boot} "
             "bootstrap refits.",
             "",
-            f"The 90 % interval is the fitted value ± {t:.2f} standard errors: "
-            f"Student's t (95 % quantile) with {plural(dof, 'degree')} of freedom, "
-            "not the normal 1.645, because a standard error from few resampled "
-            f"units is itself uncertain (±{t:.1f} SE with {dof} degree"
-            f"{'' if dof == 1 else 's'} of freedom); it is widened to the values the "
-            "objective's slice cannot tell from the optimum where those reach "
-            "further.",
+            f"The 90 % interval is the fitted value ±{t:.1f} SE: Student's t (95 % "
+            f"quantile) with {plural(dof, 'degree')} of freedom "
+            f"(±{t:.1f} SE with {dof}, ±1.76 with 14, ±1.645 with many), because a "
+            "standard error from few resampled units is itself uncertain. Where the "
+            "objective's slice cannot tell values further out from the optimum, the "
+            "interval is widened to them.",
         ]
         if lower_bound:
             explain += [

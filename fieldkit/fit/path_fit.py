@@ -41,10 +41,19 @@ bootstrap values. A flat direction gives no bootstrap spread (each refit stays w
 it starts), so the objective is also sliced across each parameter's bound range (the
 others at the optimum, ``slice_points`` points): a point whose paired mean CRPS
 excess over the runs is below 1.645 times its standard error is compatible with the
-data, and the interval is widened to include every compatible point. A parameter is
-reported as *not pinned down* when its interval spans more than
-:data:`WIDE_FRACTION` of its bound range, or when its bootstrap correlation with
-another parameter exceeds :data:`CORRELATION_LIMIT` in size.
+data, and the interval is widened to include every compatible point. Each end of the
+compatible range is then refined by :data:`SLICE_BISECTIONS` bisections between its
+outermost compatible value and the next grid point out, so the range is two-sided
+where the objective allows (the grid alone tests only its own points, and a coarse
+one ends the range at the optimum itself). A parameter is reported as *not pinned
+down* when its interval spans more than :data:`WIDE_FRACTION` of its bound range, or
+when its bootstrap correlation with another parameter exceeds
+:data:`CORRELATION_LIMIT` in size; when its interval is narrower than the slice
+resolves (an objective kinked at the optimum: simulated ensembles with common random
+numbers) there is no evidence either way, and ``pinned`` is None. With one run the
+bootstrap resamples its observed values, which are not independent: the standard
+errors and intervals are then lower bounds (:attr:`PathFitResult.
+stderr_is_lower_bound`).
 
 References
 ----------
@@ -821,6 +830,8 @@ def fit_paths(
     weights = np.ones(n_units)
     if bootstrap >= MIN_BOOTSTRAP_SE:
         stderr = boot.std(axis=0, ddof=1)
+        # every refit at the same value (e.g. a bound): 0, not rounding noise
+        stderr[stderr <= 1e-12 * span] = 0.0
         with np.errstate(invalid="ignore", divide="ignore"):
             corr = np.corrcoef(boot.T) if p > 1 else np.ones((1, 1))
         corr = np.atleast_2d(np.nan_to_num(corr, nan=0.0))

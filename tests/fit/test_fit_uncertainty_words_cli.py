@@ -89,7 +89,7 @@ def test_one_path_standard_errors_are_lower_bounds(cli, tmp_path, boulder_a):
     report = (tmp_path / "rep" / "report.md").read_text()
     assert "| standard error (a lower bound) |" in report
     assert f"| at least {p['stderr']:.2g} |" in report
-    assert "±6.3 SE with 1 degree of freedom" in report
+    assert "±6.3 SE: Student's t (95 % quantile) with 1 degree of freedom" in report
     assert "**Lower bounds.** One surveyed path" in report
 
 
