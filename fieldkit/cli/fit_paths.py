@@ -245,7 +245,11 @@ def report_markdown(
         "| pinned down by the runs |",
         "|---|---|---|---|---|---|---|",
     ]
-    pinned_words = {True: "yes", False: "no", None: "no evidence (no range resolved)"}
+    pinned_words = {
+        True: "yes, on a lower-bound interval" if lower_bound else "yes",
+        False: "no",
+        None: "no evidence (no range resolved)",
+    }
     for p in summary["parameters"]:
         lo, hi = p["interval90"]
         err = "none" if p["stderr"] is None else f"{p['stderr']:.2g}"
