@@ -145,3 +145,12 @@ def test_holdout_figure_marks_censored_and_release_stops():
     assert texts == ["30%"]  # the share of calibrated rocks stopped at run a's release
     ends = [ln for ln in fig.axes[0].lines if ln.get_marker() == ">"]
     assert len(ends) == 2 and ends[0].get_xdata()[0] == pytest.approx(120.0)
+    # the longer legend sits below the axes, clear of them and of the x label
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    renderer = FigureCanvasAgg(fig).get_renderer()
+    fig.draw_without_rendering()
+    box = fig.legends[0].get_window_extent(renderer)
+    ax = fig.axes[0]
+    assert not box.overlaps(ax.bbox)
+    assert not box.overlaps(ax.xaxis.label.get_window_extent(renderer))
