@@ -112,8 +112,7 @@ def _value(p: dict) -> str:
         else f"no 90 % range resolved: narrower than {p['slice_resolution']:.2g}"
     )  # fmt: skip
     return (
-        f"{p['value']:.4g} ± {p['stderr']:.2g}{bound} ({span}; "
-        f"start {p['start']:.4g})"
+        f"{p['value']:.4g} ± {p['stderr']:.2g}{bound} ({span}; start {p['start']:.4g})"
     )
 
 
@@ -164,7 +163,7 @@ def _kind_lines(result, summary: dict) -> list[str]:
 
 
 def _holdout_lines(summary: dict) -> list[str]:
-    return [
+    lines = [
         f"held out ({plural(h['n_runs'], 'run')}), {name}: mean CRPS "
         f"{h['mean_crps']:.2f} m, 50 % / 90 % coverage {h['coverage_50']:.0%} / "
         f"{h['coverage_90']:.0%}, median |error| {h['median_abs_error']:.1f} m, "
@@ -172,6 +171,19 @@ def _holdout_lines(summary: dict) -> list[str]:
         f"{h['mean_observed']:.1f} m"
         for name, h in summary.get("holdout", {}).items()
     ]
+    from fieldkit.fit.path_validation import RELEASE_STOP_M
+
+    what = {
+        "left_section": "rocks left the section (runout censored at its end)",
+        "stopped_at_release": f"rocks stopped within {RELEASE_STOP_M:g} m of the "
+        "release",
+    }
+    for name, marks in summary.get("holdout_censoring", {}).items():
+        for key, runs in marks.items():
+            if runs:
+                listed = ", ".join(f"{pid} {share:.0%}" for pid, share in runs.items())
+                lines.append(f"held out, {name}: {what[key]}: {listed}")
+    return lines
 
 
 def report_markdown(
@@ -327,7 +339,7 @@ def fit_paths_command(
     from fieldkit.fit.path_fit import check_settings, fit_paths
     from fieldkit.fit.path_runs import section_runs
     from fieldkit.fit.path_sections import path_runs
-    from fieldkit.fit.path_validation import validate
+    from fieldkit.fit.path_validation import censoring, validate
     from fieldkit.impact_table import ImpactTable
     from fieldkit.io.dem import read_dem
     from fieldkit.io.path_observations import (
@@ -415,6 +427,8 @@ def fit_paths_command(
                 validation = validate(held, calibration, fitted, rocks=rocks, seed=seed)
             summary["holdout"] = validation["forecasts"]
             summary["holdout_path_ids"] = validation["path_ids"]
+            summary["holdout_section_end_m"] = validation["section_end_m"]
+            summary["holdout_censoring"] = censoring(validation)
             if report is not None:
                 from fieldkit.viz.holdout_figure import write_holdout_figure
 

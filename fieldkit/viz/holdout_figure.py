@@ -8,6 +8,12 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
+from fieldkit.fit.path_validation import (
+    LISTED_SHARE,
+    RELEASE_STOP_M,
+    left_share,
+    stopped_share,
+)
 from fieldkit.outputs import OutputSet
 from fieldkit.viz.figure_files import save_png
 
@@ -15,20 +21,15 @@ _STYLE = {"calibrated": ("C0", 0.12), "uncalibrated": ("C7", -0.12)}
 _NAMES = {"calibrated": "calibrated", "uncalibrated": "starting (uncalibrated)"}
 
 
-#: A simulated runout within this distance of the section's end: the rock left the
-#: section (its runout is censored: at least that far).
-END_TOLERANCE_M = 0.5
-#: A simulated runout shorter than this stopped at its release (it never got going).
-RELEASE_STOP_M = 5.0
-
-
 def holdout_figure(validation: dict) -> Figure:
     """50 % (thick) and 90 % (thin) central intervals and median of the calibrated
     and uncalibrated forecasts per held-out run; observed runout as a black dot;
-    the climatology's 5-95 % band shaded. A bar end at the section's end (rocks
-    left the section: their runouts are only lower bounds) is marked with an
-    arrow, a bar that starts within :data:`RELEASE_STOP_M` of the release (rocks
-    that stopped where they were released) with a cross and the share of them."""
+    the climatology's 5-95 % band shaded. Where more than
+    :data:`~fieldkit.fit.path_validation.LISTED_SHARE` of a run's rocks left the
+    section (the bar ends at the section's end: those runouts are only lower
+    bounds), an arrow at the bar's end with that share; where more than that
+    stopped within :data:`~fieldkit.fit.path_validation.RELEASE_STOP_M` of the
+    release (the bar starts there), a cross at its start with their share."""
     ids = validation["path_ids"]
     observed = validation["observed"]
     ends = validation.get("section_end_m", [np.inf] * len(ids))
@@ -48,12 +49,16 @@ def holdout_figure(validation: dict) -> Figure:
             ax.plot([q[1], q[3]], [y[i] + dy] * 2, c=colour, lw=4,
                     label=f"{_NAMES[name]} model" if i == 0 else None)  # fmt: skip
             ax.plot(q[2], y[i] + dy, "|", c="k", ms=8)
-            if q[4] >= ends[i] - END_TOLERANCE_M:
+            share = left_share(e, ends[i])
+            if share > LISTED_SHARE:
                 censored = True
                 ax.plot(q[4], y[i] + dy, ">", c=colour, ms=7, mec="k", mew=0.6)
-            if q[0] < RELEASE_STOP_M:
+                ax.annotate(f"{share:.0%}", (q[4], y[i] + dy), xytext=(-6, -9),
+                            textcoords="offset points", fontsize=7,
+                            ha="right")  # fmt: skip
+            share = stopped_share(e)
+            if share > LISTED_SHARE:
                 stopped = True
-                share = float(np.mean(np.asarray(e) < RELEASE_STOP_M))
                 ax.plot(q[0], y[i] + dy, "X", c=colour, ms=7, mec="k", mew=0.6)
                 ax.annotate(f"{share:.0%}", (q[0], y[i] + dy), xytext=(6, -9),
                             textcoords="offset points", fontsize=7)  # fmt: skip
@@ -64,8 +69,8 @@ def holdout_figure(validation: dict) -> Figure:
     ax.plot([], [], "|", c="k", ms=8, label="median simulated runout")
     if censored:
         ax.plot([], [], ">", c="0.6", mec="k", mew=0.6, ms=7,
-                label="bar reaches the section's end: rocks left\nthe section, "
-                "their runout is at least this")  # fmt: skip
+                label="bar reaches the section's end: share of rocks\nthat left "
+                "the section (runout at least this)")  # fmt: skip
     if stopped:
         ax.plot([], [], "X", c="0.6", mec="k", mew=0.6, ms=7,
                 label=f"bar starts at the release: share of rocks\nthat "

@@ -129,20 +129,26 @@ def test_holdout_figure_marks_censored_and_release_stops():
         "observed": np.array([50.0, 80.0]),
         "section_end_m": [100.0, 120.0],
         "ensembles": {
-            "calibrated": [np.r_[np.zeros(30), rng.uniform(40, 90, 70)],
-                           rng.uniform(50, 110, 100)],
-            "uncalibrated": [rng.uniform(40, 90, 100),
-                             np.r_[rng.uniform(60, 110, 40), np.full(60, 120.0)]],
+            "calibrated": [
+                np.r_[np.zeros(30), rng.uniform(40, 90, 70)],
+                rng.uniform(50, 110, 100),
+            ],
+            "uncalibrated": [
+                rng.uniform(40, 90, 100),
+                np.r_[rng.uniform(60, 110, 40), np.full(60, 120.0)],
+            ],
             "climatology": [np.array([40.0, 60, 80])] * 2,
         },  # fmt: skip
         "forecasts": {"calibrated": {"mean_crps": 1.0}},
     }
     fig = holdout_figure(validation)
     labels = [t.get_text() for t in fig.legends[0].get_texts()]
-    assert any("rocks left\nthe section" in t for t in labels), labels
+    assert any("that left the section" in t for t in labels), labels
     assert any("stopped within 5 m" in t for t in labels), labels
     texts = [t.get_text() for t in fig.axes[0].texts]
-    assert texts == ["30%"]  # the share of calibrated rocks stopped at run a's release
+    # the share of calibrated rocks stopped at run a's release, of starting-model
+    # rocks that left run b's section
+    assert texts == ["30%", "60%"]
     ends = [ln for ln in fig.axes[0].lines if ln.get_marker() == ">"]
     assert len(ends) == 2 and ends[0].get_xdata()[0] == pytest.approx(120.0)
     # the longer legend sits below the axes, clear of them and of the x label
