@@ -81,7 +81,17 @@ def plural(count: int, noun: str) -> str:
 
 def parameter_words(name: str) -> str:
     """A fitted parameter in words with its unit (``materials.colluvium.e_n`` ->
-    ``colluvium: normal restitution e_n``; units where it has one)."""
+    ``colluvium: normal restitution e_n``; units where it has one).
+
+    Examples
+    --------
+    >>> parameter_words("materials.meadow.friction_deg")
+    'meadow: friction angle (deg)'
+    >>> parameter_words("velocity_scaled_restitution.k_mps")[-5:]
+    '(m/s)'
+    >>> parameter_words("core.drag_dt_s")
+    'simulator setting drag_dt_s (s)'
+    """
     from fieldkit.diagnose.labels import parameter
     from fieldkit.model.model_file import CORE_DEFAULTS
 
@@ -91,7 +101,9 @@ def parameter_words(name: str) -> str:
     words, unit = parameter(name)
     if words == name:
         return name
-    return words if unit in ("", "-") else f"{words} ({unit})"
+    if unit in ("", "-") or words.endswith(f"({unit})"):
+        return words
+    return f"{words} ({unit})"
 
 
 def _value(p: dict) -> str:

@@ -52,6 +52,10 @@ def test_tschamut_fit_writes_model_json_and_holdout_scores(cli, tmp_path):
     assert (tmp_path / "rep" / "holdout.png").stat().st_size > 20_000
     report = (tmp_path / "rep" / "report.md").read_text()
     assert "![held-out runouts](holdout.png)" in report and "## Held-out runs" in report
+    # in words with units (issue 17): no code names, sections described
+    assert "| meadow: friction angle (deg) | 19.29 |" in report
+    assert "sections: each run's steepest descent from its release on the DEM" in report
+    assert "materials.meadow" not in report and "runout_m" not in report
     for name in ("cal.json", "fit.json", "rep/report.md", "rep/holdout.png"):
         assert f"wrote {tmp_path / name}" in r.stdout
 
