@@ -322,8 +322,8 @@ def fit(
         text = result.report()
         if not result.success:
             raise FieldkitError(
-                f"the fit did not converge ({result.message}): no calibrated model "
-                "written",
+                f"the fit did not converge ({result.stop_words()}): no calibrated "
+                "model written",
                 source=str(table_file),
             )
         fit_record = result.provenance(str(table_file))
