@@ -44,6 +44,59 @@ PATH_ONLY = ("json_file", "holdout_releases", "holdout_deposits", "free", "rocks
              "seed", "bootstrap", "screen", "bound", "section")  # fmt: skip
 
 
+def impact_report_markdown(
+    result, *, table_file: Path, model_file: Path, mapping: list[str]
+) -> str:
+    """report.md of an impact fit: the verdict, each parameter in words with its
+    unit, its flags, and the residual figure."""
+    from fieldkit.cli.fit_paths import parameter_words
+
+    lines = [
+        "# Impact fit",
+        "",
+        f"Table: `{table_file}`; base model: `{model_file}`.",
+        "",
+        *[f"* {m}" for m in mapping],
+        *([""] if mapping else []),
+        f"{'Converged' if result.success else 'FAILED'}: {result.stop_words()}. "
+        f"{result.ndata} rebound values (normal and tangential rebound velocity, "
+        f"rebound spin where measured) from {result.n_impacts} impacts, "
+        f"{result.nparams} parameters.",
+        "",
+        f"**Goodness of fit:** {result.verdict()}.",
+        "",
+        f"Weights: {result.weighting_words()}. Standard errors from the fit's "
+        "Jacobian, scaled by √(reduced chi2). AIC "
+        f"{result.aic:.6g}, BIC {result.bic:.6g} (compare models fitted to the same "
+        "table: lower is better).",
+        "",
+        "## Fitted parameters",
+        "",
+        "| parameter | start | fitted | standard error | flags |",
+        "|---|---|---|---|---|",
+    ]
+    for name, v, se, s0, flags in zip(
+        result.names, result.values, result.stderr, result.start, result.flags(),
+        strict=True,
+    ):  # fmt: skip
+        lines.append(
+            f"| {parameter_words(name)} | {s0:.6g} | {v:.6g} | {se:.2g} "
+            f"| {'; '.join(flags) or 'none'} |"
+        )
+    if result.notes:
+        lines += ["", "## Notes", ""] + [f"* {n}" for n in result.notes]
+    lines += [
+        "",
+        "## Residuals",
+        "",
+        "Observed minus predicted rebound at each impact, against the impact angle "
+        "and speed: a trend is physics the model misses.",
+        "",
+        "![residuals](residuals.png)",
+    ]
+    return "\n".join(lines) + "\n"
+
+
 def _paths(options: dict) -> None:
     from fieldkit.cli.fit_paths import fit_paths_command
 
@@ -269,8 +322,8 @@ def fit(
         text = result.report()
         if not result.success:
             raise FieldkitError(
-                f"the fit did not converge ({result.message}): no calibrated model "
-                "written",
+                f"the fit did not converge ({result.stop_words()}): no calibrated "
+                "model written",
                 source=str(table_file),
             )
         fit_record = result.provenance(str(table_file))
@@ -281,14 +334,14 @@ def fit(
             from fieldkit.viz.fit_figure import write_residual_figure
 
             derived = mapping.table.derive()
-            mapped = "".join(f"* {n}\n" for n in mapping.notes)
             write_text(
                 report / "report.md",
-                f"# Impact fit\n\ntable: `{table_file}`, base model: `{model_file}`\n"
-                f"\n{mapped + chr(10) if mapped else ''}```\n{text}\n```\n\n"
-                "![residuals](residuals.png)\n",
+                impact_report_markdown(
+                    result, table_file=table_file, model_file=model_file,
+                    mapping=mapping.notes,
+                ),
                 outputs,
-            )
+            )  # fmt: skip
             write_residual_figure(
                 report / "residuals.png",
                 result,

@@ -53,23 +53,118 @@ def parse_bounds(items: list[str] | None) -> dict[str, tuple[float, float]]:
     return out
 
 
+#: Scored kinds in words with units (report and console).
+KIND_WORDS = {
+    "runout_m": "runout along the section (m)",
+    "flight_height_m": "normal flight height between impacts (m)",
+    "impact_spacing_m": "horizontal spacing of consecutive impacts (m)",
+    "speed_mps": "speed at the observed impacts (m/s)",
+}
+#: ``--section`` values in words.
+SECTION_WORDS = {
+    "descent": "each run's steepest descent from its release on the DEM",
+    "release-deposit": "the straight line from each run's release to its deposit "
+    "on the DEM",
+}
+
+
+def plural(count: int, noun: str) -> str:
+    """``1 run``, ``2 runs``.
+
+    Examples
+    --------
+    >>> plural(1, "run"), plural(18, "run")
+    ('1 run', '18 runs')
+    """
+    return f"{count} {noun}{'' if count == 1 else 's'}"
+
+
+def parameter_words(name: str) -> str:
+    """A fitted parameter in words with its unit (``materials.colluvium.e_n`` ->
+    ``colluvium: normal restitution e_n``; units where it has one).
+
+    Examples
+    --------
+    >>> parameter_words("materials.meadow.friction_deg")
+    'meadow: friction angle (deg)'
+    >>> parameter_words("velocity_scaled_restitution.k_mps")[-5:]
+    '(m/s)'
+    >>> parameter_words("core.drag_dt_s")
+    'simulator setting drag_dt_s (s)'
+    """
+    from fieldkit.diagnose.labels import parameter
+    from fieldkit.model.model_file import CORE_DEFAULTS
+
+    parts = name.split(".")
+    if parts[0] == "core" and len(parts) == 2 and parts[1] in CORE_DEFAULTS:
+        return f"simulator setting {parts[1]} ({CORE_DEFAULTS[parts[1]][3]})"
+    words, unit = parameter(name)
+    if words == name:
+        return name
+    if unit in ("", "-") or words.endswith(f"({unit})"):
+        return words
+    return f"{words} ({unit})"
+
+
 def _value(p: dict) -> str:
     """``value ± SE (90 % lo to hi; start s)``, without ± when there is no SE."""
     lo, hi = p["interval90"]
     if p["stderr"] is None:
-        span = f"; the runs cannot tell it from {lo:.4g} to {hi:.4g}" if hi > lo else ""
+        if p.get("range_resolved", True):
+            span = f"; the runs cannot tell it from {lo:.4g} to {hi:.4g}"
+        else:
+            span = (
+                f"; no range resolved: the values the runs cannot tell from it span "
+                f"less than the slice resolves, {p['slice_resolution']:.2g}"
+            )
         return f"{p['value']:.4g} (no standard error{span}; start {p['start']:.4g})"
+    bound = ", a lower bound" if p.get("stderr_is_lower_bound") else ""
+    span = (
+        f"90 % {lo:.4g} to {hi:.4g}" if p.get("range_resolved", True)
+        else f"no 90 % range resolved: narrower than {p['slice_resolution']:.2g}"
+    )  # fmt: skip
     return (
-        f"{p['value']:.4g} ± {p['stderr']:.2g} (90 % {lo:.4g} to {hi:.4g}; "
-        f"start {p['start']:.4g})"
+        f"{p['value']:.4g} ± {p['stderr']:.2g}{bound} ({span}; start {p['start']:.4g})"
     )
+
+
+def _flag(p: dict) -> str:
+    """The console's verdict on a parameter (empty when pinned down)."""
+    if p["pinned"] is None:
+        return "  [no evidence that these runs pin it down]"
+    return "" if p["pinned"] else "  [not pinned down by these runs]"
+
+
+def uncertainty_lines(summary: dict) -> list[str]:
+    """What ± and the range mean, said where they are printed (before the values)."""
+    boot, n_runs = summary["bootstrap_size"], summary["n_runs"]
+    if boot < MIN_BOOTSTRAP_SE:
+        return [
+            f"no standard errors or correlations: --bootstrap {boot} is fewer than "
+            f"the {MIN_BOOTSTRAP_SE} resamples a standard error needs; the range is "
+            "the values the runs cannot tell from the optimum (the objective's slice)"
+        ]
+    t, dof = summary["t_quantile"], summary["t_dof"]
+    lines = [
+        f"± is the standard error (SD of {boot} bootstrap refits); 90 % is ± "
+        f"{t:.2f} standard errors (Student's t with {plural(dof, 'degree')} of "
+        "freedom), widened to the objective's slice where that is wider"
+    ]
+    if n_runs == 1:
+        lines.insert(
+            0,
+            "one surveyed path: the bootstrap resamples its own observed values, "
+            "which are not independent, so every ± and 90 % range below is a lower "
+            "bound on the uncertainty (more paths give honest ones)",
+        )
+    return lines
 
 
 def _kind_lines(result, summary: dict) -> list[str]:
     """The CRPS before -> after lines, one per scored kind."""
     if result.kinds == ["runout_m"]:
         return [
-            f"mean CRPS of the {summary['n_runs']} calibration runs: "
+            f"mean CRPS of the {plural(summary['n_runs'], 'calibration run')}: "
             f"{summary['objective_start']:.2f} -> {summary['objective_optimum']:.2f} m"
         ]
     return [
@@ -80,79 +175,151 @@ def _kind_lines(result, summary: dict) -> list[str]:
 
 
 def _holdout_lines(summary: dict) -> list[str]:
-    return [
-        f"held out ({h['n_runs']} runs), {name}: mean CRPS "
+    lines = [
+        f"held out ({plural(h['n_runs'], 'run')}), {name}: mean CRPS "
         f"{h['mean_crps']:.2f} m, 50 % / 90 % coverage {h['coverage_50']:.0%} / "
         f"{h['coverage_90']:.0%}, median |error| {h['median_abs_error']:.1f} m, "
         f"mean runout {h['mean_predicted']:.1f} vs observed "
         f"{h['mean_observed']:.1f} m"
         for name, h in summary.get("holdout", {}).items()
     ]
+    from fieldkit.fit.path_validation import RELEASE_STOP_M
+
+    what = {
+        "left_section": "rocks left the section (runout censored at its end)",
+        "stopped_at_release": f"rocks stopped within {RELEASE_STOP_M:g} m of the "
+        "release",
+    }
+    for name, marks in summary.get("holdout_censoring", {}).items():
+        for key, runs in marks.items():
+            if runs:
+                listed = ", ".join(f"{pid} {share:.0%}" for pid, share in runs.items())
+                lines.append(f"held out, {name}: {what[key]}: {listed}")
+    return lines
 
 
 def report_markdown(
     summary: dict, result, *, inputs: list[str], model_file: Path, mapping: list[str]
 ) -> str:
     """report.md of a path fit: what was fitted, values, CRPS per kind, figures."""
-    from fieldkit.fit.path_fit import MIN_BOOTSTRAP_SE
-
+    n_runs = summary["n_runs"]
+    objective = (
+        "mean CRPS of the observed runouts (m)"
+        if result.kinds == ["runout_m"]
+        else "the sum over what was observed of its mean CRPS divided by its value "
+        f"at the start ({len(result.kinds)} at the start)"
+    )
     lines = [
         "# Path fit",
         "",
-        f"observations: {', '.join(f'`{p}`' for p in inputs)}; base model: "
-        f"`{model_file}`; sections: {summary['section']}",
+        f"Observations: {', '.join(f'`{p}`' for p in inputs)}; base model: "
+        f"`{model_file}`; sections: "
+        f"{SECTION_WORDS.get(summary['section'], summary['section'])}.",
         "",
-        f"{summary['n_runs']} run(s), {summary['rocks']} rocks per run and "
-        f"evaluation, seed {summary['seed']}, {summary['n_evaluations']} "
-        f"evaluations; objective: {summary['objective']}.",
+        f"{plural(n_runs, 'run')}, {summary['rocks']} simulated rocks per run and "
+        f"evaluation, seed {summary['seed']}, "
+        f"{plural(summary['n_evaluations'], 'evaluation')} of the objective: "
+        f"{objective}. The CRPS (continuous ranked probability score) is the mean "
+        "absolute error of a distribution of simulated values against the observed "
+        "one, in the observed value's unit; smaller is better.",
         "",
     ]
     lines += [f"* {m}" for m in mapping] + ([""] if mapping else [])
     boot = summary["bootstrap_size"]
-    se = (
-        f"± is the standard error: the SD of {boot} bootstrap refits"
-        if boot >= MIN_BOOTSTRAP_SE
-        else f"no standard errors: {boot} bootstrap resamples are fewer than "
-        f"{MIN_BOOTSTRAP_SE}; the range is the values the runs cannot tell from the "
-        "optimum (the objective's slice)"
-    )
-    interval = "90 % interval" if boot >= MIN_BOOTSTRAP_SE else "runs cannot tell apart"
+    lower_bound = n_runs == 1 and boot >= MIN_BOOTSTRAP_SE
+    if boot >= MIN_BOOTSTRAP_SE:
+        t, dof = summary["t_quantile"], summary["t_dof"]
+        explain = [
+            f"± is the standard error: the SD of the fitted values over {boot} "
+            "bootstrap refits.",
+            "",
+            f"The 90 % interval is the fitted value ±{t:.1f} SE: Student's t (95 % "
+            f"quantile) with {plural(dof, 'degree')} of freedom "
+            f"(±{t:.1f} SE with {dof}, ±1.76 with 14, ±1.645 with many), because a "
+            "standard error from few resampled units is itself uncertain. Where the "
+            "objective's slice cannot tell values further out from the optimum, the "
+            "interval is widened to them.",
+        ]
+        if lower_bound:
+            explain += [
+                "",
+                "**Lower bounds.** One surveyed path: the bootstrap resamples its "
+                "own observed values (flight heights, impact spacings, speeds), "
+                "which are not independent of each other, so every standard error "
+                "and 90 % interval below understates the uncertainty. Several "
+                "surveyed paths give honest ones.",
+            ]
+        interval = "90 % interval"
+    else:
+        explain = [
+            f"No standard errors: {boot} bootstrap resamples are fewer than the "
+            f"{MIN_BOOTSTRAP_SE} a standard error needs. The range is the values the "
+            "runs cannot tell from the optimum (the objective sliced across each "
+            "parameter's bounds, the others at the optimum); where none is resolved "
+            "that is no evidence either way."
+        ]
+        interval = "values the runs cannot tell from the optimum"
+    se_head = "standard error (a lower bound)" if lower_bound else "standard error"
     lines += [
         "## Fitted parameters",
         "",
-        f"{se}.",
+        *explain,
         "",
-        f"| parameter | start | fitted | standard error | {interval} | bounds "
-        "| pinned down |",
+        f"| parameter | start | fitted | {se_head} | {interval} | search bounds "
+        "| pinned down by the runs |",
         "|---|---|---|---|---|---|---|",
     ]
+    pinned_words = {
+        True: "yes, on a lower-bound interval" if lower_bound else "yes",
+        False: "no",
+        None: "no evidence (no range resolved)",
+    }
     for p in summary["parameters"]:
         lo, hi = p["interval90"]
-        err = "—" if p["stderr"] is None else f"{p['stderr']:.2g}"
+        err = "none" if p["stderr"] is None else f"{p['stderr']:.2g}"
+        if lower_bound and p["stderr"] is not None:
+            err = f"at least {err}"
+        resolved = p.get("range_resolved", True)
+        span = (
+            f"{lo:.4g} to {hi:.4g}" if resolved
+            else f"none resolved (narrower than {p['slice_resolution']:.2g})"
+        )  # fmt: skip
+        if lower_bound and resolved:
+            span = f"at least {span}"
         lines.append(
-            f"| `{p['name']}` | {p['start']:.4g} | {p['value']:.4g} | {err} "
-            f"| {lo:.4g} to {hi:.4g} | {p['bounds'][0]:g} to {p['bounds'][1]:g} "
-            f"| {'yes' if p['pinned'] else 'no'} |"
+            f"| {parameter_words(p['name'])} | {p['start']:.4g} | {p['value']:.4g} "
+            f"| {err} | {span} | {p['bounds'][0]:g} to {p['bounds'][1]:g} "
+            f"| {pinned_words[p['pinned']]} |"
         )
     lines += [
         "",
-        "## Mean CRPS, start -> calibrated",
+        "## Mean CRPS, starting model → calibrated",
         "",
-        "| observed | count | start | calibrated |",
+        "| observed | count | starting model | calibrated |",
         "|---|---|---|---|",
     ]
     for k in summary["kinds"]:
         lines.append(
-            f"| {k['kind']} | {k['observations']} | {k['crps_start']:.4g} "
-            f"| {k['crps_optimum']:.4g} |"
+            f"| {KIND_WORDS.get(k['kind'], k['kind'])} | {k['observations']} "
+            f"| {k['crps_start']:.4g} | {k['crps_optimum']:.4g} |"
         )
     if summary.get("holdout"):
         lines += ["", "## Held-out runs", ""]
         lines += [f"* {x}" for x in _holdout_lines(summary)]
         lines += ["", "![held-out runouts](holdout.png)"]
     if summary["notes"]:
-        lines += ["", "## Notes", ""] + [f"* {n}" for n in summary["notes"]]
+        lines += ["", "## Notes", ""] + [
+            f"* {_in_words(n, summary['parameters'])}" for n in summary["notes"]
+        ]
     return "\n".join(lines) + "\n"
+
+
+def _in_words(text: str, parameters: list[dict]) -> str:
+    """``text`` with each fitted parameter's name in words (the fit's notes name
+    them as the model file does; the report reads in words)."""
+    for p in sorted(parameters, key=lambda p: -len(p["name"])):
+        text = text.replace(p["name"], parameter_words(p["name"]))
+    return text
 
 
 def fit_paths_command(
@@ -184,7 +351,7 @@ def fit_paths_command(
     from fieldkit.fit.path_fit import check_settings, fit_paths
     from fieldkit.fit.path_runs import section_runs
     from fieldkit.fit.path_sections import path_runs
-    from fieldkit.fit.path_validation import validate
+    from fieldkit.fit.path_validation import censoring, validate
     from fieldkit.impact_table import ImpactTable
     from fieldkit.io.dem import read_dem
     from fieldkit.io.path_observations import (
@@ -272,6 +439,8 @@ def fit_paths_command(
                 validation = validate(held, calibration, fitted, rocks=rocks, seed=seed)
             summary["holdout"] = validation["forecasts"]
             summary["holdout_path_ids"] = validation["path_ids"]
+            summary["holdout_section_end_m"] = validation["section_end_m"]
+            summary["holdout_censoring"] = censoring(validation)
             if report is not None:
                 from fieldkit.viz.holdout_figure import write_holdout_figure
 
@@ -291,14 +460,10 @@ def fit_paths_command(
             )  # fmt: skip
             write_text(report / "report.md", text, outputs)
         written = outputs.commit()
+    for line in uncertainty_lines(summary):
+        typer.echo(line)
     for p in summary["parameters"]:
-        flag = "" if p["pinned"] else "  [not pinned down by these runs]"
-        typer.echo(f"{p['name']}: {_value(p)}{flag}")
-    if result.bootstrap.shape[0] < MIN_BOOTSTRAP_SE:
-        typer.echo(
-            f"no standard errors or correlations: --bootstrap {bootstrap} is fewer "
-            f"than the {MIN_BOOTSTRAP_SE} resamples a standard error needs"
-        )
+        typer.echo(f"{p['name']}: {_value(p)}{_flag(p)}")
     for line in _kind_lines(result, summary) + _holdout_lines(summary):
         typer.echo(line)
     report_written(written)

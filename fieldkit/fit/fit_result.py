@@ -23,6 +23,38 @@ CORRELATION_LIMIT = 0.98
 HUGE_SE_RATIO = 1.0
 #: Relative distance to a bound under which a value is "at the bound".
 BOUND_TOLERANCE = 1e-6
+#: Standard deviations of the reduced chi-square (sqrt(2 / dof) for a correct model
+#: and correct standard uncertainties) beyond which it is called far from 1.
+REDCHI_SIGMAS = 3.0
+#: The optimiser's stopping messages (scipy's least_squares) in words.
+STOP_WORDS = {
+    "`ftol` termination condition is satisfied.":
+        "the sum of squares stopped changing (relative change below 1e-8)",
+    "`xtol` termination condition is satisfied.":
+        "the parameters stopped changing (relative change below 1e-8)",
+    "`gtol` termination condition is satisfied.":
+        "the gradient vanished (below 1e-8)",
+    "Both `ftol` and `xtol` termination conditions are satisfied.":
+        "the sum of squares and the parameters stopped changing",
+}  # fmt: skip
+#: Column names in the weighting description -> words.
+WEIGHT_WORDS = {
+    "unit weights (the table has no *_sd columns)":
+        "unit weights (the table gives no standard uncertainties)",
+    "1/sd from the table's": "1 / the standard uncertainty the table gives for",
+    "vfn_sd_mps": "the normal rebound velocity (m/s)",
+    "vft_sd_mps": "the tangential rebound velocity (m/s)",
+    "omega_f_sd_radps": "the rebound spin (rad/s)",
+    "e_n_sd |vin|": "(SD of e_n) × normal impact speed",
+    "e_t_sd |vit|": "(SD of e_t) × tangential impact speed",
+    "e_n_sd": "SD of e_n",
+    "e_t_sd": "SD of e_t",
+    "sd(vfn)": "the normal rebound velocity's",
+    "sd(vft)": "the tangential's",
+    "1/sd with": "1 / standard uncertainty, with",
+    "(no omega_f_sd_radps)": "(the table gives no standard uncertainty for them)",
+    "r omega_f": "r·ω_f",
+}  # fmt: skip
 
 
 @dataclass
@@ -101,14 +133,74 @@ class FitResult:
             out.append(f)
         return out
 
+    def stop_words(self) -> str:
+        """Why the optimiser stopped, in words."""
+        return STOP_WORDS.get(self.message, self.message)
+
+    def weighting_words(self) -> str:
+        """How the data were weighted, in words (column names replaced).
+
+        Examples
+        --------
+        >>> r = FitResult([], *[np.zeros(0)] * 6, 0, 0, 0, 0, 1, 0, 1, True, "",
+        ...               "1/sd from the table's vfn_sd_mps, vft_sd_mps")
+        >>> r.weighting_words()
+        '1 / the standard uncertainty the table gives for the normal rebound velocity \
+(m/s), the tangential rebound velocity (m/s)'
+        """
+        text = self.weighting
+        for name, words in WEIGHT_WORDS.items():
+            text = text.replace(name, words)
+        return text
+
+    def verdict(self) -> str:
+        """What the reduced chi-square says: a sentence.
+
+        With weights 1/sd it is about 1 (within ``sqrt(2 / dof)``) when the model
+        explains the impacts within their standard uncertainties; far above 1 the
+        model misses physics the impacts show or the standard uncertainties are too
+        small; far below, they are too large. With unit weights it is the mean
+        squared residual and says nothing about the fit's adequacy.
+        """
+        dof = self.ndata - self.nparams
+        if self.weighting.startswith("unit weights"):
+            return (
+                f"reduced chi2 {self.redchi:.4g} (m/s)² is the mean squared residual "
+                "of unit weights: no verdict on the model without the table's "
+                "standard uncertainties"
+            )
+        if dof < 1 or not math.isfinite(self.redchi):
+            return f"reduced chi2 {self.redchi:.4g}: too few data for a verdict"
+        spread = math.sqrt(2.0 / dof)
+        expected = f"1 ± {spread:.2g} expected for {dof} degrees of freedom"
+        if self.redchi > 1.0 + REDCHI_SIGMAS * spread:
+            return (
+                f"reduced chi2 {self.redchi:.4g} is far above 1 ({expected}): the "
+                "model misses physics the impacts show, or the table's standard "
+                "uncertainties are too small; the standard errors are scaled up by "
+                f"√{self.redchi:.3g} = {math.sqrt(self.redchi):.2g} to cover it. "
+                "`fieldkit diagnose` ranks the effects that may be missing"
+            )
+        if self.redchi < 1.0 - REDCHI_SIGMAS * spread:
+            return (
+                f"reduced chi2 {self.redchi:.4g} is far below 1 ({expected}): the "
+                "table's standard uncertainties are larger than the scatter of the "
+                "impacts about the model"
+            )
+        return (
+            f"reduced chi2 {self.redchi:.4g} is about 1 ({expected}): the model "
+            "explains the impacts within their standard uncertainties"
+        )
+
     def report(self) -> str:
         """Plain-text report: statistics, then one line per parameter with flags."""
         lines = [
-            f"fit: {'converged' if self.success else 'FAILED'} ({self.message})",
+            f"fit: {'converged' if self.success else 'FAILED'} ({self.stop_words()})",
             f"data {self.ndata} from {self.n_impacts} impacts, parameters "
             f"{self.nparams}; chi2 {self.chi2:.6g}, reduced chi2 {self.redchi:.4g}, "
             f"AIC {self.aic:.6g}, BIC {self.bic:.6g}",
-            f"weights: {self.weighting}",
+            self.verdict(),
+            f"weights: {self.weighting_words()}",
             "standard errors: from the Jacobian, (J^T W J)^-1 scaled by the reduced "
             "chi2",
         ]

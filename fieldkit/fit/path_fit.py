@@ -41,10 +41,19 @@ bootstrap values. A flat direction gives no bootstrap spread (each refit stays w
 it starts), so the objective is also sliced across each parameter's bound range (the
 others at the optimum, ``slice_points`` points): a point whose paired mean CRPS
 excess over the runs is below 1.645 times its standard error is compatible with the
-data, and the interval is widened to include every compatible point. A parameter is
-reported as *not pinned down* when its interval spans more than
-:data:`WIDE_FRACTION` of its bound range, or when its bootstrap correlation with
-another parameter exceeds :data:`CORRELATION_LIMIT` in size.
+data, and the interval is widened to include every compatible point. Each end of the
+compatible range is then refined by :data:`SLICE_BISECTIONS` bisections between its
+outermost compatible value and the next grid point out, so the range is two-sided
+where the objective allows (the grid alone tests only its own points, and a coarse
+one ends the range at the optimum itself). A parameter is reported as *not pinned
+down* when its interval spans more than :data:`WIDE_FRACTION` of its bound range, or
+when its bootstrap correlation with another parameter exceeds
+:data:`CORRELATION_LIMIT` in size; when its interval is narrower than the slice
+resolves (an objective kinked at the optimum: simulated ensembles with common random
+numbers) there is no evidence either way, and ``pinned`` is None. With one run the
+bootstrap resamples its observed values, which are not independent: the standard
+errors and intervals are then lower bounds (:attr:`PathFitResult.
+stderr_is_lower_bound`).
 
 References
 ----------
@@ -107,6 +116,10 @@ BOOTSTRAP_STREAM = 7_919
 #: 71 % at 2), and the correlation of 2 points is always +-1. Below it the fit states
 #: no standard error, no correlation, and its 90 % interval is the objective's slice.
 MIN_BOOTSTRAP_SE = 10
+#: Bisections refining each end of a slice's compatible range between its last
+#: compatible value and the next (rejected) grid point: the end is then known to
+#: 1/64 of the grid step (1/512 of the bound range with 9 slice points).
+SLICE_BISECTIONS = 6
 #: Upper limits of the fit's sizes: every one of the hundreds of evaluations
 #: simulates ``rocks`` rocks per run; each resample is a refit; each screen point an
 #: evaluation.
@@ -417,7 +430,7 @@ class PathFitResult:
     upper: np.ndarray
     correlation: np.ndarray
     compatible: np.ndarray  # (p, 2) slice range the runs cannot tell apart
-    pinned: list[bool]
+    pinned: list[bool | None]  # None: no range resolved, so no evidence either way
     objective_start: float
     objective_optimum: float
     run_crps: np.ndarray  # runout CRPS per scored run, at the optimum (NaN: none)
@@ -435,6 +448,18 @@ class PathFitResult:
     scales: dict[str, float] = field(default_factory=dict)
     kind_start: dict[str, float] = field(default_factory=dict)
     kind_optimum: dict[str, float] = field(default_factory=dict)
+    #: Distance from the optimum within which each slice's ends are not resolved.
+    slice_resolution: np.ndarray | None = None
+    #: Student's t quantile of the 90 % interval (value ± t SE) and its degrees of
+    #: freedom.
+    t_quantile: float = math.nan
+    t_dof: int = 0
+
+    @property
+    def stderr_is_lower_bound(self) -> bool:
+        """Whether the standard errors understate the uncertainty: one run's
+        bootstrap resamples its observed values, which are not independent."""
+        return self.n_runs == 1 and self.bootstrap.shape[0] >= MIN_BOOTSTRAP_SE
 
     def value(self, name: str) -> float:
         """The fitted value of ``name``."""
@@ -449,6 +474,25 @@ class PathFitResult:
         lo, hi = self.interval90[self.names.index(name)]
         return float(lo), float(hi)
 
+    def interval_method(self) -> str:
+        """How the 90 % interval was made, in words."""
+        if self.bootstrap.shape[0] < MIN_BOOTSTRAP_SE:
+            return (
+                "the objective's slice: the values the runs cannot tell from the "
+                "optimum (no standard error)"
+            )
+        text = (
+            f"fitted value ± {self.t_quantile:.3g} standard errors (Student's t, 95 % "
+            f"quantile, {self.t_dof} degree{'s' if self.t_dof != 1 else ''} of "
+            "freedom), widened to the objective's slice where that is wider"
+        )
+        if self.stderr_is_lower_bound:
+            text += (
+                "; one run: the standard error resamples its observed values, which "
+                "are not independent, so it and the interval are lower bounds"
+            )
+        return text
+
     def to_dict(self) -> dict:
         """JSON-ready summary (no model; write that with ``write_model``)."""
         return {
@@ -460,9 +504,12 @@ class PathFitResult:
                     "interval90": [float(a), float(b)],
                     "start": float(s0),
                     "bounds": [float(lo), float(hi)],
-                    "pinned": bool(p),
+                    "pinned": None if p is None else bool(p),
+                    "range_resolved": p is not None,
+                    "slice_resolution": _finite(r),
+                    "stderr_is_lower_bound": self.stderr_is_lower_bound,
                 }
-                for n, v, s, (a, b), s0, lo, hi, p in zip(
+                for n, v, s, (a, b), s0, lo, hi, p, r in zip(
                     self.names,
                     self.values,
                     self.stderr,
@@ -471,6 +518,11 @@ class PathFitResult:
                     self.lower,
                     self.upper,
                     self.pinned,
+                    (
+                        self.slice_resolution
+                        if self.slice_resolution is not None
+                        else np.full(len(self.names), np.nan)
+                    ),
                     strict=True,
                 )
             ],
@@ -480,6 +532,9 @@ class PathFitResult:
                 else None
             ),
             "slice_compatible": self.compatible.tolist(),
+            "interval90_method": self.interval_method(),
+            "t_quantile": _finite(self.t_quantile),
+            "t_dof": self.t_dof,
             "objective": (
                 "mean CRPS of observed runouts [m]"
                 if self.kinds == ["runout_m"]
@@ -530,6 +585,24 @@ def _stratified_se(diff: np.ndarray, strata: Sequence[np.ndarray]) -> float:
         if stratum.size > 1:
             var += stratum.size * float(np.var(diff[stratum], ddof=1))
     return math.sqrt(var)
+
+
+def _bisect(ok: Callable[[float], bool], good: float, bad: float, steps: int) -> float:
+    """The last value found ``ok`` between ``good`` (ok) and ``bad`` (not), by
+    ``steps`` bisections (the boundary is then known to ``|bad - good| / 2**steps``).
+
+    Examples
+    --------
+    >>> _bisect(lambda v: v <= 0.3, 0.0, 1.0, 10)
+    0.2998046875
+    """
+    for _ in range(steps):
+        mid = 0.5 * (good + bad)
+        if ok(mid):
+            good = mid
+        else:
+            bad = mid
+    return good
 
 
 def _simplex(u0: np.ndarray, step: float) -> np.ndarray:
@@ -691,11 +764,15 @@ def fit_paths(
         )
     f0 = float(np.sum(objective.units_of(start_scores)))
     say(
-        f"fit {p} parameters to {n_runs} runs ({rocks} rocks each): "
+        f"fit {p} parameter{'s' * (p != 1)} to {n_runs} run{'s' * (n_runs != 1)} "
+        f"({rocks} rocks each): "
         f"start {f0:.3f}{unit and ' ' + unit}"
     )
     budget = max_evaluations or max(150, 60 * p)
-    description = f"fitting {p} parameters to {n_runs} runs ({rocks} rocks each)"
+    description = (
+        f"fitting {p} parameter{'s' * (p != 1)} to {n_runs} run"
+        f"{'s' * (n_runs != 1)} ({rocks} rocks each)"
+    )
     with stage(description, None):
         starts = [u0]
         if screen > 0:
@@ -753,6 +830,8 @@ def fit_paths(
     weights = np.ones(n_units)
     if bootstrap >= MIN_BOOTSTRAP_SE:
         stderr = boot.std(axis=0, ddof=1)
+        # every refit at the same value (e.g. a bound): 0, not rounding noise
+        stderr[stderr <= 1e-12 * span] = 0.0
         with np.errstate(invalid="ignore", divide="ignore"):
             corr = np.corrcoef(boot.T) if p > 1 else np.ones((1, 1))
         corr = np.atleast_2d(np.nan_to_num(corr, nan=0.0))
@@ -771,25 +850,39 @@ def fit_paths(
     # below Z90 times its SE over runs). A flat direction has no bootstrap spread
     # (every refit stays where it starts), so this is what reveals it.
     compatible = np.empty((p, 2))
+    resolution = span / max(slice_points - 1, 1) / 2**SLICE_BISECTIONS
+
+    def indistinct(j: int, value: float) -> bool:
+        x = x_best.copy()
+        x[j] = value
+        diff = objective.units(x) - best_units
+        return bool(diff.sum() <= Z90 * _stratified_se(diff, objective.strata))
+
     with stage(f"slicing the objective across {p} bound ranges", p) as advance:
         for j in range(p):
             grid = np.linspace(lower[j], upper[j], slice_points)
-            ok = [x_best[j]]
-            for value in grid:
-                x = x_best.copy()
-                x[j] = value
-                diff = objective.units(x) - best_units
-                se = _stratified_se(diff, objective.strata)
-                if diff.sum() <= Z90 * se:
-                    ok.append(value)
-            compatible[j] = min(ok), max(ok)
+            ok = [x_best[j]] + [v for v in grid if indistinct(j, v)]
+            lo, hi = min(ok), max(ok)
+            # The grid only tests its own points: the range's ends lie between the
+            # outermost compatible value and the next grid point out (rejected),
+            # found by bisection, so that it is two-sided where the objective
+            # allows (a coarse grid alone ends it at the optimum itself).
+            below, above = grid[grid < lo], grid[grid > hi]
+            if below.size:
+                lo = _bisect(lambda v, j=j: indistinct(j, v), lo, below.max(),
+                             SLICE_BISECTIONS)  # fmt: skip
+            if above.size:
+                hi = _bisect(lambda v, j=j: indistinct(j, v), hi, above.min(),
+                             SLICE_BISECTIONS)  # fmt: skip
+            compatible[j] = lo, hi
             advance(j + 1, p)
     say(f"slices done after {objective.evaluations} evaluations")
     # Student's t with (units - 1) degrees of freedom rather than the normal 1.645:
     # a bootstrap SE from 15 runs is itself uncertain (SBC: the normal interval
     # covered friction on 79 % of synthetic sites, its z-scores had SD 1.23).
     units = min(s.size for s in objective.strata) if n_runs < 2 else n_runs
-    quantile = float(student_t.ppf(0.95, max(units - 1, 1)))
+    dof = max(units - 1, 1)
+    quantile = float(student_t.ppf(0.95, dof))
     interval = np.column_stack(
         [
             np.clip(x_best - quantile * stderr, lower, upper),
@@ -813,6 +906,20 @@ def fit_paths(
             names[k] for k in range(p) if k != j and abs(corr[j, k]) > CORRELATION_LIMIT
         ]
         ok = bool(np.isfinite(width) and width <= WIDE_FRACTION and not partners)
+        if interval[j, 1] - interval[j, 0] < resolution[j]:
+            # Every value tried beside the optimum was told apart from it: the
+            # objective is kinked there (simulated ensembles with common random
+            # numbers), which says nothing about how well the runs pin it down.
+            ok = None
+            notes.append(
+                f"{n}: no range resolved: the values the runs cannot tell from the "
+                f"optimum span less than the slice resolves ({resolution[j]:.2g}, "
+                f"1/{2**SLICE_BISECTIONS} of its grid step), which is no evidence "
+                "that the runs pin it down"
+                + ("" if bootstrap >= MIN_BOOTSTRAP_SE else
+                   f"; {MIN_BOOTSTRAP_SE} or more bootstrap resamples give a "
+                   "standard error")
+            )  # fmt: skip
         pinned.append(ok)
         if np.isfinite(width) and width > WIDE_FRACTION:
             notes.append(
@@ -838,6 +945,9 @@ def fit_paths(
         correlation=corr,
         compatible=compatible,
         pinned=pinned,
+        slice_resolution=resolution,
+        t_quantile=quantile,
+        t_dof=dof,
         objective_start=f0,
         objective_optimum=float(np.sum(best_units)),
         kinds=list(objective.kinds),

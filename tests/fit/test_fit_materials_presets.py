@@ -148,8 +148,10 @@ def test_path_fit_report_without_holdout(cli, tmp_path, boulder_a):
     assert sorted(p.name for p in rep.iterdir()) == ["report.md"]
     text = (rep / "report.md").read_text()
     assert text.startswith("# Path fit")
-    assert "| flight_height_m | 48 |" in text and "| speed_mps | 49 |" in text
-    assert "no standard errors: 2 bootstrap resamples are fewer than 10" in text
+    # kinds in words with units (issue 17: report.md spoke in column names)
+    assert "| normal flight height between impacts (m) | 48 |" in text
+    assert "| speed at the observed impacts (m/s) | 49 |" in text
+    assert "No standard errors: 2 bootstrap resamples are fewer than the 10" in text
     assert "±" not in r.stdout
     assert "no standard errors or correlations: --bootstrap 2" in r.stdout
     fit = json.loads(js.read_text())
@@ -253,10 +255,12 @@ def test_fit_figures_label_axes_in_words_and_explain_every_mark(tmp_path):
         "forecasts": {k: {"mean_crps": 1.0}
                       for k in ("calibrated", "uncalibrated", "climatology")},
     }  # fmt: skip
-    ax = holdout_figure(validation).axes[0]
+    fig = holdout_figure(validation)
+    ax = fig.axes[0]
     assert ax.get_xlabel() == "runout along the section from the release (m)"
     assert ax.get_ylabel() == "held-out run"
-    legend = {t.get_text() for t in ax.get_legend().get_texts()}
+    # the legend sits below the axes, the figure's own (issue 17: more marks)
+    legend = {t.get_text() for t in fig.legends[0].get_texts()}
     assert {"observed runout", "calibrated model", "starting (uncalibrated) model",
             "median simulated runout", "50 % of simulated runouts (thick)",
             "90 % of simulated runouts (thin)"} <= legend  # fmt: skip

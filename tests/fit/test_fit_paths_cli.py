@@ -21,7 +21,7 @@ def test_tschamut_fit_writes_model_json_and_holdout_scores(cli, tmp_path):
         "--dem", DATA / "terrain.asc",
         "--holdout-paths", SPLIT / "holdout_release_points.csv",
         "--holdout-deposits", SPLIT / "holdout_observed_deposition.csv",
-        "--rocks", "40", "--bootstrap", "2", "--seed", "1",
+        "--rocks", "40", "--bootstrap", "2",
         "-o", tmp_path / "cal.json", "--json", tmp_path / "fit.json",
         "--report", tmp_path / "rep",
     )  # fmt: skip
@@ -29,6 +29,21 @@ def test_tschamut_fit_writes_model_json_and_holdout_scores(cli, tmp_path):
     fit = json.loads((tmp_path / "fit.json").read_text())
     assert fit["n_runs"] == 18
     assert fit["objective_optimum"] <= fit["objective_start"]
+    # the slice's ends are bisected: two-sided ranges (with the README's seed 0 the
+    # 9-point grid alone ended every one at the fitted value), so each parameter
+    # has evidence either way
+    for p in fit["parameters"]:
+        lo, hi = p["interval90"]
+        assert lo < p["value"] < hi and p["range_resolved"], p
+    # censored runouts and stops at the release are said, and marked in the figure
+    marks = fit["holdout_censoring"]
+    assert marks["calibrated"]["stopped_at_release"] == {"v086": 0.475}
+    assert marks["calibrated"]["left_section"] == {}
+    assert marks["uncalibrated"]["left_section"]["v053"] == 0.375
+    stopped = "held out, calibrated: rocks stopped within 5 m of the release: v086 48%"
+    left = ("held out, uncalibrated: rocks left the section (runout censored at its "
+            "end): v006 18%")  # fmt: skip
+    assert stopped in r.stdout and left in r.stdout
     h = fit["holdout"]
     assert set(h) == {"calibrated", "uncalibrated", "climatology"}
     assert all(v["n_runs"] == 18 for v in h.values())
@@ -37,6 +52,10 @@ def test_tschamut_fit_writes_model_json_and_holdout_scores(cli, tmp_path):
     assert (tmp_path / "rep" / "holdout.png").stat().st_size > 20_000
     report = (tmp_path / "rep" / "report.md").read_text()
     assert "![held-out runouts](holdout.png)" in report and "## Held-out runs" in report
+    # in words with units (issue 17): no code names, sections described
+    assert "| meadow: friction angle (deg) | 19.29 |" in report
+    assert "sections: each run's steepest descent from its release on the DEM" in report
+    assert "materials.meadow" not in report and "runout_m" not in report
     for name in ("cal.json", "fit.json", "rep/report.md", "rep/holdout.png"):
         assert f"wrote {tmp_path / name}" in r.stdout
 
