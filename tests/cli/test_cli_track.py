@@ -428,3 +428,43 @@ def test_impacts_to_dev_null_are_written_through(cli, clip):
                  "--impacts", "/dev/null")  # fmt: skip
     assert result.exit_code == 0, result.stderr
     assert "wrote /dev/null" in result.stdout
+
+
+def test_gravity_standard_error_allows_for_frame_to_frame_correlation(
+    cli, render, tmp_path
+):
+    """Issue 17 review: on clips rendered with g = 9.81 exactly `track` warned about
+    flights -3 to -9 standard errors off, because the free-g SE assumed independent
+    residuals while detection errors are correlated frame to frame (lag-1 ~0.5).
+    The printed SE is the least-squares one times sqrt((1 + rho) / (1 - rho)), rho
+    the lag-1 autocorrelation of the free fit's residuals (clipped to [0, 0.95])."""
+    video, _ = _clip(
+        render, tmp_path / "throw.avi", frames=300, velocity=(1.8, 1.2), g=G
+    )
+    out = tmp_path / "track.csv"
+    result = cli("track", video, "--fps", FPS, *SCALE, "--radius", "0.0375", "-o", out)
+    assert result.exit_code == 0, result.stderr
+    (match,) = re.finditer(GRAVITY_LINE, result.stdout)
+    printed_se = float(match.group(2))
+    digits = len(match.group(2).split(".")[1])
+
+    # the same flight refitted here, independently of the library
+    track = pd.read_csv(out)
+    flight = track[track["flight"] == 0]
+    t = flight["t_s"].to_numpy() - flight["t_s"].mean()
+    design = np.column_stack([np.ones_like(t), t, -0.5 * t**2])
+    residuals = []
+    for column, cols in (("x_m", 2), ("z_m", 3)):
+        a = design[:, :cols]
+        values = flight[column].to_numpy()
+        coef, *_ = np.linalg.lstsq(a, values, rcond=None)
+        residuals.append(values - a @ coef)
+    n = len(t)
+    sse = sum(float(r @ r) for r in residuals)
+    white_se = np.sqrt(sse / (2 * n - 5) * np.linalg.inv(design.T @ design)[2, 2])
+    rho = sum(float(r[:-1] @ r[1:]) for r in residuals) / sse
+    rho = min(max(rho, 0.0), 0.95)
+    assert rho > 0.1  # rendered detections are correlated frame to frame
+    honest_se = white_se * np.sqrt((1 + rho) / (1 - rho))
+    assert printed_se == pytest.approx(honest_se, abs=0.51 * 10.0**-digits)
+    assert printed_se > 1.1 * white_se
