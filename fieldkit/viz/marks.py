@@ -144,8 +144,9 @@ def impact_count_text(frame: pd.DataFrame) -> str:
 
     Examples
     --------
-    >>> f = pd.DataFrame({"e_n": [np.nan, 0.3, np.nan], "e_t": np.nan,
-    ...                   "vi_x_mps": [np.nan, 1.0, 1.0], "vf_x_mps": [1.0, 1.0, np.nan]})
+    >>> nan = np.nan
+    >>> f = pd.DataFrame({"e_n": [nan, 0.3, nan], "e_t": nan,
+    ...                   "vi_x_mps": [nan, 1.0, 1.0], "vf_x_mps": [1.0, 1.0, nan]})
     >>> impact_count_text(f)
     '1 impact (plus the release point and the stop point)'
     """
@@ -157,7 +158,8 @@ def impact_count_text(frame: pd.DataFrame) -> str:
     def finite(column: str) -> np.ndarray:
         if column not in frame.columns:
             return np.ones(len(frame), bool)
-        return np.isfinite(pd.to_numeric(frame[column], errors="coerce").to_numpy(float))
+        values = pd.to_numeric(frame[column], errors="coerce").to_numpy(float)
+        return np.isfinite(values)
 
     release = others & ~finite("vi_x_mps")
     stop = others & ~release & ~finite("vf_x_mps")
