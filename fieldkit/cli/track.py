@@ -309,5 +309,15 @@ def print_flight_gravity(flights) -> None:
             "fitted gravity per flight (free-g fit; warned beyond "
             f"{GRAVITY_WARNING_SIGMAS:g} standard errors from 9.81):"
         )
+        slow_m = max(f.g_systematic_mps2 * f.duration_s**2 / 8.0 for f in flights)
+        typer.echo(
+            "  standard error: detection noise, correlated from frame to frame"
+            + (
+                f", and a slow detection error of {1e3 * slow_m:.2g} mm (0.05 px: "
+                "compression, background) that bends a short flight like g does"
+                if slow_m > 0
+                else ""
+            )
+        )
     for flight in flights:
         typer.echo(f"  {flight.gravity_summary()}")

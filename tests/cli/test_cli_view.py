@@ -106,7 +106,7 @@ def test_many_impacts_are_recorded_columnar_with_progress(cli, tmp_path):
     out = tmp_path / "sim.rrd"
     result = cli("view", table, "-o", out)
     assert result.exit_code == 0, result.stderr
-    assert f"recording 10,000 impacts of {n_paths} path(s) ..." in result.stderr
+    assert f"recording 10,000 table rows of {n_paths} path(s) ..." in result.stderr
     assert "10,000 impacts, 400 path(s): the section shows every path" in result.stdout
     assert result.stdout.splitlines()[-1] == f"wrote {out}"
     lines = summary(out).splitlines()
