@@ -130,7 +130,9 @@ def track(
     centre to a fraction of a pixel; a marker spot gives its spin. Flights are
     fitted with ballistic parabolas; each flight's fitted g +/- standard error
     is printed and warned about, naming the flight, beyond 3 standard errors
-    from 9.81 (a wrong --fps or scale shows there). Impact and restitution
+    from 9.81 (a wrong --fps or scale shows there). The standard error allows
+    for detection errors correlated from frame to frame and for a slow one of
+    0.05 px, so a short flight checks g only loosely. Impact and restitution
     velocities come from the fits at each contact. A net contact is one event:
     counted as a net contact, with its energy efficiency.
 
