@@ -686,6 +686,18 @@ def render(
     return truth
 
 
+def clip_files(name: str, out_dir: Path, extension: str = ".avi") -> list[Path]:
+    """The files :func:`render` writes for clip ``name``, in the order written."""
+    out_dir = Path(out_dir)
+    return [
+        out_dir / f"{name}{extension}",
+        out_dir / f"{name}.truth.csv",
+        out_dir / f"{name}.homography.json",
+        out_dir / f"{name}.calibration.json",
+        out_dir / f"{name}.truth.json",
+    ]
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
@@ -706,6 +718,8 @@ def main(argv: list[str] | None = None) -> int:
             f"{args.out / truth['clip']}: {truth['frames']} frames, "
             f"{len(truth['impacts'])} impacts, contact={truth['contact'] is not None}"
         )
+        for path in clip_files(name, args.out):
+            print(f"wrote {path}")
     return 0
 
 

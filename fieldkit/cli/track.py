@@ -130,7 +130,9 @@ def track(
     centre to a fraction of a pixel; a marker spot gives its spin. Flights are
     fitted with ballistic parabolas; each flight's fitted g +/- standard error
     is printed and warned about, naming the flight, beyond 3 standard errors
-    from 9.81 (a wrong --fps or scale shows there). Impact and restitution
+    from 9.81 (a wrong --fps or scale shows there). The standard error allows
+    for detection errors correlated from frame to frame and for a slow one of
+    0.05 px, so a short flight checks g only loosely. Impact and restitution
     velocities come from the fits at each contact. A net contact is one event:
     counted as a net contact, with its energy efficiency.
 
@@ -308,6 +310,16 @@ def print_flight_gravity(flights) -> None:
         typer.echo(
             "fitted gravity per flight (free-g fit; warned beyond "
             f"{GRAVITY_WARNING_SIGMAS:g} standard errors from 9.81):"
+        )
+        slow_m = max(f.g_systematic_mps2 * f.duration_s**2 / 8.0 for f in flights)
+        typer.echo(
+            "  standard error: detection noise, correlated from frame to frame"
+            + (
+                f", and a slow detection error of {1e3 * slow_m:.2g} mm (0.05 px: "
+                "compression, background) that bends a short flight like g does"
+                if slow_m > 0
+                else ""
+            )
         )
     for flight in flights:
         typer.echo(f"  {flight.gravity_summary()}")

@@ -154,12 +154,15 @@ def view(
         if len(table) == 0:
             raise InputFileError("table has no rows", source=input_file)
         paths = len(table.paths())
-        with step(f"recording {len(table):,} impacts of {paths:,} path(s)"):
+        from fieldkit.viz.marks import impact_count_text
+
+        with step(f"recording {len(table):,} table rows of {paths:,} path(s)"):
             table = table.derive()
             rerun_log.write_impact_recording(out, table, outputs=outputs)
             written = outputs.commit()
         typer.echo(
-            f"{len(table):,} impacts, {paths:,} path(s): the section shows every path "
+            f"{impact_count_text(table.frame)}, {paths:,} path(s): the section shows "
+            "every path "
             "(one row of the path timeline each), e_n, e_t and speeds against the "
             "impact timeline (table row)"
         )

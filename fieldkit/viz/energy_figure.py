@@ -25,7 +25,7 @@ from fieldkit.outputs import OutputSet
 from fieldkit.physics.energy import energy_head, kinetic_energy, potential_energy
 from fieldkit.physics.flight import flight_samples
 from fieldkit.viz.figure_files import save_png
-from fieldkit.viz.marks import mark_flagged, outside_legend, qa_column
+from fieldkit.viz.marks import impact_rows, mark_flagged, outside_legend, qa_column
 
 
 def energy_profile(table: ImpactTable, n_samples: int = 30) -> dict[str, np.ndarray]:
@@ -161,7 +161,8 @@ def plot_energy_head(table: ImpactTable) -> Figure:
         ms=3.5,
         label="energy head just before an impact",
     )
-    mark_flagged(ax, x, head_i, qa_column(f))
+    impacts = impact_rows(f)  # the release and stop points carry no impact flags
+    mark_flagged(ax, x[impacts], head_i[impacts], qa_column(f[impacts]))
     ax.set_xlabel("x, horizontal distance along the path [m]")
     ax.set_ylabel("elevation / energy head [m]")
     ax.set_title(f"{table.paths()[0]}: energy head line (thesis §6.4.2)")

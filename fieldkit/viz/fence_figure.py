@@ -35,6 +35,25 @@ from fieldkit.viz.marks import outside_legend
 COLOURS = {"rigid": "#d62728", "flexible": "#1f77b4", "stiff": "#2ca02c"}
 
 
+_SUPERSCRIPTS = str.maketrans("0123456789.-", "⁰¹²³⁴⁵⁶⁷⁸⁹·⁻")
+
+
+def force_law_text(law: StructureLaw) -> str:
+    """The force law ``F = c t^n`` as written for a reader (F in N, t in s).
+
+    Examples
+    --------
+    >>> from fieldkit.physics.structure_forces import StructureLaw
+    >>> [force_law_text(StructureLaw("x", c, n)) for c, n in
+    ...  ((1e6, 1.0), (40000.0, 2.0), (30000.0, 0.6), (2.5e-3, 1.5))]
+    ['F = 1,000,000 t', 'F = 40,000 t²', 'F = 30,000 t⁰·⁶', 'F = 0.0025 t¹·⁵']
+    """
+    c, n = float(law.coefficient), float(law.exponent)
+    coefficient = f"{c:,.0f}" if c >= 1 and c == round(c) else f"{c:.3g}"
+    power = "" if n == 1 else f"{n:g}".translate(_SUPERSCRIPTS)
+    return f"F = {coefficient} t{power}"
+
+
 def _draw_time_force(
     ax_impulse: Axes, ax_force: Axes, impulse_ns: float, laws: Iterable[StructureLaw]
 ) -> None:
@@ -61,7 +80,7 @@ def _draw_time_force(
             force_at(law, t_in) / 1e3,
             color=colour,
             lw=2,
-            label=f"{law.name}: F = {law.coefficient:g} t^{law.exponent:g}",
+            label=f"{law.name}: {force_law_text(law)}",
         )
         ax_force.plot([t_end, t_end], [0.0, peak / 1e3], color=colour, lw=0.8, ls="--")
         ax_force.annotate(
@@ -75,7 +94,7 @@ def _draw_time_force(
     ax_impulse.text(
         0.02 * t_max,
         impulse_ns / 1e3,
-        f"rock impulse m v = {impulse_ns:,.0f} N s",
+        f"rock impulse m v = {impulse_ns / 1e3:.2f} kN s",
         va="bottom",
         fontsize=8,
     )
@@ -96,7 +115,7 @@ def _draw_time_force(
         title="time - force (Figs. 8.6, 8.8, eqs. 8.2-8.4)",
     )
     outside_legend(ax_impulse)
-    outside_legend(ax_force)
+    outside_legend(ax_force, title="force law: F in N, t in s", title_fontsize=8)
     for ax in (ax_impulse, ax_force):
         ax.grid(True, alpha=0.3)
 
@@ -106,8 +125,8 @@ def _draw_energy(ax: Axes, split: FenceEnergySplit) -> None:
     re = np.array([float(split.rotational_in_j), float(split.rotational_out_j)]) / 1e3
     totals = np.array([float(split.total_in_j), float(split.total_out_j)]) / 1e3
     x = np.array([0.0, 1.0])
-    ax.bar(x, ke, 0.6, color="#fdae6b", label="kinetic 1/2 m v^2")
-    ax.bar(x, re, 0.6, bottom=ke, color="#a1d99b", label="rotational 1/2 I w^2")
+    ax.bar(x, ke, 0.6, color="#fdae6b", label="kinetic ½ m v²")
+    ax.bar(x, re, 0.6, bottom=ke, color="#a1d99b", label="rotational ½ I ω²")
     absorbed = float(split.absorbed_j) / 1e3
     ax.bar(
         [1.0],

@@ -21,6 +21,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.axes import Axes
 from matplotlib.legend import Legend
+from matplotlib.patches import Rectangle
 from matplotlib.quiver import Quiver, QuiverKey
 
 from fieldkit.impact_table import METHOD_QA_FLAGS, QA_FLAG_LABELS
@@ -112,6 +113,69 @@ def flag_summary(qa_flags) -> FlagSummary:
     }
     apart = [[name for name in row if name not in shared] for row in names]
     return FlagSummary(apart=apart, shared=shared, rows=len(names))
+
+
+def impact_rows(frame: pd.DataFrame) -> np.ndarray:
+    """Rows of an ImpactTable frame that record an impact: a restitution coefficient
+    (``e_n`` or ``e_t``) is known, so the body arrived and left there. A reduced
+    path's first row (the release) and last row (where the body stopped) are points
+    of the path, not impacts; ``fieldkit reduce`` counts impacts the same way. Every
+    row counts when the table has neither column.
+
+    Examples
+    --------
+    >>> f = pd.DataFrame({"e_n": [np.nan, 0.3, 0.4, np.nan], "e_t": np.nan})
+    >>> impact_rows(f).tolist()
+    [False, True, True, False]
+    """
+    known = np.zeros(len(frame), bool)
+    columns = [c for c in ("e_n", "e_t") if c in frame.columns]
+    if not columns:
+        return ~known
+    for c in columns:
+        known |= np.isfinite(pd.to_numeric(frame[c], errors="coerce").to_numpy(float))
+    return known
+
+
+def impact_count_text(frame: pd.DataFrame) -> str:
+    """``48 impacts (plus the release point and the stop point)``: the impacts
+    (:func:`impact_rows`) and, apart, the other rows -- a release point (no impact
+    velocity), a stop point (no restitution velocity), other rows.
+
+    Examples
+    --------
+    >>> nan = np.nan
+    >>> f = pd.DataFrame({"e_n": [nan, 0.3, nan], "e_t": nan,
+    ...                   "vi_x_mps": [nan, 1.0, 1.0], "vf_x_mps": [1.0, 1.0, nan]})
+    >>> impact_count_text(f)
+    '1 impact (plus the release point and the stop point)'
+    """
+    impacts = impact_rows(frame)
+    n = int(impacts.sum())
+    text = f"{n:,} impact{'' if n == 1 else 's'}"
+    others = ~impacts
+
+    def finite(column: str) -> np.ndarray:
+        if column not in frame.columns:
+            return np.ones(len(frame), bool)
+        values = pd.to_numeric(frame[column], errors="coerce").to_numpy(float)
+        return np.isfinite(values)
+
+    release = others & ~finite("vi_x_mps")
+    stop = others & ~release & ~finite("vf_x_mps")
+    rest = others & ~release & ~stop
+    parts = []
+    for mask, one, many in (
+        (release, "the release point", "release points"),
+        (stop, "the stop point", "stop points"),
+        (rest, "one other row without an impact", "other rows without an impact"),
+    ):
+        k = int(mask.sum())
+        if k:
+            parts.append(one if k == 1 else f"{k:,} {many}")
+    if parts:
+        text += f" (plus {' and '.join(parts)})"
+    return text
 
 
 def qa_flagged(frame: pd.DataFrame) -> np.ndarray:
@@ -242,11 +306,26 @@ def free_corner(ax: Axes, x, y) -> str:
 
 def velocity_key(ax: Axes, quiver: Quiver, largest_mps: float, x, y) -> QuiverKey:
     """A key arrow of a round speed for ``quiver`` (at the scale of its arrows), in the
-    corner of the axes freest of the points ``(x, y)`` (what the axes draw)."""
+    corner of the axes freest of the points ``(x, y)`` (what the axes draw), on a
+    white box so that what the axes show beneath it (an image: a scale cross, a
+    texture) does not hide it."""
     speed = nice_speed(largest_mps)
     corner = free_corner(ax, x, y)
     w, h = KEY_BOX
     right, upper = corner.endswith("right"), corner.startswith("upper")
+    ax.add_patch(
+        Rectangle(
+            (1 - w if right else 0.0, 1 - h if upper else 0.0),
+            w,
+            h,
+            transform=ax.transAxes,
+            facecolor="white",
+            edgecolor="0.6",
+            linewidth=0.5,
+            zorder=9,
+            gid="velocity-key-box",
+        )
+    )
     return ax.quiverkey(
         quiver,
         1 - 0.3 * w if right else 0.7 * w,
@@ -257,4 +336,5 @@ def velocity_key(ax: Axes, quiver: Quiver, largest_mps: float, x, y) -> QuiverKe
         coordinates="axes",
         color="0.15",
         fontproperties={"size": 8},
+        zorder=10,
     )

@@ -88,7 +88,9 @@ def draw_pnv(ax, history: ImpulseHistory, *, impulse_unit: str | None = None) ->
         v_t_s = float(v_t[max(after, 0)])
         ax.plot([p_s], [0.0], "o", color=SLIP_COLOUR, ms=7, zorder=5,
                 label=f"slip stops, $p_s$ = {p_s:.3g} {unit}")  # fmt: skip
-        ax.plot([p_s], [v_t_s], "o", mfc="white", color=TANGENTIAL_COLOUR, ms=6)
+        ax.plot([p_s], [v_t_s], "o", mfc="white", color=TANGENTIAL_COLOUR, ms=6,
+                label=f"tangential velocity as slip stops: {v_t_s:.2f} m/s",
+                )  # fmt: skip
 
     ax.set_ylim(bottom - 0.14 * span, top + 0.1 * span)
     ax.set_xlim(min(0.0, p[0]) - 0.02 * p_f, p_f * 1.02)

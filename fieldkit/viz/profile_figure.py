@@ -19,6 +19,31 @@ from fieldkit.viz.figure_files import new_figure, save_png
 LINE_COLOUR = "#b22222"
 
 
+#: How each :attr:`~fieldkit.model.dem_profile.Section.ending` reads in a title.
+ENDING_TEXT = {
+    "local minimum": "the steepest descent stopped at a local minimum",
+    "flat area": "the steepest descent stopped on a flat area",
+    "grid edge": "the line stopped at the edge of the DEM",
+    "nodata": "the line stopped at nodata cells",
+    "maximum length": "the line stopped at its maximum length",
+    "vertex limit": "the line stopped at the vertex limit",
+    "end of polyline": "along the polyline to its last point",
+    "end of the CSV": "as read, to the CSV's last row",
+}
+
+
+def ending_text(ending: str) -> str:
+    """How a section ended, in words (:data:`ENDING_TEXT`; an unknown value as
+    given).
+
+    Examples
+    --------
+    >>> ending_text("local minimum")
+    'the steepest descent stopped at a local minimum'
+    """
+    return ENDING_TEXT.get(ending, ending)
+
+
 def save_profile_figure(
     grid: DemGrid | None,
     section: Section,
@@ -82,4 +107,5 @@ def _draw_section(ax_section, section: Section, title: str) -> None:
     ax_section.set_aspect("equal", adjustable="datalim")
     ax_section.grid(True, alpha=0.3)
     ax_section.legend(title="material", fontsize=8, loc="upper right")
-    ax_section.set_title(title or f"section: {section.ending}", fontsize=10)
+    ending = ending_text(section.ending)
+    ax_section.set_title(title or f"section: {ending}", fontsize=10)

@@ -25,6 +25,8 @@ from fieldkit.physics.local_axes import to_section
 from fieldkit.survey import Survey
 from fieldkit.viz.figure_files import save_png
 from fieldkit.viz.marks import (
+    impact_count_text,
+    impact_rows,
     mark_flagged,
     nice_speed,
     outside_legend,
@@ -130,7 +132,8 @@ def plot_section(table: ImpactTable, survey: Survey | None = None) -> Figure:
             zorder=6,
             label="restitution velocity $v_f$ (∝ speed)",
         )
-    mark_flagged(ax, x, z, qa_column(f))
+    impacts = impact_rows(f)  # the release and stop points carry no impact flags
+    mark_flagged(ax, x[impacts], z[impacts], qa_column(f[impacts]))
     step = max(1, len(f) // 15)
     for i, row in enumerate(f.itertuples(index=False)):
         if i % step == 0 or i == len(f) - 1:
@@ -158,7 +161,8 @@ def plot_section(table: ImpactTable, survey: Survey | None = None) -> Figure:
     ax.set_xlabel("x, horizontal distance along the path [m]")
     ax.set_ylabel("z, elevation [m]")
     ax.set_title(
-        f"{', '.join(table.paths())}: mapped impact points ({len(f)}) and trajectories"
+        f"{', '.join(table.paths())}: mapped impact points, "
+        f"{impact_count_text(f)}, and trajectories"
     )
     ax.grid(True, alpha=0.3)
     outside_legend(ax, below=True)

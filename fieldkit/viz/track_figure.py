@@ -12,8 +12,10 @@
   fits) and spin against time, contacts shaded;
 * ``residuals.png`` — distance of each sample from its fitted flight [mm], with the
   estimated position noise;
-* ``net_contact_<i>.png`` — for each extended contact, speed and share of impulse
-  absorbed against time from contact start (thesis Figs. 8.14 and 8.15).
+* ``net_contact_<i>.png`` — for each extended contact, speed, and the impulse the net
+  has applied (a vector, gravity removed) beside the speed deficit the thesis calls
+  impulse absorbed, both per impact momentum, against time from contact start
+  (thesis Figs. 8.14 and 8.15).
 
 Every axis names its unit; legends sit outside the axes.
 """
@@ -22,6 +24,7 @@ from __future__ import annotations
 
 import functools
 import os
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -29,7 +32,7 @@ from matplotlib.figure import Figure
 
 from fieldkit.outputs import OutputSet
 from fieldkit.tracking.flights.net_contacts import NetContact
-from fieldkit.tracking.flights.pipeline import TrackAnalysis
+from fieldkit.tracking.flights.pipeline import TrackAnalysis, noise_floor
 from fieldkit.viz.figure_files import new_figure, save_png
 from fieldkit.viz.image_projection import project, world_to_image
 from fieldkit.viz.marks import mark_flagged, outside_legend, qa_column, velocity_key
@@ -161,24 +164,77 @@ def plot_track(a: TrackAnalysis, background: np.ndarray | None = None) -> Figure
                     mfc="none",
                     label=label,
                 )
-        for (px, py), p, en, et in zip(
-            pts, imp["point"], imp["e_n"], imp["e_t"], strict=True
-        ):
-            ax.annotate(
-                f"{p}: e_n {en:.2f}, e_t {et:.2f}",
-                (px, py),
-                fontsize=7,
-                xytext=(4, -10),
-                textcoords="offset points",
-            )
+        _label_impacts(ax, imp, sx, h)
         mark_flagged(ax, pts[:, 0], pts[:, 1], qa_column(imp))
-        arrows = _draw_velocities(ax, imp, sx, h, span_m=span_m)
+        _, x_leave, z_leave = leaving_points(a)
+        leave = np.column_stack([sx * x_leave, z_leave])
+        arrows = _draw_velocities(ax, imp, sx, h, span_m=span_m, leave=leave)
     outside_legend(ax, fontsize=7)
     if arrows is not None:  # after the limits are set: the key goes where nothing is
         quiver, largest, tips = arrows
         drawn = np.vstack([np.column_stack([u, v]), pts, tips])
         velocity_key(ax, quiver, largest, drawn[:, 0], drawn[:, 1])
     return fig
+
+
+#: Gap between an impact's contact point and its label [points].
+LABEL_GAP_PT = 6.0
+
+
+def _label_impacts(ax, imp, sx: float, h) -> None:
+    """Label each impact ``point: e_n .., e_t ..`` on the surface side of its contact
+    point (one radius below the centre along -N, past the ground line), where no
+    trajectory runs; on a video frame the image's own axes keep the same sense."""
+    psi = np.radians(imp["slope_deg"].to_numpy(float))
+    radius = np.nan_to_num(imp["radius_m"].to_numpy(float))
+    x, z = sx * imp["x_m"].to_numpy(float), imp["z_m"].to_numpy(float)
+    away = -np.column_stack([sx * np.sin(psi), np.cos(psi)])  # -N, track frame
+    away = np.where(np.isfinite(away), away, [0.0, -1.0])  # no slope: below
+    contact = np.column_stack([x, z]) + radius[:, None] * away
+    anchor = _plot_points(h, contact[:, 0], contact[:, 1])
+    for (ax_, ay), (dx, dy), p, en, et in zip(
+        anchor, away, imp["point"], imp["e_n"], imp["e_t"], strict=True
+    ):
+        if not (np.isfinite(ax_) and np.isfinite(ay)):
+            continue
+        ax.annotate(
+            f"{p}: e_n {en:.2f}, e_t {et:.2f}",
+            (ax_, ay),
+            fontsize=7,
+            xytext=(LABEL_GAP_PT * dx, LABEL_GAP_PT * dy),
+            textcoords="offset points",
+            ha="left" if dx > 0.35 else "right" if dx < -0.35 else "center",
+            va="bottom" if dy > 0.35 else "top" if dy < -0.35 else "center",
+            bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.75),
+            zorder=8,
+        )
+
+
+def leaving_points(a: TrackAnalysis) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Where and when the body leaves each contact of ``a.impacts``: ``(t_s, x_m,
+    z_m)`` per row.
+
+    An impact row gives the contact's start (``t_s``, ``x_m``, ``z_m``); an
+    instantaneous impact leaves from there. An extended contact (a net) lasts
+    ``contact_duration_s``: the body leaves at its end, on the flight that follows
+    (the first flight starting after the contact's start), where the restitution
+    velocity and the spin after the contact belong.
+    """
+    imp = a.impacts.frame
+    t = imp["t_s"].to_numpy(float).copy()
+    x, z = imp["x_m"].to_numpy(float).copy(), imp["z_m"].to_numpy(float).copy()
+    if "contact_duration_s" not in imp.columns:
+        return t, x, z
+    duration = np.nan_to_num(imp["contact_duration_s"].to_numpy(float))
+    starts = np.array([fl.t_start_s for fl in a.flights])
+    for i in np.flatnonzero(duration > 0):
+        after = np.flatnonzero(starts > t[i])
+        if not len(after):
+            continue
+        t[i] = t[i] + duration[i]
+        px, pz = a.flights[after[0]].position(t[i])
+        x[i], z[i] = float(px), float(pz)
+    return t, x, z
 
 
 def _plot_points(h, x, z) -> np.ndarray:
@@ -205,8 +261,8 @@ def _draw_ground(ax, imp, sx: float, h, *, span_m: float, net=None) -> None:
         reach = 0.5 * np.minimum(left, right)
     net = np.zeros(len(x), bool) if net is None else np.asarray(net, bool)
     labels = {
-        False: "ground at each impact (slope_deg)",
-        True: "net's line at the contact (slope_deg)",
+        False: "ground at each impact (the surface at its fitted dip)",
+        True: "net's line at the contact (its fitted dip)",
     }
     for c, t, r, ok, is_net in zip(
         contact, tangent, reach, np.isfinite(psi), net, strict=True
@@ -225,10 +281,12 @@ def _draw_ground(ax, imp, sx: float, h, *, span_m: float, net=None) -> None:
         )
 
 
-def _draw_velocities(ax, imp, sx: float, h, *, span_m: float):
+def _draw_velocities(ax, imp, sx: float, h, *, span_m: float, leave=None):
     """Impact velocity arrows ending at each impact and restitution velocity arrows
-    leaving it, at one scale. Returns ``(quiver, largest speed, arrow tips)`` for the
-    key, or None when no velocity is finite.
+    leaving it (from ``leave``, the ``(n, 2)`` points where the body leaves each
+    contact in the track frame, :func:`leaving_points`; default the impact points),
+    at one scale. Returns ``(quiver, largest speed, arrow tips)`` for the key, or
+    None when no velocity is finite.
 
     Over a video frame the arrows are the projected displacements, scaled by the
     median image scale at the impacts [px/m], so the key is exact for a camera
@@ -253,10 +311,11 @@ def _draw_velocities(ax, imp, sx: float, h, *, span_m: float):
             h, centre[:, 0], centre[:, 1]
         )
         scale = float(np.nanmedian(np.hypot(*step.T)))
+    leave = centre if leave is None else np.asarray(leave, float)
     starts, vectors, colours = [], [], []
     for start_m, end_m, colour in (
         (centre - vi * tau, centre, VI_COLOUR),
-        (centre, centre + vf * tau, VF_COLOUR),
+        (leave, leave + vf * tau, VF_COLOUR),
     ):
         ok = np.isfinite(start_m).all(axis=1) & np.isfinite(end_m).all(axis=1)
         a = _plot_points(h, start_m[ok, 0], start_m[ok, 1])
@@ -282,10 +341,17 @@ def _draw_velocities(ax, imp, sx: float, h, *, span_m: float):
     return quiver, largest, starts + vectors * tau * scale
 
 
-def _shade_contacts(ax, a: TrackAnalysis) -> None:
+#: Legend entry of the shaded contact spans.
+CONTACT_LABEL = "contact: between two flights"
+
+
+def _shade_contacts(ax, a: TrackAnalysis, *, label: bool = True) -> None:
+    """Shade the time from each flight's last sample to the next one's first (one
+    legend entry, :data:`CONTACT_LABEL`, unless ``label`` is False)."""
     for i in range(len(a.flights) - 1):
         t0, t1 = a.flights[i].t_end_s, a.flights[i + 1].t_start_s
-        ax.axvspan(t0, t1, **_CONTACT_SHADE)
+        first = label and i == 0
+        ax.axvspan(t0, t1, label=CONTACT_LABEL if first else None, **_CONTACT_SHADE)
 
 
 def plot_speed_spin(a: TrackAnalysis) -> Figure:
@@ -299,6 +365,9 @@ def plot_speed_spin(a: TrackAnalysis) -> Figure:
     fig, (ax1, ax2) = plt.subplots(
         2, 1, figsize=(8, 6), sharex=True, layout="constrained"
     )
+    for ax in (ax1, ax2):
+        ax.grid(True, alpha=0.3)
+        _shade_contacts(ax, a)
     if ok.any():
         ax1.plot(
             t[ok],
@@ -334,19 +403,17 @@ def plot_speed_spin(a: TrackAnalysis) -> Figure:
             color="crimson",
             label="spin before the impact",
         )
+        t_leave, _, _ = leaving_points(a)
         ax2.plot(
-            imp["t_s"],
+            t_leave,
             imp["omega_f_radps"],
             "^",
             color="green",
-            label="spin after the impact",
+            label="spin after the impact (net: as it leaves)",
         )
-        outside_legend(ax2, fontsize=7)
+    outside_legend(ax2, fontsize=7)
     ax2.set_ylabel("spin omega [rad/s]")
     ax2.set_xlabel("time t [s]")
-    for ax in (ax1, ax2):
-        ax.grid(True, alpha=0.3)
-        _shade_contacts(ax, a)
     return fig
 
 
@@ -354,6 +421,7 @@ def plot_residuals(a: TrackAnalysis) -> Figure:
     """``residuals.png``: distance of each sample from its fitted flight [mm]."""
     f = a.track.frame
     fig, ax = new_figure(8.0, 4.0)
+    _shade_contacts(ax, a)
     for fl in a.flights:
         ax.plot(
             f["t_s"].to_numpy(float)[fl.rows],
@@ -370,13 +438,29 @@ def plot_residuals(a: TrackAnalysis) -> Figure:
             color="k",
             ls="--",
             lw=0.8,
-            label="noise estimate (2-D RMS)",
+            label=textwrap.fill(_noise_label(a.track, noise), 44),
         )
-    _shade_contacts(ax, a)
     ax.set_xlabel("time t [s]")
     ax.set_ylabel("distance from fitted flight [mm]")
     outside_legend(ax, fontsize=7)
     return fig
+
+
+def _noise_label(track, noise_m: float) -> str:
+    """What the dashed noise line of ``residuals.png`` is: the position noise the
+    flight finding assumed (2-D), and whether it is the scatter measured in short
+    windows or the floor for detections correlated from frame to frame
+    (:func:`fieldkit.tracking.flights.pipeline.noise_floor`), which can lie well
+    above the residuals of a clean video."""
+    mm = 1e3 * noise_m * np.sqrt(2)
+    text = f"position noise assumed to find flights, 2-D ({mm:.2f} mm)"
+    floor = noise_floor(track)
+    if floor > 0 and abs(noise_m - floor) <= 1e-9 * floor:
+        return (
+            f"{text}: its floor of 0.05 px, as detection errors are correlated "
+            "over frames"
+        )
+    return f"{text}: the scatter about local parabolas"
 
 
 def plot_net_contact(c: NetContact) -> Figure:
@@ -396,9 +480,26 @@ def plot_net_contact(c: NetContact) -> Figure:
         f"E_e = {100 * c.efficiency:.0f} % (eq. 8.1)",
         fontsize=9,
     )
-    ax2.plot(t_ms, 100 * c.impulse_absorbed_fraction, "o-", ms=3, color="darkred")
-    ax2.set_ylabel("impulse absorbed [% of m V_i]")
+    ax2.plot(
+        t_ms,
+        100 * c.net_impulse_fraction,
+        "o-",
+        ms=3,
+        color="darkred",
+        label="impulse the net has applied, |m (v - v_i - g t)| "
+        "(a vector, gravity removed)",
+    )
+    ax2.plot(
+        t_ms,
+        100 * c.impulse_absorbed_fraction,
+        "--",
+        lw=1.0,
+        color="0.45",
+        label="speed deficit m (V_i - V), the thesis' impulse absorbed (Fig. 8.15)",
+    )
+    ax2.set_ylabel("share of the impact momentum m V_i [%]")
     ax2.set_xlabel("time from contact start [ms]")
+    outside_legend(ax2, below=True, ncols=1, fontsize=7)
     for ax in (ax1, ax2):
         ax.grid(True, alpha=0.3)
     return fig

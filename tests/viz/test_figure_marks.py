@@ -283,7 +283,7 @@ def test_track_figure_draws_the_ground_one_radius_below_each_impact(bounces):
 def test_track_figure_over_a_frame_draws_the_ground_too(bounces):
     fig = plot_track(bounces, over_frame(bounces))
     labels = [line.get_label() for line in fig.axes[0].lines]
-    assert "ground at each impact (slope_deg)" in labels
+    assert "ground at each impact (the surface at its fitted dip)" in labels
 
 
 def test_every_track_axis_names_its_unit(bounces, net):

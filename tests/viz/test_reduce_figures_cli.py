@@ -65,6 +65,8 @@ def reduced(tmp_path_factory, repo):
     assert result.exit_code == 0, result.output
     assert len(saved) == 5
     table = pd.read_csv(out / "b.csv", keep_default_na=False)
+    table.attrs["path"] = out / "b.csv"
+    table.attrs["stdout"] = result.stdout
     return table, {fig.axes[0].get_title(): fig for fig in saved}
 
 
@@ -132,3 +134,31 @@ def test_every_line_drawn_is_in_the_legend(reduced):
     assert "$e_N$ = 1: normal speed kept" in legend_texts(en_theta)
     partition = next(f for t, f in figures.items() if "energy partition" in t)
     assert "impact elevation (some labelled with the point)" in legend_texts(partition)
+
+
+def test_impacts_are_counted_the_same_way_everywhere(reduced, cli, tmp_path):
+    """Issue 17 review: reduce says 48 impacts, but `view` printed "50 impacts", the
+    section title "mapped impact points (50)" and section.png / energy_head.png
+    "50 of 50", "49 of 50" for the method flags (the first and last rows are the
+    release and the stop point). Impacts are rows with an impact everywhere; the
+    release and stop points are named apart."""
+    table, figures = reduced
+    assert len(table) == 50
+    assert re.search(r"\b48 impacts\b", table.attrs["stdout"])
+    both = "48 impacts (plus the release point and the stop point)"
+    section = next(f for t, f in figures.items() if "mapped impact points" in t)
+    assert both in section.axes[0].get_title()
+    for title, fig in figures.items():
+        (said_once,) = [
+            " ".join(t.split())
+            for t in legend_texts(fig)
+            if " ".join(t.split()).startswith(SHARED_LABEL)
+        ]
+        counts = re.findall(r"\((\d+) of (\d+)\)", said_once)
+        assert counts, (title, said_once)
+        assert {of for _, of in counts} == {"48"}, (title, said_once)
+        assert {n for n, _ in counts} == {"48"}, (title, said_once)
+
+    result = cli("view", table.attrs["path"], "-o", tmp_path / "b.rrd")
+    assert result.exit_code == 0, result.stderr
+    assert result.stdout.startswith(f"{both}, 1 path(s):")

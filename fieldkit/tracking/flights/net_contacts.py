@@ -52,7 +52,9 @@ class NetContact:
         Time series through the contact [s], [m/s] (first and last value from the flight
         fits).
     impulse_absorbed_fraction
-        ``1 - V(t)/V_i``: share of the impact impulse absorbed so far (Fig. 8.15) [-].
+        ``1 - V(t)/V_i``: the speed deficit, the thesis' "impulse absorbed"
+        ``m (V_i - V(t))`` per ``m V_i`` (Fig. 8.15) [-]. A difference of speeds, not
+        the impulse vector: see :attr:`net_impulse_fraction`.
     net_impulse_ns
         Magnitude of the impulse the net has applied so far, gravity removed,
         ``m |v(t) - v_i - g (t - t_i)|`` [N s]; NaN without mass.
@@ -95,6 +97,15 @@ class NetContact:
     @property
     def duration_s(self) -> float:
         return self.t_end_s - self.t_start_s
+
+    @property
+    def net_impulse_fraction(self) -> np.ndarray:
+        """Magnitude of the impulse the net has applied so far, gravity removed, per
+        impact momentum: ``|v(t) - v_i - g (t - t_i)| / V_i`` [-] (``net_impulse_ns``
+        divided by ``m V_i``, known without the mass)."""
+        dvx = self.vx_mps - self.vx_mps[0]
+        dvz = self.vz_mps - self.vz_mps[0] + G * (self.t_s - self.t_s[0])
+        return np.hypot(dvx, dvz) / self.vi_mps
 
     def summary(self) -> str:
         """One line for the console: times, speeds and the energy efficiency (eq. 8.1),

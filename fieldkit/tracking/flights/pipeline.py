@@ -291,8 +291,11 @@ def analyse_track(
 
 
 def _fit_all(track: Track, rows_of: list[np.ndarray]) -> list[FlightFit]:
+    slow = noise_floor(track)  # detection error that varies slowly along a flight
     return [
-        fit_flight(track.t[r], track.x[r], track.z[r], index=i, rows=r)
+        fit_flight(
+            track.t[r], track.x[r], track.z[r], index=i, rows=r, systematic_m=slow
+        )
         for i, r in enumerate(rows_of)
     ]
 
