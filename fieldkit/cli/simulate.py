@@ -29,17 +29,50 @@ FLAGS = {
 
 _MEASURED_KEYS = {"x": "x_m", "speed": "speed_mps", "ke": "ke_j", "height": "height_m"}
 
+#: Standard gravity for the bound on a measured bounce height [m/s^2].
+_G_MPS2 = 9.81
+
+
+def _measured_bounds() -> dict[str, tuple[float, str, str]]:
+    """Largest measured speed, translational KE and bounce height: (limit, units,
+    why), from the command line's physical limits (``PHYSICAL_LIMITS``)."""
+    from fieldkit.cli.common import PHYSICAL_LIMITS
+
+    v_max, _, _ = PHYSICAL_LIMITS["speed_mps"]
+    m_max, _, _ = PHYSICAL_LIMITS["mass_kg"]
+    return {
+        "speed_mps": (v_max, "m/s", PHYSICAL_LIMITS["speed_mps"][2]),
+        "ke_j": (
+            0.5 * m_max * v_max**2, "J",
+            f"1/2 m v^2 of the largest rockfall block ({m_max:g} kg) at "
+            f"{v_max:g} m/s",
+        ),
+        "height_m": (
+            v_max**2 / (2 * _G_MPS2), "m",
+            f"a rock thrown up at {v_max:g} m/s rises v^2/(2g)",
+        ),
+    }  # fmt: skip
+
 
 def parse_measured(text: str):
     """``x=610,speed=18,ke=600e3[,height=1.5]`` -> a Measured (x required).
+
+    Each key may be given once; a speed, translational KE (J) or bounce height
+    must be from 0 to the bound of :func:`_measured_bounds` (100 m/s, 5e10 J,
+    510 m): a negative or larger value is a typo or a unit slip.
 
     Examples
     --------
     >>> parse_measured("x=610,speed=18,ke=600e3")
     Measured(x_m=610.0, speed_mps=18.0, ke_j=600000.0, height_m=None)
+    >>> parse_measured("x=50,speed=-5")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    fieldkit.errors.ArgumentError: measured: speed=-5 in 'x=50,speed=-5' must be ...
     """
     from fieldkit.viz.simulation_figure import Measured
 
+    bounds = _measured_bounds()
     values: dict[str, float] = {}
     for part in text.split(","):
         key, sep, value = part.partition("=")
@@ -50,6 +83,13 @@ def parse_measured(text: str):
                 f"{', '.join(_MEASURED_KEYS)}",
                 source="measured",
             )
+        name = _MEASURED_KEYS[key]
+        if name in values:
+            raise ArgumentError(
+                f"{key} given twice in {text!r} ({key}={values[name]:g} and "
+                f"{key}={value.strip()}): give each key once",
+                source="measured",
+            )
         try:
             number = float(value)
         except ValueError:
@@ -58,7 +98,15 @@ def parse_measured(text: str):
             raise ArgumentError(
                 f"{key}={value!r} is not a finite number", source="measured"
             )
-        values[_MEASURED_KEYS[key]] = number
+        if name in bounds:
+            limit, units, why = bounds[name]
+            if not 0 <= number <= limit:
+                raise ArgumentError(
+                    f"{key}={value.strip()} in {text!r} must be from 0 to "
+                    f"{limit:.4g} {units} ({why})",
+                    source="measured",
+                )
+        values[name] = number
     if "x_m" not in values:
         raise ArgumentError(f"{text!r} lacks x=<position m>", source="measured")
     return Measured(**values)
@@ -145,7 +193,8 @@ def simulate(
         typer.Option(
             "--measured",
             help="A measured value at an --at point, e.g. "
-            "x=610,speed=18,ke=600e3[,height=1.5] (ke translational, J): its "
+            "x=610,speed=18,ke=600e3[,height=1.5] (ke translational, J; each key once; "
+            "speed 0-100 m/s, ke 0-5e10 J, height 0-510 m): its "
             "percentile among the simulated rocks crossing x is printed, written to "
             "summary.json and drawn on the figures; repeatable.",
         ),

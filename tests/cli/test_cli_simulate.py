@@ -365,19 +365,19 @@ def test_a_measured_value_beyond_every_rock_has_no_percentile(core, cli, tmp_pat
     """A measured speed above every crossing rock said '100th percentile ± 0.0'; the
     sample only says it lies above all of them."""
     r = cli("simulate", MODEL, "--rocks", "60", "--seed", "3", "--at", "40",
-            "--measured", "x=40,speed=500,ke=1", "--summary", tmp_path / "s.json",
+            "--measured", "x=40,speed=95,ke=1", "--summary", tmp_path / "s.json",
             "--figures", tmp_path / "f")  # fmt: skip
     assert r.exit_code == 0, r.stderr
     m = json.loads((tmp_path / "s.json").read_text())["measured"][0]
     speed, ke = m["speed_mps"], m["ke_j"]
     assert speed["beyond"] == "above" and speed["percentile"] is None
-    assert speed["percentile_se"] is None and speed["simulated_max"] < 500
+    assert speed["percentile_se"] is None and speed["simulated_max"] < 95
     assert ke["beyond"] == "below" and ke["percentile"] is None
     assert ke["simulated_min"] > 1
     line = next(ln for ln in r.stdout.splitlines() if ln.startswith("measured at"))
     n = speed["n"]
     assert (
-        f"speed 500 m/s: above all {n} simulated rocks (their maximum "
+        f"speed 95 m/s: above all {n} simulated rocks (their maximum "
         f"{speed['simulated_max']:.3g} m/s)" in line
     )
     assert f"below all {n} simulated rocks (their minimum" in line

@@ -1,0 +1,96 @@
+"""Hostile command options from the independent audit of issue 17 (third set).
+
+Each case ran and exited 0 with a wrong or silently chosen result: a measured
+value outside physics (sim29, sim71-sim73), a key or an effect parameter given
+twice (sim74, ro05), a fence rebound with more energy than the impact (fen02), a
+fit calibrated from one impact (fit16).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+SMOKE = Path(__file__).resolve().parents[1] / "model" / "data" / "smoke.json"
+
+
+@pytest.fixture()
+def smoke_copy(tmp_path) -> Path:
+    """The smoke model copied into a folder of its own (outputs land beside it)."""
+    path = tmp_path / "model.json"
+    path.write_bytes(SMOKE.read_bytes())
+    return path
+
+
+# ------------------------------------------------------- simulate --measured
+
+
+@pytest.mark.parametrize(
+    ("measured", "words"),
+    [
+        ("x=40,speed=-5", ("speed=-5", "from 0 to 100 m/s")),  # sim29
+        ("x=40,speed=1e300", ("speed=1e300", "from 0 to 100 m/s")),  # sim71
+        ("x=40,ke=-1", ("ke=-1", "from 0 to 5e+10 J")),  # sim72
+        ("x=40,ke=6e10", ("ke=6e10", "from 0 to 5e+10 J")),
+        ("x=40,height=-3", ("height=-3", "from 0 to 509.7 m")),  # sim73
+        ("x=40,height=600", ("height=600", "from 0 to 509.7 m")),
+        ("x=40,speed=5,speed=30", ("speed given twice", "speed=5", "speed=30")),
+        ("x=40,x=50,speed=5", ("x given twice",)),  # sim74 and its like
+    ],
+)
+def test_simulate_refuses_an_impossible_or_repeated_measured_value(
+    cli, fails, digest, smoke_copy, measured, words
+):
+    before = digest(smoke_copy)
+    summary = smoke_copy.parent / "s.json"
+    r = cli(
+        "simulate", smoke_copy, "--rocks", "5", "--seed", "1", "--at", "40",
+        "--measured", measured, "--summary", summary,
+    )  # fmt: skip
+    fails(r, "--measured", *words)
+    assert r.exit_code == 1
+    assert not summary.exists() and digest(smoke_copy) == before
+
+
+def test_simulate_takes_measured_values_at_their_bounds(cli, smoke_copy):
+    """Zero and the bounds themselves are physical: ranked, not refused."""
+    summary = smoke_copy.parent / "s.json"
+    r = cli(
+        "simulate", smoke_copy, "--rocks", "20", "--seed", "1", "--at", "40",
+        "--measured", "x=40,speed=0,ke=0", "--measured", "x=40,speed=100,ke=5e10",
+        "--summary", summary,
+    )  # fmt: skip
+    assert r.exit_code == 0, r.stderr
+    low, high = json.loads(summary.read_text())["measured"]
+    assert low["speed_mps"]["measured"] == 0.0
+    assert high["speed_mps"]["measured"] == 100.0
+    assert high["ke_j"]["measured"] == 5e10
+
+
+# ---------------------------------------------------------- synth --effects
+
+
+def test_synth_refuses_an_effect_parameter_given_twice(cli, fails, smoke_copy):
+    out = smoke_copy.parent / "o.csv"
+    for effects in (
+        ["--effects", "air_drag=cd=0.5", "--effects", "air_drag=cd=0.9"],  # ro05
+        ["--effects", "air_drag=cd=0.5,cd=0.9"],
+    ):
+        r = cli("synth", smoke_copy, "--paths", "2", "--seed", "1", "-o", out, *effects)
+        fails(r, "--effects", "air_drag", "cd given twice", "cd=0.5", "cd=0.9")
+        assert r.exit_code == 1 and not out.exists()
+
+
+def test_synth_prints_every_effect_parameter_it_used(cli, smoke_copy):
+    out = smoke_copy.parent / "o.csv"
+    r = cli(
+        "synth", smoke_copy, "--paths", "2", "--seed", "1", "-o", out,
+        "--effects", "air_drag=cd=0.5", "--effects", "air_drag=air_density_kg_m3=1.1",
+    )  # fmt: skip
+    assert r.exit_code == 0, r.stderr
+    # the two values of one effect are merged; the defaults it used are printed too
+    assert "air_drag (cd 0.5, air_density_kg_m3 1.1)" in r.stdout
+    assert "angle_dependent_restitution (b 1.03, theta_ref_deg 30, a 0)" in r.stdout
+    assert f"wrote {out}" in r.stdout
