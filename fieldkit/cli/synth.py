@@ -25,7 +25,8 @@ FLAGS = {
 
 
 def parse_effect(text: str) -> tuple[str, dict[str, float]]:
-    """``NAME[=k=v,...]`` -> (name, parameter values).
+    """``NAME[=k=v,...]`` -> (name, parameter values); a parameter given twice
+    is refused (one of the two values would be dropped).
 
     Examples
     --------
@@ -47,8 +48,65 @@ def parse_effect(text: str) -> tuple[str, dict[str, float]]:
                 f"{part!r} in {text!r}: expected NAME=key=value,key=value",
                 source="effects",
             )
+        _refuse_repeat(name.strip(), key.strip(), values, number)
         values[key.strip()] = number
     return name.strip(), values
+
+
+def _refuse_repeat(
+    name: str, key: str, values: dict[str, float], number: float
+) -> None:
+    """Refuse parameter ``key`` of effect ``name`` when ``values`` has it already."""
+    if key in values:
+        raise ArgumentError(
+            f"{name} parameter {key} given twice ({key}={values[key]:g} and "
+            f"{key}={number:g}): give each effect parameter once",
+            source="effects",
+        )
+
+
+def parse_effects(texts: list[str]) -> dict[str, dict[str, float]]:
+    """Every ``--effects`` value -> {name: parameter values}.
+
+    The parameters of an effect named more than once are merged; one parameter
+    given twice, in one value or in two, is refused.
+
+    Examples
+    --------
+    >>> parse_effects(["air_drag=cd=0.5", "air_drag=air_density_kg_m3=1.0"])
+    {'air_drag': {'cd': 0.5, 'air_density_kg_m3': 1.0}}
+    >>> parse_effects(["air_drag=cd=0.5", "air_drag=cd=0.9"])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    fieldkit.errors.ArgumentError: effects: air_drag parameter cd given twice ...
+    """
+    hidden: dict[str, dict[str, float]] = {}
+    for text in texts:
+        name, values = parse_effect(text)
+        merged = hidden.setdefault(name, {})
+        for key, number in values.items():
+            _refuse_repeat(name, key, merged, number)
+            merged[key] = number
+    return hidden
+
+
+def effects_words(effects: dict[str, dict[str, float]]) -> str:
+    """The effects and every parameter value used, for the command's output.
+
+    Examples
+    --------
+    >>> effects_words({"air_drag": {"cd": 0.5, "air_density_kg_m3": 1.225}})
+    'air_drag (cd 0.5, air_density_kg_m3 1.225)'
+    >>> effects_words({})
+    'none (base model)'
+    """
+    if not effects:
+        return "none (base model)"
+    return "; ".join(
+        name + (" (" + ", ".join(f"{k} {v:g}" for k, v in values.items()) + ")"
+                if values else "")
+        for name, values in effects.items()
+    )  # fmt: skip
 
 
 @one_line_errors(flags=FLAGS)
@@ -153,7 +211,7 @@ def synth(
     from fieldkit.fit.synthetic import check_paths, synthetic_table, with_effects
     from fieldkit.model.model_file import read_model
 
-    hidden = dict(parse_effect(text) for text in (effects or []))
+    hidden = parse_effects(effects or [])
     if track:
         _synth_track(
             model_file,
@@ -180,10 +238,9 @@ def synth(
         with step(f"writing {len(table):,} impacts", announce=len(table) > 100_000):
             table.write(output, outputs=outputs)
             written = outputs.commit()
-    active = model.effects
     typer.echo(
         f"{len(table)} impacts of {paths} rocks (seed {seed}), noise F = {noise:g} "
-        f"on vf; effects: {', '.join(active) or 'none (base model)'}"
+        f"on vf; effects: {effects_words(model.effects)}"
     )
     report_written(written)
 
@@ -249,6 +306,7 @@ def _synth_track(
     typer.echo(
         f"track of {flights} flights, {len(result)} samples at {fps:g} frames/s "
         f"(seed {seed}), plane dip {dip:.1f} deg, noise {noise_m:g} m, "
-        f"air_drag cd = {float(drag['cd']):g}"
+        f"air_drag cd = {float(drag['cd']):g}, air density "
+        f"{float(drag['air_density_kg_m3']):g} kg/m3"
     )
     report_written(written)
