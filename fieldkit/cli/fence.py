@@ -144,8 +144,11 @@ def fence(
     the energy absorbed and the efficiency E_f/E_i (eq. 8.1). The rebound is
     either measured (--speed-out, --spin-out) or computed by impact mechanics
     from --radius and --angle-in (eqs. 4.20-4.24 in axes along the net, worked
-    example 8A). For the impulse m v_i, the rigid, flexible and stiff
-    time-force laws (eqs. 8.2-8.7) give the contact time and peak force.
+    example 8A). A rebound with more energy than the impact is refused: a
+    fence is passive, E_f/E_i is at most 1 (a computed one gains energy only
+    with e_N above 1, given or from eq. 5.4 at a shallow --angle-in). For the
+    impulse m v_i, the rigid, flexible and stiff time-force laws (eqs.
+    8.2-8.7) give the contact time and peak force.
 
     Example (thesis worked example 8B: the net absorbs 97.5 kJ, 72 %; the
     thesis prints 97.4, subtracting rounded totals):

@@ -36,6 +36,7 @@ from fieldkit.physics._validate import (
     as_output,
     nonnegative_array,
     positive_array,
+    raise_at_first,
     reject,
 )
 from fieldkit.physics.energy import total_kinetic_energy
@@ -49,6 +50,27 @@ __all__ = [
     "fence_energy_split",
     "fence_redirection",
 ]
+
+
+#: Relative excess of the rebound's energy over the impact's taken as rounding: a
+#: rebound computed with e_N <= 1 (which cannot gain energy) reaches 1 + 1e-12.
+ENERGY_ROUNDING = 1e-9
+
+#: Why a rebound may not carry more energy than the impact, for the error messages.
+_PASSIVE = (
+    "a fence is passive and can only absorb energy (thesis ch. 8: the efficiency "
+    "E_f/E_i of eq. 8.1 is at most 1)"
+)
+
+
+def _gains_energy(e_i: np.ndarray, e_f: np.ndarray) -> np.ndarray:
+    """Where the rebound energy ``e_f`` exceeds the impact energy ``e_i``."""
+    return np.asarray(e_f > e_i * (1.0 + ENERGY_ROUNDING))
+
+
+def _restitution_words(e_n: float, *, given: bool) -> str:
+    """The e_N a computed rebound used, and where it came from."""
+    return f"e_n {e_n:.3g}" if given else f"e_N {e_n:.3g} (eq. 5.4; no e_n given)"
 
 
 class FenceEnergySplit(NamedTuple):
@@ -131,6 +153,13 @@ def fence_energy_split(
     omega_in_radps, omega_out_radps
         Spin before and after [rad/s] (sign irrelevant for the energy).
 
+    Raises
+    ------
+    ArgumentError
+        Naming ``speed_out_mps`` when the rock leaves with more energy than it
+        brought (beyond :data:`ENERGY_ROUNDING`): a fence cannot add energy
+        (eq. 8.1, efficiency at most 1).
+
     Examples
     --------
     Worked example 8B: 520 kg, k = 0.35 m, 22 -> 11.5 m/s, 18 -> -11.6 rad/s; the
@@ -139,6 +168,10 @@ def fence_energy_split(
     >>> s = fence_energy_split(520.0, 0.35, 22.0, 18.0, 11.5, -11.6)
     >>> round(float(s.absorbed_j) / 1e3, 2), round(float(s.absorbed_fraction), 2)
     (97.49, 0.72)
+    >>> fence_energy_split(520.0, 0.35, 10.0, 0.0, 30.0, 0.0)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    fieldkit.errors.ArgumentError: speed_out_mps: the rebound (speed_out_mps 30 m/s, ...
     """
     mass = positive_array(mass_kg, "mass_kg", "kg")
     gyration = nonnegative_array(gyration_m, "gyration_m", "m")
@@ -149,6 +182,19 @@ def fence_energy_split(
     ke_f = 0.5 * mass * speed_out**2
     e_i = np.asarray(total_kinetic_energy(mass, speed_in, inertia, omega_in_radps))
     e_f = np.asarray(total_kinetic_energy(mass, speed_out, inertia, omega_out_radps))
+    raise_at_first(
+        _gains_energy(e_i, e_f),
+        lambda v, w, ef, ei: (
+            f"the rebound (speed_out_mps {v:g} m/s, spin_out_radps {w:g} rad/s) "
+            f"carries E_f = {ef / 1e3:.2f} kJ, more than the impact's E_i = "
+            f"{ei / 1e3:.2f} kJ: {_PASSIVE}"
+        ),
+        speed_out,
+        np.asarray(omega_out_radps, float),
+        e_f,
+        e_i,
+        source="speed_out_mps",
+    )
     with np.errstate(divide="ignore", invalid="ignore"):
         efficiency = np.where(e_i > 0, e_f / e_i, np.nan)
     absorbed = e_i - e_f
@@ -197,6 +243,13 @@ def fence_redirection(
     friction
         Coulomb friction at the net; ``inf`` (default) = slip stops, eqs. 4.20-4.22.
 
+    Raises
+    ------
+    ArgumentError
+        Naming ``e_n`` when the rebound carries more energy per unit mass
+        (``v^2/2 + k^2 omega^2/2``) than the impact: an ``e_n`` above 1, given or
+        from eq. 5.4 at a shallow ``angle_deg``, cannot hold for a passive net.
+
     Examples
     --------
     Worked example 8A inputs (v = 22 m/s, theta_i = 50 deg, omega = +18 rad/s,
@@ -215,6 +268,7 @@ def fence_redirection(
     theta = np.radians(angle)
     v_it = speed * np.cos(theta)
     v_in = -speed * np.sin(theta)
+    given_e_n = e_n
     if e_n is None:
         e_n = angle_dependent_restitution(angle)
     result = rough_body_impact(
@@ -225,6 +279,23 @@ def fence_redirection(
         gyration_m=gyration_m,
         e_n=e_n,
         friction=friction,
+    )
+    gyration = np.asarray(gyration_m, float)
+    e_i = 0.5 * (speed**2 + (gyration * np.asarray(omega_radps, float)) ** 2)
+    e_f = 0.5 * (result.v_f_mps**2 + (gyration * result.omega_f_radps) ** 2)
+    raise_at_first(
+        _gains_energy(e_i, e_f),
+        lambda en, a, ef, ei: (
+            _restitution_words(en, given=given_e_n is not None)
+            + f" at {a:g} deg to the net sends the rock off with {ef / ei:.3g} "
+            f"times the energy it brought ({ef:.4g} against {ei:.4g} J/kg): "
+            f"{_PASSIVE}; give an e_n of at most 1"
+        ),
+        np.asarray(e_n, float),
+        angle,
+        e_f,
+        e_i,
+        source="e_n",
     )
     return FenceRedirection(
         as_output(v_it),

@@ -94,3 +94,65 @@ def test_synth_prints_every_effect_parameter_it_used(cli, smoke_copy):
     assert "air_drag (cd 0.5, air_density_kg_m3 1.1)" in r.stdout
     assert "angle_dependent_restitution (b 1.03, theta_ref_deg 30, a 0)" in r.stdout
     assert f"wrote {out}" in r.stdout
+
+
+# --------------------------------------------------------------------- fence
+
+
+@pytest.mark.parametrize(
+    ("rebound", "words"),
+    [
+        # fen02: printed "absorbed by the fence: -208.00 kJ (-800.0%)"
+        (
+            ["--speed-out", "30"],
+            ("--speed-out 30 m/s", "--spin-out 0 rad/s", "E_f = 234.00 kJ",
+             "E_i = 26.00 kJ", "passive", "eq. 8.1"),
+        ),
+        (
+            ["--speed-out", "10", "--spin-out", "50"],
+            ("--spin-out 50 rad/s", "E_f = 105.62 kJ", "E_i = 26.00 kJ"),
+        ),
+    ],
+)  # fmt: skip
+def test_fence_refuses_a_measured_rebound_with_more_energy(
+    cli, fails, tmp_path, rebound, words
+):
+    figure = tmp_path / "fence.png"
+    r = cli(
+        "fence", "--mass", "520", "--gyration", "0.35", "--speed-in", "10",
+        *rebound, "--figure", figure,
+    )  # fmt: skip
+    fails(r, "--speed-out", *words)
+    assert r.exit_code == 1 and not figure.exists()
+    assert "absorbed" not in r.stdout
+
+
+@pytest.mark.parametrize(
+    ("options", "words"),
+    [
+        (["--e-n", "1.5", "--angle-in", "40"], ("--e-n 1.5 at 40 deg", "1.28 times")),
+        # eq. 5.4 at 5 deg gives e_N 3.72 (a spin against the slip adds the rest)
+        (
+            ["--angle-in", "5", "--spin-in=-30"],
+            ("e_N 3.72 (eq. 5.4; no --e-n given) at 5 deg", "1.03 times"),
+        ),
+    ],
+)
+def test_fence_refuses_a_computed_rebound_with_more_energy(cli, fails, options, words):
+    r = cli(
+        "fence", "--mass", "520", "--gyration", "0.35", "--radius", "0.43",
+        "--speed-in", "10", *options,
+    )  # fmt: skip
+    fails(r, "--e-n", "passive", "at most 1", *words)
+    assert r.exit_code == 1
+
+
+def test_fence_keeps_a_rebound_with_all_the_energy(cli):
+    """Efficiency 100 % (nothing absorbed) is the limit, not beyond it."""
+    r = cli(
+        "fence", "--mass", "520", "--gyration", "0.35", "--speed-in", "10",
+        "--speed-out", "10",
+    )  # fmt: skip
+    assert r.exit_code == 0, r.stderr
+    assert "absorbed by the fence: 0.00 kJ (0.0% of the impact energy)" in r.stdout
+    assert "energy efficiency E_f/E_i (eq. 8.1): 100.0%" in r.stdout
