@@ -263,7 +263,9 @@ def fit(
     (which ones is printed), else unit weights. The calibrated model keeps the
     base model's format, with the fitted values and provenance.fit (values,
     standard errors, correlations, AIC/BIC). The report flags parameters at a
-    bound, not identifiable, or unchanged.
+    bound, not identifiable, or unchanged. A table too small for standard errors
+    worth the name is refused: at least 2 impacts per fitted material and 3
+    residual degrees of freedom (data - parameters).
 
     Example (from the repository root):
 

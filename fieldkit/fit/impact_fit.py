@@ -56,6 +56,18 @@ HELD: dict[str, str] = {
     "with a > 0 it trades exactly with the material e_n",
     "slope_roughness.scale": "acts through the slope the table records",
 }
+#: Fewest impacts an impact fit takes per fitted material, and fewest residual
+#: degrees of freedom (data - parameters). Below them the standard errors are not
+#: worth the name: one impact determines its material's e_n and e_t exactly from
+#: its vfn and vft (zero residuals, nothing of its own to measure the scatter;
+#: two overdetermine them), and the errors' pooled scale sqrt(chi2 / dof) is itself
+#: uncertain by about 1 / sqrt(2 dof) -- 71 % at 1 degree of freedom, 41 % at 3
+#: (where the 95 % t multiplier is 3.2 against 12.7 at 1). Two per material keeps
+#: the README's boulder A fit (rock: 2 impacts). A path fit likewise refuses a
+#: path of one impact.
+MIN_IMPACTS_PER_MATERIAL = 2
+MIN_RESIDUAL_DOF = 3
+
 #: Primary columns every fitted row needs finite.
 FINITE_COLUMNS = ("vi_x_mps", "vi_z_mps", "vf_x_mps", "vf_z_mps", "slope_deg")
 _NOT_MEASURED_SPIN = ("estimated", "none")
@@ -424,6 +436,44 @@ def too_few(problem: ImpactProblem, names: list[str], rows=None) -> str | None:
     )
 
 
+def too_few_for_errors(problem: ImpactProblem, names: list[str]) -> str | None:
+    """Why ``problem`` cannot give ``names`` standard errors worth the name (None
+    when it can): fewer than :data:`MIN_IMPACTS_PER_MATERIAL` impacts with data on
+    a fitted material, or fewer than :data:`MIN_RESIDUAL_DOF` residual degrees of
+    freedom."""
+    used = problem.use.any(axis=1)
+    index = problem.inputs.material_index[used]
+    counts = {
+        m: int(np.sum(index == problem.inputs.material_names.index(m)))
+        for m in problem.materials
+        if f"materials.{m}.e_n" in names or f"materials.{m}.e_t" in names
+    }
+    short = {m: n for m, n in counts.items() if n < MIN_IMPACTS_PER_MATERIAL}
+    dof = int(problem.use.sum()) - len(names)
+    if not short and dof >= MIN_RESIDUAL_DOF:
+        return None
+    parts = []
+    if short:
+        parts.append(
+            ", ".join(
+                f"material {m} has {n} impact{'s' if n != 1 else ''}"
+                for m, n in short.items()
+            )
+            + f" (at least {MIN_IMPACTS_PER_MATERIAL} per fitted material)"
+        )
+    if dof < MIN_RESIDUAL_DOF:
+        parts.append(
+            f"{int(problem.use.sum())} data for {len(names)} parameters leave "
+            f"{dof} residual degree{'s' if dof != 1 else ''} of freedom (at least "
+            f"{MIN_RESIDUAL_DOF})"
+        )
+    return (
+        "too few impacts for standard errors worth the name: "
+        + "; ".join(parts)
+        + ": no calibrated model"
+    )
+
+
 def fit_result(problem: ImpactProblem, names, start, fit, notes) -> FitResult:
     """The :class:`FitResult` of a :meth:`ImpactProblem.solve` on all rows."""
     r = fit.fun
@@ -480,11 +530,12 @@ def fit_impacts(table: ImpactTable, model: Model) -> tuple[FitResult, Model]:
     ------
     InputFileError
         Required columns missing, non-finite values (rows named), materials of the
-        table not in the model (named), or fewer data than parameters.
+        table not in the model (named), fewer data than parameters, or too few
+        for standard errors (:func:`too_few_for_errors`).
     """
     problem = impact_problem(table, model)
     names, notes = free_parameters(model, problem.materials)
-    why = too_few(problem, names)
+    why = too_few(problem, names) or too_few_for_errors(problem, names)
     if why:
         raise InputFileError(why, source=table.source)
     start, start_notes = problem.start(model, names)

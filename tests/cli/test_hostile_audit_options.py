@@ -156,3 +156,99 @@ def test_fence_keeps_a_rebound_with_all_the_energy(cli):
     assert r.exit_code == 0, r.stderr
     assert "absorbed by the fence: 0.00 kJ (0.0% of the impact energy)" in r.stdout
     assert "energy efficiency E_f/E_i (eq. 8.1): 100.0%" in r.stdout
+
+
+# ----------------------------------------------------------------------- fit
+
+ASPHALT = SMOKE.parents[3] / "surveys" / "asphalt" / "model_rocfall_table_7_1.json"
+
+
+@pytest.fixture(scope="module")
+def asphalt_synth(tmp_path_factory) -> Path:
+    """`synth` of the asphalt Table 7-1 model, 4 rocks: 37 impacts (19 asphalt,
+    14 rock, 4 colluvium), spins and their SDs included."""
+    from typer.testing import CliRunner
+
+    from fieldkit.cli import app
+
+    out = tmp_path_factory.mktemp("fit") / "syn.csv"
+    r = CliRunner().invoke(
+        app, ["synth", str(ASPHALT), "--paths", "4", "--seed", "1", "-o", str(out)]
+    )
+    assert r.exit_code == 0, r.stderr
+    return out
+
+
+def _rows(source: Path, target: Path, keep) -> Path:
+    import pandas as pd
+
+    frame = pd.read_csv(source)
+    frame[keep(frame)].to_csv(target, index=False)
+    return target
+
+
+def test_fit_refuses_one_impact(cli, fails, digest, tmp_path, asphalt_synth):
+    """fit16: one impact gave 'e_n 0.771 ± 0.057' from 1 residual degree of freedom."""
+    one = _rows(asphalt_synth, tmp_path / "one.csv", lambda f: f.index < 1)
+    before = digest(one)
+    out = tmp_path / "c.json"
+    r = cli("fit", one, "--model", ASPHALT, "-o", out, "--report", tmp_path / "rep")
+    fails(
+        r, "one.csv", "too few impacts for standard errors",
+        "material rock has 1 impact (at least 2 per fitted material)",
+        "3 data for 2 parameters leave 1 residual degree of freedom (at least 3)",
+    )  # fmt: skip
+    assert r.exit_code == 1
+    assert not out.exists() and not (tmp_path / "rep").exists()
+    assert digest(one) == before
+
+
+def test_fit_refuses_a_material_with_one_impact(cli, fails, tmp_path, asphalt_synth):
+    """34 impacts leave dof to spare, but colluvium's e_n, e_t rest on one."""
+    few = _rows(
+        asphalt_synth,
+        tmp_path / "few.csv",
+        lambda f: (f["material"] != "colluvium")
+        | f.index.isin(f.index[f["material"] == "colluvium"][:1]),
+    )  # fmt: skip
+    out = tmp_path / "c.json"
+    r = cli("fit", few, "--model", ASPHALT, "-o", out)
+    fails(r, "few.csv", "material colluvium has 1 impact", "at least 2 per fitted")
+    assert "degree" not in r.stderr and not out.exists()
+
+
+def test_fit_refuses_too_few_residual_degrees_of_freedom(
+    cli, fails, tmp_path, asphalt_synth
+):
+    """Two rock impacts without spin SDs: 4 data for rock's e_n, e_t."""
+    import pandas as pd
+
+    frame = pd.read_csv(asphalt_synth)
+    frame = frame[frame["material"] == "rock"].head(2)
+    frame.drop(columns=["omega_f_sd_radps"]).to_csv(tmp_path / "two.csv", index=False)
+    r = cli("fit", tmp_path / "two.csv", "--model", ASPHALT, "-o", tmp_path / "c.json")
+    fails(
+        r, "two.csv",
+        "4 data for 2 parameters leave 2 residual degrees of freedom (at least 3)",
+    )  # fmt: skip
+    assert "material rock" not in r.stderr and not (tmp_path / "c.json").exists()
+
+
+def test_fit_takes_two_impacts_per_material(cli, tmp_path, asphalt_synth):
+    """The bound itself: two colluvium impacts (the synthetic table has four)."""
+    two = _rows(
+        asphalt_synth,
+        tmp_path / "two.csv",
+        lambda f: (f["material"] != "colluvium")
+        | f.index.isin(f.index[f["material"] == "colluvium"][:2]),
+    )  # fmt: skip
+    out = tmp_path / "c.json"
+    r = cli("fit", two, "--model", ASPHALT, "-o", out)
+    assert r.exit_code == 0, r.stderr
+    assert json.loads(out.read_text())["provenance"]["fit"]
+    assert f"wrote {out}" in r.stdout
+
+
+def test_fit_help_states_the_minimum(cli):
+    text = " ".join(cli("fit", "--help").stdout.split())
+    assert "at least 2 impacts per fitted material and 3 residual degrees" in text
