@@ -8,7 +8,7 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from fieldkit.cli.common import one_line_errors, random_generator
+from fieldkit.cli.common import note, one_line_errors, random_generator
 from fieldkit.cli.progress import report_written, step
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.outputs import OutputSet
@@ -274,6 +274,12 @@ def _synth_track(
         outputs.plan(output, argument="-o")
         model = with_effects(read_model(model_file, outputs=outputs), hidden)
         drag = model.effects.get("air_drag", {"cd": 0.0, "air_density_kg_m3": 1.225})
+        ignored = sorted(set(model.effects) - {"air_drag"})
+        if ignored:  # a track is flights down a plane: nothing else acts on it here
+            note(
+                f"a synthetic track is ballistic flights (with air_drag) down a plane: "
+                f"{', '.join(ignored)} of the model or --effects do not act on it"
+            )
         px, pz = model.profile.x_m, model.profile.z_m
         # x increases in the direction of travel and the dip is positive when the
         # ground descends that way (ARCHITECTURE §2): a profile rising toward +x
