@@ -62,8 +62,10 @@ def test_synth_track_refuses_bad_options_without_writing(cli, fails, tmp_path):
 def test_synth_track_says_which_effects_do_not_act_on_it(cli, repo, tmp_path):
     # issue 17: effects other than air_drag were dropped from a track without a word
     model = repo / "surveys" / "tornado_mountain" / "model_rocfall_table_7_1.json"
-    result = cli("synth", model, "--track", "--flights", "2", "--seed", "1",
-                 "--effects", "mass_loss=rate_per_m=0.01", "-o", tmp_path / "t.csv")  # fmt: skip
+    result = cli(
+        "synth", model, "--track", "--flights", "2", "--seed", "1",
+        "--effects", "mass_loss=rate_per_m=0.01", "-o", tmp_path / "t.csv",
+    )  # fmt: skip
     assert result.exit_code == 0, result.stderr
     note = next(line for line in result.stderr.splitlines() if "do not act" in line)
     assert "mass_loss, slope_roughness" in note  # --effects and the model's own
