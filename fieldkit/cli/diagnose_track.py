@@ -84,8 +84,8 @@ def diagnose_track_file(
     ------
     InputFileError
         Unreadable track, times that do not increase or coordinates beyond bounds
-        (:func:`fieldkit.io.track_files.read_track`), fewer than three flights, a flight with too few samples
-        (naming the file and the flight's rows).
+        (:func:`fieldkit.io.track_files.read_track`), fewer than three flights, a
+        flight with too few samples (naming the file and the flight's rows).
     ArgumentError
         A radius or mass that is not finite, not positive or beyond its bound.
     """

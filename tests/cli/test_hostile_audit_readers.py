@@ -4,9 +4,10 @@
   with its own reader, found five flights on a four-flight track and exited 0. Every
   track reader now goes through :func:`fieldkit.io.tracking_export.check_track_values`.
 * An ImpactTable with an impossible body or measurement (audit vie15, dia20): mass
-  ``inf`` (``view`` wrote a recording, a numpy warning leaked) or ``-500`` (``diagnose``,
-  ``fit`` and ``view`` accepted it). :meth:`fieldkit.impact_table.ImpactTable.read`
-  bounds the measured columns (:data:`fieldkit.impact_table.READ_BOUNDS`).
+  ``inf`` (``view`` wrote a recording, a numpy warning leaked) or ``-500``
+  (``diagnose``, ``fit`` and ``view`` accepted it).
+  :meth:`fieldkit.impact_table.ImpactTable.read` bounds the measured columns
+  (:data:`fieldkit.impact_table.READ_BOUNDS`).
 
 Every refusal: exit 1, one ``error:`` line naming file, row and column, no traceback,
 nothing written, the input unchanged.
@@ -167,9 +168,7 @@ def _args(command: str, table: Path, out: Path) -> list:
 
 
 @pytest.mark.parametrize("case", list(TABLE_CASES))
-def test_table_reader_refuses_impossible_values(
-    case, tmp_path, cli, fails, digest
-):
+def test_table_reader_refuses_impossible_values(case, tmp_path, cli, fails, digest):
     cells, fragment = TABLE_CASES[case]
     table = _table(tmp_path / f"{case}.csv", **cells)
     before = digest(table)
