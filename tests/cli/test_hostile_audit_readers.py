@@ -143,9 +143,8 @@ TABLE_CASES = {
                     "row 5: column radius_m: 50 is outside [0.001, 10] m"),
     "gyration-minus-inf": ({"gyration_m": (1, -np.inf)},
                            "row 2: column gyration_m: -inf is outside"),
-    "gyration-beyond-radius": ({"gyration_m": (6, 3.0)},
-                               "row 7: column gyration_m: k = 3 m is larger than "
-                               "radius_m r = 0.36 m"),
+    "gyration-huge": ({"gyration_m": (6, 30.0)},
+                      "row 7: column gyration_m: 30 is outside [0.001, 10] m"),
     "speed-huge": ({"vi_z_mps": (5, -1e5)},
                    "row 6: column vi_z_mps: -100000 is outside [-100, 100] m/s"),
     "x-huge": ({"x_m": (8, 1e308)},
@@ -202,6 +201,20 @@ def test_missing_body_values_are_still_read(tmp_path, cli):
     r = cli("view", table, "-o", tmp_path / "t.rrd")
     assert r.exit_code == 0, r.output
     assert (tmp_path / "t.rrd").stat().st_size > 0
+
+
+def test_an_elongated_body_with_k_beyond_r_is_read(tmp_path, cli, repo):
+    """k <= r holds for compact bodies only: a table from `reduce --shape ellipsoid`
+    landing on its side (k = 0.68 m, r = 0.25 m) is read back by `view`."""
+    gpx = repo / "surveys" / "tornado_mountain" / "boulder_a_impacts.gpx"
+    table = tmp_path / "long.csv"
+    r = cli("reduce", "--impacts", gpx, "--theta0", "32.6", "--shape", "ellipsoid",
+            "--dimensions", "3,0.5,0.5", "--radius", "0.25", "-o", table)  # fmt: skip
+    assert r.exit_code == 0, r.output
+    frame = pd.read_csv(table)
+    assert (frame["gyration_m"] > 2.7 * frame["radius_m"]).all()
+    r = cli("view", table, "-o", tmp_path / "long.rrd")
+    assert r.exit_code == 0, r.output
 
 
 def test_read_bounds_are_the_body_option_bounds():
