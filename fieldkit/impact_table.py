@@ -219,6 +219,82 @@ MAX_PLAUSIBLE_SPEED_MPS = 60.0
 MAX_PLAUSIBLE_FLIGHT_HEIGHT_M = 10.0
 
 
+#: Bounds :meth:`ImpactTable.read` puts on a table's measured (primary) columns:
+#: column -> (smallest, largest, unit, what a value outside is not). NaN (not measured)
+#: passes; infinities and values beyond a bound are refused, naming file, row and
+#: column. The body bounds are those of the body options (``--mass``, ``--radius``,
+#: ``--gyration``: 1 g to 10,000 t, 1 mm to 10 m); speeds are within 100 m/s (free
+#: fall from 500 m reaches 99 m/s); coordinates within the 10,000 km of a plan
+#: coordinate and the 11,000 m of an elevation on Earth the point readers use.
+READ_BOUNDS: dict[str, tuple[float, float, str, str]] = {
+    "x_m": (-1.0e7, 1.0e7, "m", "a distance along a fall path"),
+    "z_m": (-11_000.0, 11_000.0, "m", "an elevation on Earth"),
+    "mass_kg": (1e-3, 1e7, "kg", "a rock's mass (1 g to 10,000 t)"),
+    "radius_m": (1e-3, 10.0, "m", "a rock's contact radius"),
+    "gyration_m": (1e-3, 10.0, "m", "a rock's radius of gyration"),
+    **{
+        name: (-100.0, 100.0, "m/s", "a rockfall velocity")
+        for name in ("vi_x_mps", "vi_z_mps", "vf_x_mps", "vf_z_mps")
+    },
+}
+#: Measured columns without a bound of their own that must still be finite when
+#: given (an infinity turns every energy and residual into NaN or inf).
+READ_FINITE: tuple[str, ...] = ("theta0_deg", "omega_i_radps", "omega_f_radps", "t_s")
+
+
+def check_read_values(frame: pd.DataFrame, source: str | None) -> None:
+    """Raise :class:`InputFileError` naming the first row (and its column) whose
+    measured value is impossible: beyond :data:`READ_BOUNDS` or infinite in
+    :data:`READ_FINITE`. Rows count data rows from 1.
+
+    ``k <= r`` is not checked: it holds for compact bodies only, and a table names
+    no shape (an ellipsoid 3 x 0.5 x 0.5 m landing on its side has k = 0.68 m on a
+    contact radius of 0.25 m, :func:`fieldkit.physics.bodies.shape_body`).
+
+    Examples
+    --------
+    >>> check_read_values(pd.DataFrame({"mass_kg": [500.0, -500.0]}), "t.csv")
+    ... # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    fieldkit.errors.InputFileError: t.csv: row 2: column mass_kg: -500 is outside ...
+    """
+    first: tuple[int, str] | None = None
+
+    def consider(bad: np.ndarray, message: str) -> None:
+        nonlocal first
+        hits = np.flatnonzero(bad)
+        if len(hits) and (first is None or hits[0] < first[0]):
+            first = (int(hits[0]), message)
+
+    def values(name: str) -> np.ndarray:
+        return pd.to_numeric(frame[name], errors="coerce").to_numpy(float)
+
+    for name, (low, high, unit, what) in READ_BOUNDS.items():
+        if name not in frame:
+            continue
+        v = values(name)
+        with np.errstate(invalid="ignore"):
+            bad = ~np.isnan(v) & ~((v >= low) & (v <= high))
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            consider(
+                bad,
+                f"column {name}: {v[i]:g} is outside [{low:g}, {high:g}] {unit}: "
+                f"not {what}",
+            )
+    for name in READ_FINITE:
+        if name in frame:
+            v = values(name)
+            bad = np.isinf(v)
+            if bad.any():
+                i = int(np.flatnonzero(bad)[0])
+                consider(bad, f"column {name}: {v[i]:g} is not a finite number")
+    if first is not None:
+        i, message = first
+        raise InputFileError(message, source=source, where=f"row {i + 1}")
+
+
 def quality_flags(frame: pd.DataFrame) -> pd.Series:
     """The ``qa_flags`` of every row, from the table's own columns (:data:`QA_FLAGS`).
 
@@ -513,6 +589,12 @@ class ImpactTable:
 
         In a CSV, the ``'`` that :meth:`write` puts before formula-like text cells is
         removed (:func:`fieldkit.outputs.unescape_formulas`).
+
+        Raises
+        ------
+        InputFileError
+            An unreadable file, a missing required column, text in a number, or an
+            impossible measured value (:func:`check_read_values`), naming the row.
         """
         p = Path(path)
         fmt = table_format(p)
@@ -553,7 +635,9 @@ class ImpactTable:
             raise InputFileError("table has no rows", source=p)
         if fmt == "csv":  # written by `write`: formula-like text was quoted
             frame = unescape_formulas(frame)
-        return cls(frame, source=str(p))
+        table = cls(frame, source=str(p))
+        check_read_values(table.frame, table.source)
+        return table
 
     def write(
         self, path: str | os.PathLike[str], *, outputs: OutputSet | None = None

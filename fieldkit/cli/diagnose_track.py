@@ -16,6 +16,7 @@ import numpy as np
 
 from fieldkit.diagnose.diagnosis import Diagnosis
 from fieldkit.diagnose.flights import FlightSamples, check_body, diagnose_flights
+from fieldkit.io.track_files import read_track
 from fieldkit.track import Track
 from fieldkit.tracking.flights.pipeline import analyse_track
 
@@ -82,13 +83,16 @@ def diagnose_track_file(
     Raises
     ------
     InputFileError
-        Unreadable track, fewer than three flights, a flight with too few samples
-        (naming the file and the flight's rows).
+        Unreadable track, times that do not increase or coordinates beyond bounds
+        (:func:`fieldkit.io.track_files.read_track`), fewer than three flights, a
+        flight with too few samples (naming the file and the flight's rows).
     ArgumentError
         A radius or mass that is not finite, not positive or beyond its bound.
     """
     check_body(radius_m, mass_kg)
-    track = Track.read(path)
+    # the reader every track command uses: times strictly increasing, finite and
+    # bounded coordinates (fieldkit.io.tracking_export.check_track_values)
+    track = read_track(path, "track")
     track.source = str(path)
     flights = track_flights(track, radius_m=radius_m)
     diagnosis = diagnose_flights(
