@@ -1,0 +1,73 @@
+"""Hostile inputs of an independent audit (third set): model files, profiles given as
+vertex lists, exports on an extruded grid, RocFall folders read by import-model.
+
+Each bad input is one line naming the file (or flag) and the field or line, exit 1,
+nothing written, inputs left as they were.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+ASPHALT = REPO / "surveys" / "asphalt" / "model_rocfall_table_7_1.json"
+
+
+def _model() -> dict:
+    """The asphalt Table 7-1 model without its provenance (the audit's model.json)."""
+    data = json.loads(ASPHALT.read_text(encoding="utf-8"))
+    data.pop("provenance", None)
+    return data
+
+
+@pytest.fixture()
+def model_json(tmp_path) -> Path:
+    path = tmp_path / "model.json"
+    path.write_text(json.dumps(_model(), indent=1), encoding="utf-8")
+    return path
+
+
+def _nothing_new(folder: Path, before: set[str]) -> None:
+    assert {p.name for p in folder.iterdir()} == before
+
+
+# ------------------------------------------------------- export: grid size --
+
+
+@pytest.mark.parametrize(
+    ("extra", "words"),
+    [
+        (["--cellsize", "5", "--rows", "1000000000"],
+         ["--rows", "25,000,000", "50,000,000"]),
+        (["--cellsize", "1e-6"],
+         ["--cellsize", "170,000,000 columns", "50,000,000", "1.7e-05 m"]),
+        (["--cellsize", "5e-324"], ["--cellsize", "inf columns", "50,000,000"]),
+        (["--cellsize", "5", "--rows", "10000000"],
+         ["--cellsize", "340,000,000 cells", "at least 34 m"]),
+    ],
+)  # fmt: skip
+def test_extruded_grid_is_bounded_before_it_is_allocated(
+    cli, fails, tmp_path, model_json, extra, words
+):
+    before = {p.name for p in tmp_path.iterdir()}
+    r = cli("export", model_json, "--to", "rockyfor3d", "--extrude", *extra,
+            "-o", tmp_path / "o")  # fmt: skip
+    fails(r, *words)
+    _nothing_new(tmp_path, before)
+
+
+def test_extruded_grid_at_the_limit_of_rows_is_written(cli, tmp_path, model_json):
+    # 170 m of profile at 85 m: two columns; 2 x 1000 cells is far inside the limit
+    r = cli("export", model_json, "--to", "ramms", "--extrude", "--cellsize", "85",
+            "--rows", "1000", "-o", tmp_path / "o")  # fmt: skip
+    assert r.exit_code == 0, r.output
+    assert "wrote" in r.output
+
+
+def test_export_help_states_the_grid_bounds(cli):
+    r = cli("export", "--help")
+    text = " ".join(r.output.replace("│", " ").split())
+    assert "2 or more" in text and "50,000,000 cells" in text
