@@ -168,9 +168,7 @@ def site_from_section(
     )
 
 
-def _check_cell_count(
-    rows: int, ncols: float, length_m: float, cell_m: float
-) -> None:
+def _check_cell_count(rows: int, ncols: float, length_m: float, cell_m: float) -> None:
     """Refuse an extruded grid of more than :data:`MAX_DEM_CELLS` cells (the DEM
     limit), naming ``rows`` if even two columns are too many, else ``cellsize_m``."""
     if rows * ncols <= MAX_DEM_CELLS:
