@@ -8,7 +8,8 @@ Core settings (``"core"``) all have defaults, stated by :data:`CORE_DEFAULTS`:
   sliding/rolling phase (a 0.5 m/s hop rises 1.3 cm, well under any block radius:
   below it the lumped mass only chatters);
 * ``stop_speed_mps`` = 0.05: a sliding rock slower than this at a concave break stops;
-* ``max_impacts`` = 500: rocks reaching it are counted and reported, never silent;
+* ``max_impacts`` = 500, a whole number in [1, 1e6]: rocks reaching it are counted
+  and reported, never silent;
 * ``drag_dt_s`` = 0.25: longest flight substep when ``air_drag`` is on (substeps
   are also kept short enough for drag to change the speed by < 0.2 %, see
   :mod:`fieldkit.model.effects.air_drag`).
@@ -75,6 +76,8 @@ CORE_DEFAULTS: dict[str, tuple[float, float, float, str]] = {
     "max_impacts": (500.0, 1.0, 1e6, "-"),
     "drag_dt_s": (0.25, 1e-4, 5.0, "s"),
 }
+#: Core settings that count something: whole numbers only (500, not 500.5).
+WHOLE_NUMBER_CORE = frozenset({"max_impacts"})
 G_MPS2 = 9.81
 #: Body fields -> (lower, upper) [SI]; the lower bound is exclusive (module docstring).
 BODY_BOUNDS: dict[str, tuple[float, float]] = {
@@ -257,6 +260,7 @@ def model_from_dict(
             source=source,
             where=f"core.{key}",
             unit=unit,
+            whole=key in WHOLE_NUMBER_CORE,
         )
     trees = None
     if "trees" in data:

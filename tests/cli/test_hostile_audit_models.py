@@ -71,3 +71,25 @@ def test_export_help_states_the_grid_bounds(cli):
     r = cli("export", "--help")
     text = " ".join(r.output.replace("│", " ").split())
     assert "2 or more" in text and "50,000,000 cells" in text
+
+
+# ------------------------------------------------------ model file: counts --
+
+
+@pytest.mark.parametrize("value", [500.5, 1.5])
+def test_max_impacts_must_be_a_whole_number(cli, fails, tmp_path, value):
+    data = _model()
+    data["core"] = {"max_impacts": value}
+    path = tmp_path / "model.json"
+    path.write_text(json.dumps(data), encoding="utf-8")
+    r = cli("simulate", path, "--rocks", "5", "--seed", "1")
+    fails(r, "model.json", "core.max_impacts", f"must be a whole number (got {value})")
+
+
+def test_max_impacts_written_as_a_float_is_still_a_whole_number(cli, tmp_path):
+    data = _model()
+    data["core"] = {"max_impacts": 500.0}
+    path = tmp_path / "model.json"
+    path.write_text(json.dumps(data), encoding="utf-8")
+    r = cli("simulate", path, "--rocks", "5", "--seed", "1")
+    assert r.exit_code == 0, r.output
