@@ -46,7 +46,6 @@ replace them.
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import re
@@ -56,6 +55,7 @@ from pathlib import Path
 import numpy as np
 
 from fieldkit.errors import ArgumentError, FieldkitError, InputFileError
+from fieldkit.io.csv_table import parse_json
 from fieldkit.io.dem import read_dem
 from fieldkit.io.profile_csv import read_profile_csv
 from fieldkit.model.dem_profile import (
@@ -569,7 +569,8 @@ def read_model(
     ------
     InputFileError
         The file cannot be read, is not UTF-8 or not JSON, is nested deeper than
-        :data:`MAX_JSON_DEPTH`, or has a bad field (named).
+        :data:`MAX_JSON_DEPTH`, gives a key twice in one object
+        (:func:`fieldkit.io.csv_table.parse_json`), or has a bad field (named).
     OutputFileError
         A planned output of ``outputs`` is a file the model reads.
     """
@@ -577,7 +578,7 @@ def read_model(
     if outputs is not None:
         outputs.add_inputs([path])
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")  # a BOM, as Notepad writes
     except UnicodeDecodeError as exc:
         raise InputFileError(
             f"not a UTF-8 text file (byte {exc.start})", source=path
@@ -592,14 +593,10 @@ def read_model(
             f"{MAX_JSON_DEPTH})",
             source=path,
         )
-    try:
-        # NaN and +-Infinity (not JSON, but Python writes them) are read as floats
-        # so that the check of their field refuses them by name
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise InputFileError(
-            f"not valid JSON ({exc.msg})", source=path, where=f"line {exc.lineno}"
-        ) from None
+    # NaN and +-Infinity (not JSON, but Python writes them) are read as floats so
+    # that the check of their field refuses them by name; a key given twice is
+    # refused naming its path (Python's reader would keep the last silently)
+    data = parse_json(text, str(path))
     model = model_from_dict(data, source=str(path), base_dir=path.parent)
     model = replace(model, source_files=(str(path), *model.source_files))
     if outputs is not None:

@@ -93,3 +93,39 @@ def test_max_impacts_written_as_a_float_is_still_a_whole_number(cli, tmp_path):
     path.write_text(json.dumps(data), encoding="utf-8")
     r = cli("simulate", path, "--rocks", "5", "--seed", "1")
     assert r.exit_code == 0, r.output
+
+
+# ------------------------------------------- model file: a key given twice --
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "path"),
+    [
+        ('"e_n": 0.75', '"e_n": 0.75, "e_n": 4.5', "materials.rock.e_n"),
+        ('"mass_kg"', '"mass_kg": 1, "mass_kg"', "body.mass_kg"),
+        ('"seeder"', '"seeder": {}, "seeder"', "seeder"),
+    ],
+)
+def test_a_key_given_twice_is_refused_naming_its_path(
+    cli, fails, digest, tmp_path, old, new, path
+):
+    text = json.dumps(_model())
+    assert old in text
+    model = tmp_path / "model.json"
+    model.write_text(text.replace(old, new, 1), encoding="utf-8")
+    before = digest(model)
+    simulate = ["simulate", model, "--rocks", "5", "--seed", "1"]
+    export = ["export", model, "--to", "rocfall", "-o", tmp_path / "o"]
+    for args in (simulate, export):
+        fails(cli(*args), "model.json", f"{path} given twice")
+    assert digest(model) == before
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_model_file_with_a_bom_and_crlf_is_read(cli, tmp_path):
+    model = tmp_path / "model.json"
+    text = json.dumps(_model(), indent=1).replace("\n", "\r\n")
+    model.write_bytes(text.encode("utf-8-sig"))
+    r = cli("export", model, "--to", "rocfall", "-o", tmp_path / "o")
+    assert r.exit_code == 0, r.output
+    assert (tmp_path / "o" / "materials.txt").is_file()
