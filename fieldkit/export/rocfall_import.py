@@ -105,9 +105,11 @@ def read_rocfall(
 
 
 def _read(path: str | os.PathLike[str]) -> Text:
+    """A RocFall file's text: UTF-8, with or without a BOM (as Windows editors
+    write it, and as the CSV readers accept); CRLF line ends are read too."""
     path = Path(path)
     try:
-        return Text(path.read_text(encoding="utf-8"), str(path))
+        return Text(path.read_text(encoding="utf-8-sig"), str(path))
     except OSError as exc:
         raise InputFileError(f"cannot read ({exc.strerror})", source=path) from None
     except UnicodeDecodeError:

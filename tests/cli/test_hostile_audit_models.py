@@ -129,3 +129,35 @@ def test_a_model_file_with_a_bom_and_crlf_is_read(cli, tmp_path):
     r = cli("export", model, "--to", "rocfall", "-o", tmp_path / "o")
     assert r.exit_code == 0, r.output
     assert (tmp_path / "o" / "materials.txt").is_file()
+
+
+# ------------------------------------------------ import-model: RocFall files --
+
+
+@pytest.fixture()
+def rf(cli, tmp_path, model_json) -> Path:
+    """The audit's rf/: ``fieldkit export model.json --to rocfall -o rf``."""
+    r = cli("export", model_json, "--to", "rocfall", "-o", tmp_path / "rf")
+    assert r.exit_code == 0, r.output
+    return tmp_path / "rf"
+
+
+def _edit(path: Path, old: str, new: str) -> None:
+    text = path.read_text(encoding="utf-8")
+    assert old in text, (path.name, old)
+    path.write_text(text.replace(old, new, 1), encoding="utf-8")
+
+
+def test_rocfall_files_with_a_bom_and_crlf_are_read(cli, tmp_path, rf):
+    plain = tmp_path / "plain.json"
+    assert cli("import-model", rf, "-o", plain).exit_code == 0
+    for name in ("materials.txt", "rock_type.txt", "project_settings.txt", "slope.csv"):
+        path = rf / name
+        text = path.read_text(encoding="utf-8").replace("\n", "\r\n")
+        path.write_bytes(text.encode("utf-8-sig"))
+    bom = tmp_path / "bom.json"
+    r = cli("import-model", rf, "-o", bom)
+    assert r.exit_code == 0, r.output
+    a, b = (json.loads(p.read_text()) for p in (plain, bom))
+    for key in ("profile", "materials", "body", "seeder", "effects", "core"):
+        assert a[key] == b[key], key
