@@ -31,8 +31,11 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.export.rocfall import DISTRIBUTIONS, MATERIAL_KEYS, ROCK_KEYS
+from fieldkit.io.profile_csv import check_profile_vertices
 from fieldkit.model.materials import MATERIAL_FIELDS, check_material_name
 from fieldkit.model.model_file import CORE_DEFAULTS, Model, model_from_dict
 
@@ -461,6 +464,10 @@ def _slope(text: Text, names: dict[int, str]) -> tuple[list, list, list]:
                 where=f"line {n}",
             )
         ids.append(int(ident))
+    check_profile_vertices(  # the bounds of every profile (a profile CSV's)
+        np.array(x), np.array(z), source=text.source,
+        where=lambda axis, i: f"line {rows[i][0]}: {'x' if axis == 'x' else 'y'}",
+    )  # fmt: skip
     return x, z, ids
 
 

@@ -391,8 +391,9 @@ def _profile(prof: dict, source: str, *, base_dir, read: list[str]) -> Profile:
                 where=f"profile.{_PROFILE_FIELDS[exc.source]}",
             ) from None
         return Profile.from_arrays(
-            section.chainage_m, section.z_m, section.material, source=source
-        )
+            section.chainage_m, section.z_m, section.material, source=source,
+            where=lambda axis, i: f"profile.{kind}: section vertex {i} ({axis})",
+        )  # fmt: skip
     _unknown(prof, {"x_m", "z_m", "material"}, "profile", source)
     for key in ("x_m", "z_m", "material"):
         if key not in prof:

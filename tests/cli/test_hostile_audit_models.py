@@ -161,3 +161,50 @@ def test_rocfall_files_with_a_bom_and_crlf_are_read(cli, tmp_path, rf):
     a, b = (json.loads(p.read_text()) for p in (plain, bom))
     for key in ("profile", "materials", "body", "seeder", "effects", "core"):
         assert a[key] == b[key], key
+
+
+# ------------------------------- profiles as vertex lists: a profile CSV's bounds --
+
+
+@pytest.mark.parametrize(
+    ("key", "values", "words"),
+    [
+        ("z_m", [637, 637, 581, 511, 501, 1e12],
+         ["profile.z_m[5]", "1e+12 m is not an elevation", "11,000 m"]),
+        ("x_m", [-1e6, 0, 32.33, 113, 115.49, 160],
+         ["profile.x_m[0]", "-1e+06 m is not a chainage", "100,000 m"]),
+        ("x_m", [-10, -9.9995, 32.33, 113, 115.49, 160],
+         ["profile.x_m[1]", "0.0005 m apart", "at least 1 mm"]),
+    ],
+)  # fmt: skip
+def test_model_file_vertex_lists_get_the_profile_bounds(
+    cli, fails, tmp_path, key, values, words
+):
+    data = _model()
+    data["profile"][key] = values
+    model = tmp_path / "model.json"
+    model.write_text(json.dumps(data), encoding="utf-8")
+    fails(cli("simulate", model, "--rocks", "5", "--seed", "1"), "model.json", *words)
+    fails(cli("export", model, "--to", "rocfall", "-o", tmp_path / "o"), *words)
+    assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "words"),
+    [
+        ("-10,637,2\n0,637,2\n", "-1000000,637,2\n0,637,2\n",
+         ["line 2: x", "-1e+06 m is not a chainage"]),
+        ("160,501,", "160,1e12,", ["line 7: y", "1e+12 m is not an elevation"]),
+        ("\n0,637,2\n", "\n0,637,2\n0.0005,637,2\n",
+         ["line 4: x", "0.0005 m apart", "at least 1 mm"]),
+    ],
+)  # fmt: skip
+def test_rocfall_slope_gets_the_profile_bounds(
+    cli, fails, digest, tmp_path, rf, old, new, words
+):
+    slope = rf / "slope.csv"
+    _edit(slope, old, new)
+    before = digest(slope)
+    out = tmp_path / "m.json"
+    fails(cli("import-model", rf, "-o", out), "rf/slope.csv", *words)
+    assert not out.exists() and digest(slope) == before
