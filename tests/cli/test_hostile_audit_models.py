@@ -208,3 +208,34 @@ def test_rocfall_slope_gets_the_profile_bounds(
     out = tmp_path / "m.json"
     fails(cli("import-model", rf, "-o", out), "rf/slope.csv", *words)
     assert not out.exists() and digest(slope) == before
+
+
+# ---------------- import-model: a value is reported where it came from --
+
+
+@pytest.mark.parametrize(
+    ("name", "old", "new", "words"),
+    [
+        ("rock_type.txt", "initial horizontal velocity (m/s): 2, 1,",
+         "initial horizontal velocity (m/s): 2, 1e5,",
+         ["line 9: initial horizontal velocity (seeder.vx_mps)",
+          "must be <= 100 m/s (got 100000)"]),
+        ("rock_type.txt", "initial vertical velocity (m/s): 2, 0, 0.3,",
+         "initial vertical velocity (m/s): 2, 0, 300,",
+         ["line 10: initial vertical velocity (seeder.vz_sd_mps)",
+          "must be <= 100 m/s (got 300)"]),
+        ("rock_type.txt", "mass (kg): 1, 500,", "mass (kg): 1, 1e308,",
+         ["line 8: mass (body.mass_kg)", "must be <= 1e+09 kg (got 1e+308)"]),
+        ("rock_type.txt", "seeder y (m): 637.36", "seeder y (m): 1e6",
+         ["line 14: seeder y (seeder.z_m)", "more than 1000 m above the ground"]),
+    ],
+)  # fmt: skip
+def test_import_model_names_the_rocfall_file_and_line_of_a_value(
+    cli, fails, tmp_path, rf, name, old, new, words
+):
+    _edit(rf / name, old, new)
+    out = tmp_path / "m.json"
+    r = cli("import-model", rf, "-o", out)
+    fails(r, f"rf/{name}", *words)
+    assert "materials.txt" not in r.stderr
+    assert not out.exists()
