@@ -239,3 +239,51 @@ def test_import_model_names_the_rocfall_file_and_line_of_a_value(
     fails(r, f"rf/{name}", *words)
     assert "materials.txt" not in r.stderr
     assert not out.exists()
+
+
+# ------------- the other JSON input (a track's homography): one parser, same rule --
+
+
+@pytest.fixture(scope="module")
+def throw_clip(tmp_path_factory):
+    """A ball thrown across a 320x240 scene (as in test_cli_track_messages.py)."""
+    import importlib.util
+    import sys
+
+    import numpy as np
+
+    name = "fieldkit_video_render_for_audit_models"
+    spec = importlib.util.spec_from_file_location(name, REPO / "video" / "render.py")
+    render = importlib.util.module_from_spec(spec)
+    sys.modules[name] = render
+    spec.loader.exec_module(render)
+    path = tmp_path_factory.mktemp("clip") / "throw.avi"
+    camera = render.Camera(width=320, height=240, origin_u_px=20.0, origin_v_px=220.0)
+    rng = np.random.default_rng(4)
+    scene = render.BounceScene(plate_point_m=(0.0, -1.0))
+    bg = np.clip(render.background(camera, rng, scene) + 0.5, 0, 255).astype(np.uint8)
+    t = np.arange(80) / 1205.0
+    poses = np.column_stack(
+        [0.05 + 2.5 * t, 0.25 + 1.0 * t - 0.5 * 9.81 * t**2, 0.2 - 40.0 * t]
+    )
+    render.write_clip(path, camera, render.Ball(), bg, poses, rng)
+    return path
+
+
+def test_homography_json_with_a_key_given_twice_is_refused(
+    cli, fails, tmp_path, throw_clip
+):
+    corners = [(20, 220, 0.0, 0.0), (300, 220, 0.56, 0.0), (300, 20, 0.56, 0.4),
+               (20, 20, 0.0, 0.4)]  # fmt: skip
+    points = [{"u_px": u, "v_px": v, "x_m": x, "z_m": z} for u, v, x, z in corners]
+    text = json.dumps({"points": points}).replace(
+        '"x_m": 0.56', '"x_m": 0.5, "x_m": 0.56', 1
+    )
+    h = tmp_path / "h.json"
+    h.write_text(text, encoding="utf-8")
+    out = tmp_path / "out"
+    r = cli(
+        "track", throw_clip, "--fps", "1205", "--homography", h, "-o", out / "t.csv"
+    )
+    fails(r, f"{h}: points[1].x_m given twice")
+    assert not out.exists()
