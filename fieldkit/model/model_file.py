@@ -33,7 +33,11 @@ enough to catch a typing or unit error:
 * effects: each parameter's own bounds (``fieldkit effects NAME``).
 
 The profile's x must increase strictly, so every segment dips between -90 and 90
-degrees (inside the contract's (-180, 180] degrees).
+degrees (inside the contract's (-180, 180] degrees); vertex lists get the bounds of a
+profile CSV (chainage within 100 km, elevation within 11 km, vertices at least 1 mm
+apart: :func:`fieldkit.io.profile_csv.check_profile_vertices`, named as
+``profile.z_m[5]``). A key given twice in one object is refused, naming its path
+(``materials.rock.e_n given twice``): JSON readers otherwise keep the last silently.
 
 Files a model reads
 -------------------
