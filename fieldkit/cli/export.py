@@ -15,6 +15,7 @@ import typer
 from fieldkit.cli.common import one_line_errors, parse_point
 from fieldkit.cli.progress import report_written, step
 from fieldkit.errors import ArgumentError
+from fieldkit.io.dem import MAX_DEM_CELLS
 from fieldkit.outputs import OutputSet, write_file
 
 FLAGS = {
@@ -72,10 +73,20 @@ def export(
     ] = False,
     cellsize: Annotated[
         float | None,
-        typer.Option("--cellsize", help="With --extrude: cell size [m]."),
+        typer.Option(
+            "--cellsize",
+            help="With --extrude: cell size in metres, > 0 (default the profile "
+            "length / 500, at least 0.5 m); the grid may have at most "
+            f"{MAX_DEM_CELLS:,} cells, as a DEM.",
+        ),
     ] = None,
     rows: Annotated[
-        int, typer.Option("--rows", help="With --extrude: cells across.")
+        int,
+        typer.Option(
+            "--rows",
+            help="With --extrude: cells across, 2 or more (rows x columns at most "
+            f"{MAX_DEM_CELLS:,} cells, as a DEM).",
+        ),
     ] = 5,
     force: Annotated[
         bool, typer.Option("--force", help="Write into a folder that is not empty.")

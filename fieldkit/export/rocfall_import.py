@@ -19,7 +19,11 @@ returned beside the model: the body radius (a lumped mass has none: a sphere of
 gyration (solid sphere), the seeder (on the first slope vertex) and velocities (0)
 when the rock type gives none, fieldkit's core settings, and the parameters of
 ``rotation_friction`` when rotational velocity is on. Bad input is one
-:class:`~fieldkit.errors.InputFileError` naming the file and the line.
+:class:`~fieldkit.errors.InputFileError` naming the file and the line: a value the
+model's own checks refuse (a release speed beyond 100 m/s, a mass beyond 1e9 kg)
+is reported against the RocFall file and line it came from (:class:`_Origins`),
+naming the RocFall key and the model field, e.g. ``rock_type.txt: line 5: initial
+horizontal velocity (seeder.vx_mps): must be <= 100 m/s``.
 """
 
 from __future__ import annotations
@@ -31,8 +35,11 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.export.rocfall import DISTRIBUTIONS, MATERIAL_KEYS, ROCK_KEYS
+from fieldkit.io.profile_csv import check_profile_vertices
 from fieldkit.model.materials import MATERIAL_FIELDS, check_material_name
 from fieldkit.model.model_file import CORE_DEFAULTS, Model, model_from_dict
 
@@ -44,6 +51,13 @@ _LINE = re.compile(
     r"^(?P<key>[^:()]+?)\s*(?:\((?P<unit>[^)]*)\))?\s*:\s*(?P<value>.*?)\s*$"
 )
 _BLOCK = re.compile(r"^(?P<kind>material|rock type)\s+(?P<id>\S+)$")
+#: Rock-type seeder keys -> the model field each gives.
+_SEEDER_FIELDS = {
+    "seeder x": "seeder.x_m",
+    "seeder y": "seeder.z_m",
+    "seeder x end": "seeder.x_max_m",
+    "seeder height": "seeder.height_m",
+}
 _ON = {"on", "yes", "true", "1"}
 _OFF = {"off", "no", "false", "0"}
 
@@ -62,6 +76,40 @@ class _Entry:
     unit: str | None
     value: str
     line: int
+
+
+class _Origins:
+    """Where each model field came from: a model-file path (``seeder.vx_mps``,
+    ``materials.rock.e_n``) -> the RocFall file, line and key that gave it; a
+    coarser path (``seeder``, ``materials.rock``) -> the file (and block line).
+
+    :meth:`locate` turns an error of the model's checks (naming a model field)
+    into one naming the RocFall file and line.
+    """
+
+    def __init__(self) -> None:
+        self.paths: dict[str, tuple[str, int | None, str]] = {}
+
+    def add(self, path: str, source: str, line: int | None, key: str = "") -> None:
+        self.paths[path] = (source, line, key)
+
+    def locate(self, exc: InputFileError) -> InputFileError:
+        """``exc`` (naming a model field in ``where``) named in RocFall's terms."""
+        path = exc.where or ""
+        head = path
+        while head and head not in self.paths:
+            head = re.sub(r"(\.[^.\[]*|\[\d+\])$", "", head)
+            if head == path:
+                break
+        if head not in self.paths:
+            return exc
+        source, line, key = self.paths[head]
+        field_name = f"{key} ({path})" if key else path
+        return InputFileError(
+            f"{field_name}: {exc.message}" if field_name else exc.message,
+            source=source,
+            where=None if line is None else f"line {line}",
+        )
 
 
 @dataclass
@@ -105,9 +153,11 @@ def read_rocfall(
 
 
 def _read(path: str | os.PathLike[str]) -> Text:
+    """A RocFall file's text: UTF-8, with or without a BOM (as Windows editors
+    write it, and as the CSV readers accept); CRLF line ends are read too."""
     path = Path(path)
     try:
-        return Text(path.read_text(encoding="utf-8"), str(path))
+        return Text(path.read_text(encoding="utf-8-sig"), str(path))
     except OSError as exc:
         raise InputFileError(f"cannot read ({exc.strerror})", source=path) from None
     except UnicodeDecodeError:
@@ -136,22 +186,25 @@ def model_from_rocfall(
     (0.5, 0.04, 100.0)
     """
     notes: list[str] = []
-    mats = _materials(materials, notes)
+    origins = _Origins()
+    mats = _materials(materials, notes, origins)
     names = {ident: name for ident, (name, _) in mats.items()}
     x, z, segment_ids = _slope(slope, names)
+    origins.add("profile", slope.source, None)
     profile_materials = [names[i] for i in segment_ids]
-    effects, core, friction_rule = _settings(settings, notes)
+    effects, core, friction_rule = _settings(settings, notes, origins)
     material_data = {}
     for name, values in mats.values():
         material_data[name] = _friction_rule(name, values, friction_rule, notes)
     rough = [v.get("roughness_deg_sd", 0.0) for _, v in mats.values()]
     if any(r > 0.0 for r in rough):
         effects["slope_roughness"] = {}
+        origins.add("effects.slope_roughness", materials.source, None)
         notes.append(
             "slope_roughness on (scale 1): the materials' slope roughness SDs are "
             "fieldkit's roughness_deg_sd; roughness_m = 0 (RocFall has no CRSP s)"
         )
-    body, seeder = _rock_type(rock_type, x, z, notes)
+    body, seeder = _rock_type(rock_type, x, z, notes, origins)
     body["radius_m"] = _radius(radius_m, body["mass_kg"], notes)
     notes.append(
         "body.gyration_m: solid sphere sqrt(2/5) radius_m (RocFall's lumped mass has "
@@ -177,7 +230,10 @@ def model_from_rocfall(
             "import_notes": list(notes),
         },
     }
-    return model_from_dict(data, source=materials.source), notes
+    try:
+        return model_from_dict(data, source=materials.source), notes
+    except InputFileError as exc:  # a model field: named by the file that gave it
+        raise origins.locate(exc) from None
 
 
 # ---------------------------------------------------------------- text blocks --
@@ -330,7 +386,9 @@ def _distribution(
     return mean, sd
 
 
-def _materials(text: Text, notes: list[str]) -> dict[int, tuple[str, dict]]:
+def _materials(
+    text: Text, notes: list[str], origins: _Origins
+) -> dict[int, tuple[str, dict]]:
     out: dict[int, tuple[str, dict]] = {}
     seen: dict[str, int] = {}
     for block in _entries(text, "material"):
@@ -343,6 +401,7 @@ def _materials(text: Text, notes: list[str]) -> dict[int, tuple[str, dict]]:
                 where=f"line {block.line}",
             )
         seen[block.name] = block.ident
+        origins.add(f"materials.{block.name}", text.source, block.line, label)
         values: dict[str, float] = {}
         for key, entry in block.entries.items():
             if key not in MATERIAL_KEYS:
@@ -353,6 +412,9 @@ def _materials(text: Text, notes: list[str]) -> dict[int, tuple[str, dict]]:
                 )
             fk, unit = MATERIAL_KEYS[key]
             _check_unit(entry, unit, text.source)
+            for name in (fk, f"{fk}_sd"):
+                origins.add(f"materials.{block.name}.{name}", text.source,
+                            entry.line, key)  # fmt: skip
             what = f"{key} of {label}"
             if fk == "roughness_deg_sd":
                 values[fk] = _number(entry.value, what, text.source, entry.line)
@@ -459,6 +521,10 @@ def _slope(text: Text, names: dict[int, str]) -> tuple[list, list, list]:
                 where=f"line {n}",
             )
         ids.append(int(ident))
+    check_profile_vertices(  # the bounds of every profile (a profile CSV's)
+        np.array(x), np.array(z), source=text.source,
+        where=lambda axis, i: f"line {rows[i][0]}: {'x' if axis == 'x' else 'y'}",
+    )  # fmt: skip
     return x, z, ids
 
 
@@ -473,7 +539,9 @@ def _is_number(token: str) -> bool:
 # -------------------------------------------------------- rock type, seeder --
 
 
-def _rock_type(text: Text, x: list, z: list, notes: list[str]) -> tuple[dict, dict]:
+def _rock_type(
+    text: Text, x: list, z: list, notes: list[str], origins: _Origins
+) -> tuple[dict, dict]:
     blocks = _entries(text, "rock type")
     if len(blocks) > 1:
         raise InputFileError(
@@ -482,7 +550,17 @@ def _rock_type(text: Text, x: list, z: list, notes: list[str]) -> tuple[dict, di
             where=f"line {blocks[1].line}",
         )
     block = blocks[0]
-    seeder_keys = {"seeder", "seeder x", "seeder y", "seeder x end", "seeder height"}
+    for part in ("body", "seeder"):
+        origins.add(part, text.source, block.line, f"rock type {block.ident}")
+    seeder_keys = {"seeder", *_SEEDER_FIELDS}
+    for key, entry in block.entries.items():
+        if key in ROCK_KEYS:
+            fk, sd_key, _ = ROCK_KEYS[key]
+            origins.add(f"{'body' if fk == 'mass_kg' else 'seeder'}.{fk}", text.source,
+                        entry.line, key)  # fmt: skip
+            origins.add(f"seeder.{sd_key}", text.source, entry.line, key)
+        elif key in _SEEDER_FIELDS:
+            origins.add(_SEEDER_FIELDS[key], text.source, entry.line, key)
     body: dict[str, float] = {}
     seeder: dict[str, float] = {}
     for key, entry in block.entries.items():
@@ -600,7 +678,9 @@ def _radius(radius_m: float | None, mass_kg: float, notes: list[str]) -> float:
 # ----------------------------------------------------------------- settings --
 
 
-def _settings(text: Text | None, notes: list[str]) -> tuple[dict, dict, str]:
+def _settings(
+    text: Text | None, notes: list[str], origins: _Origins
+) -> tuple[dict, dict, str]:
     """``(effects, core, friction rule)`` from the project settings."""
     if text is None:
         notes.append(
@@ -619,6 +699,16 @@ def _settings(text: Text | None, notes: list[str]) -> tuple[dict, dict, str]:
             )
         unit = None if match["unit"] is None else match["unit"].strip().lower()
         entries[key] = _Entry(key, unit, match["value"].strip(), n)
+    for path in ("core", "effects"):
+        origins.add(path, text.source, None)
+    for key, path in (
+        ("scale rn velocity k", "effects.velocity_scaled_restitution"),
+        ("scale rn by velocity", "effects.velocity_scaled_restitution"),
+        ("consider rotational velocity", "effects.rotation_friction"),
+        ("stopped velocity cutoff", "core.stop_speed_mps"),
+    ):
+        if key in entries and path not in origins.paths:
+            origins.add(path, text.source, entries[key].line, key)
     known = {
         "analysis method",
         "units",

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fieldkit.errors import ArgumentError
-from fieldkit.io.dem import INSIDE, DemGrid
+from fieldkit.io.dem import INSIDE, MAX_DEM_CELLS, DemGrid
 from fieldkit.model.model_file import Model
 
 
@@ -103,6 +103,15 @@ def site_from_section(
     Cells of ``cellsize_m`` (default: the profile length / 500, rounded to 0.5 m,
     at least 0.5 m); column centres from the profile's first x; rows centred on
     y = 0; every cell of a column has the profile's elevation at its centre.
+    The grid may have at most :data:`fieldkit.io.dem.MAX_DEM_CELLS` cells, the
+    limit of a DEM read as input: more is refused before anything is allocated.
+
+    Raises
+    ------
+    ArgumentError
+        ``cellsize_m`` not > 0, ``rows`` not a whole number >= 2, or a grid of
+        more than :data:`~fieldkit.io.dem.MAX_DEM_CELLS` cells (naming ``rows``
+        when even two columns are too many, else ``cellsize_m``).
 
     Examples
     --------
@@ -131,7 +140,10 @@ def site_from_section(
         raise ArgumentError(
             f"rows must be a whole number >= 2 (got {rows})", source="rows"
         )
-    ncols = max(2, int(math.floor(length / cell)))
+    ratio = length / cell  # a float: tiny cells overflow an int, subnormal ones to inf
+    columns = max(2.0, math.floor(ratio)) if math.isfinite(ratio) else math.inf
+    _check_cell_count(rows, columns, length, cell)
+    ncols = int(columns)
     centres = x[0] + cell * (np.arange(ncols) + 0.5)
     z = np.interp(centres, x, model.profile.z_m)
     segment = np.clip(np.searchsorted(x, centres, side="right") - 1, 0, x.size - 2)
@@ -153,6 +165,32 @@ def site_from_section(
         f"the model's 2-D section extruded to {rows} rows of {ncols} cells of "
         f"{cell:g} m (x = chainage, y across, the same ground in every row); "
         f"release cells in the column at chainage {centres[seed_col]:.10g} m",
+    )
+
+
+def _check_cell_count(rows: int, ncols: float, length_m: float, cell_m: float) -> None:
+    """Refuse an extruded grid of more than :data:`MAX_DEM_CELLS` cells (the DEM
+    limit), naming ``rows`` if even two columns are too many, else ``cellsize_m``."""
+    if rows * ncols <= MAX_DEM_CELLS:
+        return
+
+    def count(n: float) -> str:
+        return f"{n:,.0f}" if n < 1e12 else f"{n:.3g}"
+
+    what = (
+        f"an extruded grid of {rows:,} rows x {count(ncols)} columns "
+        f"({length_m:g} m / {cell_m:g} m) is {count(rows * ncols)} cells, more than "
+        f"the limit of {MAX_DEM_CELLS:,} (a DEM's)"
+    )
+    if 2 * rows > MAX_DEM_CELLS:
+        raise ArgumentError(
+            f"rows must be <= {MAX_DEM_CELLS // 2:,}: {what}", source="rows"
+        )
+    smallest = length_m * rows / MAX_DEM_CELLS
+    raise ArgumentError(
+        f"cellsize_m too small: {what}; with {rows:,} `rows` give cells of at "
+        f"least {smallest:.3g} m, or fewer `rows`",
+        source="cellsize_m",
     )
 
 

@@ -462,15 +462,84 @@ def read_json(path: str | PathLike[str], kind: str = "JSON") -> object:
     if not text.strip():
         raise InputFileError("file is empty", source=path)
     try:
-        return json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise InputFileError(
-            f"not valid JSON ({exc.msg})", source=path, where=f"line {exc.lineno}"
-        ) from None
+        return parse_json(text, str(path))
     except RecursionError:
         raise InputFileError(
             f"JSON nested too deeply to be a {kind} file", source=path
         ) from None
+
+
+class _DuplicateKey(dict):
+    """An object of parsed JSON that had ``key`` twice (:func:`parse_json`)."""
+
+    key: str
+
+
+def parse_json(text: str, source: str) -> object:
+    """Parse JSON text, refusing a key given twice in one object, at any depth.
+
+    Python's reader keeps the last of two equal keys, so ``{"e_n": 0.75, "e_n":
+    4.5}`` would silently be 4.5; here it is an error naming the key's path
+    (``materials.rock.e_n given twice``). ``NaN`` and ``Infinity`` are parsed, for
+    the reader of each field to refuse by name.
+
+    Raises
+    ------
+    InputFileError
+        Not valid JSON (naming the line), or a key given twice (naming its path).
+
+    Examples
+    --------
+    >>> parse_json('{"a": {"b": [1, {"c": 2}]}}', "m.json")
+    {'a': {'b': [1, {'c': 2}]}}
+    >>> parse_json('{"a": {"b": [1, {"c": 2, "c": 3}]}}', "m.json")
+    Traceback (most recent call last):
+    ...
+    fieldkit.errors.InputFileError: m.json: a.b[1].c given twice: give each key once
+    """
+    found: list[_DuplicateKey] = []
+
+    def pairs_hook(pairs: list[tuple[str, object]]) -> dict:
+        keys = [key for key, _ in pairs]
+        if len(set(keys)) == len(keys):
+            return dict(pairs)
+        duplicate = _DuplicateKey(pairs)
+        duplicate.key = next(k for i, k in enumerate(keys) if k in keys[:i])
+        found.append(duplicate)
+        return duplicate
+
+    try:
+        data = json.loads(text, object_pairs_hook=pairs_hook)
+    except json.JSONDecodeError as exc:
+        raise InputFileError(
+            f"not valid JSON ({exc.msg})", source=source, where=f"line {exc.lineno}"
+        ) from None
+    if found:
+        path = _json_path(data, found[0])
+        raise InputFileError(
+            f"{path}{'.' if path else ''}{found[0].key} given twice: give each key "
+            "once",
+            source=source,
+        )
+    return data
+
+
+def _json_path(data: object, target: object) -> str:
+    """The path (``a.b[1]``) of the object ``target`` inside ``data`` (no recursion:
+    a deep file cannot overflow the stack)."""
+    stack: list[tuple[object, str]] = [(data, "")]
+    while stack:
+        item, path = stack.pop()
+        if item is target:
+            return path
+        if isinstance(item, dict):
+            stack.extend(
+                (value, f"{path}.{key}" if path else str(key))
+                for key, value in item.items()
+            )
+        elif isinstance(item, list):
+            stack.extend((value, f"{path}[{i}]") for i, value in enumerate(item))
+    return ""
 
 
 def numbered_lines(text: str) -> list[tuple[int, str]]:

@@ -22,6 +22,7 @@ filled in on every row; other columns are ignored.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from os import PathLike
 
@@ -38,12 +39,63 @@ MAX_CHAINAGE_M = 100_000.0
 MAX_ELEVATION_M = 11_000.0
 
 #: Shortest segment [m]: the profile CSV is written to 0.1 mm, and a surveyed
-#: section has no vertices a millimetre apart.
+#: section has no vertices a millimetre apart (RocFall's export needs as much).
 MIN_SEGMENT_M = 1e-3
 
 X_ALIASES = ("x", "chainage", "distance", "station")
 Z_ALIASES = ("z", "elevation", "elev", "height", "ground_z")
 MATERIAL_ALIASES = ("material", "materials", "surface")
+
+
+def check_profile_vertices(
+    x_m: np.ndarray,
+    z_m: np.ndarray,
+    *,
+    source: str,
+    where: Callable[[str, int], str],
+) -> None:
+    """Refuse vertices no slope section has, naming the first (one check for every
+    profile: this CSV, a model file's vertex lists, a RocFall slope).
+
+    A chainage beyond :data:`MAX_CHAINAGE_M`, an elevation beyond
+    :data:`MAX_ELEVATION_M`, or a vertex closer than :data:`MIN_SEGMENT_M` after
+    the one before it (vertices out of order are left to the caller, which names
+    them in its own terms). ``where(axis, i)`` names vertex ``i``'s ``axis`` (``"x"``
+    or ``"z"``) for the message, e.g. ``"row 7: column 'z_m'"`` or
+    ``"profile.z_m[5]"``. The values are finite (each reader checks that first).
+
+    Examples
+    --------
+    >>> check_profile_vertices(
+    ...     np.array([0.0, 10.0]), np.array([100.0, 1e12]), source="m.json",
+    ...     where=lambda axis, i: f"profile.{axis}_m[{i}]")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    fieldkit.errors.InputFileError: m.json: profile.z_m[1]: 1e+12 m is not an ...
+    """
+    for axis, values, limit, what in (
+        ("x", x_m, MAX_CHAINAGE_M, "a chainage (100 km, beyond any slope section)"),
+        ("z", z_m, MAX_ELEVATION_M, "an elevation on Earth (-10,994 to 8,849 m)"),
+    ):
+        beyond = np.flatnonzero(np.abs(values) > limit)
+        if beyond.size:
+            i = int(beyond[0])
+            raise InputFileError(
+                f"{values[i]:g} m is not {what}: at most {limit:,.0f} m in size",
+                source=source,
+                where=where(axis, i),
+            )
+    steps = np.diff(x_m)
+    short = np.flatnonzero((steps > 0) & (steps < MIN_SEGMENT_M))
+    if short.size:
+        i = int(short[0])
+        raise InputFileError(
+            f"vertices {steps[i]:.3g} m apart; segments must be at least "
+            f"{MIN_SEGMENT_M * 1e3:g} mm long (no surveyed section has vertices "
+            "closer; the profile CSV is written to 0.1 mm)",
+            source=source,
+            where=where("x", i + 1),
+        )
 
 
 @dataclass(frozen=True)
@@ -109,30 +161,12 @@ def read_profile_csv(
         )
     x = np.array([table.number(n, row, x_column) for n, row in rows]) * x_factor
     z = np.array([table.number(n, row, z_column) for n, row in rows]) * z_factor
-    for values, column, limit, what in (
-        (x, x_column, MAX_CHAINAGE_M, "a chainage (100 km, beyond any slope section)"),
-        (z, z_column, MAX_ELEVATION_M, "an elevation on Earth (-10,994 to 8,849 m)"),
-    ):
-        beyond = np.flatnonzero(np.abs(values) > limit)
-        if beyond.size:
-            i = int(beyond[0])
-            raise InputFileError(
-                f"column '{column.header.strip()}': {values[i]:g} m is not {what}: "
-                f"at most {limit:,.0f} m in size",
-                source=source,
-                where=f"row {rows[i][0]}",
-            )
+    headers = {"x": x_column.header.strip(), "z": z_column.header.strip()}
+    check_profile_vertices(
+        x, z, source=source,
+        where=lambda axis, i: f"row {rows[i][0]}: column '{headers[axis]}'",
+    )  # fmt: skip
     steps = np.diff(x)
-    short = np.flatnonzero((steps > 0) & (steps < MIN_SEGMENT_M))
-    if short.size:
-        i = int(short[0])
-        raise InputFileError(
-            f"column '{x_column.header.strip()}': vertices {steps[i]:.3g} m apart; "
-            f"segments must be at least {MIN_SEGMENT_M * 1e3:g} mm long (the profile "
-            "CSV is written to 0.1 mm)",
-            source=source,
-            where=f"row {rows[i + 1][0]}",
-        )
     if (steps <= 0).any():
         i = int(np.flatnonzero(steps <= 0)[0])
         header = x_column.header.strip()

@@ -139,9 +139,25 @@ def check_number(
     source: str,
     where: str,
     unit: str = "",
+    whole: bool = False,
 ) -> float:
     """``value`` as a finite float in ``[lower, upper]``, else a one-line
-    InputFileError (NaN and +-Infinity are refused whatever the bounds)."""
+    InputFileError (NaN and +-Infinity are refused whatever the bounds).
+
+    ``whole``: the field counts something, so it must be a whole number (``500``
+    or ``500.0``, not ``500.5``).
+
+    Examples
+    --------
+    >>> check_number(500.0, 1, 1e6, source="m.json", where="core.max_impacts",
+    ...              whole=True)
+    500.0
+    >>> check_number(500.5, 1, 1e6, source="m.json", where="core.max_impacts",
+    ...              whole=True)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    fieldkit.errors.InputFileError: m.json: ...: must be a whole number (got 500.5)
+    """
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise InputFileError(
             f"must be a number (got {_shown(value)})", source=source, where=where
@@ -153,6 +169,10 @@ def check_number(
     if not math.isfinite(number):
         raise InputFileError(
             f"must be a finite number (got {number})", source=source, where=where
+        )
+    if whole and not number.is_integer():
+        raise InputFileError(
+            f"must be a whole number (got {number:.10g})", source=source, where=where
         )
     unit = "" if unit in ("", "-") else f" {unit}"
     if number < lower:

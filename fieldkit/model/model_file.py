@@ -8,7 +8,8 @@ Core settings (``"core"``) all have defaults, stated by :data:`CORE_DEFAULTS`:
   sliding/rolling phase (a 0.5 m/s hop rises 1.3 cm, well under any block radius:
   below it the lumped mass only chatters);
 * ``stop_speed_mps`` = 0.05: a sliding rock slower than this at a concave break stops;
-* ``max_impacts`` = 500: rocks reaching it are counted and reported, never silent;
+* ``max_impacts`` = 500, a whole number in [1, 1e6]: rocks reaching it are counted
+  and reported, never silent;
 * ``drag_dt_s`` = 0.25: longest flight substep when ``air_drag`` is on (substeps
   are also kept short enough for drag to change the speed by < 0.2 %, see
   :mod:`fieldkit.model.effects.air_drag`).
@@ -32,7 +33,11 @@ enough to catch a typing or unit error:
 * effects: each parameter's own bounds (``fieldkit effects NAME``).
 
 The profile's x must increase strictly, so every segment dips between -90 and 90
-degrees (inside the contract's (-180, 180] degrees).
+degrees (inside the contract's (-180, 180] degrees); vertex lists get the bounds of a
+profile CSV (chainage within 100 km, elevation within 11 km, vertices at least 1 mm
+apart: :func:`fieldkit.io.profile_csv.check_profile_vertices`, named as
+``profile.z_m[5]``). A key given twice in one object is refused, naming its path
+(``materials.rock.e_n given twice``): JSON readers otherwise keep the last silently.
 
 Files a model reads
 -------------------
@@ -45,7 +50,6 @@ replace them.
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import re
@@ -55,6 +59,7 @@ from pathlib import Path
 import numpy as np
 
 from fieldkit.errors import ArgumentError, FieldkitError, InputFileError
+from fieldkit.io.csv_table import parse_json
 from fieldkit.io.dem import read_dem
 from fieldkit.io.profile_csv import read_profile_csv
 from fieldkit.model.dem_profile import (
@@ -75,6 +80,8 @@ CORE_DEFAULTS: dict[str, tuple[float, float, float, str]] = {
     "max_impacts": (500.0, 1.0, 1e6, "-"),
     "drag_dt_s": (0.25, 1e-4, 5.0, "s"),
 }
+#: Core settings that count something: whole numbers only (500, not 500.5).
+WHOLE_NUMBER_CORE = frozenset({"max_impacts"})
 G_MPS2 = 9.81
 #: Body fields -> (lower, upper) [SI]; the lower bound is exclusive (module docstring).
 BODY_BOUNDS: dict[str, tuple[float, float]] = {
@@ -257,6 +264,7 @@ def model_from_dict(
             source=source,
             where=f"core.{key}",
             unit=unit,
+            whole=key in WHOLE_NUMBER_CORE,
         )
     trees = None
     if "trees" in data:
@@ -387,8 +395,9 @@ def _profile(prof: dict, source: str, *, base_dir, read: list[str]) -> Profile:
                 where=f"profile.{_PROFILE_FIELDS[exc.source]}",
             ) from None
         return Profile.from_arrays(
-            section.chainage_m, section.z_m, section.material, source=source
-        )
+            section.chainage_m, section.z_m, section.material, source=source,
+            where=lambda axis, i: f"profile.{kind}: section vertex {i} ({axis})",
+        )  # fmt: skip
     _unknown(prof, {"x_m", "z_m", "material"}, "profile", source)
     for key in ("x_m", "z_m", "material"):
         if key not in prof:
@@ -565,7 +574,8 @@ def read_model(
     ------
     InputFileError
         The file cannot be read, is not UTF-8 or not JSON, is nested deeper than
-        :data:`MAX_JSON_DEPTH`, or has a bad field (named).
+        :data:`MAX_JSON_DEPTH`, gives a key twice in one object
+        (:func:`fieldkit.io.csv_table.parse_json`), or has a bad field (named).
     OutputFileError
         A planned output of ``outputs`` is a file the model reads.
     """
@@ -573,7 +583,7 @@ def read_model(
     if outputs is not None:
         outputs.add_inputs([path])
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")  # a BOM, as Notepad writes
     except UnicodeDecodeError as exc:
         raise InputFileError(
             f"not a UTF-8 text file (byte {exc.start})", source=path
@@ -588,14 +598,10 @@ def read_model(
             f"{MAX_JSON_DEPTH})",
             source=path,
         )
-    try:
-        # NaN and +-Infinity (not JSON, but Python writes them) are read as floats
-        # so that the check of their field refuses them by name
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise InputFileError(
-            f"not valid JSON ({exc.msg})", source=path, where=f"line {exc.lineno}"
-        ) from None
+    # NaN and +-Infinity (not JSON, but Python writes them) are read as floats so
+    # that the check of their field refuses them by name; a key given twice is
+    # refused naming its path (Python's reader would keep the last silently)
+    data = parse_json(text, str(path))
     model = model_from_dict(data, source=str(path), base_dir=path.parent)
     model = replace(model, source_files=(str(path), *model.source_files))
     if outputs is not None:

@@ -8,12 +8,14 @@ elevation; segment ``j`` joins vertices ``j`` and ``j+1`` and is made of
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from fieldkit.errors import InputFileError
+from fieldkit.io.profile_csv import check_profile_vertices
 
 
 @dataclass(frozen=True)
@@ -27,9 +29,21 @@ class Profile:
 
     @classmethod
     def from_arrays(
-        cls, x_m: ArrayLike, z_m: ArrayLike, material: object, *, source: str = ""
+        cls,
+        x_m: ArrayLike,
+        z_m: ArrayLike,
+        material: object,
+        *,
+        source: str = "",
+        where: Callable[[str, int], str] | None = None,
     ) -> Profile:
         """Validate and build; errors name ``source`` and the field (``profile.x_m``).
+
+        Every profile is built here, so every profile gets the bounds of
+        :func:`fieldkit.io.profile_csv.check_profile_vertices` (chainage within
+        100 km, elevation within 11 km, vertices at least 1 mm apart).
+        ``where(axis, i)`` names vertex ``i`` in those errors (default
+        ``profile.x_m[i]``, ``profile.z_m[i]``: a model file's vertex lists).
 
         Examples
         --------
@@ -81,6 +95,12 @@ class Profile:
                 source=source,
                 where="profile.x_m",
             )
+        check_profile_vertices(
+            x,
+            z,
+            source=source,
+            where=where or (lambda axis, i: f"profile.{axis}_m[{i}]"),
+        )
         if isinstance(material, str):
             material = [material] * (x.size - 1)
         if not isinstance(material, list | tuple) or not all(
