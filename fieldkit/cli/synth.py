@@ -275,11 +275,6 @@ def _synth_track(
         model = with_effects(read_model(model_file, outputs=outputs), hidden)
         drag = model.effects.get("air_drag", {"cd": 0.0, "air_density_kg_m3": 1.225})
         ignored = sorted(set(model.effects) - {"air_drag"})
-        if ignored:  # a track is flights down a plane: nothing else acts on it here
-            note(
-                f"a synthetic track is ballistic flights (with air_drag) down a plane: "
-                f"{', '.join(ignored)} of the model or --effects do not act on it"
-            )
         px, pz = model.profile.x_m, model.profile.z_m
         # x increases in the direction of travel and the dip is positive when the
         # ground descends that way (ARCHITECTURE §2): a profile rising toward +x
@@ -315,4 +310,9 @@ def _synth_track(
         f"air_drag cd = {float(drag['cd']):g}, air density "
         f"{float(drag['air_density_kg_m3']):g} kg/m3"
     )
+    if ignored:  # a track is flights down a plane: nothing else acts on it here
+        note(
+            f"a synthetic track is ballistic flights (with air_drag) down a plane: "
+            f"{', '.join(ignored)} of the model or --effects do not act on it"
+        )
     report_written(written)
