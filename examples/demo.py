@@ -26,6 +26,7 @@ Run:  python examples/demo.py [OUT_DIR]
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import shlex
 import subprocess
@@ -40,16 +41,15 @@ REPO = HERE.parent
 SURVEY = REPO / "surveys" / "tornado_mountain"
 PRESET = SURVEY / "boulder_a_preset.toml"
 SEED = 1
-#: The path fit of examples/export_tornado_mountain.py, smaller: free parameters and
-#: their search bounds, rocks per evaluation, Sobol screen, bootstrap resamples.
-PATH_FREE = {
-    "materials.colluvium.e_n": (0.2, 2.0),
-    "materials.colluvium.e_t": (0.3, 0.98),
-    "velocity_scaled_restitution.k_mps": (2.0, 30.0),
-    "materials.bench.e_n": (0.05, 1.2),
-    "materials.bench.e_t": (0.1, 0.98),
-}
+#: The path fit of examples/calibrate_tornado_mountain.py (its free parameters and
+#: search bounds: PATH_FREE), smaller: rocks per evaluation, Sobol screen, bootstrap.
 PATH_ROCKS, PATH_SCREEN, PATH_BOOTSTRAP = 60, 8, 10
+_spec = importlib.util.spec_from_file_location(
+    "calibrate_tornado_mountain", HERE / "calibrate_tornado_mountain.py"
+)
+_calibrate = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(_calibrate)
+PATH_FREE = _calibrate.PATH_FREE
 SIM_ROCKS, X_ANALYSIS_M = 2000, 610.0
 MEASURED = "x=610,speed=18,ke=600e3"  # §7.5.4
 
