@@ -20,11 +20,11 @@ demo: $(STAMP)
 
 ## Fast test suite (a few minutes on 2 cores).
 test: $(STAMP)
-	MPLBACKEND=Agg $(BIN)/python -m pytest -q
+	MPLBACKEND=Agg $(BIN)/python -m pytest -q -n auto
 
 ## Everything, including tests marked slow.
 test-all: $(STAMP)
-	MPLBACKEND=Agg $(BIN)/python -m pytest -q -m ''
+	MPLBACKEND=Agg $(BIN)/python -m pytest -q -n auto -m ''
 
 ## Speed and memory figures (printed, not asserted); bench_diagnose_power runs its
 ## short setting here (a few tables per condition, ~3 min on 2 cores).
