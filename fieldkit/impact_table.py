@@ -295,6 +295,39 @@ def check_read_values(frame: pd.DataFrame, source: str | None) -> None:
         raise InputFileError(message, source=source, where=f"row {i + 1}")
 
 
+def flight_sides(frame: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
+    """``(arrives, leaves)`` per row: a flight arrives (impact velocity ``vi`` known)
+    and a flight leaves (restitution velocity ``vf`` known). A reduced path's release
+    point has no arriving flight and its stop point no leaving one: they are points
+    of the path, not impacts. A table without those columns arrives and leaves
+    everywhere (a velocity is unknown only when every component the frame has is
+    empty).
+
+    Examples
+    --------
+    >>> nan = np.nan
+    >>> f = pd.DataFrame({"vi_x_mps": [nan, 1.0, 1.0], "vi_z_mps": [nan, -1.0, -1.0],
+    ...                   "vf_x_mps": [1.0, 1.0, nan], "vf_z_mps": [1.0, 1.0, nan]})
+    >>> [a.tolist() for a in flight_sides(f)]
+    [[False, True, True], [True, True, False]]
+    """
+
+    def known(*columns: str) -> np.ndarray:
+        present = [c for c in columns if c in frame]
+        if not present:
+            return np.ones(len(frame), bool)
+        return frame[present].notna().any(axis=1).to_numpy()
+
+    return known("vi_x_mps", "vi_z_mps"), known("vf_x_mps", "vf_z_mps")
+
+
+def path_point_kind(arrives: bool, leaves: bool) -> str:
+    """What a row without an impact is (:func:`flight_sides`), in words."""
+    if not arrives and not leaves:
+        return "a point with no flight on either side"
+    return "a release point" if not arrives else "a stop point"
+
+
 def quality_flags(frame: pd.DataFrame) -> pd.Series:
     """The ``qa_flags`` of every row, from the table's own columns (:data:`QA_FLAGS`).
 

@@ -58,11 +58,10 @@ from fieldkit.fit.impact_fit import (
     fit_result,
     free_parameters,
     impact_problem,
-    no_flight_rows,
     too_few,
 )
 from fieldkit.fit.synthetic import with_effects
-from fieldkit.impact_table import ImpactTable
+from fieldkit.impact_table import ImpactTable, flight_sides, path_point_kind
 from fieldkit.model.model_file import Model, model_from_dict
 
 METRIC = "cv_rmse_mps"
@@ -81,24 +80,11 @@ def not_impacts(table: ImpactTable) -> list[tuple[int, str]]:
     (:func:`~fieldkit.fit.impact_fit.no_flight_rows`): a reduced path's release
     point (no arriving flight) and stop point (no leaving flight).
     """
-    frame = table.frame
-    skip = no_flight_rows(table)
-    arrives = np.ones(len(frame), bool)
-    if {"vi_x_mps", "vi_z_mps"} <= set(frame):
-        arrives = ~(frame["vi_x_mps"].isna() & frame["vi_z_mps"].isna()).to_numpy()
-    leaves = np.ones(len(frame), bool)
-    if {"vf_x_mps", "vf_z_mps"} <= set(frame):
-        leaves = ~(frame["vf_x_mps"].isna() & frame["vf_z_mps"].isna()).to_numpy()
-    out = []
-    for i in np.flatnonzero(skip):
-        if not arrives[i] and not leaves[i]:
-            what = "a point with no flight on either side"
-        elif not arrives[i]:
-            what = "a release point"
-        else:
-            what = "a stop point"
-        out.append((int(i) + 1, what))
-    return out
+    arrives, leaves = flight_sides(table.frame)
+    return [
+        (int(i) + 1, path_point_kind(arrives[i], leaves[i]))
+        for i in np.flatnonzero(~(arrives & leaves))
+    ]
 
 
 def impact_count(table: ImpactTable) -> str:

@@ -43,7 +43,7 @@ from fieldkit.fit.impact_model import (
     predict_arrays,
     predict_rows,
 )
-from fieldkit.impact_table import ImpactTable
+from fieldkit.impact_table import ImpactTable, flight_sides
 from fieldkit.model.effects import registry
 from fieldkit.model.materials import MATERIAL_FIELDS
 from fieldkit.model.model_file import Model
@@ -86,14 +86,8 @@ def _rows(mask: np.ndarray) -> str:
 def no_flight_rows(table: ImpactTable) -> np.ndarray:
     """Rows with no arriving or no leaving flight (both components of ``vi`` or of
     ``vf`` empty): a reduced path's release and stop points, not impacts."""
-    frame = table.frame
-
-    def empty(a: str, b: str) -> np.ndarray:
-        if a not in frame or b not in frame:
-            return np.zeros(len(frame), bool)
-        return (frame[a].isna() & frame[b].isna()).to_numpy()
-
-    return empty("vi_x_mps", "vi_z_mps") | empty("vf_x_mps", "vf_z_mps")
+    arrives, leaves = flight_sides(table.frame)
+    return ~(arrives & leaves)
 
 
 def check_table(

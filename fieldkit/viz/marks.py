@@ -24,7 +24,7 @@ from matplotlib.legend import Legend
 from matplotlib.patches import Rectangle
 from matplotlib.quiver import Quiver, QuiverKey
 
-from fieldkit.impact_table import METHOD_QA_FLAGS, QA_FLAG_LABELS
+from fieldkit.impact_table import METHOD_QA_FLAGS, QA_FLAG_LABELS, flight_sides
 
 QA_COLOUR = "red"
 QA_LABEL = "quality flag"
@@ -154,16 +154,10 @@ def impact_count_text(frame: pd.DataFrame) -> str:
     n = int(impacts.sum())
     text = f"{n:,} impact{'' if n == 1 else 's'}"
     others = ~impacts
-
-    def finite(column: str) -> np.ndarray:
-        if column not in frame.columns:
-            return np.ones(len(frame), bool)
-        values = pd.to_numeric(frame[column], errors="coerce").to_numpy(float)
-        return np.isfinite(values)
-
-    release = others & ~finite("vi_x_mps")
-    stop = others & ~release & ~finite("vf_x_mps")
-    rest = others & ~release & ~stop
+    arrives, leaves = flight_sides(frame)
+    release = others & ~arrives
+    stop = others & arrives & ~leaves
+    rest = others & arrives & leaves
     parts = []
     for mask, one, many in (
         (release, "the release point", "release points"),
