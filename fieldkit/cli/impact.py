@@ -311,8 +311,6 @@ def impact(
           --figure out/pnv.png --json out/impact.json
     """
     v_it, v_in = _impact_velocity(speed, angle, vt, vn)
-    if not math.isfinite(spin):
-        raise ArgumentError(f"--spin must be finite (got {spin:g})")
     for value, flag, quantity in (
         (spin, "--spin", "spin_radps"),
         (en, "--en", "e_n"),
