@@ -22,6 +22,7 @@ from fieldkit.cli.common import (
     print_body_notes,
     warn,
 )
+from fieldkit.cli.progress import report_written
 from fieldkit.errors import ArgumentError
 from fieldkit.outputs import OutputSet, write_json
 from fieldkit.physics.bodies import ResolvedBody
@@ -396,5 +397,4 @@ def impact(
             "impulse_unit": "N s" if mass_known else "N s/kg",
         }  # fmt: skip
         write_json(json_out, payload, outputs)
-    for path in outputs.commit():
-        typer.echo(f"wrote {path}")
+    report_written(outputs.commit())
