@@ -32,6 +32,13 @@ from fieldkit.outputs import (
     unescape_formulas,
     write_file,
 )
+from fieldkit.physics.constants import (
+    MAX_LENGTH_M,
+    MAX_MASS_KG,
+    MAX_SPEED_MPS,
+    MIN_LENGTH_M,
+    MIN_MASS_KG,
+)
 from fieldkit.physics.energy import energy_head, kinetic_energy, rotational_energy
 from fieldkit.physics.local_axes import angle_to_ground_deg, to_local
 
@@ -222,18 +229,18 @@ MAX_PLAUSIBLE_FLIGHT_HEIGHT_M = 10.0
 #: Bounds :meth:`ImpactTable.read` puts on a table's measured (primary) columns:
 #: column -> (smallest, largest, unit, what a value outside is not). NaN (not measured)
 #: passes; infinities and values beyond a bound are refused, naming file, row and
-#: column. The body bounds are those of the body options (``--mass``, ``--radius``,
-#: ``--gyration``: 1 g to 10,000 t, 1 mm to 10 m); speeds are within 100 m/s (free
-#: fall from 500 m reaches 99 m/s); coordinates within the 10,000 km of a plan
+#: column. The body and speed bounds are :mod:`fieldkit.physics.constants`', shared
+#: with the body options (``--mass``, ``--radius``, ``--gyration``: 1 g to 10,000 t,
+#: 1 mm to 10 m; speeds within 100 m/s: free fall from 500 m reaches 99 m/s); coordinates within the 10,000 km of a plan
 #: coordinate and the 11,000 m of an elevation on Earth the point readers use.
 READ_BOUNDS: dict[str, tuple[float, float, str, str]] = {
     "x_m": (-1.0e7, 1.0e7, "m", "a distance along a fall path"),
     "z_m": (-11_000.0, 11_000.0, "m", "an elevation on Earth"),
-    "mass_kg": (1e-3, 1e7, "kg", "a rock's mass (1 g to 10,000 t)"),
-    "radius_m": (1e-3, 10.0, "m", "a rock's contact radius"),
-    "gyration_m": (1e-3, 10.0, "m", "a rock's radius of gyration"),
+    "mass_kg": (MIN_MASS_KG, MAX_MASS_KG, "kg", "a rock's mass (1 g to 10,000 t)"),
+    "radius_m": (MIN_LENGTH_M, MAX_LENGTH_M, "m", "a rock's contact radius"),
+    "gyration_m": (MIN_LENGTH_M, MAX_LENGTH_M, "m", "a rock's radius of gyration"),
     **{
-        name: (-100.0, 100.0, "m/s", "a rockfall velocity")
+        name: (-MAX_SPEED_MPS, MAX_SPEED_MPS, "m/s", "a rockfall velocity")
         for name in ("vi_x_mps", "vi_z_mps", "vf_x_mps", "vf_z_mps")
     },
 }

@@ -24,6 +24,13 @@ import typer
 
 from fieldkit.errors import ArgumentError, FieldkitError
 from fieldkit.physics.bodies import SHAPES, UNIT_WEIGHT_KN_M3, ResolvedBody
+from fieldkit.physics.constants import (
+    MAX_LENGTH_M,
+    MAX_MASS_KG,
+    MAX_SPEED_MPS,
+    MIN_LENGTH_M,
+    MIN_MASS_KG,
+)
 
 P = ParamSpec("P")
 R = TypeVar("R")
@@ -367,8 +374,8 @@ UnitWeightOpt = Annotated[
 #: option's default: slip always stops).
 PHYSICAL_LIMITS: dict[str, tuple[float, str, str]] = {
     "speed_mps": (
-        100.0, "m/s", "free fall from 500 m reaches 99 m/s; rockfall impacts are "
-        "tens of m/s",
+        MAX_SPEED_MPS, "m/s", "free fall from 500 m reaches 99 m/s; rockfall impacts "
+        "are tens of m/s",
     ),
     "spin_radps": (
         1000.0, "rad/s", "a 0.1 m rock rolling at 100 m/s spins at 1000 rad/s",
@@ -381,10 +388,10 @@ PHYSICAL_LIMITS: dict[str, tuple[float, str, str]] = {
         "that always stops",
     ),
     "mass_kg": (
-        1e7, "kg", "10,000 t (3,700 m3 of rock): beyond it a fall is a rock "
+        MAX_MASS_KG, "kg", "10,000 t (3,700 m3 of rock): beyond it a fall is a rock "
         "avalanche, not a rockfall",
     ),
-    "length_m": (10.0, "m", "rockfall blocks are at most a few metres across"),
+    "length_m": (MAX_LENGTH_M, "m", "rockfall blocks are at most a few metres across"),
     "dimensions_m": (20.0, "m", "rockfall blocks are at most a few metres across"),
     "angle_deg": (180.0, "deg", "an angle between two directions"),
     "impulse_ns": (1e9, "N s", "10,000 t at 100 m/s"),
@@ -397,8 +404,8 @@ PHYSICAL_LIMITS: dict[str, tuple[float, str, str]] = {
 #: Smallest body the calculators take: (minimum, units). Below a gram or a
 #: millimetre a "rock" is sand, and k^2 of 1e-300 m underflows to zero.
 BODY_MINIMA: dict[str, tuple[float, str]] = {
-    "mass_kg": (1e-3, "kg"),
-    "length_m": (1e-3, "m"),
+    "mass_kg": (MIN_MASS_KG, "kg"),
+    "length_m": (MIN_LENGTH_M, "m"),
 }
 
 
