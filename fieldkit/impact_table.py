@@ -231,8 +231,9 @@ MAX_PLAUSIBLE_FLIGHT_HEIGHT_M = 10.0
 #: passes; infinities and values beyond a bound are refused, naming file, row and
 #: column. The body and speed bounds are :mod:`fieldkit.physics.constants`', shared
 #: with the body options (``--mass``, ``--radius``, ``--gyration``: 1 g to 10,000 t,
-#: 1 mm to 10 m; speeds within 100 m/s: free fall from 500 m reaches 99 m/s); coordinates within the 10,000 km of a plan
-#: coordinate and the 11,000 m of an elevation on Earth the point readers use.
+#: 1 mm to 10 m; speeds within 100 m/s: free fall from 500 m reaches 99 m/s);
+#: coordinates within the 10,000 km of a plan coordinate and the 11,000 m of an
+#: elevation on Earth the point readers use.
 READ_BOUNDS: dict[str, tuple[float, float, str, str]] = {
     "x_m": (-1.0e7, 1.0e7, "m", "a distance along a fall path"),
     "z_m": (-11_000.0, 11_000.0, "m", "an elevation on Earth"),
