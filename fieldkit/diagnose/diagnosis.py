@@ -141,6 +141,12 @@ class Diagnosis:
     #: impacts (of 50 rows; not impacts: row 1, a release point; ...)"); not in
     #: the JSON (empty: "``n_rows`` rows").
     size: str = ""
+    #: The null of a surveyed table (:mod:`fieldkit.diagnose.survey_loop`): size,
+    #: quantile, threshold, the null campaigns' gains; None when none was run.
+    null: dict | None = None
+    #: Per candidate, the share of campaigns with it switched on at its fitted size
+    #: in which the diagnosis finds it (None when no null was run).
+    power: dict | None = None
     #: Arrays for figures and recordings (not in the JSON): ``features``,
     #: ``baseline``/``after``/``steps`` held-out residuals, ``weight``, ``path_id``,
     #: ``dependence`` (tests of the baseline and of each step), ``after_model``,
@@ -174,6 +180,8 @@ class Diagnosis:
                 k: {kk: _num(vv) for kk, vv in v.items()}
                 for k, v in self.per_material.items()
             },
+            "null": self.null,
+            "power": self.power,
             "n_rows": self.n_rows,
             "n_data": self.n_data,
             "notes": list(self.notes),

@@ -268,12 +268,15 @@ def diagnose_impacts(
     z_confound: float = CONFOUND_Z,
     candidates: list[str] | None = None,
     progress: Callable[[str], None] | None = None,
+    gain_floor: float = MIN_GAIN,
 ) -> Diagnosis:
     """Diagnose ``table`` against ``model`` (None: constant e_n, e_t per material).
 
     ``z`` is the recommendation rule (gain > z SE and > ``MIN_GAIN``);
     ``z_confound`` the rule of the conditional gains that decide
     confounding (see :func:`_alike`).
+    ``gain_floor`` is the least held-out gain a candidate must show (the rule's
+    1 %, or a null's threshold when larger: :mod:`fieldkit.diagnose.survey_loop`).
     ``rng`` deals the groups to folds (a seed reproduces the diagnosis exactly);
     ``candidates`` restricts the candidate effects (default: every one the table
     can inform); ``progress`` is called with a short message before each model is
@@ -333,7 +336,7 @@ def diagnose_impacts(
             say(f"step {len(steps) + 1}: {name}")
             variant = with_effects(current.model, {name: {}})
             scored[name] = scorer.score(variant, [*current.effects, name])
-        ranked = _rank(current, scored, z)
+        ranked = _rank(current, scored, z, max(MIN_GAIN, gain_floor))
         rankings.append(ranked)
         if first is None:
             first = ranked
@@ -429,7 +432,9 @@ def diagnose_impacts(
     )
 
 
-def _rank(current: Scored, scored: dict[str, Scored], z: float) -> list[Candidate]:
+def _rank(
+    current: Scored, scored: dict[str, Scored], z: float, floor: float = MIN_GAIN
+) -> list[Candidate]:
     out = []
     for name, s in scored.items():
         gain, se = improvement(current.held, s.held)
@@ -437,7 +442,13 @@ def _rank(current: Scored, scored: dict[str, Scored], z: float) -> list[Candidat
         added_sd = {k: v for k, v in s.params_sd.items() if k.startswith(name + ".")}
         out.append(
             Candidate(
-                name, s.cv_rmse, gain, se, meaningful(gain, se, z=z), added, added_sd
+                name,
+                s.cv_rmse,
+                gain,
+                se,
+                meaningful(gain, se, z=z, min_gain=floor),
+                added,
+                added_sd,
             )
         )
     return sorted(out, key=lambda c: c.cv_rmse)
