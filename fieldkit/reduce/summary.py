@@ -365,8 +365,8 @@ def unsolved_warning(summary: ReductionSummary) -> str:
         points += f" and {k - N_UNSOLVED_NAMED} more"
     return (
         f"warning: {k} of {summary.n_flights} flights {'has' if k == 1 else 'have'} no "
-        "ballistic solution and "
-        f"were left unsolved (leaving point{'' if k == 1 else 's'} {points}; "
+        f"ballistic solution and {'was' if k == 1 else 'were'} left unsolved "
+        f"(leaving point{'' if k == 1 else 's'} {points}; "
         f"{'the' if k == 1 else 'first'} reason: {unsolved[0][1]}): the rebound at "
         "the launch point and the impact at the arrival point are unknown "
         "(flight_unsolved column), so those rows are not impacts for fit and "

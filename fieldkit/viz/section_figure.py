@@ -2,11 +2,12 @@
 
 Left: the whole section at true scale -- ground line through the impact points, each
 flight's parabola (solid where a tree strike fixed it, dashed where the restitution
-angle was assumed; a flight with no ballistic solution as its dotted grey chord), broken trees as down arrows, impact numbers, the restitution
-velocity at each impact with its scale ("10 m/s"), impacts with quality flags ringed;
-the legend sits outside the axes. Right: the detail the thesis draws as an inset -- one
-impact with its impact and restitution velocity vectors, their N and T components on
-the local ground, and e_N, e_T.
+angle was assumed; a flight with no ballistic solution as its dotted grey chord), broken
+trees as down arrows, impact numbers, the restitution velocity at each impact with its
+scale ("10 m/s"), impacts with quality flags ringed; the legend sits outside the axes.
+Right: the detail the thesis draws as an inset -- one impact with its impact and
+restitution velocity vectors, their N and T components on the local ground, and e_N,
+e_T.
 """
 
 from __future__ import annotations
