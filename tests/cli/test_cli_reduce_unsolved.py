@@ -245,3 +245,22 @@ def test_propagate_correlation_of_neighbouring_chords_is_minus_a_half():
         correlations=(("a", "b"),),
     )
     assert out.corr["a_b_corr"] == pytest.approx(np.full(3, -0.5), abs=0.03)
+
+
+@pytest.mark.parametrize(
+    ("column", "value", "words"),
+    [
+        ("vin_vfn_corr", 1.5, "outside [-1, 1]: not a correlation coefficient"),
+        ("z_sd_m", -0.5, "outside [0, 1e+07] m: not a standard uncertainty"),
+    ],
+)
+def test_reading_a_table_checks_the_error_model_columns(
+    cli, tmp_path, fails, column, value, words
+):
+    table, _ = reduce(cli, tmp_path, UPHILL)
+    table.loc[3, column] = value
+    bad = tmp_path / "bad.csv"
+    table.to_csv(bad, index=False)
+    result = cli("view", bad, "-o", tmp_path / "v.rrd")
+    fails(result, "bad.csv", "row 4", f"column {column}", words)
+    assert not (tmp_path / "v.rrd").exists()
