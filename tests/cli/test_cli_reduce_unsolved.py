@@ -102,9 +102,19 @@ def test_a_tree_no_parabola_reaches_leaves_its_flight_unsolved(cli, tmp_path):
         "after_impact,horizontal_distance_m,strike_height_m,ground_z_m\n"
         "P2,5.0,1.0,80.0\n"
     )  # strike at 81 m, chord there at 85 m
+    figures = tmp_path / "figures"
     table, result = reduce(
-        cli, tmp_path, points, "--trees", trees, "--height-sigma", "0.3"
-    )
+        cli, tmp_path, points, "--trees", trees, "--height-sigma", "0.3",
+        "--figures", figures,
+    )  # fmt: skip
+    # the figures draw the NaN rows (the unsolved flight as its dotted chord)
+    for name in ("section", "en_theta", "et_impacts", "energy_partition"):
+        assert f"wrote {figures / name}.png" in result.stdout
+    from fieldkit.impact_table import ImpactTable
+    from fieldkit.viz.section_figure import unsolved_chords
+
+    (xs, zs), *others = unsolved_chords(ImpactTable.read(tmp_path / "p_table.csv"))
+    assert not others and xs.tolist() == [20.0, 30.0] and zs.tolist() == [88.0, 82.0]
     reason = table["flight_unsolved"]
     assert reason.notna().tolist() == [False, False, True, False, False]
     assert reason[2].startswith("tree row 2: tree strike 1.00 m high")
