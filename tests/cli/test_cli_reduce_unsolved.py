@@ -16,7 +16,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from fieldkit.impact_table import ImpactTable
 from fieldkit.reduce.uncertainty import DEFAULT_SEED, PositionError, propagate
+from fieldkit.viz.section_figure import unsolved_chords
 
 REPO = Path(__file__).resolve().parents[2]
 SURVEY = REPO / "surveys" / "tornado_mountain"
@@ -110,9 +112,6 @@ def test_a_tree_no_parabola_reaches_leaves_its_flight_unsolved(cli, tmp_path):
     # the figures draw the NaN rows (the unsolved flight as its dotted chord)
     for name in ("section", "en_theta", "et_impacts", "energy_partition"):
         assert f"wrote {figures / name}.png" in result.stdout
-    from fieldkit.impact_table import ImpactTable
-    from fieldkit.viz.section_figure import unsolved_chords
-
     (xs, zs), *others = unsolved_chords(ImpactTable.read(tmp_path / "p_table.csv"))
     assert not others and xs.tolist() == [20.0, 30.0] and zs.tolist() == [88.0, 82.0]
     reason = table["flight_unsolved"]
