@@ -61,7 +61,7 @@ from fieldkit.fit.impact_fit import (
     too_few,
 )
 from fieldkit.fit.synthetic import with_effects
-from fieldkit.impact_table import ImpactTable, flight_sides, path_point_kind
+from fieldkit.impact_table import ImpactTable, path_point_kinds
 from fieldkit.model.model_file import Model, model_from_dict
 
 METRIC = "cv_rmse_mps"
@@ -78,13 +78,10 @@ def not_impacts(table: ImpactTable) -> list[tuple[int, str]]:
 
     These are the rows every fit leaves out
     (:func:`~fieldkit.fit.impact_fit.no_flight_rows`): a reduced path's release
-    point (no arriving flight) and stop point (no leaving flight).
+    point (no arriving flight), stop point (no leaving flight) and the two ends of a
+    flight the reduction could not solve (``flight_unsolved``).
     """
-    arrives, leaves = flight_sides(table.frame)
-    return [
-        (int(i) + 1, path_point_kind(arrives[i], leaves[i]))
-        for i in np.flatnonzero(~(arrives & leaves))
-    ]
+    return path_point_kinds(table.frame)
 
 
 def impact_count(table: ImpactTable) -> str:
@@ -109,7 +106,7 @@ def impact_count(table: ImpactTable) -> str:
         return head
     named = [f"row {row}, {what}" for row, what in left[:N_NAMED_ROWS]]
     if len(left) > N_NAMED_ROWS:
-        named.append(f"{len(left) - N_NAMED_ROWS} more release or stop points")
+        named.append(f"{len(left) - N_NAMED_ROWS} more")
     return f"{head} (of {len(table)} rows; not impacts: {'; '.join(named)})"
 
 

@@ -43,7 +43,7 @@ from fieldkit.fit.impact_model import (
     predict_arrays,
     predict_rows,
 )
-from fieldkit.impact_table import ImpactTable, flight_sides
+from fieldkit.impact_table import ImpactTable, flight_sides, path_point_kinds
 from fieldkit.model.effects import registry
 from fieldkit.model.materials import MATERIAL_FIELDS
 from fieldkit.model.model_file import Model
@@ -382,9 +382,12 @@ def impact_problem(table: ImpactTable, model: Model) -> ImpactProblem:
     check_table(table, model, skip)
     notes = []
     if skip.any():
+        kinds = path_point_kinds(table.frame)
+        named = "; ".join(f"row {row}, {what}" for row, what in kinds[:5])
+        more = f"; and {len(kinds) - 5} more" if len(kinds) > 5 else ""
         notes.append(
-            f"{_rows(skip)} left out: no arriving or leaving flight (a release or "
-            "stop point, not an impact)"
+            f"{len(kinds)} row{'' if len(kinds) == 1 else 's'} left out: no arriving "
+            f"or leaving flight, not an impact ({named}{more})"
         )
         table = ImpactTable(
             table.frame.loc[~skip].reset_index(drop=True), source=table.source
