@@ -607,9 +607,12 @@ class ImpactTable:
         for col in CONTRACT_COLUMNS:
             if col.name not in out.columns:
                 out[col.name] = pd.NA if col.kind in ("str", "bool") else np.nan
+        # a column already of its kind is left alone: a table built from another
+        # one (every stage does it) then costs no conversion
+        wanted = {"float": "float64", "str": "string", "bool": "boolean"}
         for name in out.columns:
             spec = COLUMNS_BY_NAME.get(name)
-            if spec is None:
+            if spec is None or str(out[name].dtype) == wanted.get(spec.kind):
                 continue
             if spec.kind == "float":
                 out[name] = self._as_float(out[name], name)

@@ -69,6 +69,9 @@ DEFAULT_POWER = 40
 DEFAULT_QUANTILE = 0.95
 #: Power below which the report says the data cannot tell the laws apart.
 LOW_POWER = 0.5
+#: Most scars of one simulated rock in a null path: then the next rock starts again
+#: from the observed scar there at the observed speed (:func:`loop_table`).
+PIECE_SCARS = 10
 #: Least scatter of e_n, e_t given to the simulated rocks (an impact is never
 #: exactly repeatable).
 MIN_SCATTER = 0.02
@@ -279,9 +282,14 @@ def loop_table(
 ) -> tuple[ImpactTable, int, int]:
     """One virtual campaign through the reduction, standing in for the observed
     table: on each observed path's profile, rocks are simulated and surveyed until
-    they have left as many scars as the path has (the last one surveyed only that
-    far), the first from the release, each next one from the observed scar past the
-    last one's end (:func:`path_model`); each rock is reduced on its own with the path's options and its rows
+    they have left as many impacts as the path has. Each rock starts at an observed
+    scar with the rebound velocity the reduction gave the observed rock there
+    (:func:`path_model`), the first at the first scar, each next one at the
+    observed scar past the last one's end, and is surveyed for at most
+    :data:`PIECE_SCARS` scars, so the speed is brought back to the observed one
+    every few flights (a lumped-mass rock keeps whatever speed scale it has); the
+    flight from its start is reduced as a release and left out
+    (:func:`_without_release`); each rock is reduced on its own with the path's options and its rows
     take the path's id, so the diagnosis holds them out in blocks as it holds out
     the observed path. Returns the table, the rocks surveyed and the rocks whose
     reduction failed (left out).
@@ -310,7 +318,7 @@ def loop_table(
         )
         have = 0
         tries = 0
-        start = 0
+        start = 1 if len(path.x_m) > 3 else 0
         while have < path.scars:
             tries += 1
             if tries > 10 * path.scars:
@@ -320,7 +328,9 @@ def loop_table(
                     source="null campaign",
                 )
             left = path.scars - have
-            rock_design = replace(design, max_scars=max(2, left), min_scars=2)
+            rock_design = replace(
+                design, max_scars=max(2, min(left + 1, PIECE_SCARS)), min_scars=2
+            )
             model = path_model(path, materials, effects, start)
             virtual = virtual_campaign(model, rock_design, 1, rng, source="null").paths[0]
             rocks += 1
@@ -331,17 +341,33 @@ def loop_table(
                 # past the path's end: go on from a scar drawn at random (not the
                 # release again: the path has one source and one cliff)
                 start = int(rng.integers(1, max(2, len(path.x_m) - 2)))
+            start = max(start, 1) if len(path.x_m) > 3 else 0
             try:
                 reduced = reduce_path(virtual.survey, options).table.frame
             except FieldkitError:
                 failed += 1
                 continue
+            reduced = _without_release(reduced)
             reduced["path_id"] = path.path_id
             reduced["point"] = f"rock{rocks}." + reduced["point"].astype(str)
             frames.append(reduced)
-            have += len(virtual.survey.points) - 1
+            have += len(virtual.survey.points) - 2
     table = ImpactTable(pd.concat(frames, ignore_index=True), source="null campaign")
     return table, rocks, failed
+
+
+def _without_release(frame: pd.DataFrame) -> pd.DataFrame:
+    """A rock started mid-path: its first flight was reduced as a release (the
+    least-speed launch), which the observed path has only at its source; so the
+    release row goes and the first scar keeps only its rebound (no arriving
+    flight, not an impact), as the observed path's first scar after a release
+    would not be repeated."""
+    out = frame.iloc[1:].copy()
+    first = out.index[0]
+    for column in ("vi_x_mps", "vi_z_mps", "omega_i_radps"):
+        if column in out:
+            out.loc[first, column] = np.nan
+    return ImpactTable(out.reset_index(drop=True)).derive().frame
 
 
 @dataclass(frozen=True)

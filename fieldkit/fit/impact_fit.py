@@ -188,12 +188,24 @@ def _weights(table: ImpactTable, inputs: ImpactInputs) -> tuple[np.ndarray, str]
         text += ", omega_f_sd_radps"
     elif has_spin.any():
         text += "; measured spins left out (no omega_f_sd_radps)"
-    bad = ~((sd[:, 0] > 0) & (sd[:, 1] > 0) & np.isfinite(sd[:, :2]).all(axis=1))
+    known = np.isfinite(sd[:, :2])
+    bad = (known & ~(sd[:, :2] > 0)).any(axis=1) | np.isinf(sd[:, :2]).any(axis=1)
     if bad.any():
         raise InputFileError(
             "standard uncertainty is not a positive number",
             source=table.source,
             where=_rows(bad),
+        )
+    # An empty sd beside a measured rebound: the reduction could not estimate it
+    # (its flight had no ballistic solution in most survey-error draws): the datum
+    # is too fragile to weigh, so it is left out, and said so.
+    fragile = ~known.all(axis=1) & np.isfinite(inputs.vin_mps)
+    if fragile.any():
+        sd[fragile, :2] = np.nan
+        text += (
+            f"; {int(fragile.sum())} impact(s) left out whose sd is empty (their "
+            "flights have no ballistic solution in most survey-error draws: "
+            f"{_rows(fragile)})"
         )
     return sd, text
 

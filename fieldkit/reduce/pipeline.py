@@ -54,7 +54,7 @@ from fieldkit.reduce.uncertainty import (
     Propagated,
     propagate,
 )
-from fieldkit.survey import Survey
+from fieldkit.survey import Survey, TreeStrike
 
 
 @dataclass(frozen=True)
@@ -291,20 +291,78 @@ def point_kinematics(
     table (what :func:`~fieldkit.reduce.uncertainty.propagate` repeats). Tree strikes
     keep their distance from the (moved) launch point.
     """
-    frame = survey.points.frame.reset_index(drop=True).copy()
-    frame["x_m"], frame["z_m"] = x_m, z_m
-    moved = replace(survey, points=replace(survey.points, frame=frame))
-    if strike_heights_m is not None and survey.trees is not None:
-        trees = survey.trees.frame.copy()
-        trees["strike_height_m"] = np.asarray(strike_heights_m, float)
-        moved = replace(moved, trees=replace(survey.trees, frame=trees))
-    slope, _, flights = _solve(moved, options, np.asarray(x_m), np.asarray(z_m))
-    values = restitution(*flight_velocities(flights, len(frame)), slope)
-    out = {name: values[name] for name in OUTPUTS}
-    unsolved = np.zeros(len(frame))
-    unsolved[[j for j, f in enumerate(flights) if f.flight is None]] = 1.0
-    out[UNSOLVED] = unsolved
-    return out
+    return PointKinematics(survey, options)(x_m, z_m, strike_heights_m)
+
+
+class PointKinematics:
+    """:func:`point_kinematics` prepared once for one survey: the Monte Carlo of
+    :func:`~fieldkit.reduce.uncertainty.propagate` calls it a hundred times, so what
+    does not move with the points (names, surveyed slopes and angles, which flight
+    each tree strike fixes, its taped distance) is read from the frames once."""
+
+    def __init__(self, survey: Survey, options: ReduceOptions) -> None:
+        frame = survey.points.frame.reset_index(drop=True)
+        self.n = len(frame)
+        self.names = survey.points.names
+        self.surveyed = (
+            frame["slope_deg"].to_numpy(float) if "slope_deg" in frame else None
+        )
+        self.given = frame["theta0_deg"].to_numpy(float) if "theta0_deg" in frame else None
+        self.options = options
+        self.source = survey.source
+        self.trees_source = None if survey.trees is None else survey.trees.source
+        launch = {name: j for j, name in enumerate(self.names)}
+        # (row in the tree file's order, launch index, tree strike as surveyed,
+        # ground given in the file or NaN)
+        self.trees: list[tuple[int, int, TreeStrike, float]] = []
+        if survey.trees is not None:
+            by_launch = survey.trees_by_launch()  # validates, as the nominal solve
+            grounds = survey.trees.frame["ground_z_m"].to_numpy(float)
+            keys = survey.trees.frame["after_impact"].astype(str).to_list()
+            for row, key in enumerate(keys):
+                self.trees.append((row, launch[key], by_launch[key], float(grounds[row])))
+
+    def __call__(
+        self,
+        x_m: np.ndarray,
+        z_m: np.ndarray,
+        strike_heights_m: np.ndarray | None = None,
+    ) -> dict[str, np.ndarray]:
+        x = np.asarray(x_m, float)
+        z = np.asarray(z_m, float)
+        slope, _ = section_slopes(x, z, self.surveyed)
+        trees = {}
+        for row, j, tree, ground in self.trees:
+            if not math.isfinite(ground):
+                dx = x[j + 1] - x[j]
+                ground = (
+                    float(z[j] + (z[j + 1] - z[j]) * tree.distance_m / dx)
+                    if dx > 0
+                    else math.nan
+                )
+            height = (
+                tree.height_m
+                if strike_heights_m is None
+                else float(strike_heights_m[row])
+            )
+            trees[tree.after_impact] = replace(tree, height_m=height, ground_z_m=ground)
+        flights = solve_flights(
+            self.names,
+            x,
+            z,
+            slope,
+            theta0_deg=self.options.theta0_deg,
+            given_theta0_deg=self.given,
+            trees=trees,
+            points_source=self.source,
+            trees_source=self.trees_source,
+        )
+        values = restitution(*flight_velocities(flights, self.n), slope)
+        out = {name: values[name] for name in OUTPUTS}
+        unsolved = np.zeros(self.n)
+        unsolved[[j for j, f in enumerate(flights) if f.flight is None]] = 1.0
+        out[UNSOLVED] = unsolved
+        return out
 
 
 def add_flight_energy(table: ImpactTable) -> ImpactTable:
@@ -389,7 +447,7 @@ def reduce_path(survey: Survey, options: ReduceOptions | None = None) -> Reducti
         if survey.trees is not None:
             heights = survey.trees.frame["strike_height_m"].to_numpy(float)
         spread = propagate(
-            lambda xs, zs, hs=None: point_kinematics(survey, options, xs, zs, hs),
+            PointKinematics(survey, options),
             x,
             z,
             options.position_error,
