@@ -14,21 +14,12 @@ from fieldkit.fit.impact_fit import ImpactProblem
 from fieldkit.model.effects import registry
 from fieldkit.model.model_file import Model
 
-#: Impact-level candidates, in registry order.
-IMPACT_CANDIDATES = (
-    "angle_dependent_restitution",
-    "velocity_scaled_restitution",
-    "rotation_friction",
-)
-#: Why the other effects are not candidates on an ImpactTable.
+#: Impact-level candidates, in registry order (effect metadata: every effect an
+#: ImpactTable can inform, the statistical alternative included).
+IMPACT_CANDIDATES = tuple(s.name for s in registry.EFFECTS if not s.not_from_impacts)
+#: Why the other effects are not candidates on an ImpactTable (effect metadata).
 NOT_FROM_IMPACTS = {
-    "slope_roughness": "a random local slope scatters rebounds without biasing "
-    "them: it shows as a reduced chi-square above 1, not as a held-out gain",
-    "mass_loss": "changes mass and size along the path, not the rebound "
-    "velocities an impact table measures",
-    "tree_impacts": "acts in flight; reduced impact velocities come from flights "
-    "assumed ballistic, so the table cannot show it",
-    "air_drag": "acts in flight; diagnose a video track (flight residuals) instead",
+    s.name: s.not_from_impacts for s in registry.EFFECTS if s.not_from_impacts
 }
 #: Least spread of a feature (degrees, m/s) for an effect reading it to be tested.
 MIN_SPREAD = {"theta_i_deg": 2.0, "vin_mps": 0.5}
