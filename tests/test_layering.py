@@ -56,6 +56,7 @@ STAGE_EDGES: frozenset[tuple[str, str]] = frozenset(
         ("fit", "model"),
         ("diagnose", "model"),
         ("diagnose", "fit"),
+        ("diagnose", "reduce"),
         ("export", "model"),
         ("export", "fit"),
     }

@@ -48,6 +48,7 @@ def _summary(diagnosis) -> list[str]:
     """What the command prints: the verdict in words, one line per candidate."""
     from fieldkit.diagnose import labels
     from fieldkit.diagnose.report import (
+        alternative_meaning,
         baseline_label,
         dependence_sentence,
         rankings,
@@ -88,6 +89,12 @@ def _summary(diagnosis) -> list[str]:
             )
     lines += [f"confounded: {a}" for a in d.advice]
     lines.append(f"recommended: {d.recommended or 'nothing'}; stopped: {d.stopped}")
+    if len(d.accepted) > 1:
+        lines.append(f"accepted: {', '.join(d.accepted)}")
+    meaning = alternative_meaning(d)
+    if meaning:
+        lines.append(meaning)
+    lines += [f"sensitivity: {v.sentence()}" for v in d.sensitivity]
     lines += [
         f"residuals still: {dependence_sentence(x)}"
         for x in sorted(d.dependence_after, key=lambda x: x.p_value)
@@ -111,6 +118,30 @@ def _step_once_checked(description: str) -> Iterator[Callable[[str], None]]:
                 stack.enter_context(step(description))
 
         yield progress
+
+
+def _sensitivity(table, base, seed: int, folds: int, wanted: bool | None) -> list:
+    """The verdict under each variant of the table (``wanted`` None: only for a
+    reduced survey), diagnosed with the same fold seed and folds."""
+    import numpy as np
+
+    from fieldkit.diagnose.impacts import diagnose_impacts
+    from fieldkit.diagnose.sensitivity import is_surveyed, sensitivity, variants
+
+    if wanted is False or (wanted is None and not is_surveyed(table)):
+        return []
+    names = variants(table)
+    if not names:
+        return []
+
+    def again(variant_table, variant_model):
+        return diagnose_impacts(
+            variant_table, variant_model, rng=np.random.default_rng(seed),
+            folds=folds,
+        )  # fmt: skip
+
+    with step(f"sensitivity of the verdict: diagnosing {', '.join(names)}"):
+        return sensitivity(table, base, again)
 
 
 def _write_report(report_dir: Path, diagnosis, inputs, outputs: OutputSet) -> str:
@@ -188,6 +219,15 @@ def diagnose(
     ] = None,  # fmt: skip
     material: MaterialOpt = None,
     preset: PresetOpt = None,
+    sensitivity: Annotated[
+        bool | None,
+        typer.Option(
+            "--sensitivity/--no-sensitivity",
+            help="Diagnose again with the assumed launch angles theta0 -10 and +10 "
+            "deg and with the materials grouped into one, and show each verdict "
+            "(default: on for a reduced survey, a table with assumed launch angles).",
+        ),
+    ] = None,
 ) -> None:
     """Compare model and measurements; rank the missing effects; add them stepwise.
 
@@ -292,6 +332,7 @@ def diagnose(
                     table, base, rng=rng, folds=folds, progress=progress
                 )
             diagnosis.notes.extend(mapping.notes)
+            diagnosis.sensitivity = _sensitivity(table, base, seed, folds, sensitivity)
         diagnosis.notes.append(f"fold seed {seed}")
         if json_file is not None:
             write_json(json_file, diagnosis.to_json(), outputs)

@@ -100,6 +100,19 @@ def separating_measurement(first: str, second: str, problem: ImpactProblem) -> s
             "similar angles over a wider range of speeds (drops from different "
             "heights, or a steeper and a gentler slope) would separate them"
         )
+    alternatives = [n for n in (first, second) if not registry.effect(n).is_law]
+    if len(alternatives) == 1:
+        line = alternatives[0]
+        law = (pair - {line}).pop()
+        vin = np.abs(problem.inputs.vin_mps)
+        n_lo, n_hi = np.nanpercentile(vin, [5, 95])
+        return (
+            f"{law} and {line} (a straight line in the impact velocities, not a "
+            "law) cannot be told apart with these data: over the normal impact "
+            f"speeds measured ({n_lo:.1f}-{n_hi:.1f} m/s) the law is as good as a "
+            "straight line; impacts over a wider range of impact speeds and angles, "
+            "where the law curves and a line does not, would separate them"
+        )
     if "rotation_friction" in pair:
         other = (pair - {"rotation_friction"}).pop()
         return (

@@ -118,14 +118,15 @@ def test_titles_and_report_name_effects_in_words(boulder_a):
     assert f"Model: {words}; held-out RMS error" in text
     assert f"baseline, {words}: held-out RMS error" in r.stdout
     assert re.search(
-        r"^Effects: slope roughness \(thesis eq. 7.4\), velocity-scaled restitution "
-        r"\(thesis eq. 7.1\); held-out RMS error",
+        r"^Effects: slope roughness \(thesis eq. 7.4\), affine rebound "
+        r"\(a straight line, not a law\); held-out RMS error",
         text,
         flags=re.M,
     )
     for _, fig in figures:
         title = fig.texts[0].get_text()
         assert "slope_roughness" not in title and "_restitution" not in title
+        assert "affine_rebound" not in title
     assert figures[0][1].texts[0].get_text().startswith(f"Baseline, {words}")
 
 
@@ -175,7 +176,7 @@ def test_summary_nests_no_parentheses(boulder_a):
     parenthesis in another: the reason follows after "stopped:"."""
     _, r, _ = boulder_a
     assert (
-        "recommended: velocity_scaled_restitution; stopped: no remaining candidate "
-        "passes the rule (best: angle_dependent_restitution, gain -0.6% ± 3.8%)\n"
+        "recommended: affine_rebound; stopped: no remaining candidate passes the "
+        "rule (best: velocity_scaled_restitution, gain +5.9% ± 5.0%)\n"
     ) in r.stdout
     assert "))" not in r.stdout
