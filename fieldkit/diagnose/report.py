@@ -381,10 +381,10 @@ def alternative_meaning(d: Diagnosis) -> str:
     if spec is None or spec.is_law:
         return ""
     return (
-        f"{best.effect} ({spec.physics}) is the best candidate: the rebound "
-        "departs from constant e_n, e_t, but neither named law (eq. 5.4, e_n "
-        "falling with the impact angle; eq. 7.1, falling with the impact speed) "
-        "is the better description; a straight line is a statistical "
+        f"{best.effect}, a straight line in the impact velocities, is the best "
+        "candidate: the rebound departs from constant e_n, e_t, but neither named "
+        "law, eq. 5.4 (e_n falling with the impact angle) nor eq. 7.1 (falling with "
+        "the impact speed), is the better description; the line is a statistical "
         "alternative, not a physical law"
     )
 

@@ -88,7 +88,7 @@ class Variant:
             if self.unsolved_flights
             else ""
         )
-        return f"{self.variant} ({self.description}): {verdict}{best}{unsolved}"
+        return f"{self.variant}: {self.description}: {verdict}{best}{unsolved}"
 
 
 def is_surveyed(table: ImpactTable) -> bool:
@@ -226,20 +226,20 @@ def sensitivity(
         if name.startswith("theta0"):
             delta = -THETA0_SHIFT_DEG if "-" in name else THETA0_SHIFT_DEG
             values = table.frame["theta0_deg"][assumed.fillna(False)].dropna()
-            said = sorted({f"{v + delta:.1f}°" for v in values.round(6)})
+            was = sorted({round(float(v), 6) for v in values})
+            said = ", ".join(f"{v + delta:.1f}°" for v in was[:3])
+            said += ", ..." if len(was) > 3 else ""
             description = (
                 f"the {int(assumed.fillna(False).sum())} flights with an assumed "
-                f"launch angle re-solved at theta0 {delta:+g}° ("
-                + (", ".join(said[:3]) + (", ..." if len(said) > 3 else "") or "-")
-                + ")"
+                f"launch angle re-solved at theta0 {said or '-'} instead of "
+                + ", ".join(f"{v:.1f}°" for v in was[:3])
             )
             variant_table, unsolved = shifted_theta0(table, delta)
             variant_model = model
         else:
             materials = table.frame["material"].astype("string").dropna().unique()
             description = (
-                f"the {len(materials)} materials ({', '.join(sorted(materials))}) "
-                "as one"
+                f"the {len(materials)} materials {', '.join(sorted(materials))} as one"
             )
             variant_table, variant_model = grouped_materials(table, model)
             unsolved = 0
