@@ -26,6 +26,7 @@ FLAGS = {
     "seed": "--seed",
     "material": "--material",
     "preset": "--preset",
+    "sensitivity": "--sensitivity",
 }
 #: Most characters of a CSV's first line read to tell a track from a table.
 MAX_HEADER_CHARS = 1 << 20
@@ -296,6 +297,12 @@ def diagnose(
                     "and --preset apply to ImpactTables only",
                     source="model",
                 )
+            if sensitivity:
+                raise ArgumentError(
+                    "--sensitivity applies to ImpactTables only (a track has no "
+                    "assumed launch angles or materials)",
+                    source="sensitivity",
+                )
             if radius is None:
                 raise ArgumentError("a track needs --radius (the body's radius, m)")
             from fieldkit.cli.diagnose_track import diagnose_track_file
@@ -333,6 +340,11 @@ def diagnose(
                 )
             diagnosis.notes.extend(mapping.notes)
             diagnosis.sensitivity = _sensitivity(table, base, seed, folds, sensitivity)
+            if sensitivity is None and not diagnosis.sensitivity:
+                diagnosis.notes.append(
+                    "sensitivity of the verdict not run: no launch angle of this "
+                    "table was assumed (--sensitivity runs it on any table)"
+                )
         diagnosis.notes.append(f"fold seed {seed}")
         if json_file is not None:
             write_json(json_file, diagnosis.to_json(), outputs)

@@ -52,6 +52,7 @@ def test_affine_table_recommends_affine_and_says_what_it_means(cli, tmp_path):
     assert "\naccepted:" not in r.stdout
     # a table with no assumed launch angles: no sensitivity by default, stated
     assert j["sensitivity"] == []
+    assert any("sensitivity of the verdict not run" in n for n in j["notes"])
 
 
 def test_accepted_lists_every_accepted_step_in_order(cli, tmp_path):
