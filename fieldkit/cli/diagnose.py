@@ -26,6 +26,7 @@ FLAGS = {
     "seed": "--seed",
     "material": "--material",
     "preset": "--preset",
+    "sensitivity": "--sensitivity",
 }
 #: Most characters of a CSV's first line read to tell a track from a table.
 MAX_HEADER_CHARS = 1 << 20
@@ -48,6 +49,7 @@ def _summary(diagnosis) -> list[str]:
     """What the command prints: the verdict in words, one line per candidate."""
     from fieldkit.diagnose import labels
     from fieldkit.diagnose.report import (
+        alternative_meaning,
         baseline_label,
         dependence_sentence,
         rankings,
@@ -88,6 +90,12 @@ def _summary(diagnosis) -> list[str]:
             )
     lines += [f"confounded: {a}" for a in d.advice]
     lines.append(f"recommended: {d.recommended or 'nothing'}; stopped: {d.stopped}")
+    if len(d.accepted) > 1:
+        lines.append(f"accepted: {', '.join(d.accepted)}")
+    meaning = alternative_meaning(d)
+    if meaning:
+        lines.append(meaning)
+    lines += [f"sensitivity: {v.sentence()}" for v in d.sensitivity]
     lines += [
         f"residuals still: {dependence_sentence(x)}"
         for x in sorted(d.dependence_after, key=lambda x: x.p_value)
@@ -111,6 +119,30 @@ def _step_once_checked(description: str) -> Iterator[Callable[[str], None]]:
                 stack.enter_context(step(description))
 
         yield progress
+
+
+def _sensitivity(table, base, seed: int, folds: int, wanted: bool | None) -> list:
+    """The verdict under each variant of the table (``wanted`` None: only for a
+    reduced survey), diagnosed with the same fold seed and folds."""
+    import numpy as np
+
+    from fieldkit.diagnose.impacts import diagnose_impacts
+    from fieldkit.diagnose.sensitivity import is_surveyed, sensitivity, variants
+
+    if wanted is False or (wanted is None and not is_surveyed(table)):
+        return []
+    names = variants(table)
+    if not names:
+        return []
+
+    def again(variant_table, variant_model):
+        return diagnose_impacts(
+            variant_table, variant_model, rng=np.random.default_rng(seed),
+            folds=folds,
+        )  # fmt: skip
+
+    with step(f"sensitivity of the verdict: diagnosing {', '.join(names)}"):
+        return sensitivity(table, base, again)
 
 
 def _write_report(report_dir: Path, diagnosis, inputs, outputs: OutputSet) -> str:
@@ -188,6 +220,15 @@ def diagnose(
     ] = None,  # fmt: skip
     material: MaterialOpt = None,
     preset: PresetOpt = None,
+    sensitivity: Annotated[
+        bool | None,
+        typer.Option(
+            "--sensitivity/--no-sensitivity",
+            help="Diagnose again with the assumed launch angles theta0 -10 and +10 "
+            "deg and with the materials grouped into one, and show each verdict "
+            "(default: on for a reduced survey, a table with assumed launch angles).",
+        ),
+    ] = None,
 ) -> None:
     """Compare model and measurements; rank the missing effects; add them stepwise.
 
@@ -256,6 +297,12 @@ def diagnose(
                     "and --preset apply to ImpactTables only",
                     source="model",
                 )
+            if sensitivity:
+                raise ArgumentError(
+                    "--sensitivity applies to ImpactTables only (a track has no "
+                    "assumed launch angles or materials)",
+                    source="sensitivity",
+                )
             if radius is None:
                 raise ArgumentError("a track needs --radius (the body's radius, m)")
             from fieldkit.cli.diagnose_track import diagnose_track_file
@@ -292,6 +339,12 @@ def diagnose(
                     table, base, rng=rng, folds=folds, progress=progress
                 )
             diagnosis.notes.extend(mapping.notes)
+            diagnosis.sensitivity = _sensitivity(table, base, seed, folds, sensitivity)
+            if sensitivity is None and not diagnosis.sensitivity:
+                diagnosis.notes.append(
+                    "sensitivity of the verdict not run: no launch angle of this "
+                    "table was assumed (--sensitivity runs it on any table)"
+                )
         diagnosis.notes.append(f"fold seed {seed}")
         if json_file is not None:
             write_json(json_file, diagnosis.to_json(), outputs)

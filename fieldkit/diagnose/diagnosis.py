@@ -153,6 +153,15 @@ class Diagnosis:
     #: ``rankings`` (the candidates ranked in every round, the last, unaccepted
     #: one included).
     arrays: dict = field(default_factory=dict, repr=False)
+    #: The verdict under each variant of the table's reduction (assumed launch
+    #: angle +- 10 deg, materials grouped; :mod:`fieldkit.diagnose.sensitivity`).
+    sensitivity: list = field(default_factory=list)
+
+    @property
+    def accepted(self) -> list[str]:
+        """Every accepted effect, in the order accepted (``recommended`` is the
+        first)."""
+        return [s.added for s in self.steps]
 
     def to_json(self) -> dict:
         """The ``diagnose --json`` document (contract keys first)."""
@@ -165,6 +174,7 @@ class Diagnosis:
             "steps": [s.to_json(m) for s in self.steps],
             "confounded": [list(p) for p in self.confounded],
             "after": self.after.to_json(m),
+            "accepted": self.accepted,
             "rule": self.rule,
             "groups": self.groups,
             "stopped": self.stopped,
@@ -185,4 +195,5 @@ class Diagnosis:
             "n_rows": self.n_rows,
             "n_data": self.n_data,
             "notes": list(self.notes),
+            "sensitivity": [v.to_json() for v in self.sensitivity],
         }
