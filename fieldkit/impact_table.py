@@ -224,6 +224,18 @@ THETA0_SOURCES: frozenset[str] = frozenset({"tree", "assumed", "video", "given"}
 #: Key of the frame's attrs holding the columns the table's source had.
 _GIVEN = "fieldkit_given_columns"
 
+
+class _ColumnNames(tuple):
+    """The given column names kept in a frame's attrs. pandas deep-copies attrs at
+    every operation (each column read); names are immutable, so the copy is the
+    object itself (a tuple of 60 names was copied a million times per reduction's
+    Monte Carlo)."""
+
+    __slots__ = ()
+
+    def __deepcopy__(self, memo: dict) -> _ColumnNames:
+        return self
+
 FORMATS: dict[str, str] = {".csv": "csv", ".parquet": "parquet", ".xlsx": "xlsx"}
 
 _EPS = 1e-12
@@ -603,7 +615,7 @@ class ImpactTable:
         # the columns the source had, before the contract's are added as NaN (kept
         # in the frame's attrs, which copies and row selections carry along)
         given = out.attrs.get(_GIVEN, out.columns)
-        out.attrs[_GIVEN] = tuple(c for c in given if c in out.columns)
+        out.attrs[_GIVEN] = _ColumnNames(c for c in given if c in out.columns)
         for col in CONTRACT_COLUMNS:
             if col.name not in out.columns:
                 out[col.name] = pd.NA if col.kind in ("str", "bool") else np.nan
