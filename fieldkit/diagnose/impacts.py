@@ -518,3 +518,61 @@ def _per_material(
             entry[f"{label}_bias_vft_mps"] = float(np.nanmean(s.residual[rows, 1]))
         out[m] = entry
     return out
+
+
+@dataclass
+class Screen:
+    """The first step of a diagnosis only: each candidate's held-out gain over the
+    baseline and what the rule would recommend (what a null or power campaign
+    needs; :mod:`fieldkit.diagnose.survey_loop`)."""
+
+    gains: dict[str, float]
+    ses: dict[str, float]
+    baseline_cv_rmse: float
+    recommended: str | None
+
+    @property
+    def best_gain(self) -> float:
+        """The largest gain (-inf with no candidate)."""
+        return max(self.gains.values(), default=-float("inf"))
+
+
+def screen_impacts(
+    table: ImpactTable,
+    model: Model | None = None,
+    *,
+    rng: np.random.Generator,
+    folds: int = DEFAULT_FOLDS,
+    z: float = DEFAULT_Z,
+    candidates: list[str] | None = None,
+    gain_floor: float = MIN_GAIN,
+) -> Screen:
+    """:func:`diagnose_impacts`'s first step, held-out scores only: the same
+    baseline, folds (for the same ``rng``), candidates and rule, without the full-data
+    fits, the confounding check, the later steps or the residual tests. The
+    recommendation is the best candidate when it passes the rule (a confounded pair
+    is not looked for, so it is at most as strict as the full diagnosis)."""
+    if model is None:
+        model = base_model(table)
+    problem = impact_problem(table, model)
+    path_id = (
+        problem.table.frame["path_id"].astype("string").fillna("").to_numpy(str)
+        if "path_id" in problem.table.frame
+        else np.array(["path"] * len(problem.table))
+    )
+    groups = make_groups(path_id, rng, folds=folds)
+    pool, _ = cands.impact_candidates(problem, model)
+    if candidates is not None:
+        pool = [c for c in pool if c in candidates]
+    _check(problem, groups, model, pool)
+    scorer = _Scorer(problem, groups)
+    base = scorer.held_out(model)
+    gains, ses = {}, {}
+    for name in pool:
+        gains[name], ses[name] = improvement(
+            base, scorer.held_out(with_effects(model, {name: {}}))
+        )
+    floor = max(MIN_GAIN, gain_floor)
+    best = max(gains, key=gains.get, default=None)
+    passed = best is not None and meaningful(gains[best], ses[best], z=z, min_gain=floor)
+    return Screen(gains, ses, base.rmse, best if passed else None)

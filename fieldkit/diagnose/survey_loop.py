@@ -104,11 +104,14 @@ class LoopPath:
     mean_flight_m: float
     launch_vx_mps: np.ndarray
     launch_vz_mps: np.ndarray
+    #: Impacts a campaign standing in for this path surveys (None: as many as the
+    #: path has; a benchmark asks for more or fewer on the same geometry).
+    target_scars: int | None = None
 
     @property
     def scars(self) -> int:
-        """Surveyed impacts (the source not counted)."""
-        return len(self.x_m) - 1
+        """Surveyed impacts a stand-in campaign makes (the source not counted)."""
+        return len(self.x_m) - 1 if self.target_scars is None else self.target_scars
 
 
 def _first(frame: pd.DataFrame, column: str, default: float) -> float:
@@ -385,14 +388,16 @@ class LoopTask:
 
 
 def run_task(task: LoopTask) -> dict:
-    """Simulate, survey, reduce and diagnose one campaign: its best gain, each
-    candidate's gain and what the diagnosis recommends (None on failure, with why)."""
-    from fieldkit.diagnose.impacts import diagnose_impacts
+    """Simulate, survey, reduce and screen one campaign (the diagnosis's first
+    step, :func:`~fieldkit.diagnose.impacts.screen_impacts`): its best gain, each
+    candidate's gain and what the rule recommends (``failed`` says why when the
+    campaign could not be made)."""
+    from fieldkit.diagnose.impacts import screen_impacts
 
     rng = np.random.default_rng(task.seed)
     try:
         table, rocks, failed = loop_table(task.paths, task.materials, task.effects, rng)
-        d = diagnose_impacts(
+        screen = screen_impacts(
             table,
             None,
             rng=rng,
@@ -402,15 +407,13 @@ def run_task(task: LoopTask) -> dict:
         )
     except FieldkitError as exc:
         return {"kind": task.kind, "failed": str(exc)}
-    gains = {c.effect: c.improvement for c in d.candidates}
-    best = max(gains.values()) if gains else -math.inf
     return {
         "kind": task.kind,
         "failed": None,
-        "best_gain": best,
-        "gains": gains,
-        "recommended": d.recommended,
-        "baseline_cv_rmse": d.baseline.cv_rmse,
+        "best_gain": screen.best_gain,
+        "gains": screen.gains,
+        "recommended": screen.recommended,
+        "baseline_cv_rmse": screen.baseline_cv_rmse,
         "impacts": len(table),
         "rocks": rocks,
         "rocks_failed": failed,
