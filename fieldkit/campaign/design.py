@@ -91,7 +91,9 @@ class CampaignDesign:
         ):
             value = getattr(self, name)
             if not (isinstance(value, int | float) and math.isfinite(value)):
-                raise ArgumentError(f"must be a finite number (got {value!r})", source=name)
+                raise ArgumentError(
+                    f"must be a finite number (got {value!r})", source=name
+                )
             if value < 0:
                 raise ArgumentError(f"must be >= 0 (got {value:g})", source=name)
         for name in ("position_sigma_m", "elevation_sigma_m", "canopy_sigma_m",
@@ -120,8 +122,10 @@ class CampaignDesign:
                 source="min_scars",
             )
         for pair in self.canopy_x_m:
-            if len(pair) != 2 or not all(math.isfinite(v) for v in pair) or (
-                pair[0] >= pair[1]
+            if (
+                len(pair) != 2
+                or not all(math.isfinite(v) for v in pair)
+                or (pair[0] >= pair[1])
             ):
                 raise ArgumentError(
                     f"a canopy range is two chainages X0 < X1 (got {pair!r})",
@@ -164,7 +168,9 @@ class CampaignDesign:
             )
         else:
             parts.append("no trees")
-        parts.append(f"launch angle not observed (reduced with theta0 {self.theta0_deg:g} deg)")
+        parts.append(
+            f"launch angle not observed (reduced with theta0 {self.theta0_deg:g} deg)"
+        )
         if self.max_scars is not None:
             parts.append(f"at most {self.max_scars} scars per path surveyed")
         if self.min_scars > MIN_SCARS - 1:

@@ -574,5 +574,7 @@ def screen_impacts(
         )
     floor = max(MIN_GAIN, gain_floor)
     best = max(gains, key=gains.get, default=None)
-    passed = best is not None and meaningful(gains[best], ses[best], z=z, min_gain=floor)
+    passed = best is not None and meaningful(
+        gains[best], ses[best], z=z, min_gain=floor
+    )
     return Screen(gains, ses, base.rmse, best if passed else None)

@@ -48,7 +48,7 @@ import pandas as pd
 
 from fieldkit.campaign.design import CampaignDesign
 from fieldkit.campaign.virtual import virtual_campaign
-from fieldkit.errors import FieldkitError
+from fieldkit.errors import ArgumentError, FieldkitError
 from fieldkit.impact_table import ImpactTable
 from fieldkit.model.model_file import Model, model_from_dict
 from fieldkit.physics.bodies import resolve_body
@@ -67,6 +67,8 @@ DEFAULT_NULL = 99
 DEFAULT_POWER = 40
 #: The null quantile a recommended gain must exceed.
 DEFAULT_QUANTILE = 0.95
+#: Most null or power campaigns one diagnosis may ask for (each takes seconds).
+MAX_CAMPAIGNS = 10_000
 #: Power below which the report says the data cannot tell the laws apart.
 LOW_POWER = 0.5
 #: Most scars of one simulated rock in a null path: then the next rock starts again
@@ -75,14 +77,6 @@ PIECE_SCARS = 10
 #: Least scatter of e_n, e_t given to the simulated rocks (an impact is never
 #: exactly repeatable).
 MIN_SCATTER = 0.02
-
-
-def is_surveyed(table: ImpactTable) -> bool:
-    """Whether ``table`` is a reduced survey (chord slopes, solved flights)."""
-    frame = table.frame
-    return "slope_source" in frame and bool(frame["slope_source"].notna().any()) and (
-        "theta0_source" in frame
-    )
 
 
 @dataclass(frozen=True)
@@ -145,7 +139,9 @@ def loop_paths(table: ImpactTable) -> tuple[list[LoopPath], list[str]]:
                 f"z_sd_m); the loop surveys with the reduction's default "
                 f"{DEFAULT_POSITION_SIGMA_M:g} m in plan and height"
             )
-        trees = rows["tree_strike"] if "tree_strike" in rows else pd.Series([], "boolean")
+        trees = (
+            rows["tree_strike"] if "tree_strike" in rows else pd.Series([], "boolean")
+        )
         known = trees.dropna()
         share = float(known.astype(bool).mean()) if len(known) else 0.0
         x = rows["x_m"].to_numpy(float)
@@ -176,7 +172,9 @@ def loop_paths(table: ImpactTable) -> tuple[list[LoopPath], list[str]]:
                     rows, "strike_height_sd_m", DEFAULT_STRIKE_HEIGHT_SIGMA_M
                 ),
                 tree_share=share,
-                mean_flight_m=float(np.mean(np.diff(x[keep]))) if keep.sum() > 1 else 1.0,
+                mean_flight_m=float(np.mean(np.diff(x[keep])))
+                if keep.sum() > 1
+                else 1.0,
                 launch_vx_mps=vx[keep],
                 launch_vz_mps=vz[keep],
             )
@@ -227,7 +225,9 @@ def path_model(
     are; starting it from the observed rock's own scars at its own speed keeps the
     simulated flights like the surveyed ones."""
     seg_material = list(path.material[1:])
-    used = {m: materials.get(m, materials[next(iter(materials))]) for m in set(seg_material)}
+    used = {
+        m: materials.get(m, materials[next(iter(materials))]) for m in set(seg_material)
+    }
     x0 = float(path.x_m[start])
     vx = path.launch_vx_mps[start]
     vz = path.launch_vz_mps[start]
@@ -292,8 +292,8 @@ def loop_table(
     :data:`PIECE_SCARS` scars, so the speed is brought back to the observed one
     every few flights (a lumped-mass rock keeps whatever speed scale it has); the
     flight from its start is reduced as a release and left out
-    (:func:`_without_release`); each rock is reduced on its own with the path's options and its rows
-    take the path's id, so the diagnosis holds them out in blocks as it holds out
+    (:func:`_without_release`); each rock is reduced on its own with the path's
+    options and its rows take the path's id, so the diagnosis holds them out in blocks as it holds out
     the observed path. Returns the table, the rocks surveyed and the rocks whose
     reduction failed (left out).
 
@@ -335,7 +335,9 @@ def loop_table(
                 design, max_scars=max(2, min(left + 1, PIECE_SCARS)), min_scars=2
             )
             model = path_model(path, materials, effects, start)
-            virtual = virtual_campaign(model, rock_design, 1, rng, source="null").paths[0]
+            virtual = virtual_campaign(model, rock_design, 1, rng, source="null").paths[
+                0
+            ]
             rocks += 1
             # the next rock starts at the observed scar past this one's last
             end = float(virtual.truth["x_true_m"].iloc[-1])
@@ -443,6 +445,32 @@ def run_tasks(
             if progress:
                 progress(1)
     return out
+
+
+def check_loop_options(
+    null: int | None, power: int, quantile: float, workers: int | None
+) -> None:
+    """Refuse null/power sizes, a quantile or a worker count that cannot work."""
+    for name, value in (("null", null), ("power", power)):
+        if value is not None and not 0 <= value <= MAX_CAMPAIGNS:
+            raise ArgumentError(
+                f"must be from 0 to {MAX_CAMPAIGNS:,} campaigns (got {value})",
+                source=name,
+            )
+    if not (math.isfinite(quantile) and 0.5 <= quantile < 1.0):
+        raise ArgumentError(
+            f"must be at least 0.5 and below 1 (got {quantile:g})",
+            source="null_quantile",
+        )
+    if null and null < math.ceil(1.0 / (1.0 - quantile)) - 1:
+        need = math.ceil(1.0 / (1.0 - quantile)) - 1
+        raise ArgumentError(
+            f"{null} null campaigns cannot show a gain beyond their {quantile:g} "
+            f"quantile: give at least {need}",
+            source="null",
+        )
+    if workers is not None and not 1 <= workers <= 256:
+        raise ArgumentError(f"must be from 1 to 256 (got {workers})", source="workers")
 
 
 def null_threshold(gains: np.ndarray, quantile: float) -> float:
@@ -574,8 +602,9 @@ def calibrate(
         world = {**effects, cand.effect: {**effects.get(cand.effect, {}), **values}}
         power_seeds = root.spawn(power_size)
         power_tasks += [
-            LoopTask(cand.effect, paths, materials, world, candidates, folds,
-                     threshold, s)  # fmt: skip
+            LoopTask(
+                cand.effect, paths, materials, world, candidates, folds, threshold, s
+            )  # fmt: skip
             for s in power_seeds
         ]
     if power_tasks and math.isfinite(threshold):
@@ -613,7 +642,7 @@ def calibrate(
 
 
 def power_words(effect: str, entry: dict) -> str:
-    """"with this survey, velocity_scaled_restitution at k_mps 6.5 would be found in
+    """ "with this survey, velocity_scaled_restitution at k_mps 6.5 would be found in
     12 % (± 5 %) of campaigns"."""
     params = ", ".join(f"{k} {v:.3g}" for k, v in entry["params"].items())
     rate = entry.get("rate")
