@@ -147,8 +147,8 @@ def virtual_campaign(
             raise ArgumentError(
                 f"{simulated} simulated rocks gave only {len(kept)} paths with at "
                 f"least {max(MIN_SCARS - 1, design.min_scars)} scars (m vin^2/2 >= "
-                f"{design.scar_energy_j:g} J, {design.scar_spacing_m:g} m apart): lower the scar energy or "
-                "spacing, or release the rocks higher",
+                f"{design.scar_energy_j:g} J, {design.scar_spacing_m:g} m apart): "
+                "lower the scar energy or spacing, or release the rocks higher",
                 source="paths",
             )
         result = simulate(model, batch, rng, record_impacts=True)

@@ -293,8 +293,8 @@ def loop_table(
     every few flights (a lumped-mass rock keeps whatever speed scale it has); the
     flight from its start is reduced as a release and left out
     (:func:`_without_release`); each rock is reduced on its own with the path's
-    options and its rows take the path's id, so the diagnosis holds them out in blocks as it holds out
-    the observed path. Returns the table, the rocks surveyed and the rocks whose
+    options and its rows take the path's id, so the diagnosis holds them out in
+    blocks as it holds out the observed path. Returns the table, the rocks surveyed and the rocks whose
     reduction failed (left out).
 
     A lumped-mass rock of the fitted baseline often flies farther between impacts

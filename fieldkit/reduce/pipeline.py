@@ -307,7 +307,9 @@ class PointKinematics:
         self.surveyed = (
             frame["slope_deg"].to_numpy(float) if "slope_deg" in frame else None
         )
-        self.given = frame["theta0_deg"].to_numpy(float) if "theta0_deg" in frame else None
+        self.given = (
+            frame["theta0_deg"].to_numpy(float) if "theta0_deg" in frame else None
+        )
         self.options = options
         self.source = survey.source
         self.trees_source = None if survey.trees is None else survey.trees.source
@@ -320,7 +322,8 @@ class PointKinematics:
             grounds = survey.trees.frame["ground_z_m"].to_numpy(float)
             keys = survey.trees.frame["after_impact"].astype(str).to_list()
             for row, key in enumerate(keys):
-                self.trees.append((row, launch[key], by_launch[key], float(grounds[row])))
+                tree = by_launch[key]
+                self.trees.append((row, launch[key], tree, float(grounds[row])))
 
     def __call__(
         self,
