@@ -59,6 +59,7 @@ def _summary(diagnosis) -> list[str]:
         rankings,
         rule_head,
     )
+    from fieldkit.diagnose.survey_loop import loop_lines
 
     d = diagnosis
     unit = labels.unit(d.metric)
@@ -94,6 +95,7 @@ def _summary(diagnosis) -> list[str]:
             )
     lines += [f"confounded: {a}" for a in d.advice]
     lines.append(f"recommended: {d.recommended or 'nothing'}; stopped: {d.stopped}")
+    lines += loop_lines(d.null, d.power)
     if len(d.accepted) > 1:
         lines.append(f"accepted: {', '.join(d.accepted)}")
     meaning = alternative_meaning(d)

@@ -251,6 +251,7 @@ def markdown(diagnosis: Diagnosis, *, title: str, inputs: list[str]) -> str:
     if meaning:
         out.append(meaning[0].upper() + meaning[1:] + ".")
     out += [f"Stopped: {d.stopped}.", ""]
+    out += _loop_section(d)
     out += _sensitivity_section(d)
     if d.unexplained and d.confounded:
         out.append(
@@ -387,6 +388,23 @@ def alternative_meaning(d: Diagnosis) -> str:
         "the impact speed), is the better description; the line is a statistical "
         "alternative, not a physical law"
     )
+
+
+def _loop_section(d: Diagnosis) -> list[str]:
+    """The null and the power of a surveyed table (the reduction in the loop)."""
+    from fieldkit.diagnose.survey_loop import loop_lines
+
+    if not d.null:
+        return []
+    out = [
+        "## The null and the power (the survey and the reduction in the loop)",
+        "",
+        f"Method: {d.null['method']}. A candidate is recommended only when its gain "
+        f"also exceeds the {d.null['quantile']:.0%} quantile of the null gains.",
+        "",
+    ]
+    out += [f"* {line}" for line in loop_lines(d.null, d.power)]
+    return out + [""]
 
 
 def _sensitivity_section(d: Diagnosis) -> list[str]:

@@ -294,8 +294,8 @@ def loop_table(
     flight from its start is reduced as a release and left out
     (:func:`_without_release`); each rock is reduced on its own with the path's
     options and its rows take the path's id, so the diagnosis holds them out in
-    blocks as it holds out the observed path. Returns the table, the rocks surveyed and the rocks whose
-    reduction failed (left out).
+    blocks as it holds out the observed path. Returns the table, the rocks
+    surveyed and the rocks whose reduction failed (left out).
 
     A lumped-mass rock of the fitted baseline often flies farther between impacts
     than the surveyed rock did, so one observed path is usually pieced together
@@ -739,15 +739,52 @@ def diagnose_surveyed(
             f"gained as much (threshold {_pct(loop.threshold)}): no finding"
         )
     rates = [e["rate"] for e in loop.power.values() if e.get("rate") is not None]
-    if not final.recommended and (not rates or max(rates) < LOW_POWER):
-        final.advice.append(
-            "the data cannot tell the laws apart: with this survey no candidate at "
-            f"its fitted size would be found in {LOW_POWER:.0%} of campaigns ("
-            + "; ".join(e["words"] for e in final.power.values())
-            + "); more surveyed paths, tree strikes that fix the launch angle, or "
-            "measured slopes at the scars would"
+    if final.recommended:
+        verdict = (
+            f"{final.recommended} is found: its gain exceeds what "
+            f"{g.size} effect-free campaigns through the same survey and reduction "
+            f"gained in {quantile:.0%} of cases"
         )
+    elif not rates or max(rates) < LOW_POWER:
+        verdict = (
+            "the data cannot tell the laws apart: with this survey no candidate at "
+            f"its fitted size would be found in {LOW_POWER:.0%} of campaigns; more "
+            "surveyed paths, tree strikes that fix the launch angle, or measured "
+            "slopes at the scars would"
+        )
+    else:
+        verdict = (
+            "no effect found, and this survey could have found one: a candidate at "
+            f"its fitted size would be found in {max(rates):.0%} of campaigns"
+        )
+    final.null["verdict"] = verdict
     return final
+
+
+def loop_lines(null: dict | None, power: dict | None) -> list[str]:
+    """The null, the power and the verdict in words (the summary and the report)."""
+    if not null:
+        return []
+    gains = np.array([v for v in null["gains"] if v is not None], float)
+    lines = [
+        f"null: {null['size']} effect-free campaigns simulated under the fitted "
+        "baseline on the path's own profile, surveyed and reduced like the table "
+        + (f"({null['failed']} could not be made)" if null["failed"] else "")
+        + ": best gains median "
+        + (_pct(float(np.median(gains))) if gains.size else "n/a")
+        + f", {null['quantile']:.0%} quantile {_pct(null['threshold'] or math.inf)}",
+    ]
+    observed = null.get("observed_gain")
+    if observed is not None and null.get("p_value") is not None:
+        lines.append(
+            f"null: the observed best gain {observed:+.1%} is reached by "
+            f"{int(np.sum(gains >= observed))} of them (Monte Carlo p = "
+            f"{null['p_value']:.2g})"
+        )
+    lines += [f"power: {entry['words']}" for entry in (power or {}).values()]
+    if null.get("verdict"):
+        lines.append(f"verdict: {null['verdict']}")
+    return lines
 
 
 def _pct(x: float) -> str:
