@@ -56,7 +56,7 @@ def test_a_link_in_a_report_folder_is_refused_not_followed(cli, fails, repo, tmp
     result = cli(
         "diagnose", table, "--model", survey / "model_rocfall_table_7_1.json",
         "--preset", survey / "boulder_a_preset.toml", "--seed", "1",
-        "--report", folder,
+        "--report", folder, "--null", "0",
     )  # fmt: skip
     fails(result, "report.md", "symbolic link", "outside")
     assert outside.read_text() == "mine\n"

@@ -191,7 +191,7 @@ def test_diagnose_counts_and_names_the_ends_of_an_unsolved_flight(
     table, preset = boulder_a_with_a_raised_scar
     model = SURVEY / "model_rocfall_table_7_1.json"
     result = cli("diagnose", table, "--model", model, "--preset", preset, "--seed",
-                 "1")  # fmt: skip
+                 "1", "--null", "0")  # fmt: skip
     assert result.exit_code == 0, result.stderr
     text = " ".join((result.stdout + result.stderr).split())
     assert f"diagnosing 46 impacts (of 50 rows; not impacts: {ROWS_NAMED})" in text

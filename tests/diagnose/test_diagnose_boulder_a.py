@@ -54,7 +54,7 @@ def boulder_a(tmp_path_factory):
                 "diagnose", str(out / "b.csv"), "--model",
                 str(SURVEY / "model_rocfall_table_7_1.json"), "--preset", preset,
                 "--seed", "1", "--json", str(out / "d.json"), "--report",
-                str(out / "rep"),
+                str(out / "rep"), "--null", "0",
             ],
         )  # fmt: skip
     finally:
@@ -240,7 +240,7 @@ def test_theta0_shift_of_zero_reproduces_the_reduced_velocities(boulder_a):
 def test_no_sensitivity_switches_it_off(boulder_a, cli, tmp_path):
     out, _, _ = boulder_a
     r = cli("diagnose", out / "b.csv", "--seed", "1", "--no-sensitivity",
-            "--json", tmp_path / "d.json")  # fmt: skip
+            "--json", tmp_path / "d.json", "--null", "0")  # fmt: skip
     assert r.exit_code == 0, r.output
     assert json.loads((tmp_path / "d.json").read_text())["sensitivity"] == []
     assert "sensitivity:" not in r.stdout

@@ -97,12 +97,12 @@ def test_a_model_with_the_material_keeps_it(cli, tmp_path, boulder_a):
 
 
 def test_diagnose_maps_materials(cli, tmp_path, boulder_a, fails):
-    r = cli("diagnose", boulder_a, "--model", TABLE_7_1, "--seed", "1")
+    r = cli("diagnose", boulder_a, "--model", TABLE_7_1, "--seed", "1", "--null", "0")
     fails(r, "not in the model", "--material")
     out = tmp_path / "after.json"
     js = tmp_path / "diagnosis.json"
     r = cli("diagnose", boulder_a, "--model", TABLE_7_1, "--preset", PRESET,
-            "--seed", "1", "-o", out, "--json", js)  # fmt: skip
+            "--seed", "1", "-o", out, "--json", js, "--null", "0")  # fmt: skip
     assert r.exit_code == 0, r.output
     assert "material talus -> colluvium" in r.stderr
     notes = json.loads(js.read_text())["notes"]
