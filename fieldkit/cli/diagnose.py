@@ -31,6 +31,7 @@ FLAGS = {
     "power": "--power",
     "null_quantile": "--null-quantile",
     "workers": "--workers",
+    "input_files": "TABLE_OR_TRACK",
 }
 #: Most characters of a CSV's first line read to tell a track from a table.
 MAX_HEADER_CHARS = 1 << 20
