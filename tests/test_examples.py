@@ -71,7 +71,8 @@ EXPECTED = {
     # impacts (Table 2-4), boulder A's 18 m/s at 610 m placed in the simulated spread
     "demo.py": [
         r"^1\. reduce: 48 impacts of boulder A",
-        r"^2\. diagnose: (recommends \w+|no effect recommended)",
+        r"^2\. diagnose: (recommends \w+|no effect recommended).* against 19 "
+        r"effect-free campaigns .*threshold [+-]\d+\.\d%\): ",
         r"^3\. fit: colluvium e_n \d\.\d+ ± \d",
         r"^4\. simulate: runout p50 (≥ )?\d+ m.*18 m/s speed at x = 610 m is (at the "
         r"\d+th percentile|above all [\d,]+ simulated rocks)",

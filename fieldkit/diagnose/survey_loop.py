@@ -745,7 +745,13 @@ def diagnose_surveyed(
             f"{g.size} effect-free campaigns through the same survey and reduction "
             f"gained in {quantile:.0%} of cases"
         )
-    elif not rates or max(rates) < LOW_POWER:
+    elif not rates:
+        verdict = (
+            "no finding beyond what the survey and the reduction produce with no "
+            "effect; the power was not simulated (power campaigns 0), so whether "
+            "this survey could have found one is not known"
+        )
+    elif max(rates) < LOW_POWER:
         verdict = (
             "the data cannot tell the laws apart: with this survey no candidate at "
             f"its fitted size would be found in {LOW_POWER:.0%} of campaigns; more "
