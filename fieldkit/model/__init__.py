@@ -6,9 +6,18 @@ sliding/rolling phase (eq. 7.3) and stopping; physical effects are small units i
 :mod:`fieldkit.model.effects`, switched on in the model file.
 """
 
-from fieldkit.model.model_file import Model, model_from_dict, read_model, write_model
-from fieldkit.model.results import SimulationResult
-from fieldkit.model.simulate import simulate
+from fieldkit.model.cache_guard import guard
+
+guard()  # before any compiled function is loaded from numba's cache
+
+from fieldkit.model.model_file import (  # noqa: E402
+    Model,
+    model_from_dict,
+    read_model,
+    write_model,
+)
+from fieldkit.model.results import SimulationResult  # noqa: E402
+from fieldkit.model.simulate import simulate  # noqa: E402
 
 __all__ = [
     "Model",
