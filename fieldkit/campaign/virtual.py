@@ -57,6 +57,16 @@ TRUTH_COLUMNS = (
     "theta_f_deg",
     "ke_n_j",
 )
+#: Columns of a path's tree truth (one row per recorded tree strike): the flight's
+#: launch point, the tree's true chainage, its taped distance from the launch scar
+#: and the height of the rock's centre above the ground there before the
+#: measurement error.
+TREE_TRUTH_COLUMNS = (
+    "after_impact",
+    "tree_x_true_m",
+    "horizontal_distance_m",
+    "strike_height_true_m",
+)
 
 
 @dataclass(frozen=True)
@@ -76,12 +86,16 @@ class VirtualPath:
         velocities and coefficients (NaN at the source).
     impacts
         Every simulated impact of the rock (the ImpactTable of the simulation).
+    trees_truth
+        The recorded tree strikes before their height error
+        (:data:`TREE_TRUTH_COLUMNS`); None when the design has no trees.
     """
 
     path_id: str
     survey: Survey
     truth: pd.DataFrame
     impacts: ImpactTable
+    trees_truth: pd.DataFrame | None = None
 
 
 @dataclass(frozen=True)
@@ -255,6 +269,24 @@ def survey_rock(
     names = [str(k) for k in range(len(x_true))]
     trees = _tree_strikes(model, rows, idx, x_true, names, design, rng)
     dx, dz = _position_errors(x_true, design, rng)
+    trees_truth = None
+    if trees is not None:
+        launch = dict(zip(names, x_true, strict=True))
+        trees_truth = pd.DataFrame(
+            {
+                "after_impact": trees["after_impact"].astype(str),
+                "tree_x_true_m": [
+                    launch[a] + d
+                    for a, d in zip(
+                        trees["after_impact"], trees["horizontal_distance_m"],
+                        strict=True,
+                    )
+                ],
+                "horizontal_distance_m": trees["horizontal_distance_m"].astype(float),
+                "strike_height_true_m": trees["strike_height_m"].astype(float),
+            },
+            columns=list(TREE_TRUTH_COLUMNS),
+        )
     if trees is not None and len(trees):
         sd_h = design.strike_height_sigma_m
         noisy = trees["strike_height_m"].to_numpy(float) + rng.normal(
@@ -287,6 +319,7 @@ def survey_rock(
         survey=Survey(points, tree_set),
         truth=truth,
         impacts=ImpactTable(rows, source=source),
+        trees_truth=trees_truth,
     )
 
 
