@@ -275,7 +275,9 @@ def read_campaign(folder: str | Path) -> CampaignFile:
         raise InputFileError("must name the preset file", source=source, where="preset")
     entries = data.get("paths")
     if not (isinstance(entries, list) and entries):
-        raise InputFileError("must list at least one path", source=source, where="paths")
+        raise InputFileError(
+            "must list at least one path", source=source, where="paths"
+        )
     paths = []
     for k, entry in enumerate(entries):
         where = f"paths[{k}]"
@@ -289,7 +291,9 @@ def read_campaign(folder: str | Path) -> CampaignFile:
         trees = files.get("trees")
         if not (isinstance(points, str) and points):
             raise InputFileError(
-                "must name the points file", source=source, where=f"{where}.files.points"
+                "must name the points file",
+                source=source,
+                where=f"{where}.files.points",
             )
         if trees is not None and not (isinstance(trees, str) and trees):
             raise InputFileError(

@@ -22,7 +22,6 @@ FLAGS = {
     "flights": "--flights",
     "launch_speed_mps": "--launch-speed",
     "launch_angle_deg": "--launch-angle",
-    "output": "-o",
 }
 
 
@@ -231,7 +230,8 @@ def synth(
     position_sigma: Annotated[
         SurveyFloat,
         _survey_option(
-            "--position-sigma", "SD of each point's plan position error, m (default 0.5)."
+            "--position-sigma",
+            "SD of each point's plan position error, m (default 0.5).",
         ),
     ] = None,
     elevation_sigma: Annotated[
@@ -259,16 +259,13 @@ def synth(
     ] = None,
     canopy_sigma: Annotated[
         SurveyFloat,
-        _survey_option(
-            "--canopy-sigma", "position error under canopy, m (default 2)."
-        ),
+        _survey_option("--canopy-sigma", "position error under canopy, m (default 2)."),
     ] = None,
     tree_spacing: Annotated[
         SurveyFloat,
         _survey_option(
             "--tree-spacing",
-            "mean spacing of trees along the path (Poisson), m (default 0: no "
-            "trees).",
+            "mean spacing of trees along the path (Poisson), m (default 0: no trees).",
         ),
     ] = None,
     tree_height: Annotated[
@@ -359,7 +356,9 @@ def synth(
         "max_scars": max_scars,
     }
     options = {
-        SURVEY_OPTIONS[name]: value for name, value in given.items() if value is not None
+        SURVEY_OPTIONS[name]: value
+        for name, value in given.items()
+        if value is not None
     }
     if survey:
         if track:

@@ -92,7 +92,7 @@ def synth_survey(
     paths: int,
     design_options: dict[str, object],
 ) -> None:
-    """Simulate, survey and write a virtual campaign (see :func:`fieldkit.cli.synth.synth`)."""
+    """Simulate, survey and write a virtual campaign (`fieldkit synth --survey`)."""
     from fieldkit.campaign.design import CampaignDesign
     from fieldkit.campaign.files import CAMPAIGN_FILE, campaign_files, path_counts
     from fieldkit.campaign.virtual import check_paths, virtual_campaign
