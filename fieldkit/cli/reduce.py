@@ -242,12 +242,11 @@ def reduce(
     if campaign is not None:
         from fieldkit.campaign.files import read_campaign
 
-        _refuse_with_campaign(
-            {"--impacts": impacts, "--fieldbook": fieldbook, "--stations": stations,
-             "--trees": trees, "--path-id": path_id, "--preset": preset,
-             "--figures": figures, "--gpx-track": gpx_track,
-             "--declination": declination}  # fmt: skip
-        )
+        single = {"--impacts": impacts, "--fieldbook": fieldbook,
+                  "--stations": stations, "--trees": trees, "--path-id": path_id,
+                  "--preset": preset, "--figures": figures, "--gpx-track": gpx_track,
+                  "--declination": declination}  # fmt: skip
+        _refuse_with_campaign(single)
         campaign_file = read_campaign(campaign)
         preset = campaign_file.preset
     if preset is not None:
@@ -357,7 +356,8 @@ def reduce(
         if out is not None:
             table.write(out, outputs=outputs)
         written = outputs.commit()
-        note(f"from the campaign's preset {preset}: {', '.join(from_preset) or 'nothing'}"
+        taken = ", ".join(from_preset) or "nothing"
+        note(f"from the campaign's preset {preset}: {taken}"
              + (f"; from the command line instead: {', '.join(overridden)}"
                 if overridden else ""))  # fmt: skip
         typer.echo(f"body: {body.description}")
@@ -500,4 +500,5 @@ def _reduce_campaign(campaign_file, options, *, units, epsg, gpx_points):
             f"{len(left_out)} of {total} paths not reduced and left out: "
             f"{', '.join(left_out)}"
         )
-    return ImpactTable(pd.concat(frames, ignore_index=True), source=campaign_file.source)
+    frame = pd.concat(frames, ignore_index=True)
+    return ImpactTable(frame, source=campaign_file.source)
