@@ -32,7 +32,6 @@ SURVEY_FLAGS = {
     "strike_height_sigma_m": "--height-sigma",
     "theta0_deg": "--theta0",
     "max_scars": "--max-scars",
-    "min_scars": "--max-scars",
 }
 
 
@@ -62,7 +61,8 @@ def parse_canopy(texts: list[str]) -> tuple[tuple[float, float], ...]:
 
 def refuse_foreign_folder(folder: Path) -> list[str]:
     """Refuse an output folder that is a file, or holds anything but a previous
-    campaign's files; returns the names of the previous campaign's files found."""
+    campaign's files; returns the names of the previous campaign's files found
+    (those this campaign does not replace are removed once it is written)."""
     from fieldkit.campaign.files import CAMPAIGN_NAME
 
     if folder.exists() and not folder.is_dir():
@@ -72,8 +72,13 @@ def refuse_foreign_folder(folder: Path) -> list[str]:
         )
     if not folder.is_dir():
         return []
-    names = sorted(p.name for p in folder.iterdir())
-    foreign = [n for n in names if not CAMPAIGN_NAME.match(n)]
+    entries = sorted(folder.iterdir())
+    names = [p.name for p in entries]
+    foreign = [
+        p.name
+        for p in entries
+        if not CAMPAIGN_NAME.match(p.name) or (p.is_dir() and not p.is_symlink())
+    ]
     if foreign:
         raise ArgumentError(
             f"{folder} is not empty and holds files a campaign does not write "
@@ -147,12 +152,15 @@ def synth_survey(
     )
     for text in campaign.notes[2:]:
         note(text)
+    # the folder holds exactly this campaign: a previous one's files it did not
+    # replace (more paths, trees where this one has none) would be read with it
     stale = sorted(set(previous) - set(files))
+    for name in stale:
+        (output / name).unlink(missing_ok=True)
     if stale:
         note(
-            f"{len(stale)} files of a previous campaign left in {output} "
-            f"({', '.join(stale[:3])}{', ...' if len(stale) > 3 else ''}); "
-            f"{CAMPAIGN_FILE} lists only this campaign's"
+            f"removed {len(stale)} files of a previous campaign from {output} "
+            f"({', '.join(stale[:3])}{', ...' if len(stale) > 3 else ''})"
         )
     error_model = _reduce_error_note(design)
     if error_model:

@@ -100,6 +100,20 @@ def test_survey_is_deterministic_for_a_seed(cli, tmp_path, digest):
     assert {p.name: digest(p) for p in out.iterdir()} != first
 
 
+def test_a_new_campaign_replaces_a_previous_one_whole(cli, tmp_path):
+    out = tmp_path / "camp"
+    _synth(cli, out, "--paths", "3", "--seed", "1", "--tree-spacing", "8")
+    assert (out / "path03_trees.csv").exists()
+    result = _synth(cli, out, "--paths", "2", "--seed", "1")
+    files = {"campaign.json", "preset.toml"}
+    for path in _record(out)["paths"]:
+        files |= {f for f in path["files"].values() if f is not None}
+    # no trees file of the previous campaign is left to be read with this one
+    assert {p.name for p in out.iterdir()} == files
+    assert not any("trees" in name for name in files)
+    assert "removed 8 files of a previous campaign" in result.stderr
+
+
 def test_truth_is_what_the_simulation_did(cli, tmp_path):
     out = tmp_path / "camp"
     _synth(cli, out, "--paths", "4", "--seed", "11", "--scar-spacing", "3")
