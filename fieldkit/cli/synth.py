@@ -370,7 +370,7 @@ def synth(
                 "--position-sigma, --height-sigma)",
                 source="--noise",
             )
-        synth_survey(model_file, output, hidden, seed, paths, options)
+        synth_survey(model_file, output, hidden, seed, paths, options, effects_words)
         return
     if options:
         flags = [SURVEY_FLAGS[field] for field in options]

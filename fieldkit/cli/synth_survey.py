@@ -9,6 +9,7 @@ and surveyed (:func:`~fieldkit.campaign.virtual.virtual_campaign`), and the file
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from pathlib import Path
 
 import typer
@@ -96,12 +97,12 @@ def synth_survey(
     seed: int | None,
     paths: int,
     design_options: dict[str, object],
+    effects_words: Callable[[dict[str, dict[str, float]]], str],
 ) -> None:
     """Simulate, survey and write a virtual campaign (`fieldkit synth --survey`)."""
     from fieldkit.campaign.design import CampaignDesign
     from fieldkit.campaign.files import CAMPAIGN_FILE, campaign_files, path_counts
     from fieldkit.campaign.virtual import check_paths, virtual_campaign
-    from fieldkit.cli.synth import effects_words
     from fieldkit.fit.synthetic import with_effects
     from fieldkit.model.model_file import read_model
 
