@@ -316,3 +316,24 @@ def test_reduce_campaign_refuses_single_path_options(cli, fails, tmp_path):
         "--impacts goes without --campaign",
     )
     fails(cli("reduce", "--campaign", tmp_path), "campaign.json", "file not found")
+
+
+def test_reduce_campaign_options_override_the_preset(cli, tmp_path):
+    out = tmp_path / "camp"
+    _synth(cli, out, "--paths", "2", "--seed", "1", "--theta0", "28")
+    whole = tmp_path / "campaign.csv"
+    result = cli("reduce", "--campaign", out, "--theta0", "40", "--position-sigma",
+                 "0.8", "-o", whole)  # fmt: skip
+    assert result.exit_code == 0, result.stderr
+    assert "from the command line instead: --theta0 40.0" in result.stderr
+    table = pd.read_csv(whole)
+    # (a release row is "assumed" with no angle: the least-speed launch)
+    assumed = table.loc[table["theta0_source"] == "assumed", "theta0_deg"].dropna()
+    assert len(assumed) > 5 and (assumed == 40.0).all()
+    assert (table["x_sd_m"] == 0.8).all() and (table["mass_kg"] == 3750.0).all()
+    # without the override the campaign's own assumed angle
+    result = cli("reduce", "--campaign", out, "-o", whole)
+    table = pd.read_csv(whole)
+    assumed = table.loc[table["theta0_source"] == "assumed", "theta0_deg"].dropna()
+    assert len(assumed) > 5 and (assumed == 28.0).all()
+    assert "--theta0 28.0" in result.stderr
