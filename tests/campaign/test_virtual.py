@@ -97,3 +97,20 @@ def test_position_errors_are_independent_without_a_correlation_length():
     dx = np.array([_position_errors(x, CampaignDesign(), rng)[0] for _ in range(draws)])
     lag1 = [np.corrcoef(dx[:, i], dx[:, i + 1])[0, 1] for i in range(5)]
     assert np.all(np.abs(lag1) < 3.0 / np.sqrt(draws)), lag1
+
+
+def test_a_scar_surveyed_behind_the_one_before_is_merged_into_it():
+    import pandas as pd
+
+    from fieldkit.campaign.virtual import _ahead, _merge_behind
+
+    x_obs = np.array([0.0, 5.0, 4.9, 6.0, 5.5, 9.0])
+    keep = _ahead(x_obs)
+    assert keep.tolist() == [True, True, False, True, False, True]
+    truth = pd.DataFrame(
+        {"point": list("012345"), "impacts_merged": [0, 2, 1, 3, 1, 1]}
+    )
+    out = _merge_behind(truth, keep)
+    # point 2's impact goes to point 1, point 4's to point 3; none lost
+    assert out["point"].tolist() == ["0", "1", "3", "5"]
+    assert out["impacts_merged"].tolist() == [0, 3, 4, 1]

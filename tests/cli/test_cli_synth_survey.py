@@ -337,3 +337,36 @@ def test_reduce_campaign_options_override_the_preset(cli, tmp_path):
     assumed = table.loc[table["theta0_source"] == "assumed", "theta0_deg"].dropna()
     assert len(assumed) > 5 and (assumed == 28.0).all()
     assert "--theta0 28.0" in result.stderr
+
+
+def test_strikes_beyond_the_surveyed_flight_are_not_recorded(cli, tmp_path):
+    # 1.5 m position error and a tree every 3 m: some short flights are surveyed
+    # shorter than the taped distance to their tree; such a strike cannot be
+    # placed (reduce --trees refuses it), so the survey does not record it
+    out = tmp_path / "camp"
+    result = _synth(cli, out, "--paths", "3", "--seed", "1", "--tree-spacing", "3",
+                    "--position-sigma", "1.5")  # fmt: skip
+    assert "note: 2 tree strikes not recorded" in result.stderr
+    # a scar the error put behind the point before it is read as that point's
+    assert "note: 1 scar surveyed at or behind the point before" in result.stderr
+    trees = _all(out, "trees")
+    points = _all(out, "points")
+    for _, p in points.groupby("path_id"):
+        assert (np.diff(p["x_m"].to_numpy()) > 0).all()
+    truth = _all(out, "truth")
+    assert len(truth) == len(points)
+    np.testing.assert_array_equal(truth["x_m"], points["x_m"])
+    # the merged scar's impacts go to the one before: none is lost
+    for path in _record(out)["paths"]:
+        part = truth[truth["path_id"] == path["path_id"]]
+        assert part["impacts_merged"].sum() == path["counts"]["impacts_merged"]
+    for row in trees.itertuples():
+        p = points[points["path_id"] == row.path_id].reset_index(drop=True)
+        k = int(p.index[p["point"] == row.after_impact][0])
+        assert 0 < row.horizontal_distance_m < p["x_m"][k + 1] - p["x_m"][k]
+    assert len(_all(out, "trees_truth")) == len(trees)
+    whole = tmp_path / "campaign.csv"
+    result = cli("reduce", "--campaign", out, "-o", whole)
+    assert result.exit_code == 0, result.stderr
+    assert "not reduced" not in result.stderr
+    assert sorted(set(pd.read_csv(whole)["path_id"])) == ["path01", "path02", "path03"]
