@@ -97,7 +97,9 @@ class CampaignDesign:
         ):
             value = getattr(self, name)
             if not (isinstance(value, int | float) and math.isfinite(value)):
-                raise ArgumentError(f"must be a finite number (got {value!r})", source=name)
+                raise ArgumentError(
+                    f"must be a finite number (got {value!r})", source=name
+                )
             if value < 0:
                 raise ArgumentError(f"must be >= 0 (got {value:g})", source=name)
         for name in ("position_sigma_m", "elevation_sigma_m", "canopy_sigma_m",
@@ -170,7 +172,9 @@ class CampaignDesign:
             )
         else:
             parts.append("no trees")
-        parts.append(f"launch angle not observed (reduced with theta0 {self.theta0_deg:g} deg)")
+        parts.append(
+            f"launch angle not observed (reduced with theta0 {self.theta0_deg:g} deg)"
+        )
         if self.max_scars is not None:
             parts.append(f"at most {self.max_scars} scars per path surveyed")
         if self.min_scars > MIN_SCARS - 1:

@@ -168,15 +168,18 @@ def virtual_campaign(
         if simulated >= MAX_TRIES_PER_PATH * paths:
             raise ArgumentError(
                 f"{simulated} simulated rocks gave only {len(kept)} paths with at "
-                f"least {max(MIN_SCARS - 1, design.min_scars)} scars (m vin^2/2 >= {design.scar_energy_j:g} "
-                f"J, {design.scar_spacing_m:g} m apart): lower the scar energy or "
+                f"least {max(MIN_SCARS - 1, design.min_scars)} scars (m vin^2/2 >= "
+                f"{design.scar_energy_j:g} J, {design.scar_spacing_m:g} m apart): "
+                "lower the scar energy or "
                 "spacing, or release the rocks higher",
                 source="paths",
             )
         result = simulate(model, batch, rng, record_impacts=True)
         simulated += batch
         frame = result.impact_table.frame if result.impact_table is not None else None
-        groups = {} if frame is None else dict(list(frame.groupby("path_id", sort=False)))
+        groups = (
+            {} if frame is None else dict(list(frame.groupby("path_id", sort=False)))
+        )
         for rock in range(batch):
             if len(kept) == paths:
                 break
@@ -484,7 +487,8 @@ def _tree_strikes(
             if math.isfinite(height):
                 break  # the rock passed over this tree's crown: the flight has none
     columns = ["after_impact", "horizontal_distance_m", "strike_height_m",
-               "ground_z_m", "species", "dbh_mm", "tree", "row", "offset_m"]  # fmt: skip
+               "ground_z_m", "species", "dbh_mm", "tree", "row",
+               "offset_m"]  # fmt: skip
     return pd.DataFrame(out, columns=columns)
 
 
