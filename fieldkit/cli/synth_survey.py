@@ -14,7 +14,7 @@ from pathlib import Path
 
 import typer
 
-from fieldkit.cli.common import note, random_generator
+from fieldkit.cli.common import note, random_generator, warn
 from fieldkit.cli.progress import report_written, step
 from fieldkit.errors import ArgumentError
 from fieldkit.outputs import OutputSet, write_text
@@ -156,12 +156,22 @@ def synth_survey(
     # the folder holds exactly this campaign: a previous one's files it did not
     # replace (more paths, trees where this one has none) would be read with it
     stale = sorted(set(previous) - set(files))
+    kept = []
     for name in stale:
-        (output / name).unlink(missing_ok=True)
+        try:
+            (output / name).unlink(missing_ok=True)
+        except OSError:
+            kept.append(name)
     if stale:
         note(
-            f"removed {len(stale)} files of a previous campaign from {output} "
-            f"({', '.join(stale[:3])}{', ...' if len(stale) > 3 else ''})"
+            f"removed {len(stale) - len(kept)} files of a previous campaign from "
+            f"{output} ({', '.join(stale[:3])}{', ...' if len(stale) > 3 else ''})"
+        )
+    if kept:
+        warn(
+            f"could not remove {len(kept)} files of a previous campaign from "
+            f"{output} ({', '.join(kept[:3])}): remove them by hand; "
+            f"{CAMPAIGN_FILE} lists only this campaign's"
         )
     error_model = _reduce_error_note(design)
     if error_model:
