@@ -84,7 +84,7 @@ def reduce_command(folder: str, path_id: str, trees: str | None) -> str:
     --------
     >>> reduce_command("out/camp", "path01", None)  # doctest: +NORMALIZE_WHITESPACE
     'fieldkit reduce --impacts out/camp/path01_points.csv --preset
-     out/camp/preset.toml --path-id path01 -o path01_reduced.csv'
+     out/camp/preset.toml --path-id path01 -o out/camp_path01.csv'
     """
     base = folder.rstrip("/") or "/"
 
@@ -95,7 +95,9 @@ def reduce_command(folder: str, path_id: str, trees: str | None) -> str:
     if trees is not None:
         words += ["--trees", inside(trees)]
     words += ["--preset", inside(PRESET_FILE), "--path-id", path_id]
-    words += ["-o", f"{path_id}_reduced.csv"]
+    # the table goes beside the folder, not into it (the folder holds the
+    # campaign's files only) nor into the working folder
+    words += ["-o", shlex.quote(f"{base}_{path_id}.csv")]
     return " ".join(words)
 
 

@@ -208,10 +208,12 @@ def test_each_path_reduces_with_its_command(cli, tmp_path):
     for path in record["paths"]:
         argv = shlex.split(path["reduce"])
         assert argv[:2] == ["fieldkit", "reduce"] and "--trees" in argv
-        argv[argv.index("-o") + 1] = str(tmp_path / f"{path['path_id']}.csv")
+        # exactly as written: the table goes beside the campaign's folder
+        table_file = tmp_path / f"camp_{path['path_id']}.csv"
+        assert argv[argv.index("-o") + 1] == str(table_file)
         result = cli(*argv[1:])
         assert result.exit_code == 0, result.stderr
-        table = pd.read_csv(tmp_path / f"{path['path_id']}.csv")
+        table = pd.read_csv(table_file)
         assert (table["path_id"] == path["path_id"]).all()
         assert len(table) == path["counts"]["scars"] + 1
         assert (table["theta0_source"].dropna().isin(["assumed", "tree"])).all()
