@@ -151,7 +151,7 @@ def synth_survey(
         f"{len(campaign.paths)} surveyed, {campaign.rocks_too_short} left too few "
         "scars"
     )
-    for text in campaign.notes[2:]:
+    for text in campaign.notes[2:]:  # the first two: the survey and counts above
         note(text)
     # the folder holds exactly this campaign: a previous one's files it did not
     # replace (more paths, trees where this one has none) would be read with it
