@@ -12,7 +12,10 @@ Scars
     :data:`DEFAULT_SCAR_SPACING_M` (2 m in plan) to the last one kept read as one scar
     (the first, uphill one is kept), and a scar behind the last one kept (the rock
     bounced back) is not told apart from it either. So several short bounces can be
-    surveyed as one long "flight" -- as in the field.
+    surveyed as one long "flight" -- as in the field. A scar whose *surveyed*
+    position falls at or behind the point surveyed before it (the position error
+    reversed a short gap) is read as that point's scar too: a surveyed path runs in
+    order of travel with x increasing, as ``fieldkit reduce`` reads it.
 Position error
     Each point's section ``x`` (plan, along the path) and ``z`` get normal errors of
     ``position_sigma_m`` and ``elevation_sigma_m`` (0.5 m each, the reduction's
@@ -26,8 +29,11 @@ Trees
     ``tree_height_m`` scars its trunk at the height of the rock's centre above the
     ground there; the first tree of each surveyed flight is recorded (one strike fixes
     a parabola), its height measured with ``strike_height_sigma_m`` error and its
-    distance from the launch scar taped (exact). The trees only mark the path: they
-    slow the rock only when the model has ``tree_impacts`` switched on.
+    distance from the launch scar taped (exact). A strike whose taped distance lies
+    beyond the *surveyed* end of its flight (the position error shortened a short
+    flight) cannot be placed on it and is not recorded (a note counts them). The
+    trees only mark the path: they slow the rock only when the model has
+    ``tree_impacts`` switched on.
 Launch angle
     Not observed. The reduction assumes ``theta0_deg`` (32.6 deg, the thesis's mean
     of the tree-defined flights at Tornado Mountain) wherever no tree defines a flight.

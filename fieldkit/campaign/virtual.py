@@ -57,6 +57,16 @@ TRUTH_COLUMNS = (
     "theta_f_deg",
     "ke_n_j",
 )
+#: Columns of a path's tree truth (one row per recorded tree strike): the flight's
+#: launch point, the tree's true chainage, its taped distance from the launch scar
+#: and the height of the rock's centre above the ground there before the
+#: measurement error.
+TREE_TRUTH_COLUMNS = (
+    "after_impact",
+    "tree_x_true_m",
+    "horizontal_distance_m",
+    "strike_height_true_m",
+)
 
 
 @dataclass(frozen=True)
@@ -76,12 +86,24 @@ class VirtualPath:
         velocities and coefficients (NaN at the source).
     impacts
         Every simulated impact of the rock (the ImpactTable of the simulation).
+    trees_truth
+        The recorded tree strikes before their height error
+        (:data:`TREE_TRUTH_COLUMNS`); None when the design has no trees.
+    strikes_unplaced
+        Strikes not recorded because their taped distance lies beyond the
+        surveyed end of their flight (:func:`_placed_strikes`).
+    scars_behind
+        Scars the position error put at or behind the last point surveyed, read
+        as that point's scar (:func:`_ahead`).
     """
 
     path_id: str
     survey: Survey
     truth: pd.DataFrame
     impacts: ImpactTable
+    trees_truth: pd.DataFrame | None = None
+    strikes_unplaced: int = 0
+    scars_behind: int = 0
 
 
 @dataclass(frozen=True)
@@ -182,6 +204,22 @@ def virtual_campaign(
         "source point: the seeder's mean release chainage on the ground (a release "
         "scatter in the model is not surveyed)",
     ]
+    behind = sum(p.scars_behind for p in kept)
+    if behind:
+        notes.append(
+            f"{behind} scar{'s' if behind != 1 else ''} surveyed at or behind the "
+            "point before (the position error reversed a short gap) read as that "
+            "point's scar "
+            "(merged into it, their flights' tree strikes not recorded)"
+        )
+    unplaced = sum(p.strikes_unplaced for p in kept)
+    if unplaced:
+        notes.append(
+            f"{unplaced} tree strike{'s' if unplaced != 1 else ''} not recorded: "
+            "the taped distance from the "
+            "launch scar lies beyond the surveyed end of the flight (the position "
+            "error shortened a short flight), so the tree cannot be placed on it"
+        )
     if "air_drag" in model.effects:
         notes.append(
             "tree-strike heights use drag-free parabolas between impacts (the "
@@ -257,6 +295,24 @@ def survey_rock(
     names = [str(k) for k in range(len(x_true))]
     trees = _tree_strikes(model, rows, idx, x_true, names, design, rng)
     dx, dz = _position_errors(x_true, design, rng)
+    trees_truth = None
+    if trees is not None:
+        launch = dict(zip(names, x_true, strict=True))
+        trees_truth = pd.DataFrame(
+            {
+                "after_impact": trees["after_impact"].astype(str),
+                "tree_x_true_m": [
+                    launch[a] + d
+                    for a, d in zip(
+                        trees["after_impact"], trees["horizontal_distance_m"],
+                        strict=True,
+                    )
+                ],
+                "horizontal_distance_m": trees["horizontal_distance_m"].astype(float),
+                "strike_height_true_m": trees["strike_height_m"].astype(float),
+            },
+            columns=list(TREE_TRUTH_COLUMNS),
+        )
     if trees is not None and len(trees):
         sd_h = design.strike_height_sigma_m
         noisy = trees["strike_height_m"].to_numpy(float) + rng.normal(
@@ -265,8 +321,26 @@ def survey_rock(
         trees["strike_height_m"] = np.maximum(noisy, 0.05)
     x_obs = x_true + dx
     z_obs = z_true + dz
-    # a surveyed path is in order of travel: a scar pushed behind the previous one
-    # by the error is still surveyed after it (the geologist walked down the path)
+    truth = _truth(rows, idx, merged, names, x_true, z_true, x_obs, z_obs, materials)
+    # a surveyed path runs in order of travel with x increasing (what a reader of
+    # section points accepts): a scar the position error puts at or behind the
+    # last point surveyed is read as that point's scar (merged into it)
+    keep = _ahead(x_obs)
+    behind = int((~keep).sum())
+    if behind:
+        truth = _merge_behind(truth, keep)
+        dropped = {names[i] for i in np.flatnonzero(~keep)}
+        if trees is not None and len(trees):
+            gone = trees["after_impact"].astype(str).isin(dropped).to_numpy()
+            trees = trees[~gone].reset_index(drop=True)
+            trees_truth = trees_truth[~gone].reset_index(drop=True)
+        names = [n for n, k in zip(names, keep, strict=True) if k]
+        x_obs, z_obs, materials = x_obs[keep], z_obs[keep], materials[keep]
+        if len(names) < MIN_SCARS or len(names) - 1 < design.min_scars:
+            return None
+    unplaced = 0
+    if trees is not None and len(trees):
+        trees, trees_truth, unplaced = _placed_strikes(trees, trees_truth, names, x_obs)
     frame = pd.DataFrame(
         {
             "point": names,
@@ -283,13 +357,70 @@ def survey_rock(
     tree_set = None
     if trees is not None:
         tree_set = TreeStrikes(trees, source=f"{source}: {path_id} trees")
-    truth = _truth(rows, idx, merged, names, x_true, z_true, x_obs, z_obs, materials)
     return VirtualPath(
         path_id=path_id,
         survey=Survey(points, tree_set),
         truth=truth,
         impacts=ImpactTable(rows, source=source),
+        trees_truth=trees_truth,
+        strikes_unplaced=unplaced,
+        scars_behind=behind,
     )
+
+
+def _ahead(x_obs: np.ndarray) -> np.ndarray:
+    """Which surveyed points lie ahead (larger x) of every point kept before them
+    (the source always kept).
+
+    Examples
+    --------
+    >>> _ahead(np.array([0.0, 5.0, 4.9, 6.0, 5.5, 9.0])).tolist()
+    [True, True, False, True, False, True]
+    """
+    keep = np.ones(x_obs.size, bool)
+    last = x_obs[0]
+    for i in range(1, x_obs.size):
+        keep[i] = x_obs[i] > last
+        if keep[i]:
+            last = x_obs[i]
+    return keep
+
+
+def _merge_behind(truth: pd.DataFrame, keep: np.ndarray) -> pd.DataFrame:
+    """The truth of the kept points, each dropped point's simulated impacts added
+    to the kept point before it (``impacts_merged``)."""
+    counts = truth["impacts_merged"].to_numpy(int).copy()
+    last = 0
+    for i in range(1, counts.size):
+        if keep[i]:
+            last = i
+        else:
+            counts[last] += counts[i]
+    out = truth.assign(impacts_merged=counts)
+    return out[keep].reset_index(drop=True)
+
+
+def _placed_strikes(
+    trees: pd.DataFrame,
+    trees_truth: pd.DataFrame,
+    names: list[str],
+    x_obs: np.ndarray,
+) -> tuple[pd.DataFrame, pd.DataFrame, int]:
+    """The strikes the survey can place: a taped distance from the launch scar
+    that lies within the *surveyed* flight (``0 < d < x_next - x_launch`` of the
+    surveyed points). Beyond it -- a short flight whose surveyed end the position
+    error pulled back -- no reader can put the tree on its flight (``reduce
+    --trees`` refuses it), so the strike is not recorded. Returns the kept strikes,
+    their truth and how many were left out."""
+    at = {name: k for k, name in enumerate(names)}
+    k = trees["after_impact"].map(at).to_numpy(int)
+    d = trees["horizontal_distance_m"].to_numpy(float)
+    placed = (d > 0.0) & (d < x_obs[k + 1] - x_obs[k])
+    kept = trees[placed].reset_index(drop=True)
+    kept["tree"] = [f"T{i + 1}" for i in range(len(kept))]
+    kept["row"] = np.arange(len(kept)) + 2
+    truth = trees_truth[placed].reset_index(drop=True)
+    return kept, truth, int((~placed).sum())
 
 
 def _position_errors(

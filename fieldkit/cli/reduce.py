@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 from typing import Annotated
 
@@ -19,10 +20,11 @@ from fieldkit.cli.common import (
     note,
     one_line_errors,
     print_body_notes,
+    warn,
     with_flags,
 )
 from fieldkit.cli.progress import step
-from fieldkit.errors import ArgumentError
+from fieldkit.errors import ArgumentError, FieldkitError
 from fieldkit.impact_table import table_format
 from fieldkit.outputs import OutputSet
 
@@ -68,6 +70,15 @@ def reduce(
     stations: Annotated[
         Path | None,
         typer.Option("--stations", help="GPS stations of the field book (GPX or CSV)."),
+    ] = None,
+    campaign: Annotated[
+        Path | None,
+        typer.Option(
+            "--campaign",
+            help="A virtual campaign's folder (fieldkit synth --survey): every path "
+            "reduced with the campaign's preset (options given override it) into "
+            "one table.",
+        ),
     ] = None,
     trees: Annotated[
         Path | None,
@@ -227,6 +238,17 @@ def reduce(
 
     from_preset: list[str] = []
     overridden: list[str] = []
+    campaign_file = None
+    if campaign is not None:
+        from fieldkit.campaign.files import read_campaign
+
+        single = {"--impacts": impacts, "--fieldbook": fieldbook,
+                  "--stations": stations, "--trees": trees, "--path-id": path_id,
+                  "--preset": preset, "--figures": figures, "--gpx-track": gpx_track,
+                  "--declination": declination}  # fmt: skip
+        _refuse_with_campaign(single)
+        campaign_file = read_campaign(campaign)
+        preset = campaign_file.preset
     if preset is not None:
         from fieldkit.io.preset import read_preset
 
@@ -245,9 +267,10 @@ def reduce(
                                                      "radius_m"))  # fmt: skip
         gyration, path_id = current["gyration_m"], current["path_id"]
 
-    if (impacts is None) == (fieldbook is None):
+    if campaign is None and (impacts is None) == (fieldbook is None):
         raise ArgumentError(
-            "give either --impacts FILE or --fieldbook FILE --stations FILE",
+            "give either --impacts FILE, --fieldbook FILE --stations FILE or "
+            "--campaign DIR",
             source="--impacts" if impacts else "--fieldbook",
         )
     if fieldbook is not None and stations is None:
@@ -290,7 +313,11 @@ def reduce(
             DEFAULT_STRIKE_HEIGHT_SIGMA_M if height_sigma is None else height_sigma
         ),
     )
-    if height_sigma is not None and trees is None:
+    with_trees = trees is not None or (
+        campaign_file is not None
+        and any(p.trees is not None for p in campaign_file.paths)
+    )
+    if height_sigma is not None and not with_trees:
         raise ArgumentError(
             "--height-sigma goes with --trees (it is the error of tree-strike heights)",
             source="--height-sigma",
@@ -302,12 +329,46 @@ def reduce(
         note("no -o/--out or --figures given; printing the summary only")
     if out is not None:
         table_format(out)  # CSV for /dev/null or a FIFO, else by its extension
-    outputs = OutputSet(inputs=[impacts, fieldbook, stations, trees, preset])
+    campaign_inputs = []
+    if campaign_file is not None:
+        campaign_inputs = [campaign_file.source] + [
+            f for p in campaign_file.paths for f in (p.points, p.trees)
+        ]
+    outputs = OutputSet(
+        inputs=[impacts, fieldbook, stations, trees, preset, *campaign_inputs]
+    )
     outputs.confine(figures)
     if out is not None:
         outputs.plan(out, argument="-o")
     for name in FIGURE_NAMES if figures is not None else ():
         outputs.plan(figures / name, argument="--figures")
+
+    options = ReduceOptions(
+        path_id=path_id or "",
+        theta0_deg=theta0,
+        body=body,
+        friction=friction,
+        position_error=error_model,
+    )
+    if campaign_file is not None:
+        table = _reduce_campaign(campaign_file, options, units=units, epsg=epsg,
+                                 gpx_points=gpx_points)  # fmt: skip
+        if out is not None:
+            table.write(out, outputs=outputs)
+        written = outputs.commit()
+        taken = ", ".join(from_preset) or "nothing"
+        note(f"from the campaign's preset {preset}: {taken}"
+             + (f"; from the command line instead: {', '.join(overridden)}"
+                if overridden else ""))  # fmt: skip
+        typer.echo(f"body: {body.description}")
+        print_body_notes(body)
+        typer.echo(f"uncertainty (each path): {error_model.describe()}")
+        summary = summarize(table, None)
+        typer.echo(with_flags(format_summary(summary)))
+        for path in written:
+            rows = f" ({len(table)} rows)" if path == out else ""
+            typer.echo(f"wrote {path}{rows}")
+        return
 
     if impacts is not None:
         from fieldkit.io.impacts import read_impacts
@@ -337,13 +398,7 @@ def reduce(
         from fieldkit.io.trees import read_trees
 
         tree_set = read_trees(trees, points, units=units)
-    options = ReduceOptions(
-        path_id=path_id or name,
-        theta0_deg=theta0,
-        body=body,
-        friction=friction,
-        position_error=error_model,
-    )
+    options = replace(options, path_id=path_id or name)
     survey = Survey(points, tree_set)
     # seconds for a surveyed path (Monte Carlo uncertainty): shown on a terminal
     with step(f"reducing {len(points.frame)} points", announce=False):
@@ -377,3 +432,73 @@ def reduce(
     for path in written:
         rows = f" ({len(table)} rows)" if out is not None and path == out else ""
         typer.echo(f"wrote {path}{rows}")
+
+
+def _refuse_with_campaign(given: dict[str, object]) -> None:
+    """Refuse the options a campaign's own files and preset stand for."""
+    for flag, value in given.items():
+        if value is not None:
+            raise ArgumentError(
+                f"{flag} goes without --campaign (the campaign's folder holds each "
+                "path's files, id and preset; reduce one path with the command "
+                "campaign.json gives for it)",
+                source="--campaign",
+            )
+
+
+def _reduce_campaign(campaign_file, options, *, units, epsg, gpx_points):
+    """Every path of a virtual campaign reduced with ``options`` (each with its
+    own path id) into one table; a path the reduction refuses entirely is named in
+    a warning and left out. One line per path."""
+    import pandas as pd
+
+    from fieldkit.impact_table import ImpactTable
+    from fieldkit.io.impacts import read_impacts
+    from fieldkit.io.trees import read_trees
+    from fieldkit.reduce.pipeline import reduce_path
+    from fieldkit.survey import Survey
+
+    frames = []
+    left_out: list[str] = []
+    first_reason = ""
+    total = len(campaign_file.paths)
+    with step(f"reducing {total} paths", total=total) as advance:
+        for k, entry in enumerate(campaign_file.paths):
+            points = read_impacts(entry.points, units=units, epsg=epsg,
+                                  gpx_points=gpx_points)  # fmt: skip
+            tree_set = None
+            if entry.trees is not None:
+                tree_set = read_trees(entry.trees, points, units=units)
+            try:
+                reduction = reduce_path(
+                    Survey(points, tree_set), replace(options, path_id=entry.path_id)
+                )
+            except FieldkitError as exc:
+                warn(f"{entry.path_id}: not reduced, left out of the table: {exc}")
+                left_out.append(entry.path_id)
+                first_reason = first_reason or str(exc)
+                continue
+            frame = reduction.table.frame
+            unsolved = (
+                int(frame["flight_unsolved"].notna().sum())
+                if "flight_unsolved" in frame
+                else 0
+            )
+            typer.echo(
+                f"{entry.path_id}: {len(points.frame)} points, {len(frame)} rows, "
+                f"{unsolved} flights unsolved"
+            )
+            frames.append(frame)
+            advance(k + 1, total)
+    if not frames:
+        raise ArgumentError(
+            f"no path of the campaign could be reduced (first: {first_reason})",
+            source=campaign_file.source,
+        )
+    if left_out:
+        warn(
+            f"{len(left_out)} of {total} paths not reduced and left out: "
+            f"{', '.join(left_out)}"
+        )
+    frame = pd.concat(frames, ignore_index=True)
+    return ImpactTable(frame, source=campaign_file.source)

@@ -10,6 +10,7 @@ import typer
 
 from fieldkit.cli.common import note, one_line_errors, random_generator
 from fieldkit.cli.progress import report_written, step
+from fieldkit.cli.synth_survey import SURVEY_FLAGS, synth_survey
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.outputs import OutputSet
 
@@ -109,7 +110,29 @@ def effects_words(effects: dict[str, dict[str, float]]) -> str:
     )  # fmt: skip
 
 
-@one_line_errors(flags=FLAGS)
+#: ``--survey`` options: the CampaignDesign field each one sets.
+SURVEY_OPTIONS = {
+    "scar_energy": "scar_energy_j",
+    "scar_spacing": "scar_spacing_m",
+    "position_sigma": "position_sigma_m",
+    "elevation_sigma": "elevation_sigma_m",
+    "correlation_length": "correlation_length_m",
+    "canopy": "canopy_x_m",
+    "canopy_sigma": "canopy_sigma_m",
+    "tree_spacing": "tree_spacing_m",
+    "tree_height": "tree_height_m",
+    "height_sigma": "strike_height_sigma_m",
+    "theta0": "theta0_deg",
+    "max_scars": "max_scars",
+}
+SurveyFloat = float | None
+
+
+def _survey_option(flag: str, text: str):
+    return typer.Option(flag, help=f"--survey: {text}", rich_help_panel="--survey")
+
+
+@one_line_errors(flags={**FLAGS, **SURVEY_FLAGS})
 def synth(
     model_file: Annotated[
         Path, typer.Argument(metavar="MODEL.json", help="The model file (§5).")
@@ -119,7 +142,7 @@ def synth(
         typer.Option(
             "-o",
             help="The ImpactTable to write (.csv, .parquet); with --track the "
-            "track (.csv).",
+            "track (.csv); with --survey the campaign's folder.",
         ),
     ],
     effects: Annotated[
@@ -131,14 +154,14 @@ def synth(
         ),
     ] = None,
     noise: Annotated[
-        float,
+        float | None,
         typer.Option(
             "--noise",
-            help="Relative noise F: each restitution velocity component gets "
-            "N(0, (F |vf|)^2), omega_f gets N(0, (F |vf|/r)^2); impact velocities "
-            "stay exact.",
+            help="Relative noise F (default 0.05): each restitution velocity "
+            "component gets N(0, (F |vf|)^2), omega_f gets N(0, (F |vf|/r)^2); "
+            "impact velocities stay exact.",
         ),
-    ] = 0.05,
+    ] = None,
     paths: Annotated[
         int, typer.Option("--paths", help="Number of rocks (one path each).")
     ] = 100,
@@ -180,6 +203,97 @@ def synth(
             "within +-5 deg).",
         ),
     ] = 15.0,
+    survey: Annotated[
+        bool,
+        typer.Option(
+            "--survey",
+            help="Write a virtual field campaign into the folder -o: each rock's "
+            "path surveyed as a geologist would (scars, survey error, tree strikes, "
+            "no launch angle) as the raw files reduce reads, the truth beside them.",
+        ),
+    ] = False,
+    scar_energy: Annotated[
+        SurveyFloat,
+        _survey_option(
+            "--scar-energy",
+            "least normal-impact kinetic energy m vin^2/2 that leaves a scar, J "
+            "(default 5000).",
+        ),
+    ] = None,
+    scar_spacing: Annotated[
+        SurveyFloat,
+        _survey_option(
+            "--scar-spacing",
+            "scars closer than this in plan read as one, m (default 2).",
+        ),
+    ] = None,
+    position_sigma: Annotated[
+        SurveyFloat,
+        _survey_option(
+            "--position-sigma",
+            "SD of each point's plan position error, m (default 0.5).",
+        ),
+    ] = None,
+    elevation_sigma: Annotated[
+        SurveyFloat,
+        _survey_option(
+            "--elevation-sigma",
+            "SD of each point's height error, m (default: --position-sigma, 0.5).",
+        ),
+    ] = None,
+    correlation_length: Annotated[
+        SurveyFloat,
+        _survey_option(
+            "--correlation-length",
+            "position errors of successive points correlated exp(-dx/L) over this "
+            "length, m (default 0: independent).",
+        ),
+    ] = None,
+    canopy: Annotated[
+        list[str] | None,
+        _survey_option(
+            "--canopy",
+            "a chainage range X0:X1 under canopy, where the position error is "
+            "--canopy-sigma; repeatable.",
+        ),
+    ] = None,
+    canopy_sigma: Annotated[
+        SurveyFloat,
+        _survey_option("--canopy-sigma", "position error under canopy, m (default 2)."),
+    ] = None,
+    tree_spacing: Annotated[
+        SurveyFloat,
+        _survey_option(
+            "--tree-spacing",
+            "mean spacing of trees along the path (Poisson), m (default 0: no trees).",
+        ),
+    ] = None,
+    tree_height: Annotated[
+        SurveyFloat,
+        _survey_option(
+            "--tree-height", "highest strike a trunk records, m (default 20)."
+        ),
+    ] = None,
+    height_sigma: Annotated[
+        SurveyFloat,
+        _survey_option(
+            "--height-sigma", "SD of each tree-strike height error, m (default 0.25)."
+        ),
+    ] = None,
+    theta0: Annotated[
+        SurveyFloat,
+        _survey_option(
+            "--theta0",
+            "launch angle the campaign's preset assumes for the reduction, deg "
+            "(default 32.6).",
+        ),
+    ] = None,
+    max_scars: Annotated[
+        int | None,
+        _survey_option(
+            "--max-scars", "at most this many scars surveyed per path (default: all)."
+        ),
+    ] = None,
 ) -> None:
     """Make an ImpactTable (or, with --track, a video track) with hidden effects
     and noise.
@@ -207,11 +321,64 @@ def synth(
         fieldkit synth surveys/tornado_mountain/model_rocfall_table_7_1.json \\
           --track --fps 200 --noise-m 0.005 --flights 8 --seed 1 \\
           --effects air_drag=cd=0.8 -o out/track.csv
+
+    With --survey: a virtual field campaign in the folder -o. Each rock leaves a
+    scar where m vin^2/2 reaches --scar-energy, scars closer than --scar-spacing
+    read as one; every point gets survey error (--position-sigma,
+    --elevation-sigma, --correlation-length, --canopy with --canopy-sigma); with
+    --tree-spacing the first tree each flight strikes is recorded with
+    --height-sigma error; the launch angle is not observed (the preset assumes
+    --theta0). Written: pathNN_points.csv (what reduce --impacts reads),
+    pathNN_trees.csv (reduce --trees), pathNN_truth.csv and pathNN_trees_truth.csv
+    (the simulated truth), preset.toml and campaign.json (model, effects with
+    every parameter, seed, design, each path's files, counts and reduce command).
+    Reduce them all with `fieldkit reduce --campaign DIR -o table.csv`:
+
+        fieldkit synth surveys/tornado_mountain/model_rocfall_table_7_1.json \\
+          --survey --paths 3 --seed 1 --tree-spacing 8 -o out/campaign
     """
     from fieldkit.fit.synthetic import check_paths, synthetic_table, with_effects
     from fieldkit.model.model_file import read_model
 
     hidden = parse_effects(effects or [])
+    given = {
+        "scar_energy": scar_energy,
+        "scar_spacing": scar_spacing,
+        "position_sigma": position_sigma,
+        "elevation_sigma": elevation_sigma,
+        "correlation_length": correlation_length,
+        "canopy": canopy or None,
+        "canopy_sigma": canopy_sigma,
+        "tree_spacing": tree_spacing,
+        "tree_height": tree_height,
+        "height_sigma": height_sigma,
+        "theta0": theta0,
+        "max_scars": max_scars,
+    }
+    options = {
+        SURVEY_OPTIONS[name]: value
+        for name, value in given.items()
+        if value is not None
+    }
+    if survey:
+        if track:
+            raise ArgumentError("--survey and --track are two different outputs: "
+                                "give one", source="--survey")  # fmt: skip
+        if noise is not None:
+            raise ArgumentError(
+                "--noise goes without --survey (a campaign's error is the survey's: "
+                "--position-sigma, --height-sigma)",
+                source="--noise",
+            )
+        synth_survey(model_file, output, hidden, seed, paths, options, effects_words)
+        return
+    if options:
+        flags = [SURVEY_FLAGS[field] for field in options]
+        raise ArgumentError(
+            f"{', '.join(flags)} {'goes' if len(flags) == 1 else 'go'} with --survey",
+            source=flags[0],
+        )
+    noise = 0.05 if noise is None else noise
     if track:
         _synth_track(
             model_file,
