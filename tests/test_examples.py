@@ -86,6 +86,14 @@ EXPECTED = {
         r"b = 0\.7\d ± 0\.1\d \(48 impacts",
         r"asphalt_section\.csv: too few impacts to diagnose",
     ],
+    # Issue 18: a virtual campaign with eq. 7.1 hidden, surveyed, reduced with the
+    # assumed launch angle and diagnosed with its null through the same reduction
+    "diagnose_virtual_campaign.py": [
+        r"hidden: velocity_scaled_restitution at K = 7 m/s",
+        r"^ +1 path\(s\), \d+ rows: recommended \w+; best \w+ gain [+-]\d+\.\d%.*"
+        r"null threshold [+-]\d+\.\d% \(19 campaigns\)",
+        r"^the hidden law is (first found with \d+|not found with up to \d+)",
+    ],
 }
 
 #: Modules a script needs that may not be merged yet (the script is skipped until then).

@@ -335,10 +335,17 @@ def loop_table(
                 design, max_scars=max(2, min(left + 1, PIECE_SCARS)), min_scars=2
             )
             model = path_model(path, materials, effects, start)
-            virtual = virtual_campaign(model, rock_design, 1, rng, source="null").paths[
-                0
-            ]
             rocks += 1
+            try:
+                made = virtual_campaign(model, rock_design, 1, rng, source="null")
+            except FieldkitError:
+                # no rock from this scar left two scars before the profile's end
+                # (near the foot of a path): start again higher up
+                failed += 1
+                start = int(rng.integers(1, max(2, len(path.x_m) - 2)))
+                start = max(start, 1) if len(path.x_m) > 3 else 0
+                continue
+            virtual = made.paths[0]
             # the next rock starts at the observed scar past this one's last
             end = float(virtual.truth["x_true_m"].iloc[-1])
             start = int(np.searchsorted(path.x_m, end, side="right"))
@@ -588,6 +595,18 @@ def calibrate(
         for s in null_seeds
     ]
     results = run_tasks(null_tasks, workers, progress)
+    # a campaign that could not be made is replaced (fresh streams, at most two
+    # rounds), so the test has the size asked for whenever the geometry allows it
+    for _ in range(2):
+        missing = sum(r["failed"] is not None for r in results)
+        ok_count = len(results) - missing
+        if not missing or ok_count >= null_size:
+            break
+        extra = [
+            LoopTask("null", paths, materials, effects, candidates, folds, 0.0, s)
+            for s in root.spawn(null_size - ok_count)
+        ]
+        results += run_tasks(extra, workers, None)
     ok = [r for r in results if r["failed"] is None]
     failed = [r for r in results if r["failed"] is not None]
     gains = np.array([r["best_gain"] for r in ok], float)
@@ -627,7 +646,8 @@ def calibrate(
     if failed:
         notes.append(
             f"{len(failed)} of {len(results)} null campaigns could not be simulated "
-            f"or reduced (first: {failed[0]['failed']}); the null is the rest"
+            f"or reduced (first: {failed[0]['failed']}) and were replaced by new "
+            f"ones; the null is the {len(ok)} made"
         )
     return LoopResult(
         threshold=threshold,
