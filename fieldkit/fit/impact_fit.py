@@ -17,6 +17,32 @@ Weights (the first that the table allows, stated in the result):
    used again). Spins then need ``omega_f_sd_radps``, else they are left out;
 3. unit weights: residuals in m/s, spins as the surface speed ``r omega`` in m/s.
 
+Errors in the impact velocities (:func:`errors_in_variables`): when the table
+carries ``vin_sd_mps`` and ``vit_sd_mps`` beside ``vfn_sd_mps``, ``vft_sd_mps``, the
+impact velocity is a measurement too, and taking it as exact flattens the rebound
+against it (regression dilution). Two corrections, both stated in the notes:
+
+* **regression calibration** (Carroll et al. 2006, *Measurement Error in Nonlinear
+  Models*, ch. 4): each input ``vin``, ``vit`` (and ``omega_i`` with
+  ``omega_i_sd_radps``) is replaced by its best estimate given the observation,
+  ``E[v | v_obs] = mu + lambda (v_obs - mu)``, ``lambda = var_true / (var_true +
+  sd^2)`` per row, with ``mu`` and ``var_true = var(v_obs) - mean(sd^2)`` (floored
+  at :data:`CALIBRATION_FLOOR` ``var(v_obs)``) by the method of moments per
+  material. Where ``vin_vfn_corr`` (``vit_vft_corr``) says the rebound's error
+  shares the impact's (an arrival and a rebound computed from the same surveyed
+  point), the rebound is corrected by the part of its error the input's error
+  predicts, ``c / var_obs (v_obs - mu)`` with ``c = corr sd_in sd_out``;
+* **effective variance** (Orear 1982, Am. J. Phys. 50, 912): each residual's
+  variance is ``sd_out^2 - c^2 / var_obs + sum (df/dv)^2 lambda sd^2 - 2 (df/dv)
+  lambda c``, the rebound's own error plus the calibrated input's remaining error
+  carried through the model's local derivative ``df/dv`` (central differences of
+  the prediction at the model's values, recomputed once at the fitted values by
+  :func:`fit_impacts`). With ``lambda = 1`` and no calibration this is Orear's
+  ``sd_out^2 + (df/dv)^2 sd_in^2 - 2 (df/dv) cov``.
+
+Without ``vin_sd_mps``/``vit_sd_mps`` nothing of this applies and the impact
+velocities are exact inputs.
+
 Free parameters: ``materials.<m>.e_n`` and ``materials.<m>.e_t`` of every material
 the table's impacts touch, and every parameter of the active impact-stage effects
 except those an impact table cannot determine (:data:`HELD`, stated in the notes):
@@ -67,6 +93,20 @@ HELD: dict[str, str] = {
 #: path of one impact.
 MIN_IMPACTS_PER_MATERIAL = 2
 MIN_RESIDUAL_DOF = 3
+
+#: The regression calibration's floor on a material's true-value variance of an
+#: input, as a fraction of its observed variance: below it the method of moments
+#: says the spread is nearly all error, which a handful of impacts cannot tell
+#: reliably, and shrinking every impact to the mean would leave nothing to fit.
+CALIBRATION_FLOOR = 0.1
+#: Inputs measured with error: (ImpactInputs field, table value column, sd column,
+#: rebound output it shares an error with (index in vfn, vft, omega_f) and the
+#: correlation column of the two errors).
+INPUT_ERRORS = (
+    ("vin_mps", "vin_mps", "vin_sd_mps", 0, "vin_vfn_corr"),
+    ("vit_mps", "vit_mps", "vit_sd_mps", 1, "vit_vft_corr"),
+    ("omega_i_radps", "omega_i_radps", "omega_i_sd_radps", None, None),
+)
 
 #: Primary columns every fitted row needs finite.
 FINITE_COLUMNS = ("vi_x_mps", "vi_z_mps", "vf_x_mps", "vf_z_mps", "slope_deg")
@@ -188,7 +228,11 @@ def _weights(table: ImpactTable, inputs: ImpactInputs) -> tuple[np.ndarray, str]
         text += ", omega_f_sd_radps"
     elif has_spin.any():
         text += "; measured spins left out (no omega_f_sd_radps)"
-    bad = ~((sd[:, 0] > 0) & (sd[:, 1] > 0) & np.isfinite(sd[:, :2]).all(axis=1))
+    # a rebound measured exactly is allowed when the impact carries the error
+    low = 0.0 if _has_input_errors(table) and text.startswith("1/sd from") else -1.0
+    ok = (sd[:, 0] > 0) | ((sd[:, 0] == 0) & (low == 0))
+    ok &= (sd[:, 1] > 0) | ((sd[:, 1] == 0) & (low == 0))
+    bad = ~(ok & np.isfinite(sd[:, :2]).all(axis=1))
     if bad.any():
         raise InputFileError(
             "standard uncertainty is not a positive number",
@@ -196,6 +240,48 @@ def _weights(table: ImpactTable, inputs: ImpactInputs) -> tuple[np.ndarray, str]
             where=_rows(bad),
         )
     return sd, text
+
+
+def _has_input_errors(table: ImpactTable) -> bool:
+    """Whether ``table`` gives the impact velocity's standard uncertainty."""
+    return {"vin_sd_mps", "vit_sd_mps"} <= set(table.frame)
+
+
+@dataclass(frozen=True)
+class InputErrors:
+    """The regression calibration of a problem's inputs (see the module docstring).
+
+    Arrays are ``(n, 3)`` over the inputs ``vin``, ``vit``, ``omega_i``
+    (:data:`INPUT_ERRORS`): ``lam`` the calibration's ``lambda`` (1 for an exact
+    input), ``sd_in`` the input's SD (0 when exact), ``cov`` the covariance ``c`` of
+    its error with its paired rebound's (0 when none), ``var_obs`` the row's
+    observed variance ``var_true + sd^2``. ``sd_out`` is the rebound's own
+    ``(n, 3)`` SD after the correction for the shared error.
+    """
+
+    lam: np.ndarray
+    sd_in: np.ndarray
+    cov: np.ndarray
+    var_obs: np.ndarray
+    sd_out: np.ndarray
+
+    def effective_sd(self, inputs: ImpactInputs, predict) -> np.ndarray:
+        """``(n, 3)`` effective SD of each residual, the derivatives of
+        ``predict(inputs) -> (n, 3)`` taken by central differences."""
+        var = self.sd_out**2
+        for j, (fname, _, _, out, _) in enumerate(INPUT_ERRORS):
+            if not np.any(self.sd_in[:, j] > 0):
+                continue
+            x = getattr(inputs, fname)
+            h = 1e-4 * np.maximum(1.0, np.abs(x))
+            up = predict(replace(inputs, **{fname: x + h}))
+            down = predict(replace(inputs, **{fname: x - h}))
+            slope = (up - down) / (2 * h)[:, None]
+            slope[~np.isfinite(slope)] = 0.0
+            var = var + slope**2 * (self.lam[:, j] * self.sd_in[:, j] ** 2)[:, None]
+            if out is not None:
+                var[:, out] -= 2 * slope[:, out] * self.lam[:, j] * self.cov[:, j]
+        return np.sqrt(np.maximum(var, 0.0))
 
 
 @dataclass
@@ -218,6 +304,27 @@ class ImpactProblem:
     materials: list[str]
     rows: np.ndarray  # the table row (0-based) of each problem row
     notes: list[str] = field(default_factory=list)
+    errors: InputErrors | None = None  # inputs measured with error (calibrated)
+
+    def reweighted(
+        self,
+        model: Model,
+        names: list[str] | None = None,
+        theta: np.ndarray | None = None,
+    ) -> ImpactProblem:
+        """This problem with the effective variances' derivatives taken at
+        ``model`` with ``names`` set to ``theta`` (itself when its inputs are
+        exact)."""
+        if self.errors is None:
+            return self
+        e_n, e_t, effects = self.unpack(
+            model, names or [], np.zeros(0) if theta is None else theta
+        )
+        sd = self.errors.effective_sd(
+            self.inputs, lambda i: predict_arrays(i, e_n, e_t, effects)
+        )
+        sd = np.where(np.isfinite(self.sd), sd, np.nan)
+        return replace(self, sd=sd, use=self.use & (sd > 0))
 
     def unpack(
         self, model: Model, names: list[str], theta: np.ndarray
@@ -369,6 +476,88 @@ class _NoFit:
     message: str = "no free parameters"
 
 
+def errors_in_variables(
+    table: ImpactTable, inputs: ImpactInputs, observed: np.ndarray, sd: np.ndarray
+) -> tuple[ImpactInputs, np.ndarray, InputErrors, str]:
+    """Regression calibration of the inputs measured with error (module docstring).
+
+    Returns the calibrated inputs, the observed rebounds corrected for the error
+    they share with their inputs, the :class:`InputErrors` the effective variance
+    needs and a note saying what was done.
+    """
+    n = len(table)
+    labels = table.frame["material"].astype("string").to_numpy(str)
+    lam, sd_in = np.ones((n, 3)), np.zeros((n, 3))
+    cov, var_obs = np.zeros((n, 3)), np.ones((n, 3))
+    observed, sd_out = observed.copy(), sd.copy()
+    calibrated, floored, shared = {}, [], []
+    for j, (fname, column, sd_column, out, corr_column) in enumerate(INPUT_ERRORS):
+        if sd_column not in table.frame:
+            continue
+        x = getattr(inputs, fname)
+        s = np.nan_to_num(np.abs(table.column(sd_column)), nan=0.0, posinf=0.0)
+        if not np.any(s > 0):
+            continue
+        x_cal = x.copy()
+        mu_row = np.zeros(n)
+        for m in np.unique(labels):
+            rows = labels == m
+            v = np.var(x[rows]) if rows.sum() > 1 else 0.0
+            var_true = v - float(np.mean(s[rows] ** 2))
+            if var_true < CALIBRATION_FLOOR * v:
+                var_true = CALIBRATION_FLOOR * v
+                floored.append(f"{column} on {m}")
+            mu = float(np.mean(x[rows]))
+            mu_row[rows] = mu
+            var_obs[rows, j] = var_true + s[rows] ** 2
+            with np.errstate(divide="ignore", invalid="ignore"):
+                lam[rows, j] = np.where(
+                    var_obs[rows, j] > 0, var_true / var_obs[rows, j], 1.0
+                )
+            x_cal[rows] = mu + lam[rows, j] * (x[rows] - mu)
+        sd_in[:, j] = s
+        calibrated[fname] = x_cal
+        if out is not None and corr_column in table.frame:
+            r = np.nan_to_num(table.column(corr_column), nan=0.0)
+            c = np.clip(r, -1.0, 1.0) * s * np.nan_to_num(sd[:, out], nan=0.0)
+            cov[:, j] = c
+            with np.errstate(divide="ignore", invalid="ignore"):
+                k = np.where(var_obs[:, j] > 0, c / var_obs[:, j], 0.0)
+            observed[:, out] = observed[:, out] - k * (x - mu_row)
+            sd_out[:, out] = np.sqrt(np.maximum(sd[:, out] ** 2 - k * c, 0.0))
+            if np.any(c != 0):
+                shared.append(f"{('vfn', 'vft')[out]} by {corr_column}")
+    inputs = replace(inputs, **calibrated)
+    errors = InputErrors(lam=lam, sd_in=sd_in, cov=cov, var_obs=var_obs, sd_out=sd_out)
+    names = ", ".join(INPUT_ERRORS[j][1] for j in range(3) if np.any(sd_in[:, j] > 0))
+    note = (
+        f"errors in variables: the impact's {names} carry error (their *_sd "
+        "columns); each replaced by its regression calibration mu + lambda "
+        "(v_obs - mu), lambda = var_true / (var_true + sd^2), mu and var_true = "
+        "var(v_obs) - mean(sd^2) by the method of moments per material"
+        + (
+            f" (var_true floored at {CALIBRATION_FLOOR:g} var(v_obs) for "
+            + ", ".join(floored)
+            + ": the observed spread is mostly error)"
+            if floored
+            else ""
+        )
+        + "; "
+        + (
+            "rebound corrected for the error it shares with its input ("
+            + ", ".join(shared)
+            + "); "
+            if shared
+            else "no error shared between impact and rebound (no "
+            "vin_vfn_corr, vit_vft_corr); "
+        )
+        + "weights by effective variance (Orear 1982): the rebound's variance plus "
+        "the calibrated input's remaining error lambda sd^2 carried through the "
+        "model's local derivative"
+    )
+    return inputs, observed, errors, note
+
+
 def impact_problem(table: ImpactTable, model: Model) -> ImpactProblem:
     """Check ``table`` against ``model`` and gather the arrays of a fit.
 
@@ -400,7 +589,21 @@ def impact_problem(table: ImpactTable, model: Model) -> ImpactProblem:
             table.column("omega_f_radps"),
         ]
     )
-    return ImpactProblem(
+    errors = None
+    if _has_input_errors(table):
+        if weighting.startswith("1/sd from"):
+            inputs, observed, errors, text = errors_in_variables(
+                table, inputs, observed, sd
+            )
+            notes.append(text)
+            weighting += " and, by effective variance, vin_sd_mps, vit_sd_mps"
+        else:
+            notes.append(
+                "the impact velocities carry error (vin_sd_mps, vit_sd_mps) but the "
+                "rebound's own SDs (vfn_sd_mps, vft_sd_mps) are not given: the "
+                "impact velocities are taken as exact inputs"
+            )
+    problem = ImpactProblem(
         table=table,
         model=model,
         inputs=inputs,
@@ -411,7 +614,20 @@ def impact_problem(table: ImpactTable, model: Model) -> ImpactProblem:
         materials=used,
         rows=np.flatnonzero(~skip),
         notes=notes,
+        errors=errors,
     )
+    if errors is None:
+        return problem
+    problem = problem.reweighted(model)
+    bad = ~((problem.sd[:, :2] > 0).all(axis=1))
+    if bad.any():
+        raise InputFileError(
+            "standard uncertainty is not a positive number (rebound and impact "
+            "both exact)",
+            source=table.source,
+            where=_rows(bad),
+        )
+    return problem
 
 
 def too_few(problem: ImpactProblem, names: list[str], rows=None) -> str | None:
@@ -534,6 +750,10 @@ def fit_impacts(table: ImpactTable, model: Model) -> tuple[FitResult, Model]:
         raise InputFileError(why, source=table.source)
     start, start_notes = problem.start(model, names)
     fit = problem.solve(model, names, start=start)
+    if problem.errors is not None:
+        # the effective variances' derivatives once more, at the fitted values
+        problem = problem.reweighted(model, names, fit.x)
+        fit = problem.solve(model, names, start=np.asarray(fit.x, float))
     result = fit_result(problem, names, start, fit, problem.notes + notes + start_notes)
     calibrated = model.with_parameters(dict(zip(names, map(float, fit.x), strict=True)))
     return result, replace(calibrated, provenance=dict(model.provenance))
