@@ -23,22 +23,27 @@ impact velocity is a measurement too, and taking it as exact flattens the reboun
 against it (regression dilution). Two corrections, both stated in the notes:
 
 * **regression calibration** (Carroll et al. 2006, *Measurement Error in Nonlinear
-  Models*, ch. 4): each input ``vin``, ``vit`` (and ``omega_i`` with
-  ``omega_i_sd_radps``) is replaced by its best estimate given the observation,
-  ``E[v | v_obs] = mu + lambda (v_obs - mu)``, ``lambda = var_true / (var_true +
-  sd^2)`` per row, with ``mu`` and ``var_true = var(v_obs) - mean(sd^2)`` (floored
-  at :data:`CALIBRATION_FLOOR` ``var(v_obs)``) by the method of moments per
-  material. Where ``vin_vfn_corr`` (``vit_vft_corr``) says the rebound's error
-  shares the impact's (an arrival and a rebound computed from the same surveyed
+  Models*, ch. 4): the inputs ``vin``, ``vit``, ``omega_i`` (with
+  ``omega_i_sd_radps``) are replaced by their best estimate given the observation,
+  ``E[v | v_obs] = mu + K (v_obs - mu)``, ``K = Sigma_true (Sigma_true + D)^-1``
+  per row (one input alone: ``lambda = var_true / (var_true + sd^2)``), ``D`` the
+  row's error variances, ``mu`` and ``Sigma_true = cov(v_obs) - mean(D)`` by the
+  method of moments per material (eigenvalues floored at
+  :data:`CALIBRATION_FLOOR` of the observed variance). Jointly, because an
+  impact's spin and tangential speed are nearly tied (rolling) and calibrating
+  each alone would break the tie. Where ``vin_vfn_corr`` (``vit_vft_corr``)
+  says the rebound's error shares the impact's (an arrival and a rebound
+  computed from the same surveyed
   point), the rebound is corrected by the part of its error the input's error
   predicts, ``c / var_obs (v_obs - mu)`` with ``c = corr sd_in sd_out``;
 * **effective variance** (Orear 1982, Am. J. Phys. 50, 912): each residual's
-  variance is ``sd_out^2 - c^2 / var_obs + sum (df/dv)^2 lambda sd^2 - 2 (df/dv)
-  lambda c``, the rebound's own error plus the calibrated input's remaining error
-  carried through the model's local derivative ``df/dv`` (central differences of
-  the prediction at the model's values, recomputed once at the fitted values by
-  :func:`fit_impacts`). With ``lambda = 1`` and no calibration this is Orear's
-  ``sd_out^2 + (df/dv)^2 sd_in^2 - 2 (df/dv) cov``.
+  variance is ``sd_out^2 - c' V^-1 c + g' P g - 2 g' K c``: the rebound's own
+  error (less the part the correction removed) plus the calibrated inputs'
+  remaining error ``P = (I - K) Sigma_true`` carried through the model's local
+  gradient ``g = df/dv`` (central differences of the prediction at the model's
+  values, recomputed once at the fitted values by :func:`fit_impacts`), less
+  their shared part. One input with ``K = 1`` (no calibration): Orear's
+  ``sd_out^2 + g^2 sd_in^2 - 2 g cov``.
 
 Without ``vin_sd_mps``/``vit_sd_mps`` nothing of this applies and the impact
 velocities are exact inputs.
@@ -251,36 +256,36 @@ def _has_input_errors(table: ImpactTable) -> bool:
 class InputErrors:
     """The regression calibration of a problem's inputs (see the module docstring).
 
-    Arrays are ``(n, 3)`` over the inputs ``vin``, ``vit``, ``omega_i``
-    (:data:`INPUT_ERRORS`): ``lam`` the calibration's ``lambda`` (1 for an exact
-    input), ``sd_in`` the input's SD (0 when exact), ``cov`` the covariance ``c`` of
-    its error with its paired rebound's (0 when none), ``var_obs`` the row's
-    observed variance ``var_true + sd^2``. ``sd_out`` is the rebound's own
-    ``(n, 3)`` SD after the correction for the shared error.
+    Over the inputs ``vin``, ``vit``, ``omega_i`` (:data:`INPUT_ERRORS`), per row:
+    ``remaining`` ``(n, 3, 3)`` the calibrated inputs' error covariance
+    ``P = (I - K) Sigma_true``; ``gain_cov`` ``(n, 3, 3)`` column ``k`` is ``K c_k``,
+    ``c_k`` the covariances of the inputs' errors with rebound ``k``'s (zero when
+    none). ``sd_out`` ``(n, 3)`` is the rebound's own SD after the correction for
+    the shared error.
     """
 
-    lam: np.ndarray
-    sd_in: np.ndarray
-    cov: np.ndarray
-    var_obs: np.ndarray
+    remaining: np.ndarray
+    gain_cov: np.ndarray
     sd_out: np.ndarray
 
     def effective_sd(self, inputs: ImpactInputs, predict) -> np.ndarray:
-        """``(n, 3)`` effective SD of each residual, the derivatives of
-        ``predict(inputs) -> (n, 3)`` taken by central differences."""
-        var = self.sd_out**2
-        for j, (fname, _, _, out, _) in enumerate(INPUT_ERRORS):
-            if not np.any(self.sd_in[:, j] > 0):
+        """``(n, 3)`` effective SD of each residual: ``sd_out^2 + g' P g - 2 g' K c``
+        with ``g`` the gradient of ``predict(inputs) -> (n, 3)`` over the inputs
+        (central differences)."""
+        n = self.sd_out.shape[0]
+        grad = np.zeros((n, 3, 3))  # [row, input, output]
+        for j, (fname, *_) in enumerate(INPUT_ERRORS):
+            if not np.any(self.remaining[:, j, j] > 0):
                 continue
             x = getattr(inputs, fname)
             h = 1e-4 * np.maximum(1.0, np.abs(x))
             up = predict(replace(inputs, **{fname: x + h}))
             down = predict(replace(inputs, **{fname: x - h}))
-            slope = (up - down) / (2 * h)[:, None]
-            slope[~np.isfinite(slope)] = 0.0
-            var = var + slope**2 * (self.lam[:, j] * self.sd_in[:, j] ** 2)[:, None]
-            if out is not None:
-                var[:, out] -= 2 * slope[:, out] * self.lam[:, j] * self.cov[:, j]
+            grad[:, j, :] = (up - down) / (2 * h)[:, None]
+        grad[~np.isfinite(grad)] = 0.0
+        spread = np.einsum("rjk,rjl,rlk->rk", grad, self.remaining, grad)
+        shared = np.einsum("rjk,rjk->rk", grad, self.gain_cov)
+        var = self.sd_out**2 + spread - 2 * shared
         return np.sqrt(np.maximum(var, 0.0))
 
 
@@ -476,69 +481,86 @@ class _NoFit:
     message: str = "no free parameters"
 
 
+def _true_covariance(x: np.ndarray, error_var: np.ndarray) -> tuple[np.ndarray, bool]:
+    """Method-of-moments covariance of the true inputs of one material,
+    ``cov(x_obs) - diag(mean sd^2)``, its correlation-scaled eigenvalues floored
+    at :data:`CALIBRATION_FLOOR`; ``(Sigma_true, floored)``."""
+    s_obs = np.atleast_2d(np.cov(x, rowvar=False)) if len(x) > 1 else np.zeros((3, 3))
+    scale = np.sqrt(np.diag(s_obs))
+    scale = np.where(scale > 0, scale, 1.0)
+    r = (s_obs - np.diag(error_var.mean(axis=0))) / np.outer(scale, scale)
+    values, vectors = np.linalg.eigh((r + r.T) / 2)
+    floored = bool(np.any(values < CALIBRATION_FLOOR))
+    r = (vectors * np.maximum(values, CALIBRATION_FLOOR)) @ vectors.T
+    return r * np.outer(scale, scale), floored
+
+
 def errors_in_variables(
     table: ImpactTable, inputs: ImpactInputs, observed: np.ndarray, sd: np.ndarray
 ) -> tuple[ImpactInputs, np.ndarray, InputErrors, str]:
     """Regression calibration of the inputs measured with error (module docstring).
 
-    Returns the calibrated inputs, the observed rebounds corrected for the error
-    they share with their inputs, the :class:`InputErrors` the effective variance
-    needs and a note saying what was done.
+    The three inputs ``vin``, ``vit``, ``omega_i`` are calibrated jointly (an
+    impact's spin and tangential speed are strongly related, and calibrating each
+    alone would break the relation): per material ``mu`` and ``Sigma_true`` by the
+    method of moments, per row ``K = Sigma_true (Sigma_true + D)^-1`` with ``D``
+    the row's error covariance (diagonal: the *_sd columns; zero for an input
+    given exactly), ``x_cal = mu + K (x_obs - mu)``. Returns the calibrated inputs,
+    the observed rebounds corrected for the error they share with their inputs,
+    the :class:`InputErrors` the effective variance needs and a note saying what
+    was done.
     """
     n = len(table)
     labels = table.frame["material"].astype("string").to_numpy(str)
-    lam, sd_in = np.ones((n, 3)), np.zeros((n, 3))
-    cov, var_obs = np.zeros((n, 3)), np.ones((n, 3))
-    observed, sd_out = observed.copy(), sd.copy()
-    calibrated, floored, shared = {}, [], []
-    for j, (fname, column, sd_column, out, corr_column) in enumerate(INPUT_ERRORS):
-        if sd_column not in table.frame:
-            continue
-        x = getattr(inputs, fname)
-        s = np.nan_to_num(np.abs(table.column(sd_column)), nan=0.0, posinf=0.0)
-        if not np.any(s > 0):
-            continue
-        x_cal = x.copy()
-        mu_row = np.zeros(n)
-        for m in np.unique(labels):
-            rows = labels == m
-            v = np.var(x[rows]) if rows.sum() > 1 else 0.0
-            var_true = v - float(np.mean(s[rows] ** 2))
-            if var_true < CALIBRATION_FLOOR * v:
-                var_true = CALIBRATION_FLOOR * v
-                floored.append(f"{column} on {m}")
-            mu = float(np.mean(x[rows]))
-            mu_row[rows] = mu
-            var_obs[rows, j] = var_true + s[rows] ** 2
-            with np.errstate(divide="ignore", invalid="ignore"):
-                lam[rows, j] = np.where(
-                    var_obs[rows, j] > 0, var_true / var_obs[rows, j], 1.0
-                )
-            x_cal[rows] = mu + lam[rows, j] * (x[rows] - mu)
-        sd_in[:, j] = s
-        calibrated[fname] = x_cal
+    x = np.column_stack([getattr(inputs, f[0]) for f in INPUT_ERRORS])
+    err = np.zeros((n, 3))
+    for j, (_, _, sd_column, _, _) in enumerate(INPUT_ERRORS):
+        if sd_column in table.frame:
+            err[:, j] = np.nan_to_num(np.abs(table.column(sd_column)), nan=0.0)
+    cov = np.zeros((n, 3, 3))  # [row, input, output]: cov of the errors
+    shared = []
+    for j, (*_, out, corr_column) in enumerate(INPUT_ERRORS):
         if out is not None and corr_column in table.frame:
-            r = np.nan_to_num(table.column(corr_column), nan=0.0)
-            c = np.clip(r, -1.0, 1.0) * s * np.nan_to_num(sd[:, out], nan=0.0)
-            cov[:, j] = c
-            with np.errstate(divide="ignore", invalid="ignore"):
-                k = np.where(var_obs[:, j] > 0, c / var_obs[:, j], 0.0)
-            observed[:, out] = observed[:, out] - k * (x - mu_row)
-            sd_out[:, out] = np.sqrt(np.maximum(sd[:, out] ** 2 - k * c, 0.0))
-            if np.any(c != 0):
+            r = np.clip(np.nan_to_num(table.column(corr_column), nan=0.0), -1, 1)
+            cov[:, j, out] = r * err[:, j] * np.nan_to_num(sd[:, out], nan=0.0)
+            if np.any(cov[:, j, out] != 0):
                 shared.append(f"{('vfn', 'vft')[out]} by {corr_column}")
-    inputs = replace(inputs, **calibrated)
-    errors = InputErrors(lam=lam, sd_in=sd_in, cov=cov, var_obs=var_obs, sd_out=sd_out)
-    names = ", ".join(INPUT_ERRORS[j][1] for j in range(3) if np.any(sd_in[:, j] > 0))
+    x_cal = x.copy()
+    remaining = np.zeros((n, 3, 3))
+    gain_cov = np.zeros((n, 3, 3))
+    observed, sd_out = observed.copy(), sd.copy()
+    floored = []
+    for m in np.unique(labels):
+        rows = labels == m
+        sigma, low = _true_covariance(x[rows], err[rows] ** 2)
+        if low:
+            floored.append(m)
+        mu = x[rows].mean(axis=0)
+        v = sigma[None] + np.einsum("rj,jk->rjk", err[rows] ** 2, np.eye(3))
+        v_inv = np.linalg.inv(v)
+        k = sigma[None] @ v_inv
+        d = x[rows] - mu
+        x_cal[rows] = mu + np.einsum("rjk,rk->rj", k, d)
+        remaining[rows] = sigma[None] - k @ sigma[None]
+        c = cov[rows]
+        gain_cov[rows] = k @ c
+        # E[rebound error | x_obs] = c' V^-1 (x_obs - mu), its variance c' V^-1 c
+        a = np.einsum("rjk,rjl->rkl", c, v_inv)  # [row, output, input]
+        observed[rows] -= np.einsum("rkl,rl->rk", a, d)
+        explained = np.einsum("rkl,rlk->rk", a, c)
+        sd_out[rows] = np.sqrt(np.maximum(sd[rows] ** 2 - explained, 0.0))
+    inputs = replace(inputs, **{f[0]: x_cal[:, j] for j, f in enumerate(INPUT_ERRORS)})
+    errors = InputErrors(remaining=remaining, gain_cov=gain_cov, sd_out=sd_out)
+    names = ", ".join(INPUT_ERRORS[j][1] for j in range(3) if np.any(err[:, j] > 0))
     note = (
         f"errors in variables: the impact's {names} carry error (their *_sd "
-        "columns); each replaced by its regression calibration mu + lambda "
-        "(v_obs - mu), lambda = var_true / (var_true + sd^2), mu and var_true = "
-        "var(v_obs) - mean(sd^2) by the method of moments per material"
+        "columns); vin, vit, omega_i replaced jointly by their regression "
+        "calibration mu + K (v_obs - mu), K = Sigma_true (Sigma_true + D)^-1, D the "
+        "impact's error variances, mu and Sigma_true = cov(v_obs) - mean(D) by the "
+        "method of moments per material"
         + (
-            f" (var_true floored at {CALIBRATION_FLOOR:g} var(v_obs) for "
-            + ", ".join(floored)
-            + ": the observed spread is mostly error)"
+            f" (eigenvalues floored at {CALIBRATION_FLOOR:g} of the observed "
+            f"variance for {', '.join(floored)}: its observed spread is mostly error)"
             if floored
             else ""
         )
@@ -552,8 +574,8 @@ def errors_in_variables(
             "vin_vfn_corr, vit_vft_corr); "
         )
         + "weights by effective variance (Orear 1982): the rebound's variance plus "
-        "the calibrated input's remaining error lambda sd^2 carried through the "
-        "model's local derivative"
+        "the calibrated inputs' remaining error carried through the model's local "
+        "derivatives"
     )
     return inputs, observed, errors, note
 
