@@ -510,10 +510,10 @@ def errors_in_variables(
     alone would break the relation): per material ``mu`` and ``Sigma_true`` by the
     method of moments, ``K = Sigma_true (Sigma_true + D)^-1`` with ``D`` the
     material's mean error covariance (diagonal: the *_sd columns squared; zero for
-    an input given exactly), ``x_cal = mu + K (x_obs - mu)``. Returns the calibrated inputs,
-    the observed rebounds corrected for the error they share with their inputs,
-    the :class:`InputErrors` the effective variance needs and a note saying what
-    was done.
+    an input given exactly), ``x_cal = mu + K (x_obs - mu)``. Returns the
+    calibrated inputs, the observed rebounds corrected for the error they share
+    with their inputs, the :class:`InputErrors` the effective variance needs and a
+    note saying what was done.
     """
     n = len(table)
     labels = table.frame["material"].astype("string").to_numpy(str)
