@@ -641,7 +641,10 @@ def impact_problem(table: ImpactTable, model: Model) -> ImpactProblem:
                 table, inputs, observed, sd
             )
             notes.append(text)
-            weighting += " and, by effective variance, vin_sd_mps, vit_sd_mps"
+            weighting += " and, by effective variance (errors in variables), " + (
+                ", ".join(c for c in ("vin_sd_mps", "vit_sd_mps", "omega_i_sd_radps")
+                          if c in table.frame)
+            )  # fmt: skip
         else:
             notes.append(
                 "the impact velocities carry error (vin_sd_mps, vit_sd_mps) but the "
