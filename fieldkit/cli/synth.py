@@ -221,7 +221,12 @@ def synth(
           --track --fps 200 --noise-m 0.005 --flights 8 --seed 1 \\
           --effects air_drag=cd=0.8 -o out/track.csv
     """
-    from fieldkit.fit.synthetic import check_paths, synthetic_table, with_effects
+    from fieldkit.fit.synthetic import (
+        check_noise,
+        check_paths,
+        synthetic_table,
+        with_effects,
+    )
     from fieldkit.model.model_file import read_model
 
     hidden = parse_effects(effects or [])
@@ -239,6 +244,7 @@ def synth(
         )
         return
     check_paths(paths)
+    check_noise(noise, impact_noise)
     with OutputSet(inputs=[model_file]) as outputs:
         outputs.plan(output, argument="-o")
         # the hidden effects are checked before any work

@@ -76,6 +76,16 @@ def check_paths(paths: int) -> None:
         )
 
 
+def check_noise(noise_fraction: float, impact_noise_fraction: float = 0.0) -> None:
+    """Refuse a relative noise outside [0, 1] (named by its argument)."""
+    for name, value in (
+        ("noise_fraction", noise_fraction),
+        ("impact_noise_fraction", impact_noise_fraction),
+    ):
+        if not (np.isfinite(value) and 0.0 <= value <= 1.0):
+            raise ArgumentError(f"{name} must be in [0, 1] (got {value})", source=name)
+
+
 def synthetic_table(
     model: Model,
     *,
@@ -98,12 +108,7 @@ def synthetic_table(
     >>> t.paths()
     ['0', '1', '2']
     """
-    for name, value in (
-        ("noise_fraction", noise_fraction),
-        ("impact_noise_fraction", impact_noise_fraction),
-    ):
-        if not (np.isfinite(value) and 0.0 <= value <= 1.0):
-            raise ArgumentError(f"{name} must be in [0, 1] (got {value})", source=name)
+    check_noise(noise_fraction, impact_noise_fraction)
     check_paths(paths)
     hidden = with_effects(model, effects)
     table = simulate(hidden, int(paths), rng, record_impacts=True).impact_table
