@@ -186,8 +186,9 @@ def error_draws(red: Reduced, draws: int, rng: np.random.Generator) -> np.ndarra
 
     Each draw moves every point by N(0, sigma) in x and z and every tree-strike
     height by N(0, sigma_h) (the reduction's own error model), re-solves all flights
-    and returns the change from the surveyed values; draws with no ballistic solution
-    are left out (as in the reduction's ``*_sd``). Shape ``(used draws, n, 4)``.
+    and returns the change from the surveyed values; draws in which a flight of the
+    table's impacts has no ballistic solution are left out. Shape
+    ``(used draws, n, 4)``.
     """
     err = red.options.position_error
     frame = red.survey.points.frame.reset_index(drop=True)
@@ -212,7 +213,10 @@ def error_draws(red: Reduced, draws: int, rng: np.random.Generator) -> np.ndarra
             moved = point_kinematics(red.survey, red.options, x + dx, z + dz, dh)
         except FieldkitError:
             continue
-        out.append(np.column_stack([moved[c] for c in LOCAL])[red.rows] - base)
+        delta = np.column_stack([moved[c] for c in LOCAL])[red.rows] - base
+        if not np.isfinite(delta).all():  # a flight of the table unsolved here
+            continue
+        out.append(delta)
     return np.array(out).reshape(-1, len(red.rows), 4)
 
 

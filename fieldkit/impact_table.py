@@ -149,6 +149,37 @@ EXTENSION_COLUMNS: tuple[Column, ...] = (
     Column(
         "theta_i_sd_deg", "float", False, "standard uncertainty of theta_i_deg [deg]"
     ),
+    Column(
+        "flight_unsolved",
+        "str",
+        False,
+        "why the flight leaving this point has no ballistic solution (NA: solved or "
+        "no flight); then vf here and vi at the next point are unknown",
+    ),
+    Column(
+        "x_sd_m", "float", False, "standard uncertainty of x_m the reduction used [m]"
+    ),
+    Column(
+        "z_sd_m", "float", False, "standard uncertainty of z_m the reduction used [m]"
+    ),
+    Column(
+        "strike_height_sd_m",
+        "float",
+        False,
+        "standard uncertainty of a tree-strike height the reduction used [m]",
+    ),
+    Column(
+        "vin_vfn_corr",
+        "float",
+        False,
+        "correlation of the errors of vin_mps and vfn_mps (one surveyed point) [-]",
+    ),
+    Column(
+        "vit_vft_corr",
+        "float",
+        False,
+        "correlation of the errors of vit_mps and vft_mps (one surveyed point) [-]",
+    ),
 )
 
 #: Value column -> its standard-uncertainty column (docs/architecture.md §3
@@ -166,6 +197,23 @@ SD_COLUMNS: dict[str, str] = {
     "theta_i_deg": "theta_i_sd_deg",
 }
 
+#: Pairs of values whose errors are correlated -> their correlation column
+#: (``<a>_<b>_corr``, units dropped): an impact's arrival and rebound velocities
+#: share the surveyed point between the two flights, so a reduction's Monte Carlo
+#: gives each row the correlation coefficient of their errors over the draws.
+CORR_COLUMNS: dict[tuple[str, str], str] = {
+    ("vin_mps", "vfn_mps"): "vin_vfn_corr",
+    ("vit_mps", "vft_mps"): "vit_vft_corr",
+}
+
+#: The measurement error model a reduction used, on every row: surveyed quantity ->
+#: its standard-uncertainty column (``strike_height_sd_m`` only with a tree file).
+ERROR_MODEL_COLUMNS: dict[str, str] = {
+    "x_m": "x_sd_m",
+    "z_m": "z_sd_m",
+    "strike_height_m": "strike_height_sd_m",
+}
+
 COLUMNS_BY_NAME: dict[str, Column] = {
     c.name: c for c in CONTRACT_COLUMNS + EXTENSION_COLUMNS
 }
@@ -175,6 +223,18 @@ REQUIRED_COLUMNS: tuple[str, ...] = tuple(
 THETA0_SOURCES: frozenset[str] = frozenset({"tree", "assumed", "video", "given"})
 #: Key of the frame's attrs holding the columns the table's source had.
 _GIVEN = "fieldkit_given_columns"
+
+
+class _ColumnNames(tuple):
+    """The given column names kept in a frame's attrs. pandas deep-copies attrs at
+    every operation (each column read); names are immutable, so the copy is the
+    object itself (a tuple of 60 names was copied a million times per reduction's
+    Monte Carlo)."""
+
+    __slots__ = ()
+
+    def __deepcopy__(self, memo: dict) -> _ColumnNames:
+        return self
 
 FORMATS: dict[str, str] = {".csv": "csv", ".parquet": "parquet", ".xlsx": "xlsx"}
 
@@ -233,7 +293,8 @@ MAX_PLAUSIBLE_FLIGHT_HEIGHT_M = 10.0
 #: with the body options (``--mass``, ``--radius``, ``--gyration``: 1 g to 10,000 t,
 #: 1 mm to 10 m; speeds within 100 m/s: free fall from 500 m reaches 99 m/s);
 #: coordinates within the 10,000 km of a plan coordinate and the 11,000 m of an
-#: elevation on Earth the point readers use.
+#: elevation on Earth the point readers use; error correlations within [-1, 1] and
+#: the error model's standard uncertainties not negative.
 READ_BOUNDS: dict[str, tuple[float, float, str, str]] = {
     "x_m": (-1.0e7, 1.0e7, "m", "a distance along a fall path"),
     "z_m": (-11_000.0, 11_000.0, "m", "an elevation on Earth"),
@@ -243,6 +304,14 @@ READ_BOUNDS: dict[str, tuple[float, float, str, str]] = {
     **{
         name: (-MAX_SPEED_MPS, MAX_SPEED_MPS, "m/s", "a rockfall velocity")
         for name in ("vi_x_mps", "vi_z_mps", "vf_x_mps", "vf_z_mps")
+    },
+    **{
+        name: (-1.0, 1.0, "", "a correlation coefficient")
+        for name in CORR_COLUMNS.values()
+    },
+    **{
+        name: (0.0, 1.0e7, "m", "a standard uncertainty of a position")
+        for name in ERROR_MODEL_COLUMNS.values()
     },
 }
 #: Measured columns without a bound of their own that must still be finite when
@@ -288,7 +357,8 @@ def check_read_values(frame: pd.DataFrame, source: str | None) -> None:
             i = int(np.flatnonzero(bad)[0])
             consider(
                 bad,
-                f"column {name}: {v[i]:g} is outside [{low:g}, {high:g}] {unit}: "
+                f"column {name}: {v[i]:g} is outside [{low:g}, {high:g}]"
+                f"{' ' + unit if unit else ''}: "
                 f"not {what}",
             )
     for name in READ_FINITE:
@@ -329,11 +399,80 @@ def flight_sides(frame: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
     return known("vi_x_mps", "vi_z_mps"), known("vf_x_mps", "vf_z_mps")
 
 
-def path_point_kind(arrives: bool, leaves: bool) -> str:
-    """What a row without an impact is (:func:`flight_sides`), in words."""
+def unsolved_sides(frame: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
+    """``(arrives_unsolved, leaves_unsolved)`` per row: the flight arriving at the
+    row, resp. leaving it, is one the reduction could not solve (``flight_unsolved``
+    of the launch row; the arrival is the next row of the same path). All False
+    without a ``flight_unsolved`` column.
+
+    Examples
+    --------
+    >>> f = pd.DataFrame({"path_id": ["a"] * 3 + ["b"],
+    ...                   "flight_unsolved": [None, "point 3: ...", None, None]})
+    >>> [a.tolist() for a in unsolved_sides(f)]
+    [[False, False, True, False], [False, True, False, False]]
+    """
+    n = len(frame)
+    if "flight_unsolved" not in frame:
+        return np.zeros(n, bool), np.zeros(n, bool)
+    text = frame["flight_unsolved"].astype("string").str.strip()
+    leaves = (text.notna() & text.ne("")).to_numpy(dtype=bool, na_value=False)
+    arrives = np.zeros(n, bool)
+    arrives[1:] = leaves[:-1]
+    if "path_id" in frame:
+        path = frame["path_id"].astype("string").to_numpy(dtype=object)
+        arrives[1:] &= path[1:] == path[:-1]
+    return arrives, leaves
+
+
+def path_point_kind(
+    arrives: bool,
+    leaves: bool,
+    arrives_unsolved: bool = False,
+    leaves_unsolved: bool = False,
+) -> str:
+    """What a row without an impact is (:func:`flight_sides`,
+    :func:`unsolved_sides`), in words.
+
+    Examples
+    --------
+    >>> path_point_kind(False, True), path_point_kind(True, False)
+    ('a release point', 'a stop point')
+    >>> path_point_kind(False, True, arrives_unsolved=True)
+    'arrives by an unsolved flight'
+    >>> path_point_kind(True, False, leaves_unsolved=True)
+    'leaves on an unsolved flight'
+    """
+    unsolved = [
+        words
+        for flag, words in (
+            (arrives_unsolved, "arrives by an unsolved flight"),
+            (leaves_unsolved, "leaves on an unsolved flight"),
+        )
+        if flag
+    ]
+    if unsolved:
+        return " and ".join(unsolved)
     if not arrives and not leaves:
         return "a point with no flight on either side"
     return "a release point" if not arrives else "a stop point"
+
+
+def path_point_kinds(frame: pd.DataFrame) -> list[tuple[int, str]]:
+    """``(row, what)`` of every row that is not an impact (no arriving or no leaving
+    flight, or one of them unsolved), row 1-based, in words
+    (:func:`path_point_kind`)."""
+    arrives, leaves = flight_sides(frame)
+    arrives_unsolved, leaves_unsolved = unsolved_sides(frame)
+    return [
+        (
+            int(i) + 1,
+            path_point_kind(
+                arrives[i], leaves[i], arrives_unsolved[i], leaves_unsolved[i]
+            ),
+        )
+        for i in np.flatnonzero(~(arrives & leaves))
+    ]
 
 
 def quality_flags(frame: pd.DataFrame) -> pd.Series:
@@ -476,13 +615,16 @@ class ImpactTable:
         # the columns the source had, before the contract's are added as NaN (kept
         # in the frame's attrs, which copies and row selections carry along)
         given = out.attrs.get(_GIVEN, out.columns)
-        out.attrs[_GIVEN] = tuple(c for c in given if c in out.columns)
+        out.attrs[_GIVEN] = _ColumnNames(c for c in given if c in out.columns)
         for col in CONTRACT_COLUMNS:
             if col.name not in out.columns:
                 out[col.name] = pd.NA if col.kind in ("str", "bool") else np.nan
+        # a column already of its kind is left alone: a table built from another
+        # one (every stage does it) then costs no conversion
+        wanted = {"float": "float64", "str": "string", "bool": "boolean"}
         for name in out.columns:
             spec = COLUMNS_BY_NAME.get(name)
-            if spec is None:
+            if spec is None or str(out[name].dtype) == wanted.get(spec.kind):
                 continue
             if spec.kind == "float":
                 out[name] = self._as_float(out[name], name)

@@ -42,6 +42,7 @@ LAYERS: dict[str, int] = {
     "model": 4,
     "fit": 4,
     "diagnose": 4,
+    "campaign": 4,
     "export": 4,
     "viz": 5,
     "cli": 6,
@@ -56,6 +57,9 @@ STAGE_EDGES: frozenset[tuple[str, str]] = frozenset(
         ("fit", "model"),
         ("diagnose", "model"),
         ("diagnose", "fit"),
+        ("diagnose", "campaign"),
+        ("diagnose", "reduce"),
+        ("campaign", "model"),
         ("export", "model"),
         ("export", "fit"),
     }

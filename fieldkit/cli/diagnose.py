@@ -26,6 +26,11 @@ FLAGS = {
     "seed": "--seed",
     "material": "--material",
     "preset": "--preset",
+    "sensitivity": "--sensitivity",
+    "null": "--null",
+    "power": "--power",
+    "null_quantile": "--null-quantile",
+    "workers": "--workers",
 }
 #: Most characters of a CSV's first line read to tell a track from a table.
 MAX_HEADER_CHARS = 1 << 20
@@ -48,6 +53,7 @@ def _summary(diagnosis) -> list[str]:
     """What the command prints: the verdict in words, one line per candidate."""
     from fieldkit.diagnose import labels
     from fieldkit.diagnose.report import (
+        alternative_meaning,
         baseline_label,
         dependence_sentence,
         rankings,
@@ -88,6 +94,12 @@ def _summary(diagnosis) -> list[str]:
             )
     lines += [f"confounded: {a}" for a in d.advice]
     lines.append(f"recommended: {d.recommended or 'nothing'}; stopped: {d.stopped}")
+    if len(d.accepted) > 1:
+        lines.append(f"accepted: {', '.join(d.accepted)}")
+    meaning = alternative_meaning(d)
+    if meaning:
+        lines.append(meaning)
+    lines += [f"sensitivity: {v.sentence()}" for v in d.sensitivity]
     lines += [
         f"residuals still: {dependence_sentence(x)}"
         for x in sorted(d.dependence_after, key=lambda x: x.p_value)
@@ -113,6 +125,72 @@ def _step_once_checked(description: str) -> Iterator[Callable[[str], None]]:
         yield progress
 
 
+@contextlib.contextmanager
+def _bar_once_checked(description: str) -> Iterator[Callable[[int, int], None]]:
+    """:func:`_step_once_checked` with a bar: ``advance(done, total)`` starts the
+    step at its first call (after the table has passed every check)."""
+    with contextlib.ExitStack() as stack:
+        bar = None
+
+        def advance(done: int, total: int) -> None:
+            nonlocal bar
+            if bar is None:
+                bar = stack.enter_context(step(description, total=total))
+            bar(done, total)
+
+        yield advance
+
+
+def _sensitivity(
+    table, base, seed: int, folds: int, wanted: bool | None, floor: float | None = None
+) -> list:
+    """The verdict under each variant of the table (``wanted`` None: only for a
+    reduced survey), diagnosed with the same fold seed and folds, and with the
+    observed table's null threshold ``floor`` as the least gain when there is one."""
+    import numpy as np
+
+    from fieldkit.diagnose.impacts import diagnose_impacts
+    from fieldkit.diagnose.sensitivity import is_surveyed, sensitivity, variants
+
+    if wanted is False or (wanted is None and not is_surveyed(table)):
+        return []
+    names = variants(table)
+    if not names:
+        return []
+
+    def again(variant_table, variant_model):
+        return diagnose_impacts(
+            variant_table, variant_model, rng=np.random.default_rng(seed),
+            folds=folds, gain_floor=floor if floor is not None else 0.0,
+        )  # fmt: skip
+
+    with step(f"sensitivity of the verdict: diagnosing {', '.join(names)}"):
+        return sensitivity(table, base, again)
+
+
+def _read_tables(paths: list[Path]):
+    """The ImpactTables of ``paths`` as one (each path_id in one file only)."""
+    import pandas as pd
+
+    from fieldkit.impact_table import ImpactTable
+
+    tables = [ImpactTable.read(p) for p in paths]
+    if len(tables) == 1:
+        return tables[0]
+    seen: dict[str, Path] = {}
+    for path, table in zip(paths, tables, strict=True):
+        for pid in table.paths():
+            if pid in seen:
+                raise ArgumentError(
+                    f"path {pid!r} is in {seen[pid]} and in {path}: give each path "
+                    "once (reduce them with distinct --path-id)",
+                    source="input_files",
+                )
+            seen[pid] = path
+    frame = pd.concat([t.frame for t in tables], ignore_index=True)
+    return ImpactTable(frame, source=" + ".join(str(p) for p in paths))
+
+
 def _write_report(report_dir: Path, diagnosis, inputs, outputs: OutputSet) -> str:
     from fieldkit.diagnose.report import markdown
     from fieldkit.viz.diagnose_figure import write_diagnosis_figures
@@ -125,12 +203,13 @@ def _write_report(report_dir: Path, diagnosis, inputs, outputs: OutputSet) -> st
 
 @one_line_errors(flags=FLAGS)
 def diagnose(
-    input_file: Annotated[
-        Path,
+    input_files: Annotated[
+        list[Path],
         typer.Argument(
-            metavar="TABLE_OR_TRACK",
+            metavar="TABLE_OR_TRACK...",
             help="An ImpactTable (.csv, .parquet, .xlsx) or a track CSV "
-            "(t_s, x_m, z_m).",
+            "(t_s, x_m, z_m); several ImpactTables (e.g. one reduced path each) are "
+            "diagnosed together, each path_id once.",
         ),
     ],
     json_file: Annotated[
@@ -188,6 +267,46 @@ def diagnose(
     ] = None,  # fmt: skip
     material: MaterialOpt = None,
     preset: PresetOpt = None,
+    null: Annotated[
+        int | None,
+        typer.Option(
+            "--null",
+            help="Null campaigns simulated through the survey and the reduction "
+            "for a reduced survey (default 99; 0 = none, the plain rule only); "
+            "19 is the least for a 5 % test.",
+        ),
+    ] = None,
+    power: Annotated[
+        int,
+        typer.Option(
+            "--power",
+            help="Campaigns per candidate, simulated with it at its fitted size, "
+            "for the power this survey gives it (0 = none).",
+        ),
+    ] = 40,
+    null_quantile: Annotated[
+        float,
+        typer.Option(
+            "--null-quantile",
+            help="The quantile of the null gains a recommended gain must exceed.",
+        ),
+    ] = 0.95,
+    workers: Annotated[
+        int | None,
+        typer.Option(
+            "--workers",
+            help="Processes for the null and power campaigns (default: every core).",
+        ),
+    ] = None,
+    sensitivity: Annotated[
+        bool | None,
+        typer.Option(
+            "--sensitivity/--no-sensitivity",
+            help="Diagnose again with the assumed launch angles theta0 -10 and +10 "
+            "deg and with the materials grouped into one, and show each verdict "
+            "(default: on for a reduced survey, a table with assumed launch angles).",
+        ),
+    ] = None,
 ) -> None:
     """Compare model and measurements; rank the missing effects; add them stepwise.
 
@@ -228,13 +347,18 @@ def diagnose(
             f"seed must be between 0 and 2^64 - 1 (got {seed})", source="seed"
         )
     check_folds(folds)
-    check_readable(input_file)
+    from fieldkit.diagnose.survey_loop import check_loop_options
+
+    check_loop_options(null, power, null_quantile, workers)
+    for path in input_files:
+        check_readable(path)
+    input_file = input_files[0]
     if output is not None and model is None:
         raise ArgumentError(
             "-o needs --model (the base model supplies profile, body and seeder)",
             source="output",
         )
-    inputs = [input_file] + ([model] if model is not None else [])
+    inputs = [*input_files] + ([model] if model is not None else [])
     with OutputSet(inputs=[*inputs, preset]) as outputs:
         outputs.confine(report_dir)
         if json_file is not None:
@@ -250,11 +374,27 @@ def diagnose(
             note(f"`seed` not given: used {seed}; pass --seed {seed} to reproduce")
         rng = np.random.default_rng(seed)
         if _is_track(input_file):
+            if len(input_files) > 1:
+                raise ArgumentError(
+                    "a track is diagnosed on its own: give one track CSV",
+                    source="input_files",
+                )
+            if null or null_quantile != 0.95:
+                raise ArgumentError(
+                    "--null and --null-quantile apply to reduced surveys only",
+                    source="null",
+                )
             if model is not None or output is not None or material or preset:
                 raise ArgumentError(
                     "a track is diagnosed at flight level: --model, -o, --material "
                     "and --preset apply to ImpactTables only",
                     source="model",
+                )
+            if sensitivity:
+                raise ArgumentError(
+                    "--sensitivity applies to ImpactTables only (a track has no "
+                    "assumed launch angles or materials)",
+                    source="sensitivity",
                 )
             if radius is None:
                 raise ArgumentError("a track needs --radius (the body's radius, m)")
@@ -278,20 +418,60 @@ def diagnose(
                     "gives the body on every row)"
                 )
             from fieldkit.diagnose.impacts import diagnose_impacts, impact_count
-            from fieldkit.impact_table import ImpactTable
+            from fieldkit.diagnose.survey_loop import DEFAULT_NULL, diagnose_surveyed
             from fieldkit.model.model_file import read_model
 
             base = read_model(model, outputs=outputs) if model is not None else None
-            mapping = mapped_table(ImpactTable.read(input_file), base, material, preset)
+            from fieldkit.diagnose.sensitivity import is_surveyed
+
+            joined = _read_tables(input_files)
+            mapping = mapped_table(joined, base, material, preset)
             table = mapping.table
-            with _step_once_checked(
-                f"diagnosing {impact_count(table)}: scoring the baseline and each "
-                f"candidate effect by {folds}-fold cross-validation"
-            ) as progress:
-                diagnosis = diagnose_impacts(
-                    table, base, rng=rng, folds=folds, progress=progress
+            surveyed = is_surveyed(table)
+            size = (DEFAULT_NULL if surveyed else 0) if null is None else null
+            if size and not surveyed:
+                raise ArgumentError(
+                    "--null simulates campaigns through the survey and the "
+                    "reduction: it needs a reduced survey (a table with assumed "
+                    "launch angles, theta0_source 'assumed')",
+                    source="null",
+                )
+            floor = None
+            if size:
+                with _bar_once_checked(
+                    f"diagnosing {impact_count(table)} with its null and power: "
+                    f"{size} effect-free campaigns and {power} per candidate, each "
+                    "simulated, surveyed, reduced and diagnosed"
+                ) as advance:
+                    diagnosis = diagnose_surveyed(
+                        table, base, seed=seed, folds=folds, null_size=size,
+                        power_size=power, quantile=null_quantile, workers=workers,
+                        loop_progress=advance,
+                    )  # fmt: skip
+                floor = (diagnosis.null or {}).get("threshold")
+            else:
+                with _step_once_checked(
+                    f"diagnosing {impact_count(table)}: scoring the baseline and "
+                    f"each candidate effect by {folds}-fold cross-validation"
+                ) as progress:
+                    diagnosis = diagnose_impacts(
+                        table, base, rng=rng, folds=folds, progress=progress
+                    )
+            if surveyed and not size:
+                diagnosis.notes.append(
+                    "no null campaigns (--null 0): the verdict is the plain rule's, "
+                    "which on a reduced survey cannot tell physics from artefacts of "
+                    "the assumed launch angles and the survey error"
                 )
             diagnosis.notes.extend(mapping.notes)
+            diagnosis.sensitivity = _sensitivity(
+                table, base, seed, folds, sensitivity, floor
+            )
+            if sensitivity is None and not diagnosis.sensitivity:
+                diagnosis.notes.append(
+                    "sensitivity of the verdict not run: no launch angle of this "
+                    "table was assumed (--sensitivity runs it on any table)"
+                )
         diagnosis.notes.append(f"fold seed {seed}")
         if json_file is not None:
             write_json(json_file, diagnosis.to_json(), outputs)
@@ -318,7 +498,7 @@ def diagnose(
             provenance = {
                 **after.provenance,
                 "diagnose": {
-                    "table": str(input_file),
+                    "table": ", ".join(str(p) for p in input_files),
                     "material_map": mapping.provenance(),
                     "added": [s.added for s in diagnosis.steps],
                     "cv_rmse_mps": diagnosis.after.cv_rmse,

@@ -203,7 +203,14 @@ def reduce(
     vi_sd_mps, vf_sd_mps, vin/vit/vfn/vft_sd_mps, theta_i_sd_deg) propagated by
     Monte Carlo from --position-sigma (default 0.5 m in plan and in height per
     point) and --height-sigma (default 0.25 m per tree strike); the summary
-    states the model and how many e_n are known to better than 0.1.
+    states the model and how many e_n are known to better than 0.1. The table
+    records that model (x_sd_m, z_sd_m, strike_height_sd_m) and the correlation
+    of each impact's arrival and rebound errors (vin_vfn_corr, vit_vft_corr).
+
+    A flight no ballistic path makes (under --theta0 the next point lies above
+    the launch line; a tree strike no parabola reaches) is kept unsolved: its
+    reason in flight_unsolved, the velocities at its two ends NaN (not impacts
+    for fit and diagnose), a warning line, and the rest of the path reduced.
 
     Example (thesis Table 2-4, Tornado Mountain boulder A, whose preset holds
     --theta0 32.6 --mass 3750 --radius 0.725 --gyration 0.46 --path-id boulder_a;

@@ -14,21 +14,12 @@ from fieldkit.fit.impact_fit import ImpactProblem
 from fieldkit.model.effects import registry
 from fieldkit.model.model_file import Model
 
-#: Impact-level candidates, in registry order.
-IMPACT_CANDIDATES = (
-    "angle_dependent_restitution",
-    "velocity_scaled_restitution",
-    "rotation_friction",
-)
-#: Why the other effects are not candidates on an ImpactTable.
+#: Impact-level candidates, in registry order (effect metadata: every effect an
+#: ImpactTable can inform, the statistical alternative included).
+IMPACT_CANDIDATES = tuple(s.name for s in registry.EFFECTS if not s.not_from_impacts)
+#: Why the other effects are not candidates on an ImpactTable (effect metadata).
 NOT_FROM_IMPACTS = {
-    "slope_roughness": "a random local slope scatters rebounds without biasing "
-    "them: it shows as a reduced chi-square above 1, not as a held-out gain",
-    "mass_loss": "changes mass and size along the path, not the rebound "
-    "velocities an impact table measures",
-    "tree_impacts": "acts in flight; reduced impact velocities come from flights "
-    "assumed ballistic, so the table cannot show it",
-    "air_drag": "acts in flight; diagnose a video track (flight residuals) instead",
+    s.name: s.not_from_impacts for s in registry.EFFECTS if s.not_from_impacts
 }
 #: Least spread of a feature (degrees, m/s) for an effect reading it to be tested.
 MIN_SPREAD = {"theta_i_deg": 2.0, "vin_mps": 0.5}
@@ -108,6 +99,19 @@ def separating_measurement(first: str, second: str, problem: ImpactProblem) -> s
             "and an angle law and a speed law predict the same rebounds; impacts at "
             "similar angles over a wider range of speeds (drops from different "
             "heights, or a steeper and a gentler slope) would separate them"
+        )
+    alternatives = [n for n in (first, second) if not registry.effect(n).is_law]
+    if len(alternatives) == 1:
+        line = alternatives[0]
+        law = (pair - {line}).pop()
+        vin = np.abs(problem.inputs.vin_mps)
+        n_lo, n_hi = np.nanpercentile(vin, [5, 95])
+        return (
+            f"{law} and {line} (a straight line in the impact velocities, not a "
+            "law) cannot be told apart with these data: over the normal impact "
+            f"speeds measured ({n_lo:.1f}-{n_hi:.1f} m/s) the law is as good as a "
+            "straight line; impacts over a wider range of impact speeds and angles, "
+            "where the law curves and a line does not, would separate them"
         )
     if "rotation_friction" in pair:
         other = (pair - {"rotation_friction"}).pop()

@@ -141,12 +141,27 @@ class Diagnosis:
     #: impacts (of 50 rows; not impacts: row 1, a release point; ...)"); not in
     #: the JSON (empty: "``n_rows`` rows").
     size: str = ""
+    #: The null of a surveyed table (:mod:`fieldkit.diagnose.survey_loop`): size,
+    #: quantile, threshold, the null campaigns' gains; None when none was run.
+    null: dict | None = None
+    #: Per candidate, the share of campaigns with it switched on at its fitted size
+    #: in which the diagnosis finds it (None when no null was run).
+    power: dict | None = None
     #: Arrays for figures and recordings (not in the JSON): ``features``,
     #: ``baseline``/``after``/``steps`` held-out residuals, ``weight``, ``path_id``,
     #: ``dependence`` (tests of the baseline and of each step), ``after_model``,
     #: ``rankings`` (the candidates ranked in every round, the last, unaccepted
     #: one included).
     arrays: dict = field(default_factory=dict, repr=False)
+    #: The verdict under each variant of the table's reduction (assumed launch
+    #: angle +- 10 deg, materials grouped; :mod:`fieldkit.diagnose.sensitivity`).
+    sensitivity: list = field(default_factory=list)
+
+    @property
+    def accepted(self) -> list[str]:
+        """Every accepted effect, in the order accepted (``recommended`` is the
+        first)."""
+        return [s.added for s in self.steps]
 
     def to_json(self) -> dict:
         """The ``diagnose --json`` document (contract keys first)."""
@@ -159,6 +174,7 @@ class Diagnosis:
             "steps": [s.to_json(m) for s in self.steps],
             "confounded": [list(p) for p in self.confounded],
             "after": self.after.to_json(m),
+            "accepted": self.accepted,
             "rule": self.rule,
             "groups": self.groups,
             "stopped": self.stopped,
@@ -174,7 +190,10 @@ class Diagnosis:
                 k: {kk: _num(vv) for kk, vv in v.items()}
                 for k, v in self.per_material.items()
             },
+            "null": self.null,
+            "power": self.power,
             "n_rows": self.n_rows,
             "n_data": self.n_data,
             "notes": list(self.notes),
+            "sensitivity": [v.to_json() for v in self.sensitivity],
         }

@@ -61,7 +61,7 @@ from fieldkit.fit.impact_fit import (
     too_few,
 )
 from fieldkit.fit.synthetic import with_effects
-from fieldkit.impact_table import ImpactTable, flight_sides, path_point_kind
+from fieldkit.impact_table import ImpactTable, path_point_kinds
 from fieldkit.model.model_file import Model, model_from_dict
 
 METRIC = "cv_rmse_mps"
@@ -78,13 +78,10 @@ def not_impacts(table: ImpactTable) -> list[tuple[int, str]]:
 
     These are the rows every fit leaves out
     (:func:`~fieldkit.fit.impact_fit.no_flight_rows`): a reduced path's release
-    point (no arriving flight) and stop point (no leaving flight).
+    point (no arriving flight), stop point (no leaving flight) and the two ends of a
+    flight the reduction could not solve (``flight_unsolved``).
     """
-    arrives, leaves = flight_sides(table.frame)
-    return [
-        (int(i) + 1, path_point_kind(arrives[i], leaves[i]))
-        for i in np.flatnonzero(~(arrives & leaves))
-    ]
+    return path_point_kinds(table.frame)
 
 
 def impact_count(table: ImpactTable) -> str:
@@ -109,7 +106,7 @@ def impact_count(table: ImpactTable) -> str:
         return head
     named = [f"row {row}, {what}" for row, what in left[:N_NAMED_ROWS]]
     if len(left) > N_NAMED_ROWS:
-        named.append(f"{len(left) - N_NAMED_ROWS} more release or stop points")
+        named.append(f"{len(left) - N_NAMED_ROWS} more")
     return f"{head} (of {len(table)} rows; not impacts: {'; '.join(named)})"
 
 
@@ -268,12 +265,15 @@ def diagnose_impacts(
     z_confound: float = CONFOUND_Z,
     candidates: list[str] | None = None,
     progress: Callable[[str], None] | None = None,
+    gain_floor: float = MIN_GAIN,
 ) -> Diagnosis:
     """Diagnose ``table`` against ``model`` (None: constant e_n, e_t per material).
 
     ``z`` is the recommendation rule (gain > z SE and > ``MIN_GAIN``);
     ``z_confound`` the rule of the conditional gains that decide
     confounding (see :func:`_alike`).
+    ``gain_floor`` is the least held-out gain a candidate must show (the rule's
+    1 %, or a null's threshold when larger: :mod:`fieldkit.diagnose.survey_loop`).
     ``rng`` deals the groups to folds (a seed reproduces the diagnosis exactly);
     ``candidates`` restricts the candidate effects (default: every one the table
     can inform); ``progress`` is called with a short message before each model is
@@ -327,7 +327,7 @@ def diagnose_impacts(
             say(f"step {len(steps) + 1}: {name}")
             variant = with_effects(current.model, {name: {}})
             scored[name] = scorer.score(variant, [*current.effects, name])
-        ranked = _rank(current, scored, z)
+        ranked = _rank(current, scored, z, max(MIN_GAIN, gain_floor))
         rankings.append(ranked)
         if first is None:
             first = ranked
@@ -423,7 +423,9 @@ def diagnose_impacts(
     )
 
 
-def _rank(current: Scored, scored: dict[str, Scored], z: float) -> list[Candidate]:
+def _rank(
+    current: Scored, scored: dict[str, Scored], z: float, floor: float = MIN_GAIN
+) -> list[Candidate]:
     out = []
     for name, s in scored.items():
         gain, se = improvement(current.held, s.held)
@@ -431,7 +433,13 @@ def _rank(current: Scored, scored: dict[str, Scored], z: float) -> list[Candidat
         added_sd = {k: v for k, v in s.params_sd.items() if k.startswith(name + ".")}
         out.append(
             Candidate(
-                name, s.cv_rmse, gain, se, meaningful(gain, se, z=z), added, added_sd
+                name,
+                s.cv_rmse,
+                gain,
+                se,
+                meaningful(gain, se, z=z, min_gain=floor),
+                added,
+                added_sd,
             )
         )
     return sorted(out, key=lambda c: c.cv_rmse)
@@ -504,3 +512,63 @@ def _per_material(
             entry[f"{label}_bias_vft_mps"] = float(np.nanmean(s.residual[rows, 1]))
         out[m] = entry
     return out
+
+
+@dataclass
+class Screen:
+    """The first step of a diagnosis only: each candidate's held-out gain over the
+    baseline and what the rule would recommend (what a null or power campaign
+    needs; :mod:`fieldkit.diagnose.survey_loop`)."""
+
+    gains: dict[str, float]
+    ses: dict[str, float]
+    baseline_cv_rmse: float
+    recommended: str | None
+
+    @property
+    def best_gain(self) -> float:
+        """The largest gain (-inf with no candidate)."""
+        return max(self.gains.values(), default=-float("inf"))
+
+
+def screen_impacts(
+    table: ImpactTable,
+    model: Model | None = None,
+    *,
+    rng: np.random.Generator,
+    folds: int = DEFAULT_FOLDS,
+    z: float = DEFAULT_Z,
+    candidates: list[str] | None = None,
+    gain_floor: float = MIN_GAIN,
+) -> Screen:
+    """:func:`diagnose_impacts`'s first step, held-out scores only: the same
+    baseline, folds (for the same ``rng``), candidates and rule, without the full-data
+    fits, the confounding check, the later steps or the residual tests. The
+    recommendation is the best candidate when it passes the rule (a confounded pair
+    is not looked for, so it is at most as strict as the full diagnosis)."""
+    if model is None:
+        model = base_model(table)
+    problem = impact_problem(table, model)
+    path_id = (
+        problem.table.frame["path_id"].astype("string").fillna("").to_numpy(str)
+        if "path_id" in problem.table.frame
+        else np.array(["path"] * len(problem.table))
+    )
+    groups = make_groups(path_id, rng, folds=folds)
+    pool, _ = cands.impact_candidates(problem, model)
+    if candidates is not None:
+        pool = [c for c in pool if c in candidates]
+    _check(problem, groups, model, pool)
+    scorer = _Scorer(problem, groups)
+    base = scorer.held_out(model)
+    gains, ses = {}, {}
+    for name in pool:
+        gains[name], ses[name] = improvement(
+            base, scorer.held_out(with_effects(model, {name: {}}))
+        )
+    floor = max(MIN_GAIN, gain_floor)
+    best = max(gains, key=gains.get, default=None)
+    passed = best is not None and meaningful(
+        gains[best], ses[best], z=z, min_gain=floor
+    )
+    return Screen(gains, ses, base.rmse, best if passed else None)

@@ -130,6 +130,8 @@ def effect(name: str) -> str:
     'angle-dependent restitution (thesis eq. 5.4)'
     >>> effect("air_drag")
     'air drag (quadratic)'
+    >>> effect("affine_rebound")
+    'affine rebound (a straight line, not a law)'
     """
     spec = registry.BY_NAME.get(name)
     words = {
@@ -139,7 +141,9 @@ def effect(name: str) -> str:
     if spec is None:
         return words
     ref = spec.reference.split(",")[0]
-    if ref.startswith("none"):
+    if not spec.is_law:
+        ref = "a straight line, not a law"
+    elif ref.startswith("none"):
         ref = "quadratic"
     return f"{words} ({ref})"
 

@@ -16,6 +16,7 @@ import math
 
 from fieldkit.diagnose import labels, residual_tests
 from fieldkit.diagnose.diagnosis import Candidate, Dependence, Diagnosis
+from fieldkit.model.effects import registry
 
 
 def figure_names(diagnosis: Diagnosis) -> list[str]:
@@ -246,7 +247,11 @@ def markdown(diagnosis: Diagnosis, *, title: str, inputs: list[str]) -> str:
             "No effect recommended: no candidate the data can inform passes the "
             "rule (see *Which effect is missing*)."
         )
+    meaning = alternative_meaning(d)
+    if meaning:
+        out.append(meaning[0].upper() + meaning[1:] + ".")
     out += [f"Stopped: {d.stopped}.", ""]
+    out += _sensitivity_section(d)
     if d.unexplained and d.confounded:
         out.append(
             "**Residual structure left**: the confounded candidates below may "
@@ -363,6 +368,55 @@ def markdown(diagnosis: Diagnosis, *, title: str, inputs: list[str]) -> str:
     ]
     out += [f"* {n}" for n in d.notes]
     return "\n".join(out) + "\n"
+
+
+def alternative_meaning(d: Diagnosis) -> str:
+    """What it means when the statistical alternative (an effect whose metadata
+    kind is not a law, ``affine_rebound``) is the best candidate that passes the
+    rule, in words; ``""`` otherwise."""
+    best = d.candidates[0] if d.candidates else None
+    if best is None or not best.meaningful:
+        return ""
+    spec = registry.BY_NAME.get(best.effect)
+    if spec is None or spec.is_law:
+        return ""
+    return (
+        f"{best.effect}, a straight line in the impact velocities, is the best "
+        "candidate: the rebound departs from constant e_n, e_t, but neither named "
+        "law, eq. 5.4 (e_n falling with the impact angle) nor eq. 7.1 (falling with "
+        "the impact speed), is the better description; the line is a statistical "
+        "alternative, not a physical law"
+    )
+
+
+def _sensitivity_section(d: Diagnosis) -> list[str]:
+    if not d.sensitivity:
+        return []
+    out = [
+        "## Sensitivity of the verdict",
+        "",
+        "The same diagnosis (fold seed and options) on variants of the table: "
+        "the assumed launch angles shifted, the materials grouped.",
+        "",
+        "| variant | what changed | recommended | accepted | best candidate | "
+        "gain ± SE | flights without a solution |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for v in d.sensitivity:
+        if v.error:
+            out.append(
+                f"| {v.variant} | {v.description} | not diagnosed: {v.error} "
+                f"| | | | {v.unsolved_flights} |"
+            )
+            continue
+        gain = f"{v.gain:+.1%} ± {v.gain_se:.1%}" if math.isfinite(v.gain) else "-"
+        out.append(
+            f"| {v.variant} | {v.description} | {v.recommended or 'nothing'} | "
+            f"{', '.join(v.accepted) or 'none'} | {v.best or '-'} | {gain} | "
+            f"{v.unsolved_flights} |"
+        )
+    out.append("")
+    return out
 
 
 def rule_head(d: Diagnosis) -> str:

@@ -42,6 +42,7 @@ import numpy as np
 
 from fieldkit.errors import ArgumentError
 from fieldkit.export.fitted import with_error
+from fieldkit.export.lumped import not_a_law
 from fieldkit.export.result import Export, Mapped
 from fieldkit.export.site import ExportSite
 from fieldkit.model.model_file import Model
@@ -545,9 +546,10 @@ def _unmapped_effects(model: Model) -> list[tuple[str, str]]:
     }
     out = []
     for name, params in model.effects.items():
-        if name in reasons:
+        why = reasons.get(name) or not_a_law(name, "CRSP")
+        if why:
             values = ", ".join(f"{k} = {v:g}" for k, v in params.items())
-            out.append((f"effect {name} ({values})", reasons[name]))
+            out.append((f"effect {name} ({values})", why))
     return out
 
 

@@ -22,15 +22,37 @@ from dataclasses import replace
 
 import numpy as np
 
+from fieldkit.model.effects import registry
 from fieldkit.model.model_file import Model
 from fieldkit.model.simulate import simulate
 
-#: Impact-stage effects that change the restitution pair of an impact.
-RESTITUTION_LAWS = (
-    "velocity_scaled_restitution",
-    "angle_dependent_restitution",
-    "rotation_friction",
-)
+#: Impact-stage effects that change the restitution pair of an impact (effect
+#: metadata, :attr:`~fieldkit.model.effects.spec.EffectSpec.changes_rebound`).
+RESTITUTION_LAWS = tuple(s.name for s in registry.EFFECTS if s.changes_rebound)
+
+
+def not_a_law(name: str, target: str) -> str:
+    """Why ``target`` cannot take effect ``name`` when the effect is the diagnosis's
+    statistical alternative (:attr:`EffectSpec.kind <fieldkit.model.effects.spec.
+    EffectSpec.kind>` ``"alternative"``); ``""`` for a physical law.
+
+    Examples
+    --------
+    >>> not_a_law("affine_rebound", "CRSP")[:40]
+    'affine_rebound is a statistical alternat'
+    >>> not_a_law("air_drag", "CRSP")
+    ''
+    """
+    spec = registry.effect(name)
+    if spec.is_law:
+        return ""
+    return (
+        f"{name} is a statistical alternative ({spec.physics}), not a physical "
+        f"law: {target} has no such law; a model that needs it is not described "
+        "by any law a target program has"
+    )
+
+
 #: Rocks simulated, and the seed, for the realised pair.
 ROCKS, SEED = 400, 0
 
@@ -71,6 +93,9 @@ def lumped_equivalent(
     frame = result.impact_table.frame
     materials = dict(model.materials)
     lines = []
+    alternatives = "".join(
+        f"; {w}" for w in (not_a_law(a, target) for a in active) if w
+    )
     for name, material in model.materials.items():
         rows = frame[frame["material"] == name]
         vin = rows["vin_mps"].to_numpy(float)
@@ -94,7 +119,7 @@ def lumped_equivalent(
             f"they realise, e_n {e_n:.3f}, e_t {e_t:.3f} (least squares over the "
             f"{int(ok.sum())} impacts on {name} of {rocks} simulated rocks, seed "
             f"{seed}); the target's rebounds no longer vary with impact speed or "
-            "angle as the calibrated ones do"
+            "angle as the calibrated ones do" + alternatives
         )
     effects = {k: v for k, v in model.effects.items() if k not in active}
     return replace(model, materials=materials, effects=effects), lines

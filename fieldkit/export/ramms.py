@@ -45,6 +45,7 @@ import numpy as np
 
 from fieldkit.export.ascii_grid import ascii_grid_text
 from fieldkit.export.fitted import with_error
+from fieldkit.export.lumped import not_a_law
 from fieldkit.export.result import Export, Mapped
 from fieldkit.export.site import ExportSite, checked_site
 from fieldkit.model.model_file import Model
@@ -362,7 +363,8 @@ def _unmapped(model: Model) -> list[tuple[str, str]]:
         out.append(
             (
                 f"effect {name} ({values})",
-                "a lumped-mass effect: RAMMS's rigid-body contact has no such "
+                not_a_law(name, "RAMMS")
+                or "a lumped-mass effect: RAMMS's rigid-body contact has no such "
                 "parameter"
                 + (" (forest is set in RAMMS by polygons)" if "tree" in name else ""),
             )

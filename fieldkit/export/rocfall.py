@@ -59,6 +59,7 @@ from scipy.stats import norm, truncnorm
 
 from fieldkit.errors import ArgumentError
 from fieldkit.export.fitted import with_error
+from fieldkit.export.lumped import not_a_law
 from fieldkit.export.result import Export, Mapped
 from fieldkit.export.site import ExportSite
 from fieldkit.model.model_file import Model
@@ -618,9 +619,10 @@ _NO_EFFECT = {
 def _unmapped(model: Model) -> list[tuple[str, str]]:
     out = []
     for name, params in model.effects.items():
-        if name in _NO_EFFECT:
+        why = _NO_EFFECT.get(name) or not_a_law(name, "RocFall")
+        if why:
             values = ", ".join(f"{k} = {v:g}" for k, v in params.items())
-            out.append((f"{name} ({values})", _NO_EFFECT[name]))
+            out.append((f"{name} ({values})", why))
     rf = model.effects.get("rotation_friction")
     if rf is not None:
         out.append(

@@ -80,7 +80,7 @@ from fieldkit.fit.impact_model import (
     predict_arrays,
     predict_rows,
 )
-from fieldkit.impact_table import ImpactTable, flight_sides
+from fieldkit.impact_table import ImpactTable, flight_sides, path_point_kinds
 from fieldkit.model.effects import registry
 from fieldkit.model.materials import MATERIAL_FIELDS
 from fieldkit.model.model_file import Model
@@ -239,16 +239,27 @@ def _weights(table: ImpactTable, inputs: ImpactInputs) -> tuple[np.ndarray, str]
         text += ", omega_f_sd_radps"
     elif has_spin.any():
         text += "; measured spins left out (no omega_f_sd_radps)"
+    known = np.isfinite(sd[:, :2])
     # a rebound measured exactly is allowed when the impact carries the error
-    low = 0.0 if _has_input_errors(table) and text.startswith("1/sd from") else -1.0
-    ok = (sd[:, 0] > 0) | ((sd[:, 0] == 0) & (low == 0))
-    ok &= (sd[:, 1] > 0) | ((sd[:, 1] == 0) & (low == 0))
-    bad = ~(ok & np.isfinite(sd[:, :2]).all(axis=1))
+    exact_ok = _has_input_errors(table) and text.startswith("1/sd from")
+    positive = sd[:, :2] >= 0 if exact_ok else sd[:, :2] > 0
+    bad = (known & ~positive).any(axis=1) | np.isinf(sd[:, :2]).any(axis=1)
     if bad.any():
         raise InputFileError(
             "standard uncertainty is not a positive number",
             source=table.source,
             where=_rows(bad),
+        )
+    # An empty sd beside a measured rebound: the reduction could not estimate it
+    # (its flight had no ballistic solution in most survey-error draws): the datum
+    # is too fragile to weigh, so it is left out, and said so.
+    fragile = ~known.all(axis=1) & np.isfinite(inputs.vin_mps)
+    if fragile.any():
+        sd[fragile, :2] = np.nan
+        text += (
+            f"; {int(fragile.sum())} impact(s) left out whose sd is empty (their "
+            "flights have no ballistic solution in most survey-error draws: "
+            f"{_rows(fragile)})"
         )
     return sd, text
 
@@ -655,9 +666,12 @@ def impact_problem(table: ImpactTable, model: Model) -> ImpactProblem:
     check_table(table, model, skip)
     notes = []
     if skip.any():
+        kinds = path_point_kinds(table.frame)
+        named = "; ".join(f"row {row}, {what}" for row, what in kinds[:5])
+        more = f"; and {len(kinds) - 5} more" if len(kinds) > 5 else ""
         notes.append(
-            f"{_rows(skip)} left out: no arriving or leaving flight (a release or "
-            "stop point, not an impact)"
+            f"{len(kinds)} row{'' if len(kinds) == 1 else 's'} left out: no arriving "
+            f"or leaving flight, not an impact ({named}{more})"
         )
         table = ImpactTable(
             table.frame.loc[~skip].reset_index(drop=True), source=table.source

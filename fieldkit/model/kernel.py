@@ -40,6 +40,7 @@ import numpy as np
 from numba import njit, prange
 
 from fieldkit.model.effects import (
+    affine_rebound,
     air_drag,
     angle_dependent_restitution,
     mass_loss,
@@ -100,6 +101,7 @@ F_ROUGH = _NAMES.index("slope_roughness")
 F_MASS = _NAMES.index("mass_loss")
 F_TREE = _NAMES.index("tree_impacts")
 F_DRAG = _NAMES.index("air_drag")
+F_AFF = _NAMES.index("affine_rebound")
 P_ADR_B = LAYOUT["angle_dependent_restitution.b"]
 P_ADR_REF = LAYOUT["angle_dependent_restitution.theta_ref_deg"]
 P_ADR_A = LAYOUT["angle_dependent_restitution.a"]
@@ -114,6 +116,8 @@ P_TREE_C = LAYOUT["tree_impacts.energy_factor"]
 P_TREE_EXP = LAYOUT["tree_impacts.energy_exponent"]
 P_DRAG_CD = LAYOUT["air_drag.cd"]
 P_DRAG_RHO = LAYOUT["air_drag.air_density_kg_m3"]
+P_AFF_BN = LAYOUT["affine_rebound.b_n_mps"]
+P_AFF_BT = LAYOUT["affine_rebound.b_t_mps"]
 # Material table columns.
 M_EN, M_ET, M_PHI, M_EN_SD, M_ET_SD, M_PHI_SD, M_ROUGH, M_ROUGH_SD = range(8)
 
@@ -389,7 +393,9 @@ def restitution(vin, vit, e_n, e_n_mean, e_t, omega_i, r, kg, flags, par):
     ``vfn = -e_n vin``, ``vft = e_t vit`` (eqs. 4.6, 4.7; spin after impact rolling,
     ``-vft/r``, eq. 7.5), modified by the active impact-stage effects in ``flags`` /
     ``par``: angle-dependent ``e_n`` (eq. 5.4), velocity-scaled ``vfn`` (eq. 7.1),
-    rotation friction (eqs. 4.20-4.22). ``e_n``, ``e_t`` are this impact's draws,
+    rotation friction (eqs. 4.20-4.22), then the affine rebound's intercepts (the
+    diagnosis's statistical alternative; the spin stays rolling, ``-vft/r``, unless
+    rotation friction sets it). ``e_n``, ``e_t`` are this impact's draws,
     ``e_n_mean`` the material mean. ``vin >= 0`` (moving away from the ground) keeps
     the tangential velocity and stops the normal one. :func:`run_rock` and
     :mod:`fieldkit.fit.impact_model` both call this one function.
@@ -411,6 +417,10 @@ def restitution(vin, vit, e_n, e_n_mean, e_t, omega_i, r, kg, flags, par):
     else:
         vft = e_t * vit
         w = -vft / r
+    if flags[F_AFF] == 1:
+        vfn, vft = affine_rebound.rebound(vfn, vft, vit, par[P_AFF_BN], par[P_AFF_BT])
+        if flags[F_ROT] != 1:
+            w = -vft / r
     return vfn, vft, w
 
 

@@ -18,9 +18,14 @@ than the two end points; in order of preference:
     the rock leaves with as little energy as the geometry allows.
 
 Launch speed and velocities then follow from eq. 3.5 through the two impacts
-(:func:`fieldkit.physics.flight.flight_between`). Impossible geometry (a tree strike no
-downward parabola reaches, an uphill flight no ballistic path makes) raises
-:class:`~fieldkit.errors.PhysicsError` naming the file and the point or row.
+(:func:`fieldkit.physics.flight.flight_between`). A flight the geometry does not allow
+(a tree strike no downward parabola reaches; under the assumed or given theta0 the next
+point lies above the launch line, common on steep ground with half a metre of GNSS
+error) is kept as an *unsolved* flight with its reason (:attr:`SolvedFlight.unsolved`):
+its launch and arrival velocities are unknown and the rest of the path is solved as
+usual. Only a path none of whose flights can be solved raises
+:class:`~fieldkit.errors.PhysicsError` (the first flight's reason, naming the file and
+the point or row).
 """
 
 from __future__ import annotations
@@ -42,16 +47,33 @@ class SolvedFlight:
     """One solved flight from point ``launch`` to point ``arrival``.
 
     ``theta0_deg`` is the launch angle to the ground at the launch point (eq. 3.6),
-    NaN when that ground slope is unknown (the source).
+    NaN when that ground slope is unknown (the source). An *unsolved* flight (no
+    parabola through its end points meets its condition) has ``flight`` None, NaN
+    angles, ``theta0_source`` None and ``unsolved`` the one-line reason (without the
+    file name; ``unsolved_error`` is the full error, file and point or row included).
     """
 
     launch: str
     arrival: str
     alpha_deg: float
     theta0_deg: float
-    theta0_source: str
-    flight: Flight
+    theta0_source: str | None
+    flight: Flight | None
     tree: TreeStrike | None
+    unsolved: str | None = None
+    unsolved_error: FieldkitError | None = None
+
+
+def _unsolved(
+    launch: str, arrival: str, tree: TreeStrike | None, error: FieldkitError
+) -> SolvedFlight:
+    where = error.where
+    if where and tree is not None:
+        where = f"tree {where}"  # a row of the tree file, not of the points
+    reason = f"{where}: {error.message}" if where else error.message
+    return SolvedFlight(
+        launch, arrival, math.nan, math.nan, None, None, tree, reason, error
+    )
 
 
 def least_speed_launch_angle_deg(dx_m: float, dz_m: float) -> float:
@@ -105,13 +127,18 @@ def solve_flights(
     Returns
     -------
     list of SolvedFlight
-        ``n - 1`` flights, in order.
+        ``n - 1`` flights, in order. A flight no ballistic path makes (reason
+        ``"point 7: flight from point 6 to point 7 ..."``) or whose tree strike no
+        parabola reaches (``"tree row 4: tree strike ..."``) is unsolved
+        (:attr:`SolvedFlight.unsolved`).
 
     Raises
     ------
     PhysicsError
-        ``"<points file>: point 7: ..."`` for a flight no ballistic path makes;
-        ``"<tree file>: row 4: ..."`` for a tree strike no parabola reaches.
+        Every flight unsolved: the first one's reason, with the file (``"<points
+        file>: point 7: ..."`` or ``"<tree file>: row 4: ..."``).
+    PhysicsError, InputFileError
+        A tree strike after the last point or after a point not on the path.
     ArgumentError
         A flight with no way to fix its parabola (no tree, no angle, no ``theta0_deg``).
 
@@ -137,7 +164,11 @@ def solve_flights(
         psi = float(slope_deg[j])
         tree = trees.get(launch)
         if tree is not None:
-            flight = _tree_flight(tree, x_m, z_m, j, launch, arrival, trees_source)
+            try:
+                flight = _tree_flight(tree, x_m, z_m, j, launch, arrival, trees_source)
+            except PhysicsError as error:
+                out.append(_unsolved(launch, arrival, tree, error))
+                continue
             alpha = float(flight.alpha_deg)
             out.append(
                 SolvedFlight(launch, arrival, alpha, alpha + psi, "tree", flight, tree)
@@ -163,13 +194,15 @@ def solve_flights(
         try:
             flight = flight_between(dx, dz, alpha)
         except FieldkitError as exc:
-            raise PhysicsError(
+            error = PhysicsError(
                 f"flight from point {launch} to point {arrival} "
                 f"({dx:.2f} m along, {dz:+.2f} m up) with theta0 {theta0:.1f}° "
                 f"({source}) on a {psi:.1f}° slope: {exc.message}",
                 source=points_source,
                 where=f"point {arrival}",
-            ) from None
+            )
+            out.append(_unsolved(launch, arrival, None, error))
+            continue
         out.append(SolvedFlight(launch, arrival, alpha, theta0, source, flight, None))
     unused = set(trees) - {str(p) for p in points[:-1]}
     if unused:
@@ -180,6 +213,8 @@ def solve_flights(
             source=trees_source,
             where=tree.where,
         )
+    if out and all(f.unsolved for f in out):
+        raise out[0].unsolved_error
     return out
 
 

@@ -23,7 +23,8 @@
    energy change beside the measured one (``dke_theory_j``, thesis §6.3).
 
 The source (first point) has no impact velocity and the stopped point (last) no
-restitution velocity: those stay NaN.
+restitution velocity: those stay NaN; so do both ends of a flight with no ballistic
+solution (``flight_unsolved`` says why), which the fit and the diagnosis leave out.
 """
 
 from __future__ import annotations
@@ -35,13 +36,25 @@ import numpy as np
 import pandas as pd
 
 from fieldkit.errors import InputFileError
-from fieldkit.impact_table import ImpactTable, restitution
+from fieldkit.impact_table import (
+    CORR_COLUMNS,
+    ERROR_MODEL_COLUMNS,
+    SD_COLUMNS,
+    ImpactTable,
+    restitution,
+)
 from fieldkit.physics.bodies import ResolvedBody
 from fieldkit.physics.energy import kinetic_energy
 from fieldkit.reduce.flights import SolvedFlight, solve_flights
 from fieldkit.reduce.impact_theory import DEFAULT_FRICTION, add_theory_columns
-from fieldkit.reduce.uncertainty import OUTPUTS, PositionError, Propagated, propagate
-from fieldkit.survey import Survey
+from fieldkit.reduce.uncertainty import (
+    OUTPUTS,
+    UNSOLVED,
+    PositionError,
+    Propagated,
+    propagate,
+)
+from fieldkit.survey import Survey, TreeStrike
 
 
 @dataclass(frozen=True)
@@ -131,6 +144,11 @@ def impact_rows(
     flight leaving ``j``. Spin is estimated as ``omega_f = -V_f / r`` (eq. 3.17,
     clockwise negative for travel toward +x) and carried unchanged through the flight,
     so ``omega_i`` of the next impact equals it (§3.1.3: no torque in flight).
+
+    An unsolved flight leaves its launch row's restitution velocity, spin and flight
+    columns and its arrival row's impact velocity NaN (and ``t_s`` from its arrival
+    on: the time of the flight is unknown), and puts its reason in the launch row's
+    ``flight_unsolved`` (NA on every other row).
     """
     n = len(frame)
     nan = np.full(n, np.nan)
@@ -139,13 +157,17 @@ def impact_rows(
     theta0 = nan.copy()
     theta0_source: list[str | None] = [None] * n
     tree_strike: list[bool | None] = [None] * n
+    unsolved: list[str | None] = [None] * n
     for j, f in enumerate(flights):
+        if trees_given:
+            tree_strike[j + 1] = f.tree is not None
         fl = f.flight
+        if fl is None:
+            unsolved[j] = f.unsolved
+            continue
         t_flight[j], length[j] = float(fl.time_s), float(fl.dx_m)
         h_vert[j], h_norm[j] = float(fl.hmax_vertical_m), float(fl.hmax_normal_m)
         theta0[j], theta0_source[j] = f.theta0_deg, f.theta0_source
-        if trees_given:
-            tree_strike[j + 1] = f.tree is not None
     t_s = np.concatenate([[0.0], np.cumsum(t_flight[:-1])])
 
     body = options.body
@@ -184,6 +206,7 @@ def impact_rows(
             "t_s": t_s,
             "omega_source": "estimated" if math.isfinite(r) else "none",
             "slope_source": pd.array(slope_source, dtype="string"),
+            "flight_unsolved": pd.array(unsolved, dtype="string"),
         }
     )
     out["material"] = out["material"].astype("string")
@@ -196,11 +219,14 @@ def flight_velocities(
     """``vi_x, vi_z, vf_x, vf_z`` [m/s] of ``n`` points from the ``n - 1`` flights.
 
     Point ``j`` arrives at the end of flight ``j - 1`` and leaves on flight ``j``;
-    NaN where there is no such flight (the source's impact, the stop's restitution).
+    NaN where there is no such flight (the source's impact, the stop's restitution)
+    or it is unsolved.
     """
     vi_x, vi_z, vf_x, vf_z = (np.full(n, np.nan) for _ in range(4))
     for j, f in enumerate(flights):
         fl = f.flight
+        if fl is None:
+            continue
         vf_x[j], vf_z[j] = float(fl.launch_vx_mps), float(fl.launch_vz_mps)
         vi_x[j + 1], vi_z[j + 1] = float(fl.arrival_vx_mps), float(fl.arrival_vz_mps)
     return vi_x, vi_z, vf_x, vf_z
@@ -265,16 +291,81 @@ def point_kinematics(
     table (what :func:`~fieldkit.reduce.uncertainty.propagate` repeats). Tree strikes
     keep their distance from the (moved) launch point.
     """
-    frame = survey.points.frame.reset_index(drop=True).copy()
-    frame["x_m"], frame["z_m"] = x_m, z_m
-    moved = replace(survey, points=replace(survey.points, frame=frame))
-    if strike_heights_m is not None and survey.trees is not None:
-        trees = survey.trees.frame.copy()
-        trees["strike_height_m"] = np.asarray(strike_heights_m, float)
-        moved = replace(moved, trees=replace(survey.trees, frame=trees))
-    slope, _, flights = _solve(moved, options, np.asarray(x_m), np.asarray(z_m))
-    values = restitution(*flight_velocities(flights, len(frame)), slope)
-    return {name: values[name] for name in OUTPUTS}
+    return PointKinematics(survey, options)(x_m, z_m, strike_heights_m)
+
+
+class PointKinematics:
+    """:func:`point_kinematics` prepared once for one survey: the Monte Carlo of
+    :func:`~fieldkit.reduce.uncertainty.propagate` calls it a hundred times, so what
+    does not move with the points (names, surveyed slopes and angles, which flight
+    each tree strike fixes, its taped distance) is read from the frames once."""
+
+    def __init__(self, survey: Survey, options: ReduceOptions) -> None:
+        frame = survey.points.frame.reset_index(drop=True)
+        self.n = len(frame)
+        self.names = survey.points.names
+        self.surveyed = (
+            frame["slope_deg"].to_numpy(float) if "slope_deg" in frame else None
+        )
+        self.given = (
+            frame["theta0_deg"].to_numpy(float) if "theta0_deg" in frame else None
+        )
+        self.options = options
+        self.source = survey.source
+        self.trees_source = None if survey.trees is None else survey.trees.source
+        launch = {name: j for j, name in enumerate(self.names)}
+        # (row in the tree file's order, launch index, tree strike as surveyed,
+        # ground given in the file or NaN)
+        self.trees: list[tuple[int, int, TreeStrike, float]] = []
+        if survey.trees is not None:
+            by_launch = survey.trees_by_launch()  # validates, as the nominal solve
+            grounds = survey.trees.frame["ground_z_m"].to_numpy(float)
+            keys = survey.trees.frame["after_impact"].astype(str).to_list()
+            for row, key in enumerate(keys):
+                tree = by_launch[key]
+                self.trees.append((row, launch[key], tree, float(grounds[row])))
+
+    def __call__(
+        self,
+        x_m: np.ndarray,
+        z_m: np.ndarray,
+        strike_heights_m: np.ndarray | None = None,
+    ) -> dict[str, np.ndarray]:
+        x = np.asarray(x_m, float)
+        z = np.asarray(z_m, float)
+        slope, _ = section_slopes(x, z, self.surveyed)
+        trees = {}
+        for row, j, tree, ground in self.trees:
+            if not math.isfinite(ground):
+                dx = x[j + 1] - x[j]
+                ground = (
+                    float(z[j] + (z[j + 1] - z[j]) * tree.distance_m / dx)
+                    if dx > 0
+                    else math.nan
+                )
+            height = (
+                tree.height_m
+                if strike_heights_m is None
+                else float(strike_heights_m[row])
+            )
+            trees[tree.after_impact] = replace(tree, height_m=height, ground_z_m=ground)
+        flights = solve_flights(
+            self.names,
+            x,
+            z,
+            slope,
+            theta0_deg=self.options.theta0_deg,
+            given_theta0_deg=self.given,
+            trees=trees,
+            points_source=self.source,
+            trees_source=self.trees_source,
+        )
+        values = restitution(*flight_velocities(flights, self.n), slope)
+        out = {name: values[name] for name in OUTPUTS}
+        unsolved = np.zeros(self.n)
+        unsolved[[j for j, f in enumerate(flights) if f.flight is None]] = 1.0
+        out[UNSOLVED] = unsolved
+        return out
 
 
 def add_flight_energy(table: ImpactTable) -> ImpactTable:
@@ -311,8 +402,13 @@ def reduce_survey(survey: Survey, options: ReduceOptions | None = None) -> Impac
     -------
     ImpactTable
         Every contract column the data allow, plus ``omega_source``, ``slope_source``,
-        ``flight_dke_j``, ``e_n_next_chord`` and the ``*_sd`` columns
-        (:func:`reduce_path` also says how the uncertainties were obtained).
+        ``flight_unsolved``, ``flight_dke_j``, ``e_n_next_chord``, the ``*_sd``
+        columns, the error correlations ``vin_vfn_corr`` and ``vit_vft_corr`` and
+        the error model used (``x_sd_m``, ``z_sd_m``, with trees
+        ``strike_height_sd_m``) (:func:`reduce_path` also says how the
+        uncertainties were obtained). A flight with no ballistic solution is kept
+        unsolved (:func:`fieldkit.reduce.flights.solve_flights`): its reason in
+        ``flight_unsolved``, its two ends' velocities NaN.
 
     Raises
     ------
@@ -354,14 +450,25 @@ def reduce_path(survey: Survey, options: ReduceOptions | None = None) -> Reducti
         if survey.trees is not None:
             heights = survey.trees.frame["strike_height_m"].to_numpy(float)
         spread = propagate(
-            lambda xs, zs, hs=None: point_kinematics(survey, options, xs, zs, hs),
+            PointKinematics(survey, options),
             x,
             z,
             options.position_error,
             strike_heights_m=heights,
+            correlations=tuple(CORR_COLUMNS),
         )
+        nominal = restitution(*flight_velocities(flights, len(frame)), slope)
+        known = {name: np.isfinite(nominal[name]) for name in OUTPUTS}
         for name, values in spread.sd.items():
-            rows[name] = values
+            value = next(v for v, c in SD_COLUMNS.items() if c == name)
+            rows[name] = np.where(known[value], values, np.nan)  # no value, no sd
+        for (a, b), name in CORR_COLUMNS.items():
+            rows[name] = np.where(known[a] & known[b], spread.corr[name], np.nan)
+        model = options.position_error
+        rows[ERROR_MODEL_COLUMNS["x_m"]] = model.position_sigma_m
+        rows[ERROR_MODEL_COLUMNS["z_m"]] = model.elevation_sigma_m
+        if survey.trees is not None:
+            rows[ERROR_MODEL_COLUMNS["strike_height_m"]] = model.strike_height_sigma_m
     table = ImpactTable(rows, source=source).derive()
     table = add_flight_energy(table)
     table = add_theory_columns(table, friction=options.friction)

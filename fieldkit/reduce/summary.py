@@ -89,6 +89,15 @@ class ReductionSummary:
     e_n_meaningful: int = 0
     #: How the ``*_sd`` columns were obtained (None: not propagated).
     uncertainty: str | None = None
+    #: Flights with no ballistic solution: ``(launch point, reason)`` in path order
+    #: (``flight_unsolved``).
+    unsolved_flights: tuple[tuple[str, str], ...] = ()
+    #: Flights the path has (points less one, per path).
+    n_flights: int = 0
+
+
+#: Unsolved flights named one by one in the summary's warning.
+N_UNSOLVED_NAMED = 3
 
 
 def _sd(values: np.ndarray) -> float:
@@ -179,6 +188,16 @@ def summarize(
             )
         )
     sources = f["theta0_source"].dropna().value_counts()
+    unsolved: tuple[tuple[str, str], ...] = ()
+    if "flight_unsolved" in f:
+        rows = f[f["flight_unsolved"].notna()]
+        unsolved = tuple(
+            (str(p), str(r))
+            for p, r in zip(rows["point"], rows["flight_unsolved"], strict=True)
+        )
+    flight_sources = {str(k): int(v) for k, v in sources.items()}
+    if unsolved:
+        flight_sources["unsolved"] = len(unsolved)
     potential = 0.0
     for _, path in f.groupby("path_id", sort=False):
         m = path["mass_kg"].to_numpy(float)[0]
@@ -212,7 +231,7 @@ def summarize(
         path_ids=tuple(str(p) for p in table.paths()),
         n_points=len(f),
         n_impacts=len(impacts),
-        flight_sources={str(k): int(v) for k, v in sources.items()},
+        flight_sources=flight_sources,
         by_material=tuple(stats),
         impact_ke_change_j=float(np.nansum(f["dke_j"].to_numpy(float))),
         flight_ke_gain_j=float(np.nansum(f["flight_dke_j"].to_numpy(float)))
@@ -241,6 +260,8 @@ def summarize(
         e_n_sd_count=len(all_sd),
         e_n_meaningful=int(np.sum(all_sd < E_N_SD_MEANINGFUL)),
         uncertainty=None if uncertainty is None else uncertainty.describe(),
+        unsolved_flights=unsolved,
+        n_flights=len(f) - f["path_id"].nunique(),
     )
 
 
@@ -319,6 +340,8 @@ def format_summary(summary: ReductionSummary) -> str:
             "quality flags (qa_flags; meanings in fieldkit.impact_table.QA_FLAGS): "
             + ", ".join(f"{k} {v}" for k, v in summary.flag_counts.items())
         )
+    if summary.unsolved_flights:
+        lines.append(unsolved_warning(summary))
     if summary.slope_sensitive:
         lines.append(
             f"warning: at {summary.slope_sensitive} of {summary.chord_impacts} impacts "
@@ -330,3 +353,22 @@ def format_summary(summary: ReductionSummary) -> str:
             "column) to settle it"
         )
     return "\n".join(lines)
+
+
+def unsolved_warning(summary: ReductionSummary) -> str:
+    """One ``warning:`` line: how many flights were left unsolved, the first few
+    launch points, the first reason, and what that means for fit and diagnose."""
+    unsolved = summary.unsolved_flights
+    k = len(unsolved)
+    points = ", ".join(point for point, _ in unsolved[:N_UNSOLVED_NAMED])
+    if k > N_UNSOLVED_NAMED:
+        points += f" and {k - N_UNSOLVED_NAMED} more"
+    return (
+        f"warning: {k} of {summary.n_flights} flights {'has' if k == 1 else 'have'} no "
+        f"ballistic solution and {'was' if k == 1 else 'were'} left unsolved "
+        f"(leaving point{'' if k == 1 else 's'} {points}; "
+        f"{'the' if k == 1 else 'first'} reason: {unsolved[0][1]}): the rebound at "
+        "the launch point and the impact at the arrival point are unknown "
+        "(flight_unsolved column), so those rows are not impacts for fit and "
+        "diagnose"
+    )

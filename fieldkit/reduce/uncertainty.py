@@ -51,10 +51,23 @@ Sampling
     fixed :data:`DEFAULT_SEED`, so a reduction is reproducible. The standard deviation
     of 100 draws is itself uncertain by about 7 % (``1/sqrt(2(N-1))``): enough to tell
     an ``e_n`` known to 0.05 from one known to 0.3, at 10-15 ms per draw for a
-    50-point path (each draw solves every flight again). A draw whose
-    geometry has no ballistic solution (a point pushed past the next one, a tree strike
-    no parabola reaches) is left out and counted: leaving out the extreme draws makes
-    the spread a little too small, and the report says how many.
+    50-point path (each draw solves every flight again). A flight with no ballistic
+    solution in a draw (a point pushed past the next one, a tree strike no parabola
+    reaches) leaves only that flight's outputs NaN in that draw (the reduction keeps
+    it as an unsolved flight), counted per launch point (``Propagated.unsolved``); a
+    point's sd uses the draws in which its value is finite, and is NaN where fewer
+    than half are: leaving out the extreme draws makes the spread a little too small,
+    and the report says how many. A draw the reduction refuses whole (every flight
+    unsolved) is left out and counted.
+
+Correlations
+    An impact's arrival and rebound velocities both hang on the surveyed point between
+    the two flights, so their errors are correlated. ``propagate(...,
+    correlations=(("vin_mps", "vfn_mps"), ...))`` keeps the draws and gives each
+    point the correlation coefficient of the pair over the draws where both are
+    finite (NaN where fewer than half the draws are, or where either does not vary):
+    the ``vin_vfn_corr`` and ``vit_vft_corr`` columns
+    (:data:`fieldkit.impact_table.CORR_COLUMNS`).
 """
 
 from __future__ import annotations
@@ -62,12 +75,12 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from fieldkit.errors import ArgumentError, FieldkitError
-from fieldkit.impact_table import SD_COLUMNS
+from fieldkit.impact_table import CORR_COLUMNS, SD_COLUMNS
 
 __all__ = [
     "DEFAULT_DRAWS",
@@ -76,8 +89,10 @@ __all__ = [
     "DEFAULT_SEED",
     "DEFAULT_STRIKE_HEIGHT_SIGMA_M",
     "OUTPUTS",
+    "UNSOLVED",
     "PositionError",
     "Propagated",
+    "corr_column",
     "propagate",
     "sd_column",
 ]
@@ -100,6 +115,10 @@ DEFAULT_SEED = 2004
 #: each is its column).
 OUTPUTS = tuple(SD_COLUMNS)
 
+#: Output a reduction may add (one 0/1 per point: the flight leaving it had no
+#: solution in that draw); :func:`propagate` counts it per point, not as a value.
+UNSOLVED = "flight_unsolved"
+
 #: Unit suffixes kept last in a column name: ``vi_mps`` -> ``vi_sd_mps``.
 _UNITS = ("_mps", "_m", "_deg", "_j", "_s", "_radps", "_kg")
 
@@ -116,6 +135,26 @@ def sd_column(name: str) -> str:
         if name.endswith(unit) and len(name) > len(unit):
             return f"{name[: -len(unit)]}_sd{unit}"
     return f"{name}_sd"
+
+
+def corr_column(a: str, b: str) -> str:
+    """The error-correlation column of values ``a`` and ``b`` (units dropped).
+
+    Examples
+    --------
+    >>> corr_column("vin_mps", "vfn_mps"), corr_column("e_n", "e_t")
+    ('vin_vfn_corr', 'e_n_e_t_corr')
+    """
+    if (a, b) in CORR_COLUMNS:
+        return CORR_COLUMNS[(a, b)]
+
+    def bare(name: str) -> str:
+        for unit in _UNITS:
+            if name.endswith(unit) and len(name) > len(unit):
+                return name[: -len(unit)]
+        return name
+
+    return f"{bare(a)}_{bare(b)}_corr"
 
 
 @dataclass(frozen=True)
@@ -184,18 +223,45 @@ class PositionError:
 
 @dataclass(frozen=True)
 class Propagated:
-    """Standard deviations over the draws, by sd column name, and the bookkeeping."""
+    """Standard deviations over the draws, by sd column name, and the bookkeeping.
+
+    Attributes
+    ----------
+    sd
+        ``sd_column(name)`` -> per point standard deviation.
+    model
+        The error model and sampling.
+    used, failed
+        Draws the reduction solved, and refused whole (every flight unsolved).
+    first_failure
+        The first refused draw's error.
+    corr
+        ``corr_column(a, b)`` -> per point correlation coefficient over the draws.
+    unsolved
+        Per point, in how many used draws the flight leaving it had no solution
+        (None when the reduction does not report :data:`UNSOLVED`).
+    """
 
     sd: dict[str, np.ndarray]
     model: PositionError
     used: int
     failed: int
     first_failure: str | None = None
+    corr: dict[str, np.ndarray] = field(default_factory=dict)
+    unsolved: np.ndarray | None = None
 
     def describe(self) -> str:
         """One line for the report: model, columns, failed draws."""
-        columns = ", ".join(self.sd)
+        columns = ", ".join([*self.sd, *self.corr])
         text = f"{self.model.describe()} -> {columns}"
+        if self.unsolved is not None and self.unsolved.any():
+            worst = int(np.argmax(self.unsolved))
+            text += (
+                f"; in {int(self.unsolved.sum())} (flight, draw) pairs a flight had "
+                f"no ballistic solution and only its values were left out of that "
+                f"draw (most: {int(self.unsolved[worst])} of {self.used} draws, the "
+                f"flight leaving row {worst + 1})"
+            )
         if self.failed:
             text += (
                 f"; {self.failed} of {self.model.draws} draws had no ballistic "
@@ -212,6 +278,7 @@ def propagate(
     *,
     outputs: Sequence[str] = OUTPUTS,
     strike_heights_m: Sequence[float] | np.ndarray | None = None,
+    correlations: Sequence[tuple[str, str]] = (),
 ) -> Propagated:
     """Standard uncertainty of a reduction's outputs from the position error.
 
@@ -232,13 +299,19 @@ def propagate(
         Tree-strike heights [m], if the survey has any: then ``reduction`` is called
         as ``reduction(x_m, z_m, strike_heights_m)`` with the heights perturbed by
         ``model.strike_height_sigma_m`` too.
+    correlations
+        Pairs of ``outputs`` whose error correlation to compute per point.
 
     Returns
     -------
     Propagated
         ``sd[sd_column(name)]``: sample standard deviation (ddof 1) per point over
-        the draws that solved; NaN where fewer than half the draws gave a finite
-        value (e.g. the source has no impact velocity).
+        the draws where the value is finite; NaN where fewer than half the draws
+        gave a finite value (e.g. the source has no impact velocity).
+        ``corr[corr_column(a, b)]``: Pearson correlation per point over the draws
+        where both are finite, NaN where fewer than half are (or one is constant).
+        ``unsolved``: the per-point sum of the reduction's :data:`UNSOLVED` output,
+        if it gives one.
 
     Examples
     --------
@@ -257,8 +330,17 @@ def propagate(
     heights = None
     if strike_heights_m is not None and len(strike_heights_m):
         heights = np.asarray(strike_heights_m, dtype=float)
+    for pair in correlations:
+        missing = [name for name in pair if name not in outputs]
+        if missing:
+            raise ArgumentError(
+                f"correlation of {pair[0]} and {pair[1]}: {missing[0]} is not among "
+                "the outputs propagated",
+                source="correlations",
+            )
     rng = np.random.default_rng(model.seed)
     samples: dict[str, list[np.ndarray]] = {name: [] for name in outputs}
+    unsolved: np.ndarray | None = None
     failed, first = 0, None
     for _ in range(model.draws):
         dx = rng.normal(0.0, model.position_sigma_m, x.shape)
@@ -275,18 +357,55 @@ def propagate(
             continue
         for name in outputs:
             samples[name].append(np.asarray(values[name], dtype=float))
+        if UNSOLVED in values:
+            counted = np.asarray(values[UNSOLVED], dtype=float)
+            unsolved = counted if unsolved is None else unsolved + counted
     used = model.draws - failed
+    enough = max(2, used / 2)
+    stacks: dict[str, np.ndarray] = {}
     sd: dict[str, np.ndarray] = {}
     for name in outputs:
         if used < 2:
             sd[sd_column(name)] = np.full(x.shape, np.nan)
             continue
         stack = np.vstack(samples[name])
+        stack = np.where(np.isfinite(stack), stack, np.nan)
+        stacks[name] = stack
         finite = np.isfinite(stack).sum(axis=0)
         with warnings.catch_warnings():  # all-NaN columns: no impact there
             warnings.simplefilter("ignore", RuntimeWarning)
-            spread = np.nanstd(
-                np.where(np.isfinite(stack), stack, np.nan), axis=0, ddof=1
-            )
-        sd[sd_column(name)] = np.where(finite >= max(2, used / 2), spread, np.nan)
-    return Propagated(sd=sd, model=model, used=used, failed=failed, first_failure=first)
+            spread = np.nanstd(stack, axis=0, ddof=1)
+        sd[sd_column(name)] = np.where(finite >= enough, spread, np.nan)
+    corr = {
+        corr_column(a, b): (
+            _correlation(stacks[a], stacks[b], enough)
+            if used >= 2
+            else np.full(x.shape, np.nan)
+        )
+        for a, b in correlations
+    }
+    return Propagated(
+        sd=sd,
+        model=model,
+        used=used,
+        failed=failed,
+        first_failure=first,
+        corr=corr,
+        unsolved=None if unsolved is None else unsolved.astype(int),
+    )
+
+
+def _correlation(a: np.ndarray, b: np.ndarray, enough: float) -> np.ndarray:
+    """Per column Pearson correlation of ``a`` and ``b`` (draws x points) over the
+    rows where both are finite; NaN where fewer than ``enough`` are or one of them
+    does not vary."""
+    both = np.isfinite(a) & np.isfinite(b)
+    count = both.sum(axis=0)
+    a = np.where(both, a, 0.0)
+    b = np.where(both, b, 0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        da = a - a.sum(axis=0) / count
+        db = b - b.sum(axis=0) / count
+        da, db = np.where(both, da, 0.0), np.where(both, db, 0.0)
+        r = (da * db).sum(axis=0) / np.sqrt((da**2).sum(axis=0) * (db**2).sum(axis=0))
+    return np.where((count >= enough) & np.isfinite(r), np.clip(r, -1.0, 1.0), np.nan)

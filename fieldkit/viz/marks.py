@@ -24,7 +24,12 @@ from matplotlib.legend import Legend
 from matplotlib.patches import Rectangle
 from matplotlib.quiver import Quiver, QuiverKey
 
-from fieldkit.impact_table import METHOD_QA_FLAGS, QA_FLAG_LABELS, flight_sides
+from fieldkit.impact_table import (
+    METHOD_QA_FLAGS,
+    QA_FLAG_LABELS,
+    flight_sides,
+    unsolved_sides,
+)
 
 QA_COLOUR = "red"
 QA_LABEL = "quality flag"
@@ -140,7 +145,8 @@ def impact_rows(frame: pd.DataFrame) -> np.ndarray:
 def impact_count_text(frame: pd.DataFrame) -> str:
     """``48 impacts (plus the release point and the stop point)``: the impacts
     (:func:`impact_rows`) and, apart, the other rows -- a release point (no impact
-    velocity), a stop point (no restitution velocity), other rows.
+    velocity), a stop point (no restitution velocity), the ends of a flight the
+    reduction could not solve (``flight_unsolved``), other rows.
 
     Examples
     --------
@@ -155,6 +161,9 @@ def impact_count_text(frame: pd.DataFrame) -> str:
     text = f"{n:,} impact{'' if n == 1 else 's'}"
     others = ~impacts
     arrives, leaves = flight_sides(frame)
+    arrives_unsolved, leaves_unsolved = unsolved_sides(frame)
+    unsolved = others & (arrives_unsolved | leaves_unsolved)
+    others = others & ~unsolved
     release = others & ~arrives
     stop = others & arrives & ~leaves
     rest = others & arrives & leaves
@@ -162,6 +171,11 @@ def impact_count_text(frame: pd.DataFrame) -> str:
     for mask, one, many in (
         (release, "the release point", "release points"),
         (stop, "the stop point", "stop points"),
+        (
+            unsolved,
+            "one end of an unsolved flight",
+            "ends of unsolved flights",
+        ),
         (rest, "one other row without an impact", "other rows without an impact"),
     ):
         k = int(mask.sum())

@@ -2,11 +2,12 @@
 
 Left: the whole section at true scale -- ground line through the impact points, each
 flight's parabola (solid where a tree strike fixed it, dashed where the restitution
-angle was assumed), broken trees as down arrows, impact numbers, the restitution
-velocity at each impact with its scale ("10 m/s"), impacts with quality flags ringed;
-the legend sits outside the axes. Right: the detail the thesis draws as an inset -- one
-impact with its impact and restitution velocity vectors, their N and T components on
-the local ground, and e_N, e_T.
+angle was assumed; a flight with no ballistic solution as its dotted grey chord), broken
+trees as down arrows, impact numbers, the restitution velocity at each impact with its
+scale ("10 m/s"), impacts with quality flags ringed; the legend sits outside the axes.
+Right: the detail the thesis draws as an inset -- one impact with its impact and
+restitution velocity vectors, their N and T components on the local ground, and e_N,
+e_T.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from fieldkit.impact_table import ImpactTable
+from fieldkit.impact_table import ImpactTable, unsolved_sides
 from fieldkit.outputs import OutputSet
 from fieldkit.physics.flight import flight_samples
 from fieldkit.physics.local_axes import to_section
@@ -37,6 +38,7 @@ from fieldkit.viz.marks import (
 TREE_COLOUR = "#2e7d32"
 FLIGHT_COLOUR = "#1f4e9c"
 IMPACT_COLOUR = "#b22222"
+UNSOLVED_COLOUR = "#7f7f7f"
 
 
 def flight_paths(table: ImpactTable, n_samples: int = 40) -> list[tuple]:
@@ -55,6 +57,18 @@ def flight_paths(table: ImpactTable, n_samples: int = 40) -> list[tuple]:
         )
         out.append((s.x_m, s.z_m, str(row.theta0_source)))
     return out
+
+
+def unsolved_chords(table: ImpactTable) -> list[tuple[np.ndarray, np.ndarray]]:
+    """``(x, z)`` of the straight chord of each flight the reduction could not solve
+    (``flight_unsolved``): its end points are known, its parabola is not, so the
+    figure draws the chord (dotted) instead of a path."""
+    f = table.frame
+    _, leaves = unsolved_sides(f)
+    x, z = f["x_m"].to_numpy(float), f["z_m"].to_numpy(float)
+    return [
+        (x[i : i + 2], z[i : i + 2]) for i in np.flatnonzero(leaves) if i + 1 < len(f)
+    ]
 
 
 def detail_row(table: ImpactTable) -> int | None:
@@ -105,6 +119,14 @@ def plot_section(table: ImpactTable, survey: Survey | None = None) -> Figure:
         ax.plot(xs, zs, style, color=FLIGHT_COLOUR, lw=0.9)
     ax.plot([], [], "-", color=FLIGHT_COLOUR, label="flight fixed by a tree strike")
     ax.plot([], [], "--", color=FLIGHT_COLOUR, label="flight with assumed θ0")
+    chords = unsolved_chords(table)
+    for xs, zs in chords:
+        ax.plot(xs, zs, ":", color=UNSOLVED_COLOUR, lw=2.2, zorder=4)  # over ground
+    if chords:
+        ax.plot(
+            [], [], ":", color=UNSOLVED_COLOUR, lw=2.2,
+            label="unsolved flight (no ballistic solution): chord",
+        )  # fmt: skip
     ax.plot(
         x,
         z,
@@ -161,8 +183,8 @@ def plot_section(table: ImpactTable, survey: Survey | None = None) -> Figure:
     ax.set_xlabel("x, horizontal distance along the path [m]")
     ax.set_ylabel("z, elevation [m]")
     ax.set_title(
-        f"{', '.join(table.paths())}: mapped impact points, "
-        f"{impact_count_text(f)}, and trajectories"
+        f"{', '.join(table.paths())}: mapped impact points and trajectories\n"
+        f"{impact_count_text(f)}"
     )
     ax.grid(True, alpha=0.3)
     outside_legend(ax, below=True)

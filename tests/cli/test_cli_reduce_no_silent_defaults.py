@@ -452,11 +452,6 @@ def test_impossible_gpx_elevation_names_the_waypoint(cli, tmp_path, fails, diges
             "after_impact,horizontal_distance_m,strike_height_m\nP1,1e308,1\n",
             ("row 2", "horizontal distance 1e+308 m is outside the flight"),
         ),
-        (  # below the chord between the impacts: no downward parabola reaches it
-            "after_impact,horizontal_distance_m,strike_height_m,ground_z_m\n"
-            "P1,5,0.5,88\n",
-            ("row 2", "no parabola"),
-        ),
     ],
 )
 def test_impossible_tree_strikes_name_the_row(

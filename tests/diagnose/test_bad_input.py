@@ -58,16 +58,17 @@ def test_too_few_groups_says_how_many_are_needed(frame):
 
 def test_too_few_impacts_per_training_fold_says_how_many(frame):
     # four impacts on three materials: each training fold holds three impacts
-    # (9 data) for 3 x 2 material parameters + 4 effect parameters = 10;
-    # 10 parameters / 3 data per impact -> at least 4 impacts
+    # (9 data) for 3 x 2 material parameters + 6 effect parameters (4 of the
+    # laws, 2 of affine_rebound) = 12; 12 parameters / 3 data per impact -> at
+    # least 5 impacts
     rows = []
     for material in ("rock", "talus", "soil"):
         rows.append(frame[frame["material"] == material].index[0])
     rows.append(frame[frame["material"] == "talus"].index[1])
     few = frame.loc[rows].reset_index(drop=True)
     text = _fails(ImpactTable(few, source="t.csv"), "too few impacts to fit")
-    assert "9 data for 10 parameters" in text
-    assert "at least 4 impacts" in text
+    assert "9 data for 12 parameters" in text
+    assert "at least 5 impacts" in text
     assert "in every training fold" in text
 
 

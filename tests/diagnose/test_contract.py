@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from diagnose_cases import ANGLE, ROTATION, VELOCITY
 
+from fieldkit.diagnose import candidates as cands
 from fieldkit.diagnose.impacts import diagnose_impacts
 from fieldkit.diagnose.scoring import DEFAULT_Z, MIN_GAIN
 from fieldkit.model.effects import registry
@@ -69,7 +70,10 @@ def test_json_matches_contract(diagnosed, effects, paths):
     assert all(k.startswith("materials.") for k in base["params"])
     # candidates: the impact-level effects, each either ranked or skipped
     ranked = [c["effect"] for c in j["candidates"]]
-    assert sorted(ranked) == sorted([ANGLE, VELOCITY, ROTATION])
+    # every candidate the registry's metadata names (the laws and the statistical
+    # alternative affine_rebound)
+    assert sorted(ranked) == sorted(cands.IMPACT_CANDIDATES)
+    assert {ANGLE, VELOCITY, ROTATION, "affine_rebound"} <= set(ranked)
     assert set(ranked).isdisjoint(j["skipped"])
     assert set(ranked) | set(j["skipped"]) == {s.name for s in registry.EFFECTS}
     assert all(isinstance(v, str) and v for v in j["skipped"].values())
@@ -88,6 +92,9 @@ def test_json_matches_contract(diagnosed, effects, paths):
     else:
         assert j["recommended"] is None
     assert j["after"]["effects"] == [s["added"] for s in j["steps"]]
+    # accepted: every accepted step in order, right after the contract keys
+    assert list(j)[len(CONTRACT_KEYS)] == "accepted"
+    assert j["accepted"] == [s["added"] for s in j["steps"]]
     assert j["after"]["cv_rmse_mps"] == before
     _check_params(j["after"]["params"])
     assert {k.split(".")[0] for k in j["after"]["params"]} == {

@@ -118,13 +118,15 @@ def test_titles_and_report_name_effects_in_words(boulder_a):
     assert f"Model: {words}; held-out RMS error" in text
     assert f"baseline, {words}: held-out RMS error" in r.stdout
     assert re.search(
-        r"^Effects: slope roughness \(thesis eq. 7.4\); held-out RMS error",
+        r"^Effects: slope roughness \(thesis eq. 7.4\), velocity-scaled restitution "
+        r"\(thesis eq. 7.1\); held-out RMS error",
         text,
         flags=re.M,
     )
     for _, fig in figures:
         title = fig.texts[0].get_text()
         assert "slope_roughness" not in title and "_restitution" not in title
+        assert "affine_rebound" not in title
     assert figures[0][1].texts[0].get_text().startswith(f"Baseline, {words}")
 
 
@@ -174,7 +176,71 @@ def test_summary_nests_no_parentheses(boulder_a):
     parenthesis in another: the reason follows after "stopped:"."""
     _, r, _ = boulder_a
     assert (
-        "recommended: nothing; stopped: no remaining candidate passes the rule "
-        "(best: velocity_scaled_restitution, gain +12.6% ± 8.2%)\n"
+        "recommended: velocity_scaled_restitution; stopped: no remaining candidate "
+        "passes the rule (best: affine_rebound, gain +4.2% ± 4.3%)\n"
     ) in r.stdout
     assert "))" not in r.stdout
+
+
+def test_sensitivity_gives_the_verdict_of_each_variant(boulder_a):
+    """Issue 18 item 4: the verdict's sensitivity to the assumed launch angle
+    (32.6° ± 10°) and to the material grouping, in the JSON, the report and the
+    printed summary. Measured (fold seed 1): theta0 22.6° and 42.6° accept
+    affine_rebound too (+21.9 % ± 6.9 %, +18.7 % ± 7.7 %)."""
+    out, r, _ = boulder_a
+    j = json.loads((out / "d.json").read_text())
+    variants = {v["variant"]: v for v in j["sensitivity"]}
+    assert list(variants) == ["theta0 - 10 deg", "theta0 + 10 deg", "materials grouped"]
+    assert "22.6°" in variants["theta0 - 10 deg"]["description"]
+    assert "42.6°" in variants["theta0 + 10 deg"]["description"]
+    assert "colluvium, rock" in variants["materials grouped"]["description"]
+    for v in variants.values():
+        assert v["error"] == ""
+        assert set(v) >= {"recommended", "accepted", "best", "gain", "gain_se",
+                          "unsolved_flights"}  # fmt: skip
+        assert v["accepted"][:1] == ([v["recommended"]] if v["recommended"] else [])
+        assert v["gain_se"] > 0.0
+    assert variants["materials grouped"]["unsolved_flights"] == 0
+    printed = [
+        line for line in r.stdout.splitlines() if line.startswith("sensitivity:")
+    ]
+    assert len(printed) == 3
+    text = (out / "rep" / "report.md").read_text()
+    assert "## Sensitivity of the verdict" in text
+    assert "| theta0 + 10 deg |" in text
+
+
+def test_theta0_shift_of_zero_reproduces_the_reduced_velocities(boulder_a):
+    """An independent check of the re-solve: at theta0 + 0 every flight solved
+    again from x, z, slope_deg and theta0_deg gives the reduction's velocities."""
+    import numpy as np
+
+    from fieldkit.diagnose.sensitivity import shifted_theta0
+    from fieldkit.impact_table import ImpactTable
+
+    out, _, _ = boulder_a
+    table = ImpactTable.read(out / "b.csv")
+    again, unsolved = shifted_theta0(table, 0.0)
+    assert unsolved == 0
+    assumed = (table.frame["theta0_source"] == "assumed").fillna(False).to_numpy()
+    assert assumed.sum() >= 30
+    for column in ("vi_x_mps", "vi_z_mps", "vf_x_mps", "vf_z_mps", "vin_mps",
+                   "vfn_mps", "omega_f_radps"):  # fmt: skip
+        np.testing.assert_allclose(
+            again.column(column), table.column(column), rtol=1e-12, atol=0.0
+        )
+    shifted, _ = shifted_theta0(table, 10.0)
+    moved = ~np.isclose(shifted.column("vf_z_mps"), table.column("vf_z_mps"))
+    assert (
+        moved[assumed].all()
+        and not moved[~assumed & np.isfinite(table.column("vf_z_mps"))].any()
+    )
+
+
+def test_no_sensitivity_switches_it_off(boulder_a, cli, tmp_path):
+    out, _, _ = boulder_a
+    r = cli("diagnose", out / "b.csv", "--seed", "1", "--no-sensitivity",
+            "--json", tmp_path / "d.json")  # fmt: skip
+    assert r.exit_code == 0, r.output
+    assert json.loads((tmp_path / "d.json").read_text())["sensitivity"] == []
+    assert "sensitivity:" not in r.stdout

@@ -163,8 +163,12 @@ def test_one_hidden_effect_over_seeds(diagnosed, effect):
     assert len(beyond) <= 1, beyond
 
 
-#: Least detections out of 8 tables at 10 % noise.
-AT_10_PERCENT = {ANGLE: 7, VELOCITY: 6, ROTATION: 7}
+#: Least detections out of 8 tables at 10 % noise. The velocity law's 6 became 5
+#: when affine_rebound joined the candidates (issue 18): a straight line is a real
+#: look-alike of eq. 7.1 over these speeds, and on seed 3 the two are confounded
+#: (velocity +1.9 % ± 0.6 %, affine +1.3 % ± 0.5 %; neither adds to the other),
+#: which is the verdict the rule should give, not a miss to hide.
+AT_10_PERCENT = {ANGLE: 7, VELOCITY: 5, ROTATION: 7}
 
 
 @pytest.mark.slow
@@ -173,8 +177,10 @@ def test_one_hidden_effect_at_10_percent_noise(diagnosed, effect):
     """Eight tables per effect at 10 % noise (same sizes as at 5 %).
 
     Measured: angle 8/8 (falls 0.111-0.131: below the 25 % of 5 % noise),
-    rotation_friction 8/8 (falls 0.451-0.495), velocity 7/8 (seed 2 not
-    recommended; falls 0.012-0.025; with 160 paths, ~730 impacts, 5/6: one
+    rotation_friction 8/8 (falls 0.451-0.495), velocity 7/8 before
+    affine_rebound was a candidate, 5/8 with it (seeds 0 and 3 confounded, with
+    the angle law and with affine_rebound; seed 2 nothing passes; falls
+    0.012-0.025; with 160 paths, ~730 impacts, 5/6: one
     confounded with the angle law, one with rotation_friction added on top).
     Only the recommendation is asserted: at 10 % two of the eight angle tables
     also get a second effect added at its neutral value (velocity K = 13396 m/s,

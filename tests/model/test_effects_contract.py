@@ -19,10 +19,15 @@ CONTRACT = {
     "angle_dependent_restitution", "velocity_scaled_restitution", "rotation_friction",
     "slope_roughness", "mass_loss", "tree_impacts", "air_drag",
 }  # fmt: skip
+#: Statistical alternatives the diagnosis compares the laws with (issue 18).
+ALTERNATIVES = {"affine_rebound"}
 
 
 def test_registry_is_the_architecture_vocabulary():
-    assert set(NAMES) == CONTRACT and len(NAMES) == len(CONTRACT)
+    assert set(NAMES) == CONTRACT | ALTERNATIVES
+    assert len(NAMES) == len(CONTRACT) + len(ALTERNATIVES)
+    assert {s.name for s in EFFECTS if s.is_law} == CONTRACT
+    assert {s.name for s in EFFECTS if not s.is_law} == ALTERNATIVES
 
 
 @pytest.mark.parametrize("name", NAMES)

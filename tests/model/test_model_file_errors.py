@@ -44,7 +44,7 @@ CASES = [
     ("unknown effect", lambda d: d.update(effects={"drag": {}}),
      "effects.drag: unknown effect (known: angle_dependent_restitution, "
      "velocity_scaled_restitution, rotation_friction, slope_roughness, mass_loss, "
-     "tree_impacts, air_drag)"),
+     "tree_impacts, air_drag, affine_rebound)"),
     ("parameter out of bounds", lambda d: d.update(
         effects={"rotation_friction": {"coupling": 1.5}}),
      "effects.rotation_friction.coupling: must be in [0, 1] - (got 1.5)"),

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pandas as pd
@@ -154,8 +155,13 @@ def test_errors_name_the_file_and_point_or_row():
     with pytest.raises(ArgumentError, match=r"synthetic.csv: point b: .*`theta0_deg`"):
         reduce_survey(Survey(pts, None), ReduceOptions("p", None))
     below = trees([["a", 5.0, 0.5, 14.0]])  # strike at 14.5 m, chord at 17 m
+    # that flight unsolved, the next one reduced; with no other flight, an error
+    f = reduce_survey(Survey(pts, below), ReduceOptions("p", 30.0)).frame
+    assert f["flight_unsolved"].notna().tolist() == [True, False, False]
+    assert re.match(r"tree row 2: .*no parabola", f["flight_unsolved"][0])
+    two = points(["a", "b"], x[:2], z[:2])
     with pytest.raises(PhysicsError, match=r"trees.csv: row 2: .*no parabola"):
-        reduce_survey(Survey(pts, below), ReduceOptions("p", 30.0))
+        reduce_survey(Survey(two, below), ReduceOptions("p", 30.0))
     last = trees([["c", 1.0, 1.0, 8.0]])
     with pytest.raises(InputFileError, match=r"trees.csv: row 2: .*last point"):
         reduce_survey(Survey(pts, last), ReduceOptions("p", 30.0))

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fieldkit.errors import ArgumentError
+from fieldkit.errors import ArgumentError, PhysicsError
 from fieldkit.io.point_sets import point_set_from_section
 from fieldkit.physics.bodies import resolve_body
 from fieldkit.reduce.pipeline import (
@@ -126,13 +126,35 @@ def test_same_seed_same_sd_and_the_model_is_stated():
 
 
 def test_draws_without_a_solution_are_counted_not_hidden():
-    # Points 0.6 m apart in plan: a 0.5 m error often puts one behind the other.
+    """Points 0.6 m apart in plan: a 0.5 m error often puts one behind the other.
+    Such a draw leaves only that flight unsolved (it used to throw the whole draw
+    away): the draw still counts for the other points, and how often each flight was
+    unsolved is counted and said."""
     x = np.array([0.0, 10.0, 10.6, 20.0])
     z = np.array([30.0, 24.0, 23.5, 17.0])
     names = ["a", "b", "c", "d"]
     points = point_set_from_section(names, x, z, source="close.csv")
     reduction = reduce_path(Survey(points, None), ReduceOptions("p", 30.0, BODY))
     spread = reduction.uncertainty
+    assert spread.failed == 0 and spread.used == spread.model.draws
+    assert spread.unsolved[0] == 0 and spread.unsolved[3] == 0
+    assert 0 < spread.unsolved[1] < spread.model.draws  # the flight b -> c
+    assert "had no ballistic solution and only its values were left out" in (
+        spread.describe()
+    )
+    # the first flight (a -> b) solves in every draw: b's impact sd uses all draws
+    assert np.isfinite(reduction.table.frame["vi_sd_mps"][1])
+
+
+def test_a_draw_every_flight_of_which_fails_is_left_out_and_counted():
+    x, z = np.array([0.0, 0.3]), np.array([30.0, 30.0])
+
+    def reduction(xs, zs):
+        if xs[1] <= xs[0]:
+            raise PhysicsError("behind", source="close.csv", where="point b")
+        return {"k": np.full(2, zs[1] - zs[0])}
+
+    spread = propagate(reduction, x, z, PositionError(0.5, 0.5), outputs=("k",))
     assert 0 < spread.failed < spread.model.draws
     assert spread.used + spread.failed == spread.model.draws
     assert "had no ballistic solution and were left out" in spread.describe()

@@ -39,6 +39,8 @@ SPEC = EffectSpec(
     reference="none in the thesis (standard quadratic drag)",
     reads=("vi_x_mps", "vi_z_mps", "radius_m", "mass_kg"),
     writes=("vi_x_mps", "vi_z_mps"),
+    not_from_impacts="acts in flight; diagnose a video track (flight "
+    "residuals) instead",
 )
 
 

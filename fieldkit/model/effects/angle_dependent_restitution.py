@@ -51,6 +51,7 @@ SPEC = EffectSpec(
     reference="thesis eq. 5.4, section 5.2.3",
     reads=("theta_i_deg", "e_n"),
     writes=("e_n",),
+    changes_rebound=True,
 )
 
 THETA_MIN_DEG = 1.0

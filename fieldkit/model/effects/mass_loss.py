@@ -35,6 +35,8 @@ SPEC = EffectSpec(
     reference="thesis eqs. 6.15, 6.16, section 6.5",
     reads=("x_m",),
     writes=("mass_kg", "radius_m", "gyration_m"),
+    not_from_impacts="changes mass and size along the path, not the rebound "
+    "velocities an impact table measures",
 )
 
 

@@ -16,6 +16,7 @@ import numpy as np
 
 from fieldkit.errors import ArgumentError
 from fieldkit.model.effects import (
+    affine_rebound,
     air_drag,
     angle_dependent_restitution,
     mass_loss,
@@ -38,8 +39,15 @@ EFFECTS: tuple[EffectSpec, ...] = (
     mass_loss.SPEC,
     tree_impacts.SPEC,
     air_drag.SPEC,
+    affine_rebound.SPEC,
 )
 BY_NAME: dict[str, EffectSpec] = {spec.name: spec for spec in EFFECTS}
+#: :attr:`EffectSpec.kind` in words (``fieldkit effects NAME``).
+KIND_WORDS = {
+    "law": "a physical law",
+    "alternative": "a statistical alternative, not a physical law: no export "
+    "target has it",
+}
 
 
 def effect(name: str) -> EffectSpec:
@@ -142,6 +150,7 @@ def describe(name: str) -> str:
         f"{spec.name} ({spec.stage} stage): {spec.summary}",
         f"  physics:   {spec.physics}",
         f"  reference: {spec.reference}",
+        f"  kind:      {KIND_WORDS[spec.kind]}",
         "  parameters:",
     ]
     for p in spec.parameters:

@@ -46,6 +46,7 @@ SPEC = EffectSpec(
     reference="thesis eqs. 4.20-4.22, section 4.6.4, appendix C",
     reads=("vit_mps", "vin_mps", "omega_i_radps", "radius_m", "gyration_m"),
     writes=("vft_mps", "omega_f_radps"),
+    changes_rebound=True,
 )
 
 

@@ -31,6 +31,8 @@ SPEC = EffectSpec(
     reference="thesis eq. 7.4, section 7.3.6; RocFall Table 7-1",
     reads=("slope_deg", "radius_m"),
     writes=("slope_deg",),
+    not_from_impacts="a random local slope scatters rebounds without biasing "
+    "them: it shows as a reduced chi-square above 1, not as a held-out gain",
 )
 
 

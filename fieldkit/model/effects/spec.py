@@ -20,9 +20,23 @@ class Parameter:
     neutral: float | None  # value that makes the effect a no-op (None: no such value)
 
 
+#: What an effect is: ``"law"``, a physical law with its reference (thesis or
+#: literature); ``"alternative"``, a statistical alternative the diagnosis compares
+#: the laws with (no target program has it: an export says so).
+KINDS = ("law", "alternative")
+
+
 @dataclass(frozen=True)
 class EffectSpec:
-    """Declared metadata of one effect."""
+    """Declared metadata of one effect.
+
+    Besides the physics, the metadata say what the rest of fieldkit does with the
+    effect: ``kind`` (:data:`KINDS`), ``changes_rebound`` (it changes the
+    restitution pair of an impact, so a target with one constant pair per
+    material writes the pair it realises, :mod:`fieldkit.export.lumped`) and
+    ``not_from_impacts`` (why an ImpactTable cannot inform it; empty when it can,
+    which makes it a candidate of the diagnosis).
+    """
 
     name: str
     stage: str  # "impact" | "flight" | "slide"
@@ -32,6 +46,18 @@ class EffectSpec:
     reference: str
     reads: tuple[str, ...] = ()
     writes: tuple[str, ...] = ()
+    kind: str = "law"
+    changes_rebound: bool = False
+    not_from_impacts: str = ""
+
+    def __post_init__(self) -> None:
+        if self.kind not in KINDS:
+            raise ValueError(f"{self.name}: kind {self.kind!r} not in {KINDS}")
+
+    @property
+    def is_law(self) -> bool:
+        """True for a physical law, False for the statistical alternative."""
+        return self.kind == "law"
 
     def parameter(self, name: str) -> Parameter:
         """The parameter called ``name``; ArgumentError listing the known ones."""

@@ -51,6 +51,8 @@ SPEC = EffectSpec(
     reference="thesis section 6.6, Fig. 6.8 (Dorren and Berger 2005)",
     reads=("x_m", "z_m", "mass_kg"),
     writes=("vi_x_mps", "vi_z_mps", "tree_strike"),
+    not_from_impacts="acts in flight; reduced impact velocities come from "
+    "flights assumed ballistic, so the table cannot show it",
 )
 
 

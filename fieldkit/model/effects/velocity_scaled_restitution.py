@@ -29,6 +29,7 @@ SPEC = EffectSpec(
     reference="thesis eq. 7.1",
     reads=("vin_mps",),
     writes=("vfn_mps",),
+    changes_rebound=True,
 )
 
 
