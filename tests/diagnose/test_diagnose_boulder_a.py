@@ -78,7 +78,7 @@ def test_every_material_strip_is_ticked_with_its_count(boulder_a):
     with how many impacts it holds, and every point lies inside its strip."""
     _, _, figures = boulder_a
     axes = _material_axes(figures)
-    assert len(axes) == 1  # baseline only: no step accepted
+    assert len(axes) == 3  # baseline; step 1 before and after
     for ax in axes:
         ticks = [t.get_text() for t in ax.get_xticklabels()]
         assert ticks == ["colluvium\n(n = 46)", "rock\n(n = 2)"]
