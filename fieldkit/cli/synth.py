@@ -22,6 +22,8 @@ FLAGS = {
     "flights": "--flights",
     "launch_speed_mps": "--launch-speed",
     "launch_angle_deg": "--launch-angle",
+    "noise_fraction": "--noise",
+    "impact_noise_fraction": "--impact-noise",
 }
 
 
@@ -158,10 +160,19 @@ def synth(
         typer.Option(
             "--noise",
             help="Relative noise F (default 0.05): each restitution velocity "
-            "component gets N(0, (F |vf|)^2), omega_f gets N(0, (F |vf|/r)^2); "
-            "impact velocities stay exact.",
+            "component gets N(0, (F |vf|)^2), omega_f gets N(0, (F |vf|/r)^2).",
         ),
     ] = None,
+    impact_noise: Annotated[
+        float,
+        typer.Option(
+            "--impact-noise",
+            help="Relative noise on the impact velocity, independent of --noise: "
+            "vi_x, vi_z each get N(0, (F |vi|)^2), omega_i N(0, (F |vi|/r)^2); "
+            "written with vin_sd_mps, vit_sd_mps, omega_i_sd_radps and the clean "
+            "values in *_true. 0 (default): impact velocities exact.",
+        ),
+    ] = 0.0,
     paths: Annotated[
         int, typer.Option("--paths", help="Number of rocks (one path each).")
     ] = 100,
@@ -300,10 +311,12 @@ def synth(
 
     The model's rocks are simulated with the hidden effects switched on (added to
     the model's own, or overriding their parameters), every impact recorded, and
-    the restitution velocities perturbed by relative noise. The clean values are
-    kept in *_true columns (vf_x_mps_true, vfn_mps_true, ...) and the noise SDs in
-    vfn_sd_mps, vft_sd_mps, omega_f_sd_radps, so `fieldkit fit` can weight by them
-    and a test can compare a fit with the truth.
+    the restitution velocities (and, with --impact-noise, the impact velocities)
+    perturbed by relative noise. The clean values are kept in *_true columns
+    (vf_x_mps_true, vfn_mps_true, vin_mps_true, ...) and the noise SDs in
+    vfn_sd_mps, vft_sd_mps, omega_f_sd_radps (and vin_sd_mps, vit_sd_mps,
+    omega_i_sd_radps), so `fieldkit fit` and `fieldkit diagnose` can weight by
+    them and a test can compare a fit with the truth.
 
     Example (from the repository root):
 
@@ -337,7 +350,12 @@ def synth(
         fieldkit synth surveys/tornado_mountain/model_rocfall_table_7_1.json \\
           --survey --paths 3 --seed 1 --tree-spacing 8 -o out/campaign
     """
-    from fieldkit.fit.synthetic import check_paths, synthetic_table, with_effects
+    from fieldkit.fit.synthetic import (
+        check_noise,
+        check_paths,
+        synthetic_table,
+        with_effects,
+    )
     from fieldkit.model.model_file import read_model
 
     hidden = parse_effects(effects or [])
@@ -364,12 +382,14 @@ def synth(
         if track:
             raise ArgumentError("--survey and --track are two different outputs: "
                                 "give one", source="--survey")  # fmt: skip
-        if noise is not None:
-            raise ArgumentError(
-                "--noise goes without --survey (a campaign's error is the survey's: "
-                "--position-sigma, --height-sigma)",
-                source="--noise",
-            )
+        for given, flag in ((noise is not None, "--noise"),
+                            (impact_noise != 0.0, "--impact-noise")):  # fmt: skip
+            if given:
+                raise ArgumentError(
+                    f"{flag} goes without --survey (a campaign's error is the "
+                    "survey's: --position-sigma, --height-sigma)",
+                    source=flag,
+                )
         synth_survey(model_file, output, hidden, seed, paths, options, effects_words)
         return
     if options:
@@ -393,6 +413,7 @@ def synth(
         )
         return
     check_paths(paths)
+    check_noise(noise, impact_noise)
     with OutputSet(inputs=[model_file]) as outputs:
         outputs.plan(output, argument="-o")
         # the hidden effects are checked before any work
@@ -400,14 +421,21 @@ def synth(
         rng, seed = random_generator(seed)
         with step(f"simulating {paths:,} rocks"):
             table = synthetic_table(
-                model, effects={}, noise_fraction=noise, paths=paths, rng=rng
+                model,
+                effects={},
+                noise_fraction=noise,
+                impact_noise_fraction=impact_noise,
+                paths=paths,
+                rng=rng,
             )
         with step(f"writing {len(table):,} impacts", announce=len(table) > 100_000):
             table.write(output, outputs=outputs)
             written = outputs.commit()
     typer.echo(
         f"{len(table)} impacts of {paths} rocks (seed {seed}), noise F = {noise:g} "
-        f"on vf; effects: {effects_words(model.effects)}"
+        f"on vf, F = {impact_noise:g} on vi"
+        + (" (impact velocities exact)" if impact_noise == 0 else "")
+        + f"; effects: {effects_words(model.effects)}"
     )
     report_written(written)
 

@@ -309,12 +309,6 @@ def diagnose_impacts(
         pool = [c for c in pool if c in candidates]
     _check(problem, groups, model, pool)
     scorer = _Scorer(problem, groups)
-    if {"vin_sd_mps", "vit_sd_mps"} <= set(problem.table.frame):
-        notes.append(
-            "the impact velocities carry error (vin_sd_mps, vit_sd_mps) but are "
-            "taken as exact inputs: errors in them can pass for a speed or angle "
-            "law (docs/real-data-diagnosis.md)"
-        )
     say = progress or (lambda _msg: None)
     say("baseline")
     baseline = scorer.score(model, list(model.effects))

@@ -5,20 +5,31 @@ noisy ones, so a recovery test can compare a fit with the truth.
 
 * Hidden effects are added to (or override the parameters of) the model's own.
 * One path per rock (``path_id`` = rock number), ``paths`` rocks.
-* Noise model (relative, isotropic, on the *restitution* velocity only): each
-  section component of ``vf`` gets independent ``N(0, (F |vf|)^2)`` noise, so the
-  local components ``vfn``, ``vft`` carry the same SD ``F |vf|`` (a rotation keeps an
+* Noise on the rebound (relative, isotropic, ``noise_fraction`` F): each section
+  component of ``vf`` gets independent ``N(0, (F |vf|)^2)`` noise, so the local
+  components ``vfn``, ``vft`` carry the same SD ``F |vf|`` (a rotation keeps an
   isotropic Gaussian); ``omega_f`` gets ``N(0, (F |vf| / r)^2)`` (the same relative
-  error on the rolling-equivalent spin, never zero for a moving rock). The impact
-  velocity ``vi`` and ``omega_i`` are left exact: the fit treats them as known
-  inputs (no errors-in-variables model), and noise there would bias ``e_n`` by
-  about ``F^2 |vi|^2 / vin^2``.
+  error on the rolling-equivalent spin, never zero for a moving rock).
+* Noise on the impact (``impact_noise_fraction`` F_i, default 0: exact), the same
+  model, independent of the rebound's: ``vi_x``, ``vi_z`` each ``N(0, (F_i |vi|)^2)``
+  and ``omega_i`` ``N(0, (F_i |vi| / r)^2)``. A survey measures both velocities with
+  error; the fit and the diagnosis take it into account when the table carries
+  ``vin_sd_mps``, ``vit_sd_mps`` (:func:`fieldkit.fit.impact_fit.impact_problem`);
+  without that, noise on ``vi`` dilutes the regression (flattens the rebound
+  against the impact speed) and biases ``e_n`` by about ``F_i^2 |vi|^2 / vin^2``.
 * Clean values are kept in ``vf_x_mps_true``, ``vf_z_mps_true``, ``vfn_mps_true``,
-  ``vft_mps_true``, ``omega_f_radps_true``; the noise SDs in ``vfn_sd_mps``,
-  ``vft_sd_mps``, ``omega_f_sd_radps`` (omitted when ``F = 0``).
+  ``vft_mps_true``, ``omega_f_radps_true`` and, with impact noise,
+  ``vi_x_mps_true``, ``vi_z_mps_true``, ``vin_mps_true``, ``vit_mps_true``,
+  ``omega_i_radps_true``; the noise SDs in ``vfn_sd_mps``, ``vft_sd_mps``,
+  ``omega_f_sd_radps`` (when F > 0 or F_i > 0; zero when F = 0) and ``vin_sd_mps``,
+  ``vit_sd_mps``, ``omega_i_sd_radps`` (when F_i > 0). The impact and rebound
+  errors are independent, so no ``vin_vfn_corr``/``vit_vft_corr`` is written.
 
-The random numbers come from one ``numpy.random.Generator``: the simulation's
-first, then the noise, so a seed reproduces the table exactly.
+The random numbers come from one ``numpy.random.Generator`` in this order: the
+simulation's, then the rebound noise (a ``(3, n)`` standard normal block: ``vf_x``,
+``vf_z``, ``omega_f``), then -- only when F_i > 0 -- the impact noise (another
+``(3, n)`` block: ``vi_x``, ``vi_z``, ``omega_i``). A seed reproduces the table
+exactly, and with F_i = 0 a seed gives the same table as before impact noise existed.
 """
 
 from __future__ import annotations
@@ -41,6 +52,8 @@ MAX_PATHS = 5_000
 
 #: Clean copies kept next to the noisy columns.
 TRUE_COLUMNS = ("vf_x_mps", "vf_z_mps", "vfn_mps", "vft_mps", "omega_f_radps")
+#: ... and of the impact columns, when the impact velocity is noisy.
+TRUE_IMPACT_COLUMNS = ("vi_x_mps", "vi_z_mps", "vin_mps", "vit_mps", "omega_i_radps")
 
 
 def with_effects(model: Model, effects: dict[str, dict[str, float]]) -> Model:
@@ -63,6 +76,16 @@ def check_paths(paths: int) -> None:
         )
 
 
+def check_noise(noise_fraction: float, impact_noise_fraction: float = 0.0) -> None:
+    """Refuse a relative noise outside [0, 1] (named by its argument)."""
+    for name, value in (
+        ("noise_fraction", noise_fraction),
+        ("impact_noise_fraction", impact_noise_fraction),
+    ):
+        if not (np.isfinite(value) and 0.0 <= value <= 1.0):
+            raise ArgumentError(f"{name} must be in [0, 1] (got {value})", source=name)
+
+
 def synthetic_table(
     model: Model,
     *,
@@ -70,6 +93,7 @@ def synthetic_table(
     noise_fraction: float,
     paths: int,
     rng: np.random.Generator,
+    impact_noise_fraction: float = 0.0,
 ) -> ImpactTable:
     """An ImpactTable of ``paths`` simulated rocks with hidden ``effects`` and noise.
 
@@ -84,11 +108,7 @@ def synthetic_table(
     >>> t.paths()
     ['0', '1', '2']
     """
-    if not (np.isfinite(noise_fraction) and 0.0 <= noise_fraction <= 1.0):
-        raise ArgumentError(
-            f"noise_fraction must be in [0, 1] (got {noise_fraction})",
-            source="noise_fraction",
-        )
+    check_noise(noise_fraction, impact_noise_fraction)
     check_paths(paths)
     hidden = with_effects(model, effects)
     table = simulate(hidden, int(paths), rng, record_impacts=True).impact_table
@@ -99,16 +119,33 @@ def synthetic_table(
     frame = table.frame.copy()
     for name in TRUE_COLUMNS:
         frame[f"{name}_true"] = frame[name].to_numpy(float)
+    radius = frame["radius_m"].to_numpy(float)
     vf = np.hypot(frame["vf_x_mps"].to_numpy(float), frame["vf_z_mps"].to_numpy(float))
     sd_v = noise_fraction * vf
-    sd_w = sd_v / frame["radius_m"].to_numpy(float)
+    sd_w = sd_v / radius
     n = len(frame)
     noise = rng.standard_normal((3, n))
     frame["vf_x_mps"] = frame["vf_x_mps"].to_numpy(float) + sd_v * noise[0]
     frame["vf_z_mps"] = frame["vf_z_mps"].to_numpy(float) + sd_v * noise[1]
     frame["omega_f_radps"] = frame["omega_f_radps"].to_numpy(float) + sd_w * noise[2]
-    if noise_fraction > 0.0:
+    if noise_fraction > 0.0 or impact_noise_fraction > 0.0:
         frame["vfn_sd_mps"] = sd_v
         frame["vft_sd_mps"] = sd_v
         frame["omega_f_sd_radps"] = sd_w
+    if impact_noise_fraction > 0.0:
+        for name in TRUE_IMPACT_COLUMNS:
+            frame[f"{name}_true"] = frame[name].to_numpy(float)
+        vi = np.hypot(
+            frame["vi_x_mps"].to_numpy(float), frame["vi_z_mps"].to_numpy(float)
+        )
+        sd_i = impact_noise_fraction * vi
+        noise = rng.standard_normal((3, n))
+        frame["vi_x_mps"] = frame["vi_x_mps"].to_numpy(float) + sd_i * noise[0]
+        frame["vi_z_mps"] = frame["vi_z_mps"].to_numpy(float) + sd_i * noise[1]
+        frame["omega_i_radps"] = (
+            frame["omega_i_radps"].to_numpy(float) + sd_i / radius * noise[2]
+        )
+        frame["vin_sd_mps"] = sd_i
+        frame["vit_sd_mps"] = sd_i
+        frame["omega_i_sd_radps"] = sd_i / radius
     return ImpactTable(frame, source="synthetic").derive()
