@@ -275,8 +275,10 @@ def diagnose(
         typer.Option(
             "--null",
             help="Null campaigns simulated through the survey and the reduction "
-            "for a reduced survey (default 99; 0 = none, the plain rule only); "
-            "19 is the least for a 5 % test.",
+            "for a reduced survey (default 99; 0 = none, the plain rule only); on "
+            "a table with impact-velocity errors (vin_sd_mps, vit_sd_mps) null "
+            "tables of its fitted baseline with those errors (default none); 19 "
+            "is the least for a 5 % test.",
         ),
     ] = None,
     power: Annotated[
@@ -432,15 +434,29 @@ def diagnose(
             table = mapping.table
             surveyed = is_surveyed(table)
             size = (DEFAULT_NULL if surveyed else 0) if null is None else null
-            if size and not surveyed:
+            in_table = size and not surveyed
+            if in_table and not {"vin_sd_mps", "vit_sd_mps"} <= set(table.frame):
                 raise ArgumentError(
-                    "--null simulates campaigns through the survey and the "
-                    "reduction: it needs a reduced survey (a table with assumed "
-                    "launch angles, theta0_source 'assumed')",
+                    "--null needs a reduced survey (a table with assumed launch "
+                    "angles: campaigns through the survey and the reduction) or "
+                    "a table that gives its impact velocities' errors (vin_sd_mps, "
+                    "vit_sd_mps: null tables with those errors)",
                     source="null",
                 )
             floor = None
-            if size:
+            if in_table:
+                from fieldkit.diagnose.table_null import diagnose_with_table_null
+
+                with _bar_once_checked(
+                    f"diagnosing {impact_count(table)} against {size} null tables "
+                    "of its fitted baseline with its own errors"
+                ) as advance:
+                    diagnosis = diagnose_with_table_null(
+                        table, base, seed=seed, folds=folds, size=size,
+                        quantile=null_quantile, progress=advance,
+                    )  # fmt: skip
+                floor = (diagnosis.null or {}).get("threshold")
+            elif size:
                 with _bar_once_checked(
                     f"diagnosing {impact_count(table)} with its null and power: "
                     f"{size} effect-free campaigns and {power} per candidate, each "

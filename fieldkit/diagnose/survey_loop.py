@@ -514,6 +514,7 @@ class LoopResult:
         g = self.null_gains
         exceed = int(np.sum(g >= observed_gain)) if math.isfinite(observed_gain) else 0
         return {
+            "kind": "campaigns",
             "method": "campaigns simulated under the fitted baseline on each path's "
             "own profile, surveyed and reduced with the table's own options, "
             "diagnosed; the statistic is the best candidate's held-out gain",
@@ -792,10 +793,15 @@ def loop_lines(null: dict | None, power: dict | None) -> list[str]:
     if not null:
         return []
     gains = np.array([v for v in null["gains"] if v is not None], float)
+    what = (
+        "null tables of the fitted baseline with the table's own errors"
+        if null.get("kind") == "tables"
+        else "effect-free campaigns simulated under the fitted baseline on the "
+        "path's own profile, surveyed and reduced like the table"
+    )
     lines = [
-        f"null: {null['size']} effect-free campaigns simulated under the fitted "
-        "baseline on the path's own profile, surveyed and reduced like the table "
-        + (f"({null['failed']} could not be made)" if null["failed"] else "")
+        f"null: {null['size']} {what}"
+        + (f" ({null['failed']} could not be made, replaced)" if null["failed"] else "")
         + ": best gains median "
         + (_pct(float(np.median(gains))) if gains.size else "n/a")
         + f", {null['quantile']:.0%} quantile {_pct(null['threshold'] or math.inf)}",

@@ -176,3 +176,21 @@ def test_null_tables_keep_the_tables_spread_and_the_baselines_laws(tmp_path, cli
                     abs(value - values[name])
                     < 4 * result.stderr[result.names.index(name)] + 0.01
                 ), name
+
+
+def test_null_tables_through_the_command_line(cli, tmp_path):
+    """--null on a table with impact-velocity errors: null tables of its fitted
+    baseline; a recommendation must beat their 95 % quantile (the Monte Carlo
+    test's order statistic: with 19, their largest gain)."""
+    model = REPO / "surveys" / "tornado_mountain" / "model_rocfall_table_7_1.json"
+    table = tmp_path / "t.csv"
+    r = cli("synth", model, "--paths", "4", "--seed", "3", "--impact-noise", "0.1",
+            "-o", table)  # fmt: skip
+    assert r.exit_code == 0, r.output
+    js = tmp_path / "d.json"
+    r = cli("diagnose", table, "--seed", "1", "--null", "19", "--json", js)
+    assert r.exit_code == 0, r.output
+    null = json.loads(js.read_text())["null"]
+    assert null["kind"] == "tables" and null["size"] == 19
+    assert null["threshold"] == max(null["gains"])
+    assert "null: 19 null tables of the fitted baseline" in r.stdout
