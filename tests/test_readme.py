@@ -44,10 +44,10 @@ def test_shell_blocks_run(repo_copy, shell_commands, run_shell, monkeypatch):
     before = {p.name for p in repo_copy.iterdir()}
     ran = run_blocks(selected, repo_copy, shell_commands, run_shell, monkeypatch)
     # --version, reduce, impact, fence, view (2), effects, simulate, profile, synth,
-    # fit, fit --paths (2), diagnose, synth --track, diagnose (track), export (2),
-    # import-model; the video block
+    # fit, fit --paths (2), diagnose, synth --track, diagnose (track), synth --survey,
+    # reduce --campaign, diagnose (campaign), export (2), import-model; the video block
     # runs when slow
-    assert ran == 19
+    assert ran == 22
     # every README command writes under out/ only (issue 17): nothing new at the root
     assert {p.name for p in repo_copy.iterdir()} - before == {"out"}
     out = repo_copy / "out"
@@ -64,6 +64,9 @@ def test_shell_blocks_run(repo_copy, shell_commands, run_shell, monkeypatch):
     assert (out / "r3d" / "soiltype.asc").is_file()
     assert (out / "diagnosis" / "report.md").is_file()
     assert (out / "track_diagnosis" / "report.md").is_file()
+    assert (out / "campaign" / "campaign.json").is_file()
+    campaign = (out / "campaign_diagnosis.json").read_text()
+    assert '"kind": "campaigns"' in campaign and '"size": 19' in campaign
 
 
 @pytest.mark.slow
