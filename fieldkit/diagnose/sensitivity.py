@@ -92,13 +92,18 @@ class Variant:
 
 
 def is_surveyed(table: ImpactTable) -> bool:
-    """True when some flight of ``table`` was solved with an assumed ``theta0``."""
+    """True when some rebound of ``table`` was solved with an assumed ``theta0``.
+
+    The flight from a path's release is "assumed" too (the least-speed launch),
+    but its ``theta0`` is empty (no ground slope at the source) and it assumes no
+    rebound angle: a table whose only assumed flight is that one (Ehime's, where
+    every rebound angle was measured) is not a survey with assumed angles."""
     frame = table.frame
     if "theta0_source" not in frame:
         return False
-    return bool(
-        (frame["theta0_source"].astype("string") == "assumed").fillna(False).any()
-    )
+    assumed = (frame["theta0_source"].astype("string") == "assumed").fillna(False)
+    finite = np.isfinite(frame["theta0_deg"].to_numpy(float))
+    return bool((assumed.to_numpy(bool) & finite).any())
 
 
 def shifted_theta0(table: ImpactTable, delta_deg: float) -> tuple[ImpactTable, int]:

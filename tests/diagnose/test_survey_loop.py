@@ -158,3 +158,19 @@ def test_several_tables_are_diagnosed_together_each_path_once(short_path, cli, f
     table, out = short_path
     r = cli("diagnose", table, table, "--seed", "1", "--null", "0")
     fails(r, "TABLE_OR_TRACK", "boulder_a", "once")
+
+
+def test_a_release_alone_is_not_an_assumed_angle(cli, tmp_path):
+    """Ehime's rebound angles were all measured; only its release flight is
+    "assumed" (the least-speed launch, no theta0): no null, no sensitivity."""
+    table = tmp_path / "ehime.csv"
+    section = REPO / "surveys" / "ehime" / "cube_section.csv"
+    r = cli("reduce", "--impacts", section, "--mass", "520", "--radius", "0.3",
+            "--gyration", "0.245", "-o", table)  # fmt: skip
+    assert r.exit_code == 0, r.output
+    js = tmp_path / "d.json"
+    r = cli("diagnose", table, "--seed", "1", "--json", js)
+    assert r.exit_code == 0, r.output
+    d = json.loads(js.read_text())
+    assert d["null"] is None and d["sensitivity"] == []
+    assert "null:" not in r.stdout
