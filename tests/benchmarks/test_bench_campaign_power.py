@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import doctest
 import importlib.util
+import json
 import re
 import sys
 from pathlib import Path
@@ -71,6 +72,13 @@ def test_short_mode_prints_the_table(bench, capsys, tmp_path):
     assert re.search(timed, text)
     assert "load average" in text
     assert out.read_text().strip() == text.strip()
+    assert "1×20 trees: the true law's own gain, eq. 7.1 K=7: median" in text
+    # every campaign's screen kept: 2 threshold nulls + 5 cells of 1
+    dumped = [json.loads(line) for line in out.with_suffix(".jsonl").open()]
+    assert len(dumped) == 7
+    assert sum(d["kind"] == "threshold" for d in dumped) == 2
+    candidates = set(bench.boulder_a().candidates)
+    assert all(set(d["gains"]) == candidates for d in dumped)
 
 
 def test_effect_size_is_zero_without_effect_and_grows_with_it(bench):
