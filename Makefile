@@ -27,14 +27,19 @@ test-all: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q -n auto -m ''
 
 ## Speed and memory figures (printed, not asserted); bench_diagnose_power runs its
-## short setting here (a few tables per condition, ~3 min on 2 cores).
+## short setting here (a few tables per condition, ~3 min on 2 cores), and
+## bench_campaign_power its short grid of virtual campaigns (1 and 3 paths of 20
+## and 50 scars, a few campaigns per cell).
 bench: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python benchmarks/run_all.py
 
-## The measured run of diagnose's power and false-finding rates (>= 100 tables per
-## target condition; long: about an hour on 2 idle cores).
+## The measured run of diagnose's power and false-finding rates: on clean tables
+## (>= 100 tables per target condition; about an hour on 2 idle cores), then on
+## virtual campaigns through the reduction (the done-when rows with >= 100
+## campaigns, then the grid of 1/3/10 paths x 20/50/100 scars x trees; hours).
 bench-diagnose: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python benchmarks/bench_diagnose_power.py --full
+	MPLBACKEND=Agg $(BIN)/python benchmarks/bench_campaign_power.py --full
 
 ## Re-render the synthetic high-speed clips in video/ (deterministic).
 video: $(STAMP)
