@@ -255,6 +255,32 @@ def _check(problem: ImpactProblem, groups: Groups, model: Model, extra: list[str
             )
 
 
+def _prepare(
+    table: ImpactTable,
+    model: Model,
+    rng: np.random.Generator,
+    folds: int,
+    candidates: list[str] | None,
+):
+    """The problem, path ids, fold groups, candidate pool and skipped candidates
+    of a diagnosis (and of its first-step screen), every check passed."""
+    problem = impact_problem(table, model)
+    path_id = (
+        problem.table.frame["path_id"].astype("string").fillna("").to_numpy(str)
+        if "path_id" in problem.table.frame
+        else np.array(["path"] * len(problem.table))
+    )
+    groups = make_groups(path_id, rng, folds=folds)
+    pool, skipped = cands.impact_candidates(problem, model)
+    if candidates is not None:
+        for name in pool:
+            if name not in candidates:
+                skipped[name] = "left out by the caller"
+        pool = [c for c in pool if c in candidates]
+    _check(problem, groups, model, pool)
+    return problem, path_id, groups, pool, skipped
+
+
 def diagnose_impacts(
     table: ImpactTable,
     model: Model | None = None,
@@ -292,22 +318,11 @@ def diagnose_impacts(
         notes.append(
             "baseline: constant e_n, e_t per material (no --model given), fitted"
         )
-    problem = impact_problem(table, model)
+    problem, path_id, groups, pool, skipped = _prepare(
+        table, model, rng, folds, candidates
+    )
     notes += problem.notes
     notes.append(f"weights: {problem.weighting}")
-    path_id = (
-        problem.table.frame["path_id"].astype("string").fillna("").to_numpy(str)
-        if "path_id" in problem.table.frame
-        else np.array(["path"] * len(problem.table))
-    )
-    groups = make_groups(path_id, rng, folds=folds)
-    pool, skipped = cands.impact_candidates(problem, model)
-    if candidates is not None:
-        for name in pool:
-            if name not in candidates:
-                skipped[name] = "left out by the caller"
-        pool = [c for c in pool if c in candidates]
-    _check(problem, groups, model, pool)
     scorer = _Scorer(problem, groups)
     say = progress or (lambda _msg: None)
     say("baseline")
@@ -548,17 +563,7 @@ def screen_impacts(
     is not looked for, so it is at most as strict as the full diagnosis)."""
     if model is None:
         model = base_model(table)
-    problem = impact_problem(table, model)
-    path_id = (
-        problem.table.frame["path_id"].astype("string").fillna("").to_numpy(str)
-        if "path_id" in problem.table.frame
-        else np.array(["path"] * len(problem.table))
-    )
-    groups = make_groups(path_id, rng, folds=folds)
-    pool, _ = cands.impact_candidates(problem, model)
-    if candidates is not None:
-        pool = [c for c in pool if c in candidates]
-    _check(problem, groups, model, pool)
+    problem, _, groups, pool, _ = _prepare(table, model, rng, folds, candidates)
     scorer = _Scorer(problem, groups)
     base = scorer.held_out(model)
     gains, ses = {}, {}
