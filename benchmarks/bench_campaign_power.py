@@ -208,10 +208,18 @@ def seeds(seed: int, stream: int, key: tuple, n: int) -> list[np.random.SeedSequ
 
 
 # ---------------------------------------------------------------------- effect size
-def effect_size(world: World, effects: dict, rocks: int, seed: int, key: int) -> float:
+def effect_size(
+    world: World,
+    effects: dict,
+    rocks: int,
+    seed: int,
+    key: int,
+    simulated_with: dict | None = None,
+) -> float:
     """``A`` [m/s] of ``effects`` over the true impacts of ``rocks`` rocks simulated
-    in the world with them (started as the loop starts them, at random observed
-    scars); module docstring."""
+    in the world with them (or with ``simulated_with``: two effects compared on the
+    same impacts), started as the loop starts them, at random observed scars;
+    module docstring."""
     from fieldkit.campaign.virtual import virtual_campaign
     from fieldkit.diagnose.survey_loop import PIECE_SCARS, path_design, path_model
     from fieldkit.fit.impact_model import ImpactInputs, predict_arrays
@@ -222,7 +230,8 @@ def effect_size(world: World, effects: dict, rocks: int, seed: int, key: int) ->
     frames = []
     for _ in range(rocks):
         start = int(rng.integers(1, len(path.x_m) - 2))
-        model = path_model(path, world.materials, effects, start)
+        world_effects = effects if simulated_with is None else simulated_with
+        model = path_model(path, world.materials, world_effects, start)
         truth = virtual_campaign(model, design, 1, rng, source="size").paths[0].truth
         frames.append(truth.iloc[1:])  # the release point is no impact
     vin = np.concatenate([f["vin_mps"].to_numpy(float) for f in frames])
