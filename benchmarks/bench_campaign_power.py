@@ -121,6 +121,7 @@ class Design:
     def label(self) -> str:
         return f"{self.paths}×{self.scars} {'trees' if self.trees else 'no trees'}"
 
+
     @property
     def key(self) -> tuple[int, int, int]:
         return (self.paths, self.scars, int(self.trees))
@@ -139,6 +140,9 @@ class World:
     materials: dict
     candidates: list[str]
     notes: list[str]
+    #: The share of flights a tree strike fixes in a "trees" design (None: boulder
+    #: A's own, 31 %); ``--tree-share``.
+    tree_share: float | None = None
 
 
 def boulder_a() -> World:
@@ -185,7 +189,7 @@ def boulder_a() -> World:
 
 def campaign_paths(world: World, design: Design, scars: int | None = None) -> list:
     """``design.paths`` copies of boulder A's path with distinct ids."""
-    share = world.path.tree_share if design.trees else 0.0
+    share = (world.tree_share or world.path.tree_share) if design.trees else 0.0
     return [
         replace(
             world.path,
@@ -589,6 +593,13 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
         "--scars", default=None, help="comma list (short 20,50; full 20,50,100)"
     )
     ap.add_argument(
+        "--tree-share",
+        type=float,
+        default=None,
+        help="share of flights a tree strike fixes in a 'trees' design (default: "
+        "boulder A's 0.31; 0.95 nearly every flight, no launch angle assumed)",
+    )
+    ap.add_argument(
         "--trees",
         default=None,
         help="'a' (boulder A's), 'none' or 'a,none' (short a, full a,none)",
@@ -674,6 +685,8 @@ def main(argv: list[str] | None = None) -> int:
         + " ".join(f"{v:.2f}" for v in os.getloadavg())
     )
     world = boulder_a()
+    if args.tree_share is not None:
+        world = replace(world, tree_share=args.tree_share)
     p = world.path
     out(
         f"\nBoulder A: {p.scars} scars, theta0 assumed {p.theta0_deg:g} deg, "
