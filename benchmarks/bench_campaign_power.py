@@ -143,6 +143,9 @@ class World:
     #: The share of flights a tree strike fixes in a "trees" design (None: boulder
     #: A's own, 31 %); ``--tree-share``.
     tree_share: float | None = None
+    #: The campaigns' survey error in plan and height [m] (None: GNSS_SIGMA_M);
+    #: ``--position-sigma`` (a total station: a few centimetres).
+    position_sigma_m: float | None = None
 
 
 def boulder_a() -> World:
@@ -190,9 +193,12 @@ def boulder_a() -> World:
 def campaign_paths(world: World, design: Design, scars: int | None = None) -> list:
     """``design.paths`` copies of boulder A's path with distinct ids."""
     share = (world.tree_share or world.path.tree_share) if design.trees else 0.0
+    sigma = world.position_sigma_m or world.path.position_sigma_m
     return [
         replace(
             world.path,
+            position_sigma_m=sigma,
+            elevation_sigma_m=sigma,
             path_id=f"{world.path.path_id}-{k + 1}",
             target_scars=scars or design.scars,
             tree_share=share,
@@ -593,6 +599,13 @@ def parse(argv: list[str] | None) -> argparse.Namespace:
         "--scars", default=None, help="comma list (short 20,50; full 20,50,100)"
     )
     ap.add_argument(
+        "--position-sigma",
+        type=float,
+        default=None,
+        help="the campaigns' survey error in plan and height, m (default 0.5: "
+        "handheld GNSS; 0.05: a total station)",
+    )
+    ap.add_argument(
         "--tree-share",
         type=float,
         default=None,
@@ -687,6 +700,8 @@ def main(argv: list[str] | None = None) -> int:
     world = boulder_a()
     if args.tree_share is not None:
         world = replace(world, tree_share=args.tree_share)
+    if args.position_sigma is not None:
+        world = replace(world, position_sigma_m=args.position_sigma)
     p = world.path
     out(
         f"\nBoulder A: {p.scars} scars, theta0 assumed {p.theta0_deg:g} deg, "
