@@ -511,22 +511,49 @@ class LoopResult:
 
     def null_json(self, observed_gain: float) -> dict:
         """The JSON's ``null`` (ARCHITECTURE §7: size, quantile, gains)."""
-        g = self.null_gains
-        exceed = int(np.sum(g >= observed_gain)) if math.isfinite(observed_gain) else 0
-        return {
-            "kind": "campaigns",
-            "method": "campaigns simulated under the fitted baseline on each path's "
-            "own profile, surveyed and reduced with the table's own options, "
-            "diagnosed; the statistic is the best candidate's held-out gain",
-            "size": int(g.size),
-            "failed": int(self.null_failed),
-            "quantile": self.quantile,
-            "threshold": _num(self.threshold),
-            "observed_gain": _num(observed_gain),
-            "p_value": (1 + exceed) / (g.size + 1) if g.size else None,
-            "gains": [_num(v) for v in g],
-            "baseline_cv_rmse_mps": [_num(v) for v in self.null_baseline_cv_rmse],
-        }
+        return null_record(
+            "campaigns",
+            "campaigns simulated under the fitted baseline on each path's own "
+            "profile, surveyed and reduced with the table's own options, diagnosed; "
+            "the statistic is the best candidate's held-out gain",
+            self.null_gains,
+            self.quantile,
+            self.threshold,
+            observed_gain,
+            failed=self.null_failed,
+            baseline_cv_rmse=self.null_baseline_cv_rmse,
+        )
+
+
+def null_record(
+    kind: str,
+    method: str,
+    gains: np.ndarray,
+    quantile: float,
+    threshold: float,
+    observed_gain: float,
+    *,
+    failed: int = 0,
+    baseline_cv_rmse: np.ndarray | None = None,
+) -> dict:
+    """A diagnosis's ``null`` (docs/architecture.md §4), for null campaigns and
+    null tables alike: the Monte Carlo p of ``observed_gain`` among ``gains``."""
+    g = np.asarray(gains, float)
+    exceed = int(np.sum(g >= observed_gain)) if math.isfinite(observed_gain) else 0
+    return {
+        "kind": kind,
+        "method": method,
+        "size": int(g.size),
+        "failed": int(failed),
+        "quantile": quantile,
+        "threshold": _num(threshold),
+        "observed_gain": _num(observed_gain),
+        "p_value": (1 + exceed) / (g.size + 1) if g.size else None,
+        "gains": [_num(v) for v in g],
+        "baseline_cv_rmse_mps": [
+            _num(v) for v in (baseline_cv_rmse if baseline_cv_rmse is not None else [])
+        ],
+    }
 
 
 def _num(x: float) -> float | None:
@@ -748,7 +775,7 @@ def diagnose_surveyed(
         f"; on a surveyed table the gain must also exceed the {quantile:.0%} "
         f"quantile of the gains of {g.size} effect-free campaigns simulated under "
         "the fitted baseline and surveyed and reduced like this one "
-        f"({_pct(loop.threshold)})"
+        f"({gain_text(loop.threshold)})"
     )
     if first.recommended and not final.recommended:
         c = next(c for c in first.candidates if c.effect == first.recommended)
@@ -757,7 +784,7 @@ def diagnose_surveyed(
             f"{c.effect} lowers the held-out error by {c.improvement:+.1%} ± "
             f"{c.improvement_se:.1%}, which passes the plain rule, but {exceed} of "
             f"{g.size} effect-free campaigns through the same survey and reduction "
-            f"gained as much (threshold {_pct(loop.threshold)}): no finding"
+            f"gained as much (threshold {gain_text(loop.threshold)}): no finding"
         )
     rates = [e["rate"] for e in loop.power.values() if e.get("rate") is not None]
     if final.recommended:
@@ -803,8 +830,9 @@ def loop_lines(null: dict | None, power: dict | None) -> list[str]:
         f"null: {null['size']} {what}"
         + (f" ({null['failed']} could not be made, replaced)" if null["failed"] else "")
         + ": best gains median "
-        + (_pct(float(np.median(gains))) if gains.size else "n/a")
-        + f", {null['quantile']:.0%} quantile {_pct(null['threshold'] or math.inf)}",
+        + (gain_text(float(np.median(gains))) if gains.size else "n/a")
+        + f", {null['quantile']:.0%} quantile "
+        + gain_text(null["threshold"] or math.inf),
     ]
     observed = null.get("observed_gain")
     if observed is not None and null.get("p_value") is not None:
@@ -819,5 +847,6 @@ def loop_lines(null: dict | None, power: dict | None) -> list[str]:
     return lines
 
 
-def _pct(x: float) -> str:
+def gain_text(x: float) -> str:
+    """A gain as a signed percentage, or 'not available' when not finite."""
     return f"{x:+.1%}" if math.isfinite(x) else "not available"

@@ -155,7 +155,7 @@ def diagnose_with_table_null(
     video track's impacts, a synthetic table with ``--impact-noise``. No power is
     simulated here (the null is in the table's own space)."""
     from fieldkit.diagnose.impacts import diagnose_impacts, screen_impacts
-    from fieldkit.diagnose.survey_loop import _pct, null_threshold
+    from fieldkit.diagnose.survey_loop import gain_text, null_record, null_threshold
 
     first = diagnose_impacts(
         table, model, rng=np.random.default_rng(seed), folds=folds
@@ -184,34 +184,28 @@ def diagnose_with_table_null(
     )  # fmt: skip
     final.notes = first.notes
     best = max((c.improvement for c in final.candidates), default=float("nan"))
-    exceed = int(np.sum(g >= best))
-    final.null = {
-        "method": "tables made from the fitted baseline at the impact velocities "
-        "recoloured to their estimated true spread, with fresh errors of the "
-        "table's own sds (and correlations); the statistic is the best "
-        "candidate's held-out gain",
-        "kind": "tables",
-        "size": int(g.size),
-        "failed": 0,
-        "quantile": quantile,
-        "threshold": float(threshold) if np.isfinite(threshold) else None,
-        "observed_gain": float(best) if np.isfinite(best) else None,
-        "p_value": (1 + exceed) / (g.size + 1),
-        "gains": [float(v) for v in g],
-        "baseline_cv_rmse_mps": [],
-        "verdict": (
-            f"{final.recommended} is found: its gain exceeds the {quantile:.0%} "
-            f"quantile of {g.size} null tables ({_pct(threshold)})"
-            if final.recommended
-            else "no finding: no candidate passes both the rule and the "
-            f"{quantile:.0%} quantile of {g.size} null tables ({_pct(threshold)})"
-        ),
-    }
+    final.null = null_record(
+        "tables",
+        "tables made from the fitted baseline at the impact velocities recoloured "
+        "to their estimated true spread, with fresh errors of the table's own sds "
+        "(and correlations); the statistic is the best candidate's held-out gain",
+        g,
+        quantile,
+        threshold,
+        best,
+    )
+    final.null["verdict"] = (
+        f"{final.recommended} is found: its gain exceeds the {quantile:.0%} "
+        f"quantile of {g.size} null tables ({gain_text(threshold)})"
+        if final.recommended
+        else "no finding: no candidate passes both the rule and the "
+        f"{quantile:.0%} quantile of {g.size} null tables ({gain_text(threshold)})"
+    )
     final.power = {}
     final.rule += (
         f"; the gain must also exceed the {quantile:.0%} quantile of the gains of "
         f"{g.size} null tables of the fitted baseline with the table's own errors "
-        f"({_pct(threshold)})"
+        f"({gain_text(threshold)})"
     )
     return final
 
