@@ -35,6 +35,12 @@ class Mapped:
 class Export:
     """A target's files (relative path -> text or bytes) and the translation account.
 
+    ``translation`` holds the README lines (markdown) of the translation error --
+    the calibrated model against fieldkit's emulation of the exported values under
+    the target's own law; ``sources`` the documents each of the target's rules
+    comes from (repository + path, or page title), one per line; ``unconfirmed``
+    what those sources leave open, listed once.
+
     Examples
     --------
     >>> e = Export("demo", "Demo simulator", {"a.txt": "1\\n"},
@@ -55,6 +61,9 @@ class Export:
     mismatches: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     how_to_use: str = ""
+    translation: list[str] = field(default_factory=list)
+    sources: list[str] = field(default_factory=list)
+    unconfirmed: list[str] = field(default_factory=list)
 
     def readme(self, model_source: str) -> str:
         """The ``README.md`` written beside the files."""
@@ -88,6 +97,19 @@ class Export:
         lines += [f"* {m}" for m in self.mismatches] or [
             "* None: every value was written as calibrated."
         ]
+        if self.translation:
+            lines += [
+                "",
+                "## Translation error: calibrated model vs the target's law",
+                "",
+            ]
+            lines += self.translation
+        if self.sources:
+            lines += ["", "## Sources of the target's rules", ""]
+            lines += [f"* {s}" for s in self.sources]
+        if self.unconfirmed:
+            lines += ["", "## Unconfirmed", ""]
+            lines += [f"* {u}" for u in self.unconfirmed]
         if self.notes:
             lines += ["", "## Notes", ""]
             lines += [f"* {n}" for n in self.notes]

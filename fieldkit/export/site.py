@@ -221,3 +221,90 @@ def checked_site(site: ExportSite | None, target: str) -> ExportSite:
     if not (site.release & ground_cells(site)).any():
         raise ArgumentError("the site has no release cell on ground", source="site")
     return site
+
+
+def pad_site(site: ExportSite, cells: int) -> ExportSite:
+    """``site`` with ``cells`` cells added on every side that has a release cell
+    closer than ``cells`` to it, so that every release cell lies at least ``cells``
+    cells inside the grid (a target that ignores its outer rows or columns, or
+    never starts a stone on its edge row, then starts them all).
+
+    The added cells continue the outermost row or column's elevation and material
+    (a flat continuation of the edge: it adds no relief a rock could gain speed
+    on); none is a release cell. A site whose release cells are all far enough
+    inside is returned as it is. The description says what was added.
+
+    Raises
+    ------
+    ArgumentError
+        ``cells`` not a whole number >= 0, or a padded grid of more than
+        :data:`~fieldkit.io.dem.MAX_DEM_CELLS` cells.
+
+    Examples
+    --------
+    >>> g = DemGrid.from_corner(np.arange(12.0).reshape(3, 4), x_left_m=0,
+    ...                         y_top_m=15, cellsize_m=5)
+    >>> release = np.zeros((3, 4), bool); release[1, 0] = True
+    >>> s = ExportSite(g, np.full((3, 4), "rock", object), release, "test")
+    >>> p = pad_site(s, 2)
+    >>> p.grid.shape, p.grid.x_m[:3].tolist(), p.grid.y_m[0]
+    ((5, 6), [-7.5, -2.5, 2.5], 17.5)
+    >>> np.argwhere(p.release).tolist(), p.grid.values[2, :3].tolist()
+    ([[2, 2]], [4.0, 4.0, 4.0])
+    >>> pad_site(p, 2) is p
+    True
+    """
+    if isinstance(cells, bool) or not isinstance(cells, int) or cells < 0:
+        raise ArgumentError(
+            f"cells must be a whole number >= 0 (got {cells})", source="cells"
+        )
+    rows, cols = np.nonzero(site.release)
+    nrows, ncols = site.grid.shape
+    if rows.size == 0:
+        return site
+    top = max(0, cells - int(rows.min()))
+    bottom = max(0, cells - (nrows - 1 - int(rows.max())))
+    left = max(0, cells - int(cols.min()))
+    right = max(0, cells - (ncols - 1 - int(cols.max())))
+    if not (top or bottom or left or right):
+        return site
+    shape = (nrows + top + bottom, ncols + left + right)
+    if shape[0] * shape[1] > MAX_DEM_CELLS:
+        raise ArgumentError(
+            f"padding the grid by {cells} cells gives {shape[0]} x {shape[1]} cells, "
+            f"more than the limit of {MAX_DEM_CELLS:,}",
+            source="site",
+        )
+    widths = ((top, bottom), (left, right))
+    values = np.pad(site.grid.values, widths, mode="edge")
+    material = np.pad(site.material, widths, mode="edge")
+    release = np.pad(site.release, widths, mode="constant", constant_values=False)
+    g = site.grid
+    grid = DemGrid.from_corner(
+        values,
+        x_left_m=float(g.x_m[0] - g.dx_m / 2 - left * g.dx_m),
+        y_top_m=float(g.y_m[0] + g.dy_m / 2 + top * g.dy_m),
+        cellsize_m=g.dx_m,
+        cellsize_y_m=g.dy_m,
+        crs=g.crs,
+        source=g.source,
+        notes=g.notes,
+    )
+    sides = ", ".join(
+        f"{n} {name}"
+        for n, name in (
+            (top, "north"),
+            (bottom, "south"),
+            (left, "west"),
+            (right, "east"),
+        )
+        if n
+    )
+    return ExportSite(
+        grid,
+        material,
+        release,
+        f"{site.description}; padded by {sides} (cells continuing the edge's "
+        f"elevation and ground) so every release cell lies >= {cells} cells inside "
+        "the grid",
+    )
