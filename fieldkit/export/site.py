@@ -247,7 +247,7 @@ def pad_site(site: ExportSite, cells: int) -> ExportSite:
     >>> release = np.zeros((3, 4), bool); release[1, 0] = True
     >>> s = ExportSite(g, np.full((3, 4), "rock", object), release, "test")
     >>> p = pad_site(s, 2)
-    >>> p.grid.shape, p.grid.x_m[:3].tolist(), p.grid.y_m[0]
+    >>> p.grid.shape, p.grid.x_m[:3].tolist(), float(p.grid.y_m[0])
     ((5, 6), [-7.5, -2.5, 2.5], 17.5)
     >>> np.argwhere(p.release).tolist(), p.grid.values[2, :3].tolist()
     ([[2, 2]], [4.0, 4.0, 4.0])
