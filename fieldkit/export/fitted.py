@@ -69,9 +69,49 @@ def _number(value: object) -> float:
 
 
 def with_error(model: Model, name: str, value: float, unit: str = "") -> str:
-    """``"name = value ± se unit"`` (or without ± when not fitted), for a README."""
-    fitted = fitted_parameters(model).get(name)
+    """``"name = value ± se unit"`` (or without ± when not fitted), for a README.
+
+    A value an export wrote in place of the calibrated one (the provenance entry
+    ``lumped`` of :func:`fieldkit.export.lumped.with_coefficients`) is shown with
+    its own spread over the impacts it was fitted to, and the calibrated value
+    beside it -- never with the calibrated parameter's standard error.
+
+    Examples
+    --------
+    >>> from dataclasses import replace
+    >>> from fieldkit.model.model_file import model_from_dict
+    >>> m = model_from_dict({"profile": {"x_m": [0, 10], "z_m": [5, 0],
+    ...   "material": "rock"}, "materials": {"rock": {"e_n": 0.3, "e_t": 0.8,
+    ...   "friction_deg": 25}}, "body": {"mass_kg": 100, "radius_m": 0.2},
+    ...   "seeder": {"x_m": 1, "z_m": 6}})
+    >>> m = replace(m, provenance={"fit": {"parameters": {"materials.rock.e_n":
+    ...     {"value": 1.2, "stderr": 0.02}}}, "lumped": {"materials.rock.e_n":
+    ...     {"value": 0.3, "spread": 0.11, "impacts": 50, "calibrated": 1.2}}})
+    >>> for part in with_error(m, "materials.rock.e_n", 0.3).split("; "):
+    ...     print(part)
+    materials.rock.e_n = 0.3 written (spread 0.11 over 50 impacts)
+    calibrated 1.2 ± 0.02 (fit)
+    """
     unit = f" {unit}" if unit else ""
+    lumped = (
+        model.provenance.get("lumped") if isinstance(model.provenance, dict) else None
+    )
+    if isinstance(lumped, dict) and isinstance(lumped.get(name), dict):
+        entry = lumped[name]
+        spread = _number(entry.get("spread"))
+        own = (
+            f"spread {spread:.2g} over {int(entry.get('impacts') or 0)} impacts"
+            if math.isfinite(spread)
+            else str(entry.get("unfitted") or "not fitted to impacts")
+        )
+        calibrated = f"{_number(entry.get('calibrated')):.4g}"
+        fitted = fitted_parameters(model).get(name)
+        if fitted is not None and math.isfinite(fitted.stderr):
+            calibrated += f" ± {fitted.stderr:.2g}{unit} ({fitted.fit})"
+        else:
+            calibrated += unit
+        return f"{name} = {value:.4g}{unit} written ({own}); calibrated {calibrated}"
+    fitted = fitted_parameters(model).get(name)
     if fitted is not None and math.isfinite(fitted.stderr):
         return f"{name} = {value:.4g} ± {fitted.stderr:.2g}{unit} ({fitted.fit})"
     return f"{name} = {value:.4g}{unit}"

@@ -17,14 +17,20 @@ calibrated model's simulated impacts of each material,
 
 from __future__ import annotations
 
-from collections.abc import Iterable
-from dataclasses import replace
+import math
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from fieldkit.export.translation import (
+    IMPACT_ROCKS,
+    IMPACT_SEED,
+    fit_scaled,
+    realised_impacts,
+)
 from fieldkit.model.effects import registry
 from fieldkit.model.model_file import Model
-from fieldkit.model.simulate import simulate
 
 #: Impact-stage effects that change the restitution pair of an impact (effect
 #: metadata, :attr:`~fieldkit.model.effects.spec.EffectSpec.changes_rebound`).
@@ -53,8 +59,239 @@ def not_a_law(name: str, target: str) -> str:
     )
 
 
-#: Rocks simulated, and the seed, for the realised pair.
-ROCKS, SEED = 400, 0
+#: Rocks simulated, and the seed, for the realised pair (the impacts of
+#: :func:`fieldkit.export.translation.realised_impacts`).
+ROCKS, SEED = IMPACT_ROCKS, IMPACT_SEED
+
+
+@dataclass(frozen=True)
+class Coefficient:
+    """One written restitution coefficient of a material and where it came from.
+
+    Attributes
+    ----------
+    name
+        The model parameter, e.g. ``"materials.colluvium.e_n"``.
+    calibrated
+        The calibrated model's value (its own law).
+    written
+        The value written for the target (within ``range``).
+    spread
+        The impacts' own weighted SD of ``v_f / (f v_i)`` around ``written``
+        (:func:`~fieldkit.export.translation.fit_scaled`); NaN when not fitted.
+    n
+        Impacts the value was fitted to (0: not fitted to impacts of its own).
+    unfitted
+        Why the value is not a fit to the material's own impacts ("" when it is).
+    unclipped
+        The least-squares value before the range clipped it (NaN: not fitted).
+    """
+
+    name: str
+    calibrated: float
+    written: float
+    spread: float
+    n: int
+    unfitted: str = ""
+    unclipped: float = math.nan
+
+    @property
+    def clipped(self) -> bool:
+        """Whether the target's range moved the fitted value."""
+        return math.isfinite(self.unclipped) and self.written != self.unclipped
+
+    def text(self) -> str:
+        """``written (spread s over n impacts)`` for a README's target column."""
+        if self.n and math.isfinite(self.spread):
+            return (
+                f"{self.written:.4g} (spread {self.spread:.2g} of the {self.n} "
+                "impacts' own rebound ratio around it)"
+            )
+        return f"{self.written:.4g} ({self.unfitted})"
+
+
+def calibrated_normal_factor(model: Model, vin_abs: np.ndarray) -> np.ndarray | None:
+    """The calibrated model's normal rebound per unit e_n at normal impact speeds
+    ``vin_abs``: ``1 / (1 + (v/K)^2)`` with ``velocity_scaled_restitution``, 1
+    without; None when another active law changes the normal rebound (its value
+    depends on more than the normal speed)."""
+    others = [
+        law
+        for law in RESTITUTION_LAWS
+        if law in model.effects
+        and law not in ("velocity_scaled_restitution", "rotation_friction")
+    ]
+    if others:
+        return None
+    params = model.effects.get("velocity_scaled_restitution")
+    if params is None or not math.isfinite(params["k_mps"]):
+        return np.ones_like(vin_abs)
+    return 1.0 / (1.0 + (vin_abs / params["k_mps"]) ** 2)
+
+
+def fit_coefficients(
+    model: Model,
+    target: str,
+    normal_factor: Callable[[np.ndarray], np.ndarray],
+    rn_range: tuple[float, float],
+    rt_range: tuple[float, float],
+    *,
+    fit_rt: bool = True,
+    rocks: int = ROCKS,
+    seed: int = SEED,
+) -> tuple[dict[str, tuple[Coefficient, Coefficient]], list[str]]:
+    """Per material the (Rn, Rt) in the target's ranges whose rebounds under the
+    target's law ``v_fN = Rn f(|v_iN|) |v_iN|``, ``v_fT = Rt v_iT`` are closest (least
+    squares) to the calibrated model's simulated impacts on that material.
+
+    Parameters
+    ----------
+    model
+        The calibrated model.
+    target
+        The target's name, for the lines.
+    normal_factor
+        The target's scaling ``f`` of the normal rebound at normal impact speeds
+        (``lambda v: np.ones_like(v)`` for a constant pair).
+    rn_range, rt_range
+        The target's documented ranges ``[lo, hi]``.
+    fit_rt
+        False: Rt is the calibrated e_t clipped to ``rt_range`` (the target's own
+        rotation replaces the calibrated tangential law).
+    rocks, seed
+        The simulation of :func:`~fieldkit.export.translation.realised_impacts`.
+
+    Returns
+    -------
+    coefficients, lines
+        ``{material: (Rn, Rt)}`` and one line per material that no simulated rock
+        touched (for the export's mismatches; said loudly: its values are not fitted
+        to impacts of its own).
+
+    Notes
+    -----
+    A material without impacts of its own: Rn is fitted to the material's own
+    calibrated law evaluated at the normal speeds of every simulated impact (on
+    any material), when that law depends on the normal speed only; otherwise, and
+    when no rock struck anything, the calibrated value is clipped to the range.
+    """
+    impacts = realised_impacts(model, rocks, seed)
+    vin_all = -impacts["vin_mps"].to_numpy(float)
+    out: dict[str, tuple[Coefficient, Coefficient]] = {}
+    lines: list[str] = []
+    lo_n, hi_n = rn_range
+    lo_t, hi_t = rt_range
+    for name, material in model.materials.items():
+        rows = impacts[impacts["material"] == name]
+        key = f"materials.{name}"
+        vin = -rows["vin_mps"].to_numpy(float)
+        if len(rows) >= 2:
+            rn = _coefficient(
+                f"{key}.e_n",
+                material.e_n,
+                fit_scaled(
+                    vin, rows["vfn_mps"].to_numpy(float), normal_factor(vin), lo_n, hi_n
+                ),
+            )
+            if fit_rt:
+                rt = _coefficient(
+                    f"{key}.e_t",
+                    material.e_t,
+                    fit_scaled(
+                        rows["vit_mps"].to_numpy(float),
+                        rows["vft_mps"].to_numpy(float),
+                        1.0,
+                        lo_t,
+                        hi_t,
+                    ),
+                )
+            else:
+                rt = _clipped(
+                    f"{key}.e_t",
+                    material.e_t,
+                    rt_range,
+                    f"calibrated e_t; {target}'s own rotation replaces "
+                    "the calibrated tangential law",
+                )
+            out[name] = (rn, rt)
+            continue
+        own = calibrated_normal_factor(model, vin_all)
+        if own is not None and vin_all.size >= 2:
+            fit = fit_scaled(
+                vin_all,
+                material.e_n * own * vin_all,
+                normal_factor(vin_all),
+                lo_n,
+                hi_n,
+            )
+            why = (
+                f"NO SIMULATED IMPACT on {name} ({rocks} rocks, seed {seed}): fitted "
+                f"to its own calibrated law at the normal speeds of all {fit.n} "
+                "simulated impacts on the other materials"
+            )
+            rn = Coefficient(
+                f"{key}.e_n", material.e_n, fit.value, math.nan, 0, why, fit.unclipped
+            )
+        else:
+            why = (
+                f"NO SIMULATED IMPACT on {name} ({rocks} rocks, seed {seed}) and its "
+                "calibrated law depends on more than the normal speed: the "
+                f"calibrated e_n clipped to {target}'s range"
+            )
+            rn = _clipped(f"{key}.e_n", material.e_n, rn_range, why)
+        rt = _clipped(
+            f"{key}.e_t",
+            material.e_t,
+            rt_range,
+            f"NO SIMULATED IMPACT on {name}: the calibrated e_t clipped to "
+            f"{target}'s range",
+        )
+        out[name] = (rn, rt)
+        lines.append(
+            f"{name}: NO SIMULATED IMPACT on it ({rocks} rocks, seed {seed}), so its "
+            f"values are not fitted to rebounds of its own: Rn {rn.written:.4g} "
+            f"({rn.unfitted}), Rt {rt.written:.4g} (the calibrated e_t "
+            f"{material.e_t:.4g} clipped to [{lo_t:g}, {hi_t:g}]). Nothing in this "
+            f"export tests them: check {name} in {target} before relying on it"
+        )
+    return out, lines
+
+
+def _coefficient(name: str, calibrated: float, fit) -> Coefficient:
+    return Coefficient(
+        name, calibrated, fit.value, fit.spread, fit.n, "", fit.unclipped
+    )
+
+
+def _clipped(
+    name: str, value: float, bounds: tuple[float, float], why: str
+) -> Coefficient:
+    lo, hi = bounds
+    return Coefficient(name, value, float(min(max(value, lo), hi)), math.nan, 0, why)
+
+
+def with_coefficients(
+    model: Model, coefficients: dict[str, tuple[Coefficient, Coefficient]]
+) -> Model:
+    """``model`` with each material's e_n, e_t the written values, and the
+    provenance entry ``lumped`` that says so (so that
+    :func:`fieldkit.export.fitted.with_error` shows a written value with its own
+    spread, never with the calibrated parameter's standard error)."""
+    materials = dict(model.materials)
+    record = {}
+    for name, (rn, rt) in coefficients.items():
+        materials[name] = replace(materials[name], e_n=rn.written, e_t=rt.written)
+        for c in (rn, rt):
+            record[c.name] = {
+                "value": c.written,
+                "spread": c.spread if math.isfinite(c.spread) else None,
+                "impacts": c.n,
+                "calibrated": c.calibrated,
+                "unfitted": c.unfitted,
+            }
+    provenance = dict(model.provenance) if isinstance(model.provenance, dict) else {}
+    provenance["lumped"] = record
+    return replace(model, materials=materials, provenance=provenance)
 
 
 def lumped_equivalent(
@@ -72,7 +309,9 @@ def lumped_equivalent(
     -------
     model, lines
         The lumped model (``model`` itself when no law is active) and one line per
-        material for the export's mismatches.
+        material for the export's mismatches. The lumped model's provenance
+        ``lumped`` records each written value with its own spread
+        (:func:`with_coefficients`).
 
     Examples
     --------
@@ -89,37 +328,32 @@ def lumped_equivalent(
     active = [law for law in laws if law in model.effects]
     if not active:
         return model, []
-    result = simulate(model, rocks, np.random.default_rng(seed), record_impacts=True)
-    frame = result.impact_table.frame
-    materials = dict(model.materials)
-    lines = []
+    coefficients, loud = fit_coefficients(
+        model,
+        target,
+        np.ones_like,
+        (0.0, math.inf),
+        (0.0, math.inf),
+        rocks=rocks,
+        seed=seed,
+    )
     alternatives = "".join(
         f"; {w}" for w in (not_a_law(a, target) for a in active) if w
     )
+    lines = list(loud)
     for name, material in model.materials.items():
-        rows = frame[frame["material"] == name]
-        vin = rows["vin_mps"].to_numpy(float)
-        vit = rows["vit_mps"].to_numpy(float)
-        vfn = rows["vfn_mps"].to_numpy(float)
-        vft = rows["vft_mps"].to_numpy(float)
-        ok = np.isfinite(vin) & np.isfinite(vit) & np.isfinite(vfn) & np.isfinite(vft)
-        if ok.sum() < 2:
-            lines.append(
-                f"{name}: no simulated impact on it ({rocks} rocks): e_n "
-                f"{material.e_n:.4g}, e_t {material.e_t:.4g} written without "
-                f"{', '.join(active)}, which {target} cannot represent"
-            )
+        rn, rt = coefficients[name]
+        if not rn.n:
             continue
-        e_n = float(np.sum(vfn[ok] * np.abs(vin[ok])) / np.sum(vin[ok] ** 2))
-        e_t = float(np.sum(vft[ok] * vit[ok]) / np.sum(vit[ok] ** 2))
-        materials[name] = replace(material, e_n=e_n, e_t=e_t)
         lines.append(
             f"{name}: {target} has no {', '.join(active)}: e_n {material.e_n:.4g}, "
             f"e_t {material.e_t:.4g} with them are written as the constant pair "
-            f"they realise, e_n {e_n:.3f}, e_t {e_t:.3f} (least squares over the "
-            f"{int(ok.sum())} impacts on {name} of {rocks} simulated rocks, seed "
+            f"they realise, e_n {rn.written:.3f} (spread {rn.spread:.2g}), e_t "
+            f"{rt.written:.3f} (spread {rt.spread:.2g}) (least squares over the "
+            f"{rn.n} impacts on {name} of {rocks} simulated rocks, seed "
             f"{seed}); the target's rebounds no longer vary with impact speed or "
             "angle as the calibrated ones do" + alternatives
         )
+    lumped = with_coefficients(model, coefficients)
     effects = {k: v for k, v in model.effects.items() if k not in active}
-    return replace(model, materials=materials, effects=effects), lines
+    return replace(lumped, effects=effects), lines
