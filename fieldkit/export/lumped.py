@@ -357,3 +357,86 @@ def lumped_equivalent(
     lumped = with_coefficients(model, coefficients)
     effects = {k: v for k, v in model.effects.items() if k not in active}
     return replace(lumped, effects=effects), lines
+
+
+class WrittenOutOfRange(RuntimeError):
+    """A value an exporter was about to write lies outside the target's documented
+    range: a bug in the exporter (the in-range fit or a conversion), never bad
+    input, so it is not a :class:`~fieldkit.errors.FieldkitError`."""
+
+
+@dataclass(frozen=True)
+class DocumentedRange:
+    """A target field's range ``[lo, hi]`` (``open_lo``: ``lo`` excluded) and the
+    document it comes from."""
+
+    field: str
+    lo: float
+    hi: float
+    source: str
+    open_lo: bool = False
+
+    def text(self) -> str:
+        """``field: [lo, hi] (source)`` for a README."""
+        left = "(" if self.open_lo else "["
+        hi = "inf" if math.isinf(self.hi) else f"{self.hi:g}"
+        return f"{self.field}: {left}{self.lo:g}, {hi}] ({self.source})"
+
+    def check(self, value: float, where: str) -> None:
+        """Raise :class:`WrittenOutOfRange` unless ``value`` lies in the range.
+
+        Examples
+        --------
+        >>> DocumentedRange("Rn", 0.0, 1.0, "doc").check(1.2, "clay")
+        Traceback (most recent call last):
+        ...
+        fieldkit.export.lumped.WrittenOutOfRange: clay: Rn = 1.2 outside [0, 1] (doc)
+        """
+        low_ok = value > self.lo if self.open_lo else value >= self.lo
+        if not (math.isfinite(value) and low_ok and value <= self.hi):
+            raise WrittenOutOfRange(
+                f"{where}: {self.field} = {value:g} outside "
+                + self.text().split(": ", 1)[1]
+            )
+
+
+def no_rule(name: str, target: str) -> str:
+    """Why an effect without a rule in ``target``'s exporter is not written: said,
+    never left out (an effect added to the registry after the exporter)."""
+    return (
+        f"NOT MAPPED: the {target} export has no rule for {name} (an effect newer "
+        "than the exporter); the files are written without it"
+    )
+
+
+def effects_account(
+    model: Model, target: str, rules: dict[str, tuple[bool, str]]
+) -> list[str]:
+    """One line per effect of the registry (on or off in ``model``): mapped to what,
+    or not mapped and why. ``rules``: effect -> (mapped, how or why); the
+    statistical alternative and an effect without a rule are said by
+    :func:`not_a_law` and :func:`no_rule`.
+
+    Examples
+    --------
+    >>> from fieldkit.model.model_file import model_from_dict
+    >>> m = model_from_dict({"profile": {"x_m": [0, 10], "z_m": [5, 0],
+    ...   "material": "rock"}, "materials": {"rock": {"e_n": 0.3, "e_t": 0.8,
+    ...   "friction_deg": 25}}, "effects": {"air_drag": {}}, "body": {"mass_kg":
+    ...   100, "radius_m": 0.2}, "seeder": {"x_m": 1, "z_m": 6}})
+    >>> lines = effects_account(m, "Demo", {"air_drag": (False, "no drag")})
+    >>> len(lines) == len(registry.EFFECTS), lines[6]
+    (True, 'effect air_drag (on in this model): not mapped: no drag')
+    """
+    out = []
+    for spec in registry.EFFECTS:
+        state = "on" if spec.name in model.effects else "off"
+        rule = rules.get(spec.name)
+        if rule is None:
+            why = not_a_law(spec.name, target) or no_rule(spec.name, target)
+            text = f"not mapped: {why}"
+        else:
+            mapped, how = rule
+            text = f"mapped: {how}" if mapped else f"not mapped: {how}"
+        out.append(f"effect {spec.name} ({state} in this model): {text}")
+    return out

@@ -28,16 +28,20 @@ where RocFall's range applies (below); a value without an SD is ``1, mean, 0, 0,
 0``. fieldkit draws ``N(mean, sd)`` clipped at 0 and has no upper bound: where a
 bound cuts closer than 3 SD, the README states the mean of RocFall's truncated draws.
 
-**Restitution above 1.** Rocscience documents Rn and Rt in [0, 1] (RocFall help
-"Coefficient of Restitution" and FAQ) and advises choosing SDs so that drawn values
-cannot exceed 1 (support article "How can I determine Rt?") -- advice, which implies
-RocFall itself does not stop draws above 1; the thesis ran RocFall 4.0 with Rn =
-1.00 +- 0.04 (Table 7-1). Rule here: Rt <= 1 always and Rn <= 1 without velocity
-scaling (else :class:`~fieldkit.errors.ArgumentError`); with ``scale rn by
-velocity`` on (``velocity_scaled_restitution``), Rn above 1 is written as calibrated
--- the scaled Rn ``Rn / (1 + (v/K)^2)`` is below 1 for normal impact speeds above
-``K sqrt(Rn - 1)`` -- with its draws not cut at 1, and the README says so. Whether
-RocFall's material dialog accepts a *mean* above 1 could not be confirmed.
+**Within RocFall's ranges, under RocFall's law.** Rocscience documents Rn and Rt in
+[0, 1] (RocFall help "Coefficient of Restitution" and FAQ) and advises SDs whose
+draws cannot exceed 1 (support article "How can I determine Rt?"). RocFall's "scale
+Rn by velocity" is ``Rn / (1 + (v/K)^2)`` with K = 9.144 m/s (30 ft/s, thesis
+§7.3.4). A calibrated model is written as it is when its law is RocFall's (no
+rebound law but velocity scaling at that K, every coefficient in [0, 1]); otherwise
+(a velocity-scaled e_n above 1, another K, an angle law, the statistical
+alternative) each material's Rn, Rt are the values in [0, 1] whose rebounds under
+RocFall's law are closest to the calibrated model's simulated impacts
+(:func:`fieldkit.export.lumped.fit_coefficients`), and the README gives the
+translation error: the calibrated model against fieldkit's reading of the files
+written (:mod:`fieldkit.export.rocfall_import`, the exact round trip) simulated on
+the same section (:func:`fieldkit.export.translation.translation_error`). Every
+written value is checked against :data:`RANGES` before anything is returned.
 
 Sources: Rocscience RocFall help pages "Coefficient of Restitution", "Analysis
 Method" (friction options, ``Phi = arctan((1 - Rt)/Rt)``, consider rotational
@@ -52,16 +56,26 @@ public; the blocks follow the fields of its dialogs.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.stats import norm, truncnorm
 
 from fieldkit.errors import ArgumentError
 from fieldkit.export.fitted import with_error
-from fieldkit.export.lumped import not_a_law
+from fieldkit.export.lumped import (
+    RESTITUTION_LAWS,
+    Coefficient,
+    DocumentedRange,
+    effects_account,
+    fit_coefficients,
+    no_rule,
+    not_a_law,
+    with_coefficients,
+)
 from fieldkit.export.result import Export, Mapped
 from fieldkit.export.site import ExportSite
+from fieldkit.export.translation import translation_error
 from fieldkit.model.model_file import Model
 from fieldkit.outputs import csv_text
 
@@ -84,6 +98,98 @@ RESTITUTION_MAX = 1.0
 FRICTION_MAX_DEG = 90.0
 #: RocFall's shortest slope segment (help "Slope Overview"), in metres here.
 MIN_SEGMENT_M = 0.001
+#: RocFall's velocity scale of Rn, "scale Rn by velocity" [m/s] (30 ft/s).
+ROCFALL_K_MPS = 9.144
+_HELP = "Rocscience RocFall help"
+#: The documented range of every numeric field written (checked on every export).
+RANGES: dict[str, DocumentedRange] = {
+    "rn": DocumentedRange(
+        "Rn (mean, min, max)",
+        0.0,
+        RESTITUTION_MAX,
+        f"{_HELP} 'Coefficient of Restitution': all real materials between 0 and 1; "
+        "FAQs: coefficients of restitution range from 0 to 1",
+    ),
+    "rt": DocumentedRange(
+        "Rt (mean, min, max)",
+        0.0,
+        RESTITUTION_MAX,
+        f"{_HELP} 'Coefficient of Restitution'; FAQs",
+    ),
+    "friction angle": DocumentedRange(
+        "friction angle (mean, min, max) [deg]",
+        0.0,
+        FRICTION_MAX_DEG,
+        f"{_HELP} 'Analysis Method': Phi = arctan((1 - Rt)/Rt) lies in [0, 90] deg "
+        "for Rt in [0, 1]",
+    ),
+    "slope roughness sd": DocumentedRange(
+        "slope roughness sd [deg]",
+        0.0,
+        FRICTION_MAX_DEG,
+        "an SD of the segment dip (thesis §7.3.6, Table 7-1); at most 90 deg here",
+    ),
+    "segment": DocumentedRange(
+        "slope segment length [m]",
+        MIN_SEGMENT_M,
+        math.inf,
+        f"{_HELP} 'Slope Overview': segments of at least 0.001 length units",
+    ),
+    "mass": DocumentedRange(
+        "mass (mean, min) [kg]",
+        0.0,
+        math.inf,
+        "a mass (RocFall FAQ: the lumped mass only gives energies)",
+        open_lo=True,
+    ),
+    "k": DocumentedRange(
+        "scale rn velocity k [m/s]",
+        ROCFALL_K_MPS,
+        ROCFALL_K_MPS,
+        "RocFall's K = 30 ft/s (thesis §7.3.4, eq. 7.1; fieldkit's "
+        "velocity_scaled_restitution default)",
+    ),
+    "cutoff": DocumentedRange(
+        "stopped velocity cutoff [m/s]",
+        0.0,
+        math.inf,
+        f"{_HELP} 'Engine Conditions': the velocity below which a rock has stopped",
+        open_lo=True,
+    ),
+}
+#: Where RocFall's rules in this export come from (README "Sources").
+SOURCES = (
+    "Rocscience RocFall help 'Coefficient of Restitution' "
+    "(rocscience.com/help/rocfall/documentation/slope/materials/"
+    "coefficient-of-restitution): Rn, Rt definitions, range 0 to 1",
+    "Rocscience RocFall help 'FAQs' (rocscience.com/help/rocfall/overview/faqs): "
+    "coefficients of restitution range from 0 to 1; scale Rn by mass",
+    "Rocscience RocFall help 'Analysis Method' (rocscience.com/help/rocfall/"
+    "documentation/project-settings/general-settings/analysis-method): lumped mass, "
+    "friction angle options, Phi = arctan((1 - Rt)/Rt), consider rotational velocity",
+    "Rocscience RocFall help 'Engine Conditions' (rocscience.com/help/rocfall/"
+    "documentation/project-settings/engine-conditions): stopped velocity cutoff, "
+    "maximum steps per rock",
+    "Rocscience RocFall help 'Slope Overview': segments >= 0.001 length units, "
+    "vertices left to right",
+    "Rocscience RocFall3 help 'Random Variables': distribution, SD, relative min "
+    "and max; RocPlane help 'Normal Distribution': 3 SD bounds",
+    "Rocscience support article 'How can I determine Rt?': SDs whose draws cannot "
+    "exceed 1",
+    "RocNews Fall 2003 'Determining Input Parameters for a RocFall Analysis' "
+    "(lists coefficient of normal restitution scaling among RocFall's inputs)",
+    "Thesis ch. 7: eq. 7.1 and §7.3.4 (scale Rn by velocity, K = 9.144 m/s = "
+    "30 ft/s), §7.3.6 and Table 7-1 (slope roughness as the SD of the dip)",
+)
+#: What the sources leave open (README "Unconfirmed").
+UNCONFIRMED = (
+    "RocFall's on-disk project syntax (.fal, .rf3): the blocks follow its dialogs",
+    "whether RocFall lets the user change K of 'scale Rn by velocity' (9.144 m/s is "
+    "written; the help pages read give no K field), and whether its v is the normal "
+    "impact speed (as eq. 7.1 and fieldkit) or the full impact speed",
+    "when RocFall redraws the slope roughness (per rock or per impact)",
+    "how RocFall's lumped-mass 'consider rotational velocity' changes Rt",
+)
 #: Material keys -> (fieldkit field, unit written in the key).
 MATERIAL_KEYS: dict[str, tuple[str, str]] = {
     "rn": ("e_n", ""),
@@ -234,31 +340,13 @@ def velocity_k_mps(model: Model) -> float | None:
 
 
 def check_rocfall(model: Model) -> None:
-    """Refuse values RocFall does not accept (module docstring: the rule).
+    """Refuse a profile RocFall cannot take.
 
     Raises
     ------
     ArgumentError
-        Rt above 1; Rn above 1 without velocity scaling; a slope segment shorter
-        than RocFall's 0.001 length units.
+        A slope segment shorter than RocFall's 0.001 length units.
     """
-    scaled = velocity_k_mps(model) is not None
-    for name, m in model.materials.items():
-        if m.e_t > RESTITUTION_MAX:
-            raise ArgumentError(
-                f"material {name}: e_t = {m.e_t:g} is outside RocFall's Rt range "
-                f"[0, {RESTITUTION_MAX:g}] (Rocscience: coefficients of restitution "
-                "range from 0 to 1)",
-                source="model",
-            )
-        if m.e_n > RESTITUTION_MAX and not scaled:
-            raise ArgumentError(
-                f"material {name}: e_n = {m.e_n:g} is outside RocFall's Rn range "
-                f"[0, {RESTITUTION_MAX:g}]; Rn above 1 is exported only with "
-                "velocity scaling on (velocity_scaled_restitution), where RocFall "
-                "scales it by 1/(1 + (v/K)^2)",
-                source="model",
-            )
     lengths = np.hypot(np.diff(model.profile.x_m), np.diff(model.profile.z_m))
     short = np.flatnonzero(lengths < MIN_SEGMENT_M)
     if short.size:
@@ -270,15 +358,95 @@ def check_rocfall(model: Model) -> None:
         )
 
 
+def rocfall_law(model: Model) -> tuple[bool, list[str]]:
+    """Whether RocFall's velocity scaling is on for ``model``, and why the model's
+    law cannot be written in RocFall's terms as it is (empty: it can).
+
+    Examples
+    --------
+    >>> from fieldkit.model.model_file import model_from_dict
+    >>> m = model_from_dict({"profile": {"x_m": [0, 10], "z_m": [5, 0],
+    ...   "material": "rock"}, "materials": {"rock": {"e_n": 1.2, "e_t": 0.8,
+    ...   "friction_deg": 25}}, "effects": {"velocity_scaled_restitution":
+    ...   {"k_mps": 13.2}}, "body": {"mass_kg": 100, "radius_m": 0.2},
+    ...   "seeder": {"x_m": 1, "z_m": 6}})
+    >>> scaled, why = rocfall_law(m)
+    >>> scaled, len(why)
+    (True, 2)
+    """
+    k = velocity_k_mps(model)
+    reasons = []
+    if k is not None and not math.isclose(k, ROCFALL_K_MPS, rel_tol=1e-9):
+        reasons.append(
+            f"velocity_scaled_restitution.k_mps = {k:.4g} m/s, but RocFall scales "
+            f"Rn with K = {ROCFALL_K_MPS:g} m/s"
+        )
+    for law in RESTITUTION_LAWS:
+        if law in model.effects and law not in (
+            "velocity_scaled_restitution",
+            "rotation_friction",
+        ):
+            reasons.append(f"{law}: RocFall's lumped mass has no such law")
+    for name, m in model.materials.items():
+        for field, key in (("e_n", "Rn"), ("e_t", "Rt")):
+            value = getattr(m, field)
+            if not 0.0 <= value <= RESTITUTION_MAX:
+                reasons.append(
+                    f"materials.{name}.{field} = {value:.4g} is outside RocFall's "
+                    f"{key} range [0, 1]"
+                )
+    return k is not None, reasons
+
+
+def normal_factor(v_mps: np.ndarray) -> np.ndarray:
+    """RocFall's scaling of Rn at normal impact speeds ``v``: ``1 / (1 + (v/K)^2)``,
+    K = :data:`ROCFALL_K_MPS`."""
+    return 1.0 / (1.0 + (np.asarray(v_mps, float) / ROCFALL_K_MPS) ** 2)
+
+
+def rocfall_model(
+    model: Model,
+) -> tuple[Model, dict[str, tuple[Coefficient, Coefficient]], list[str], list[str]]:
+    """The model as RocFall is given it, from which the files are written.
+
+    Returns
+    -------
+    written, coefficients, reasons, loud
+        ``written``: ``model`` with RocFall's law (velocity scaling at
+        :data:`ROCFALL_K_MPS` when the model scales, no other rebound law) and the
+        written Rn, Rt; ``coefficients``: per material the fitted (Rn, Rt) (empty
+        when the model's law is RocFall's and it is written as calibrated);
+        ``reasons``: why it was fitted; ``loud``: the lines of materials no
+        simulated rock touched.
+    """
+    scaled, reasons = rocfall_law(model)
+    effects = {
+        name: params
+        for name, params in model.effects.items()
+        if name not in RESTITUTION_LAWS or name == "rotation_friction"
+    }
+    if scaled:
+        effects["velocity_scaled_restitution"] = {"k_mps": ROCFALL_K_MPS}
+    if not reasons:
+        return replace(model, effects=effects), {}, [], []
+    coefficients, loud = fit_coefficients(
+        model,
+        "RocFall",
+        normal_factor if scaled else np.ones_like,
+        (0.0, RESTITUTION_MAX),
+        (0.0, RESTITUTION_MAX),
+        fit_rt="rotation_friction" not in model.effects,
+    )
+    written = with_coefficients(model, coefficients)
+    return replace(written, effects=effects), coefficients, reasons, loud
+
+
 def material_distributions(model: Model) -> dict[str, dict[str, Distribution]]:
     """Per material: ``{"rn": ..., "rt": ..., "friction angle": ...}`` tuples."""
-    scaled = velocity_k_mps(model) is not None
     out = {}
     for name, m in model.materials.items():
         out[name] = {
-            "rn": distribution(
-                m.e_n, m.e_n_sd, lower=0.0, upper=None if scaled else RESTITUTION_MAX
-            ),
+            "rn": distribution(m.e_n, m.e_n_sd, lower=0.0, upper=RESTITUTION_MAX),
             "rt": distribution(m.e_t, m.e_t_sd, lower=0.0, upper=RESTITUTION_MAX),
             "friction angle": distribution(
                 m.friction_deg, m.friction_deg_sd, lower=0.0, upper=FRICTION_MAX_DEG
@@ -320,8 +488,7 @@ def materials_text(model: Model) -> str:
         "# RocFall slope materials (lumped mass), from fieldkit",
         _HEADER.rstrip("\n"),
         f"# Convention: normal truncated at {TRUNCATION_SD:g} sd each side, min >= 0,"
-        f" Rt max <= 1, Rn max <= 1 unless velocity scaling is on,"
-        f" friction max <= {FRICTION_MAX_DEG:g} deg",
+        f" Rn and Rt max <= 1, friction max <= {FRICTION_MAX_DEG:g} deg",
         "# slope roughness sd: standard deviation of the segment dip [deg]",
     ]
     for name, i in material_ids(model).items():
@@ -422,21 +589,25 @@ def export_rocfall(model: Model, site: ExportSite | None = None) -> Export:
     Raises
     ------
     ArgumentError
-        Values RocFall does not accept (:func:`check_rocfall`).
+        A profile RocFall does not accept (:func:`check_rocfall`).
     """
     del site
     check_rocfall(model)
+    written, coefficients, reasons, loud = rocfall_model(model)
     files = {
-        "materials.txt": materials_text(model),
-        "rock_type.txt": rock_type_text(model),
-        "project_settings.txt": settings_text(model),
-        "slope.csv": slope_csv(model),
-        "material_ids.csv": material_ids_csv(model),
+        "materials.txt": materials_text(written),
+        "rock_type.txt": rock_type_text(written),
+        "project_settings.txt": settings_text(written),
+        "slope.csv": slope_csv(written),
+        "material_ids.csv": material_ids_csv(written),
     }
-    mapped, mismatches = _mapped_materials(model)
-    mapped += _mapped_rest(model)
+    check_written(written)
+    mapped, mismatches = _mapped_materials(model, written, coefficients)
+    mapped += _mapped_rest(model, written)
     unmapped = _unmapped(model)
+    mismatches = [*loud, *_fit_lines(reasons, coefficients), *mismatches]
     mismatches += _mismatches_rest(model)
+    emulated = emulation(files, model)
     return Export(
         target="rocfall",
         title="RocFall (Rocscience), lumped mass",
@@ -447,13 +618,93 @@ def export_rocfall(model: Model, site: ExportSite | None = None) -> Export:
             "metric throughout: set RocFall's project units to metric (m, kg, m/s)",
             "x = fieldkit chainage x_m [m], y = fieldkit elevation z_m [m]",
             "angles in degrees (friction angle, slope roughness SD), as in fieldkit",
-            "scale rn velocity k in m/s (RocFall's default 9.144 m/s = 30 ft/s)",
+            "scale rn velocity k in m/s (RocFall's K = 9.144 m/s = 30 ft/s)",
             "rotational velocity in rad/s",
         ],
         mismatches=mismatches,
-        notes=_notes(),
+        notes=_notes() + effects_account(model, "RocFall", EFFECT_RULES),
         how_to_use=_HOW_TO_USE,
+        translation=_translation_lines(model, emulated),
+        sources=list(SOURCES),
+        unconfirmed=list(UNCONFIRMED),
     )
+
+
+def emulation(files: dict[str, str], model: Model) -> Model:
+    """fieldkit's model of RocFall's law with the values written: the files read
+    back (:func:`fieldkit.export.rocfall_import.model_from_rocfall`, exact), with
+    the calibrated body's radius (a lumped mass has none)."""
+    from fieldkit.export.rocfall_import import Text, model_from_rocfall
+
+    emulated, _ = model_from_rocfall(
+        Text(files["materials.txt"], "materials.txt"),
+        Text(files["slope.csv"], "slope.csv"),
+        Text(files["rock_type.txt"], "rock_type.txt"),
+        settings=Text(files["project_settings.txt"], "project_settings.txt"),
+        radius_m=model.body.radius_m,
+    )
+    return emulated
+
+
+def _translation_lines(model: Model, emulated: Model) -> list[str]:
+    lines = translation_error(model, emulated).lines()
+    return [
+        *lines,
+        "",
+        "The emulation is fieldkit reading the files back (the exact round trip): "
+        "RocFall's law as fieldkit's velocity_scaled_restitution at K = 9.144 m/s "
+        "(or a constant pair), the written Rn, Rt and their SDs, the slope "
+        "roughness as a dip SD; it differs from RocFall in what fieldkit cannot "
+        "reproduce: RocFall truncates its draws at min/max (fieldkit clips at 0 "
+        "only), RocFall's own rotation, sliding and stopping rules.",
+    ]
+
+
+def check_written(written: Model) -> None:
+    """Every numeric field written against :data:`RANGES`.
+
+    Raises
+    ------
+    fieldkit.export.lumped.WrittenOutOfRange
+        A value outside its documented range (an exporter bug).
+    """
+    for name, dists in material_distributions(written).items():
+        for key, d in dists.items():
+            for value in (d.mean, d.minimum, d.maximum):
+                RANGES[key].check(value, f"material {name}")
+    for name, value in roughness_sd_deg(written).items():
+        RANGES["slope roughness sd"].check(value, f"material {name}")
+    p = written.profile
+    for j, length in enumerate(np.hypot(np.diff(p.x_m), np.diff(p.z_m))):
+        RANGES["segment"].check(float(length), f"slope segment {j}")
+    mass = distribution(written.body.mass_kg, written.seeder.mass_sd_kg, lower=0.0)
+    RANGES["mass"].check(mass.mean, "rock type 1")
+    k = velocity_k_mps(written)
+    if k is not None:
+        RANGES["k"].check(k, "project settings")
+    RANGES["cutoff"].check(written.core["stop_speed_mps"], "project settings")
+
+
+def _fit_lines(
+    reasons: list[str], coefficients: dict[str, tuple[Coefficient, Coefficient]]
+) -> list[str]:
+    if not reasons:
+        return []
+    out = [
+        "The calibrated law cannot be written in RocFall's terms ("
+        + "; ".join(reasons)
+        + "): each material's Rn, Rt are the values in [0, 1] whose rebounds under "
+        "RocFall's law are closest (least squares) to the calibrated model's "
+        "simulated impacts on it; see the translation error"
+    ]
+    for coefficient in (c for pair in coefficients.values() for c in pair):
+        if coefficient.clipped:
+            out.append(
+                f"{coefficient.name}: the least-squares value under RocFall's law is "
+                f"{coefficient.unclipped:.4g}, outside RocFall's range [0, 1]: "
+                f"{coefficient.written:g} is written"
+            )
+    return out
 
 
 _HOW_TO_USE = """\
@@ -471,11 +722,14 @@ _HOW_TO_USE = """\
 `fieldkit` reads these files back (`fieldkit.export.rocfall_import.read_rocfall`)."""
 
 
-def _mapped_materials(model: Model) -> tuple[list[Mapped], list[str]]:
-    dists = material_distributions(model)
-    rough = roughness_sd_deg(model)
-    ids = material_ids(model)
-    k = velocity_k_mps(model)
+def _mapped_materials(
+    model: Model,
+    written: Model,
+    coefficients: dict[str, tuple[Coefficient, Coefficient]],
+) -> tuple[list[Mapped], list[str]]:
+    dists = material_distributions(written)
+    rough = roughness_sd_deg(written)
+    ids = material_ids(written)
     mapped, mismatches = [], []
     fields = (
         ("rn", "e_n", ""),
@@ -483,16 +737,23 @@ def _mapped_materials(model: Model) -> tuple[list[Mapped], list[str]]:
         ("friction angle", "friction_deg", "deg"),
     )
     for name, m in model.materials.items():
+        fitted = dict(zip(("e_n", "e_t"), coefficients.get(name, ()), strict=False))
         for key, field, unit in fields:
             d = dists[name][key]
             sd_field = f"{field}_sd"
-            text = with_error(model, f"materials.{name}.{field}", d.mean, unit)
+            calibrated = getattr(m, field)
+            text = with_error(model, f"materials.{name}.{field}", calibrated, unit)
+            how = f"{DISTRIBUTIONS[d.kind]}, min {d.minimum:.4g}, max {d.maximum:.4g}"
+            if field in fitted:
+                how = (
+                    f"written {fitted[field].text()}, fitted under RocFall's law; "
+                    + how
+                )
             mapped.append(
                 Mapped(
-                    f"{text}; {sd_field} = {d.sd:g}",
+                    f"{text}; {sd_field} = {getattr(m, sd_field):g}",
                     f"material {ids[name]} ({name}): {key} = ({d.text()})",
-                    f"{DISTRIBUTIONS[d.kind]}, min {d.minimum:.4g}, max "
-                    f"{d.maximum:.4g}",
+                    how,
                 )
             )
             if _cut(d):
@@ -517,14 +778,6 @@ def _mapped_materials(model: Model) -> tuple[list[Mapped], list[str]]:
                 "slope_roughness on, 0 off",
             )
         )
-        if m.e_n > RESTITUTION_MAX and k is not None:
-            mismatches.append(
-                f"{name} rn = {m.e_n:g} > 1, written as calibrated: with scale rn by "
-                f"velocity (K = {k:g} m/s) the scaled Rn is below 1 for normal impact "
-                f"speeds above K sqrt(Rn - 1) = {k * math.sqrt(m.e_n - 1.0):.3g} m/s. "
-                "Rocscience documents Rn in [0, 1]; whether RocFall's material "
-                "dialog accepts a mean above 1 is not confirmed"
-            )
         if "slope_roughness" in model.effects and (
             m.roughness_m > 0.0 or model.effects["slope_roughness"]["scale"] != 1.0
         ):
@@ -538,8 +791,8 @@ def _mapped_materials(model: Model) -> tuple[list[Mapped], list[str]]:
     return mapped, mismatches
 
 
-def _mapped_rest(model: Model) -> list[Mapped]:
-    s, k = model.seeder, velocity_k_mps(model)
+def _mapped_rest(model: Model, written: Model) -> list[Mapped]:
+    s, k, k_written = model.seeder, velocity_k_mps(model), velocity_k_mps(written)
     out = [
         Mapped(
             with_error(model, "body.mass_kg", model.body.mass_kg, "kg")
@@ -585,10 +838,10 @@ def _mapped_rest(model: Model) -> list[Mapped]:
                 if "velocity_scaled_restitution" in model.effects
                 else "velocity_scaled_restitution off"
             ),
-            f"scale rn by velocity: on, k = {k:g} m/s"
-            if k is not None
+            f"scale rn by velocity: on, k = {k_written:g} m/s"
+            if k_written is not None
             else "scale rn by velocity: off",
-            "vfn = Rn vin / (1 + (vin/K)^2), thesis eq. 7.1",
+            "vfn = Rn vin / (1 + (vin/K)^2), thesis eq. 7.1, with RocFall's K",
         ),
         Mapped(
             "rotation_friction "
@@ -608,18 +861,40 @@ def _mapped_rest(model: Model) -> list[Mapped]:
 #: Effects RocFall (lumped mass) cannot represent -> why.
 _NO_EFFECT = {
     "angle_dependent_restitution": "RocFall's lumped-mass Rn is scaled by velocity "
-    "or by mass only; no impact-angle law for Rn was found in its documentation",
+    "or by mass only; no impact-angle law for Rn was found in its documentation: "
+    "Rn, Rt are fitted in range to the rebounds the law realises",
     "mass_loss": "RocFall's lumped-mass rock keeps its mass (no breakage or abrasion)",
     "tree_impacts": "RocFall's lumped mass has no trees (barriers only); the trees "
     "are not exported",
     "air_drag": "RocFall's lumped mass ignores air resistance",
+}
+#: How RocFall takes every effect of the registry (README "Notes").
+EFFECT_RULES: dict[str, tuple[bool, str]] = {
+    **{name: (False, why) for name, why in _NO_EFFECT.items()},
+    "velocity_scaled_restitution": (
+        True,
+        "'scale Rn by velocity' at RocFall's K = 9.144 m/s; another K or an Rn "
+        "above 1 is fitted in range under that law",
+    ),
+    "rotation_friction": (
+        True,
+        "'consider rotational velocity' (on/off only: RocFall's own rotation, its "
+        "friction and coupling are not written)",
+    ),
+    "slope_roughness": (True, "each material's slope roughness (SD of the dip)"),
 }
 
 
 def _unmapped(model: Model) -> list[tuple[str, str]]:
     out = []
     for name, params in model.effects.items():
-        why = _NO_EFFECT.get(name) or not_a_law(name, "RocFall")
+        if name in EFFECT_RULES and EFFECT_RULES[name][0]:
+            continue
+        why = (
+            _NO_EFFECT.get(name)
+            or not_a_law(name, "RocFall")
+            or no_rule(name, "RocFall")
+        )
         if why:
             values = ", ".join(f"{k} = {v:g}" for k, v in params.items())
             out.append((f"{name} ({values})", why))
@@ -686,22 +961,19 @@ def _notes() -> list[str]:
     return [
         "RocFall's own project files (.fal, .rf3) are proprietary: these blocks "
         "follow the fields of RocFall's dialogs (material editor, rock type and "
-        "seeder, project settings), not its on-disk syntax, which could not be "
-        "confirmed.",
+        "seeder, project settings), not its on-disk syntax.",
         f"Distribution convention (fieldkit's, stated): normal truncated at "
         f"{TRUNCATION_SD:g} SD each side (Rocscience: bounds 3 SD from the mean give "
-        "a complete normal), clipped so min >= 0, friction max <= 90 deg, Rt max <= 1 "
-        "and Rn max <= 1 unless velocity scaling is on; no SD -> (1, mean, 0, 0, 0).",
-        "Restitution range: Rocscience documents Rn, Rt in [0, 1] (help "
-        "'Coefficient of Restitution', FAQ) and advises SDs that cannot draw above 1 "
-        "(support 'How can I determine Rt?'); the thesis ran RocFall 4.0 with Rn = "
-        "1.00 +- 0.04 (Table 7-1). fieldkit refuses Rt > 1, and Rn > 1 without "
-        "velocity scaling.",
-        "Velocity scaling: vfn = Rn vin / (1 + (vin/K)^2) (thesis eq. 7.1), as "
-        "fieldkit's velocity_scaled_restitution.",
+        "a complete normal), clipped so min >= 0, Rn and Rt max <= 1, friction max "
+        "<= 90 deg; no SD -> (1, mean, 0, 0, 0).",
+        "Documented ranges, checked on every value written: "
+        + "; ".join(r.text() for r in RANGES.values())
+        + ".",
+        "Velocity scaling: vfn = Rn vin / (1 + (vin/K)^2) (thesis eq. 7.1) with "
+        f"RocFall's K = {ROCFALL_K_MPS:g} m/s, as fieldkit's "
+        "velocity_scaled_restitution.",
         "Slope roughness: RocFall's roughness is the SD of the segment dip (thesis "
-        "§7.3.6, Table 7-1); fieldkit draws the dip perturbation at each impact. "
-        "When RocFall redraws it (per rock or per impact) could not be confirmed.",
+        "§7.3.6, Table 7-1); fieldkit draws the dip perturbation at each impact.",
         "Friction: RocFall's lumped mass can take the friction angle from the "
         "material, from Rt (Phi = arctan((1 - Rt)/Rt)) or zero (help 'Analysis "
         "Method'); the export sets 'use material friction angle'.",
