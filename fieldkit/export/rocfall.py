@@ -437,6 +437,11 @@ def rocfall_model(
         (0.0, RESTITUTION_MAX),
         fit_rt="rotation_friction" not in model.effects,
     )
+    # the value RocFall is given is the value in the file (15 significant digits)
+    coefficients = {
+        name: tuple(replace(c, written=float(number(c.written))) for c in pair)
+        for name, pair in coefficients.items()
+    }
     written = with_coefficients(model, coefficients)
     return replace(written, effects=effects), coefficients, reasons, loud
 

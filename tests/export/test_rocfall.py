@@ -8,24 +8,30 @@ Rn of 1.2 falls below 1 (9.144 sqrt(0.2)), arctan((1 - Rt)/Rt) for Rt = 0.59.
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import fields
 
 import numpy as np
 import pytest
 
-from fieldkit.errors import ArgumentError, InputFileError
+from fieldkit.errors import InputFileError
+from fieldkit.export.lumped import WrittenOutOfRange
 from fieldkit.export.rocfall import (
     Distribution,
+    check_written,
     clipped_mean,
     distribution,
     export_rocfall,
+    rocfall_model,
     truncated_mean,
 )
 from fieldkit.export.rocfall_import import Text, model_from_rocfall, read_rocfall
+from fieldkit.export.translation import realised_impacts
 from fieldkit.model.model_file import model_from_dict, model_to_dict, read_model
 
 TABLE_7_1 = "surveys/tornado_mountain/model_rocfall_table_7_1.json"
+PATH_START = "surveys/tornado_mountain/model_path_start.json"
 
 
 @pytest.fixture()
@@ -63,7 +69,9 @@ def _block_line(text, material, key):
 
 
 def test_round_trip_table_7_1_with_velocity_scaling(table_7_1, tmp_path):
-    model = _scaled(table_7_1, k_mps=7.5)
+    # RocFall's own K: the law is RocFall's and every value is written as calibrated
+    # (another K is fitted in range: test_a_law_rocfall_cannot_take_round_trips_...)
+    model = _scaled(table_7_1, k_mps=9.144)
     export = export_rocfall(model)
     for name, text in export.files.items():
         (tmp_path / name).write_text(text, encoding="utf-8")
@@ -78,7 +86,7 @@ def test_round_trip_table_7_1_with_velocity_scaling(table_7_1, tmp_path):
     for name, material in model.materials.items():
         for f in fields(material):
             assert getattr(back.materials[name], f.name) == getattr(material, f.name)
-    assert back.effects["velocity_scaled_restitution"] == {"k_mps": 7.5}
+    assert back.effects["velocity_scaled_restitution"] == {"k_mps": 9.144}
     assert back.effects["slope_roughness"] == {"scale": 1.0}
     assert set(back.effects) == {"velocity_scaled_restitution", "slope_roughness"}
     assert np.array_equal(back.profile.x_m, model.profile.x_m)
@@ -109,9 +117,10 @@ def test_distribution_tuples_by_hand(table_7_1):
     # friction 2.86 +- 1.5: 3 sd = 4.5 above; below cut at 0 -> relative min 2.86
     assert _block_line(plain, "rock", "friction angle") == "2, 2.86, 1.5, 2.86, 4.5"
     assert _block_line(plain, "rock", "slope roughness sd") == "35"
-    # colluvium rn 1.0 +- 0.04: max cut at 1 without scaling, 1.12 with it
+    # colluvium rn 1.0 +- 0.04: max cut at 1, with velocity scaling too (RocFall
+    # documents Rn in [0, 1]; before issue 19 the scaled max was 1.12)
     assert _block_line(plain, "colluvium", "rn") == "2, 1, 0.04, 0.12, 0"
-    assert _block_line(scaled, "colluvium", "rn") == "2, 1, 0.04, 0.12, 0.12"
+    assert _block_line(scaled, "colluvium", "rn") == "2, 1, 0.04, 0.12, 0"
     assert _block_line(plain, "colluvium", "friction angle") == "2, 19.29, 2, 6, 6"
     # no SD -> distribution 1 (none)
     assert distribution(3.007, 0.0).text() == "1, 3.007, 0, 0, 0"
@@ -131,31 +140,141 @@ def test_truncation_mismatch_by_hand(table_7_1):
     assert "colluvium rn" in text and "mean 0.9684" in text
 
 
-def test_rn_above_one_refused_without_velocity_scaling(table_7_1):
-    table_7_1["materials"]["colluvium"]["e_n"] = 1.2
-    with pytest.raises(ArgumentError) as exc:
-        export_rocfall(model_from_dict(table_7_1))
-    message = str(exc.value)
-    assert "\n" not in message
-    for part in ("colluvium", "e_n = 1.2", "[0, 1]", "velocity_scaled_restitution"):
-        assert part in message
+def _tuples(text, key):
+    """Every ``key`` tuple of materials.txt as (mean, min, max)."""
+    out = []
+    for line in text.splitlines():
+        if line.startswith(f"{key}:"):
+            kind, mean, sd, rel_min, rel_max = map(float, line[3:].split(","))
+            out.append((mean, mean - rel_min, mean + rel_max))
+    return out
 
 
-def test_rt_above_one_refused(table_7_1):
+def test_rt_above_one_is_fitted_in_range(table_7_1):
+    # before issue 19: refused; now the in-range value under RocFall's law
     table_7_1["materials"]["rock"]["e_t"] = 1.05
-    with pytest.raises(ArgumentError, match=r"material rock: e_t = 1.05 .*\[0, 1\]"):
-        export_rocfall(_scaled(table_7_1))
-
-
-def test_rn_above_one_with_velocity_scaling_is_written_and_flagged(table_7_1):
-    table_7_1["materials"]["colluvium"]["e_n"] = 1.2
-    export = export_rocfall(_scaled(table_7_1))
-    assert _block_line(export.files["materials.txt"], "colluvium", "rn") == (
-        "2, 1.2, 0.04, 0.12, 0.12"
+    export = export_rocfall(model_from_dict(table_7_1))
+    rt = [t for t in _tuples(export.files["materials.txt"], "rt")]
+    assert all(0.0 <= v <= 1.0 for t in rt for v in t), rt
+    assert any(
+        "materials.rock.e_t = 1.05 is outside RocFall's Rt" in m
+        for m in export.mismatches
     )
-    # scaled Rn < 1 above K sqrt(Rn - 1) = 9.144 * 0.447214 = 4.089 m/s
-    flagged = [m for m in export.mismatches if "colluvium rn = 1.2" in m]
-    assert len(flagged) == 1 and "4.09 m/s" in flagged[0]
+
+
+def test_check_written_refuses_a_value_out_of_range(table_7_1):
+    table_7_1["materials"]["colluvium"]["e_n"] = 1.2
+    with pytest.raises(WrittenOutOfRange, match=r"material colluvium: Rn .* = 1.2"):
+        check_written(model_from_dict(table_7_1))
+
+
+def _calibrated(repo, tmp_path, **changes):
+    """Tornado's path-calibrated model as the README reports it (colluvium e_n
+    1.186 with eq. 7.1 at K = 13.24 m/s, bench e_n 0.83), written to a file."""
+    data = json.loads((repo / PATH_START).read_text())
+    data["materials"]["colluvium"]["e_n"] = 1.18581256337219
+    data["materials"]["bench"]["e_n"] = 0.83
+    data["effects"]["velocity_scaled_restitution"] = {"k_mps": 13.2440621510482}
+    for key, value in changes.items():
+        data[key] = value
+    path = tmp_path / "calibrated.json"
+    path.write_text(json.dumps(data))
+    return path
+
+
+def test_calibrated_tornado_written_in_range_with_translation_error(
+    cli, repo, tmp_path
+):
+    out = tmp_path / "rocfall"
+    r = cli("export", _calibrated(repo, tmp_path), "--to", "rocfall", "-o", out)
+    assert r.exit_code == 0, r.output
+    for name in ("materials.txt", "README.md"):
+        assert f"wrote {out / name}" in r.output
+    text = (out / "materials.txt").read_text()
+    # before issue 19: "rn: 2, 1.18581256337219, 0.04, 0.12, 0.12", K 13.24
+    for key in ("rn", "rt"):
+        for mean, low, high in _tuples(text, key):
+            assert 0.0 <= low <= mean <= high <= 1.0
+    assert (
+        "scale rn velocity k (m/s): 9.144" in (out / "project_settings.txt").read_text()
+    )
+    readme = (out / "README.md").read_text()
+    # colluvium: under RocFall's K the least-squares Rn is above 1: clipped, said
+    assert (
+        "materials.colluvium.e_n: the least-squares value under RocFall's law is 1.4"
+        in readme
+    )
+    assert "## Translation error: calibrated model vs the target's law" in readme
+    assert "| runout p50 |" in readme and "| runout p95 |" in readme
+    assert "p95 total energy at" in readme and "p95 bounce height at" in readme
+    # the written value carries its own spread; the calibrated one is beside it
+    row = next(x for x in readme.splitlines() if "material 2 (colluvium): rn" in x)
+    calibrated, target, how = row.strip("| ").split(" | ")
+    assert calibrated == "materials.colluvium.e_n = 1.186; e_n_sd = 0.04"
+    assert target == "material 2 (colluvium): rn = (2, 1, 0.04, 0.12, 0)"
+    assert how.startswith("written 1 (spread 0.4")
+    for section in ("## Sources of the target's rules", "## Unconfirmed"):
+        assert section in readme
+
+
+def test_a_law_rocfall_cannot_take_round_trips_to_the_values_written(repo, tmp_path):
+    model = read_model(_calibrated(repo, tmp_path))
+    export = export_rocfall(model)
+    back, _ = _reimport(export, radius_m=model.body.radius_m)
+    written, coefficients, reasons, _ = rocfall_model(model)
+    assert reasons and back.effects["velocity_scaled_restitution"] == {"k_mps": 9.144}
+    for name, (rn, rt) in coefficients.items():
+        assert back.materials[name].e_n == rn.written == written.materials[name].e_n
+        assert back.materials[name].e_t == rt.written
+        assert back.materials[name].e_n_sd == model.materials[name].e_n_sd
+
+
+def test_fitted_rn_is_the_least_squares_value_under_rocfalls_law(repo, tmp_path):
+    # the bench's Rn by hand from the calibrated model's own impacts:
+    # p = sum(vfN f v) / sum((f v)^2), f = 1 / (1 + (v / 9.144)^2), v = |viN|
+    model = read_model(_calibrated(repo, tmp_path))
+    impacts = realised_impacts(model)
+    bench = impacts[impacts["material"] == "bench"]
+    v = -bench["vin_mps"].to_numpy()
+    f = 1.0 / (1.0 + (v / 9.144) ** 2)
+    p = float(np.sum(bench["vfn_mps"].to_numpy() * f * v) / np.sum((f * v) ** 2))
+    _, coefficients, _, _ = rocfall_model(model)
+    assert 0.0 < p < 1.0
+    assert coefficients["bench"][0].written == pytest.approx(p, rel=1e-12)
+
+
+def test_a_material_no_rock_touches_is_not_written_raw(cli, repo, tmp_path):
+    # a segment above the seeder: no rock ever strikes "crest"
+    data = {
+        "profile": {
+            "x_m": [0, 10, 70, 140],
+            "z_m": [80, 70, 30, 10],
+            "material": ["crest", "talus", "talus"],
+        },
+        "materials": {
+            "crest": {"e_n": 0.5, "e_t": 0.8, "friction_deg": 30},
+            "talus": {"e_n": 1.1, "e_t": 0.8, "friction_deg": 30},
+        },
+        "effects": {"velocity_scaled_restitution": {"k_mps": 13.0}},
+        "body": {"mass_kg": 100, "radius_m": 0.2},
+        "seeder": {"x_m": 12, "z_m": 72},
+    }
+    path = tmp_path / "m.json"
+    path.write_text(json.dumps(data))
+    out = tmp_path / "out"
+    r = cli("export", path, "--to", "rocfall", "-o", out)
+    assert r.exit_code == 0, r.output
+    readme = " ".join((out / "README.md").read_text().split())
+    assert "crest: NO SIMULATED IMPACT on it" in readme
+    # crest's own law, 0.5 / (1 + (v/13)^2), at every simulated impact's normal
+    # speed, fitted under RocFall's 1 / (1 + (v/9.144)^2): above 0.5, not raw 0.5
+    impacts = realised_impacts(model_from_dict(data))
+    assert (impacts["material"] == "talus").all()
+    v = -impacts["vin_mps"].to_numpy()
+    g, f = 1 / (1 + (v / 13.0) ** 2), 1 / (1 + (v / 9.144) ** 2)
+    p = float(np.sum(0.5 * g * f * v * v) / np.sum((f * v) ** 2))
+    rn = _block_line((out / "materials.txt").read_text(), "crest", "rn")
+    assert p > 0.5 and float(rn.split(",")[1]) == pytest.approx(p, rel=1e-12)
 
 
 def test_unmapped_effects_listed(table_7_1):
