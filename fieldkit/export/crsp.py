@@ -9,14 +9,22 @@ values, written here from the model's profile one cell per segment:
 * **S**, the surface roughness: the perpendicular variation of the slope from its
   average inclination within a slope distance equal to the rock's radius, from
   which CRSP takes the roughness angle ``atan(S / r)`` (thesis §7.3.6, eq. 7.4,
-  after Pfeiffer & Bowen 1989). fieldkit's ``roughness_m`` is that same ``s``
-  (:mod:`fieldkit.model.effects.slope_roughness`), so S = ``roughness_m`` in feet.
+  after Pfeiffer & Bowen 1989). fieldkit's dip SD ``scale * hypot(atan(s / r),
+  roughness_deg_sd)`` (:mod:`fieldkit.model.effects.slope_roughness`, eq. 7.4 with
+  RocFall's dip SD folded in) is that angle, so ``S = r tan(dip SD)`` in feet
+  (``roughness_m`` itself at scale 1 without a dip SD).
 * **Rt**, the tangential coefficient, which CRSP scales at each impact by a friction
   function f(F) and a scaling factor SF of the impact velocities and Rn (thesis
   §7.3.5): CRSP's *effective* tangential restitution is not Rt, so the calibrated
   lumped ``e_t`` written as Rt is a starting value, not an equivalent.
 * **Rn**, the normal coefficient of restitution, which CRSP scales by the impact
   velocity (thesis eq. 7.1, K = 30 ft/s = 9.144 m/s, §7.3.4).
+
+Where the calibrated law is not CRSP's (no velocity scaling, another K, an e_n above
+1, an angle law), each material's Rn, Rt are the values in (0, 1] whose rebounds
+under CRSP's law are closest to the calibrated model's simulated impacts
+(:func:`fieldkit.export.lumped.fit_coefficients`), and the README gives the
+translation error against fieldkit's emulation of CRSP (:func:`emulation`).
 
 The rock is a sphere, cylinder or disk of a diameter and a density (CRSP takes the
 mass from them; thesis §7.2): fieldkit's body is a mass, a contact radius and a
@@ -29,22 +37,34 @@ volume of a sphere of radius ``r``
 What could not be confirmed from the sources available (the stored copy of the
 CRSP 4.0 manual gave its title page only): CRSP's own input limits for Rn, Rt and S,
 its largest number of cells, its coordinate convention and its start-zone form.
-fieldkit therefore enforces only what the definitions require (0 < Rn, Rt <= 1: a
-coefficient above 1 would add energy at every impact; S >= 0) and says so in the
-README.
+fieldkit therefore checks every written value against what the definitions require
+(:data:`RANGES`: 0 < Rn, Rt <= 1, a coefficient above 1 would add energy at every
+impact; S >= 0; a positive density and diameter) and says so in the README.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
 from fieldkit.errors import ArgumentError
 from fieldkit.export.fitted import with_error
-from fieldkit.export.lumped import not_a_law
+from fieldkit.export.lumped import (
+    RESTITUTION_LAWS,
+    Coefficient,
+    DocumentedRange,
+    effects_account,
+    fit_coefficients,
+    no_rule,
+    not_a_law,
+    with_coefficients,
+)
 from fieldkit.export.result import Export, Mapped
 from fieldkit.export.site import ExportSite
+from fieldkit.export.translation import translation_error
+from fieldkit.model.effects.slope_roughness import dip_sd_rad
 from fieldkit.model.model_file import Model
 from fieldkit.outputs import csv_text
 from fieldkit.physics.bodies import sphere_density_kg_m3
@@ -60,6 +80,52 @@ AXIS_K_OVER_R = math.sqrt(0.5)
 CRSP_K_MPS = 30.0 * M_PER_FT
 #: What fieldkit enforces for Rn and Rt: lower < value <= upper.
 COEFFICIENT_RANGE = (0.0, 1.0)
+#: The range the in-range fit uses: the cells hold 3 decimals, so 0.001 is the
+#: smallest Rn, Rt above 0 a cell can carry.
+FIT_RANGE = (0.001, 1.0)
+_DEFINITION = "by definition (the CRSP 4.0 manual's own input limits were not read)"
+#: The range of every numeric field written (checked on every export).
+RANGES: dict[str, DocumentedRange] = {
+    "Rn": DocumentedRange(
+        "Rn",
+        0.0,
+        1.0,
+        "a coefficient of restitution: above 1 a rebound gains energy; " + _DEFINITION,
+        open_lo=True,
+    ),
+    "Rt": DocumentedRange(
+        "Rt",
+        0.0,
+        1.0,
+        "a coefficient of restitution, scaled by CRSP's f(F) and SF; " + _DEFINITION,
+        open_lo=True,
+    ),
+    "S": DocumentedRange(
+        "S [ft]",
+        0.0,
+        math.inf,
+        "a height: the slope's perpendicular variation within one rock radius "
+        "(Pfeiffer & Bowen 1989, thesis §7.3.6)",
+    ),
+    "density": DocumentedRange(
+        "density [pcf]", 0.0, math.inf, "a density", open_lo=True
+    ),
+    "diameter": DocumentedRange(
+        "diameter [ft]", 0.0, math.inf, "a diameter", open_lo=True
+    ),
+}
+UNCONFIRMED = (
+    "CRSP 4.0's own input limits for Rn, Rt and S, its largest number of cells, its "
+    "coordinate convention and its start-zone form (the manual's body could not be "
+    "read: only its title and report pages)",
+    "whether CRSP 4.0 lets K (30 ft/s) be changed or the velocity scaling of Rn be "
+    "switched off, and whether its v is the normal impact speed (eq. 7.1, as "
+    "fieldkit) or the full speed",
+    "the form of CRSP's f(F) and SF (Rt's scaling): the emulation keeps Rt constant",
+    "how CRSP draws the impact angle within atan(S/r) (Pfeiffer & Higgins 1990: "
+    "randomly, within limits set by rock size and slope irregularities); fieldkit "
+    "draws a normal dip perturbation with that SD",
+)
 
 SOURCES = (
     "Jones, C.L., Higgins, J.D. & Andrew, R.D. (2000) Colorado Rockfall Simulation "
@@ -72,6 +138,11 @@ SOURCES = (
     "default sphere, §7.3.4 eq. 7.1 velocity scaling of Rn with K = 30 ft/s, "
     "§7.3.5 Rt scaled by f(F) and SF, §7.3.6 roughness S and eq. 7.4, §7.3.7 "
     "rotation w = v_T / r)",
+    "Pfeiffer, T.J. & Higgins, J.D. (1990) Rockfall hazard analysis using the "
+    "Colorado Rockfall Simulation Program, Transportation Research Record 1288 "
+    "(abstract: the impact angle varied randomly within limits set by rock size "
+    "and slope irregularities; slope angle and surface roughness the most "
+    "important inputs on steep slopes)",
 )
 
 HOW_TO_USE = """\
@@ -96,7 +167,7 @@ def export_crsp(model: Model, site: ExportSite | None = None) -> Export:
     Raises
     ------
     ArgumentError
-        A material's Rn or Rt outside (0, 1], or a roughness CRSP cannot take.
+        A roughness CRSP cannot take (an angle of 89 deg or more).
 
     Examples
     --------
@@ -104,42 +175,242 @@ def export_crsp(model: Model, site: ExportSite | None = None) -> Export:
     >>> m = model_from_dict({"profile": {"x_m": [0, 30.48], "z_m": [30.48, 0],
     ...   "material": "rock"}, "materials": {"rock": {"e_n": 0.35, "e_t": 0.85,
     ...   "friction_deg": 30, "roughness_m": 0.3048}}, "effects":
-    ...   {"slope_roughness": {}}, "body": {"mass_kg": 100, "radius_m": 0.2},
-    ...   "seeder": {"x_m": 1, "z_m": 31}})
+    ...   {"slope_roughness": {}, "velocity_scaled_restitution": {}},
+    ...   "body": {"mass_kg": 100, "radius_m": 0.2}, "seeder": {"x_m": 1, "z_m": 31}})
     >>> print(export_crsp(m).files["cells.csv"], end="")
     cell,begin_x_ft,begin_y_ft,end_x_ft,end_y_ft,S_ft,Rt,Rn,material
     1,0.00,100.00,100.00,0.00,1.00,0.850,0.350,rock
     """
     del site
-    _check_coefficients(model)
-    surface = {name: _surface(model, name) for name in model.materials}
+    written, coefficients, reasons, loud = crsp_model(model)
+    surface = {name: _surface(written, name) for name in written.materials}
     shape, shape_note = rock_shape(model.body.radius_m, model.body.gyration_m)
-    mapped, mismatches = _mapped_materials(model, surface)
+    files = {
+        "cells.csv": cells_csv(written, surface),
+        "rock.csv": rock_csv(written, shape),
+        "start.csv": start_csv(written),
+    }
+    check_written(written, surface)
+    mapped, mismatches = _mapped_materials(model, surface, coefficients)
     rock_mapped, rock_mismatch = _mapped_rock(model, shape, shape_note)
     velocity_mapped, velocity_mismatch = _velocity_scaling(model)
     mapped += rock_mapped + _mapped_geometry(model) + velocity_mapped
     mismatches = [
+        *loud,
+        *_fit_lines(reasons, coefficients),
         _rt_mismatch(),
         *mismatches,
         *rock_mismatch,
         *velocity_mismatch,
-        *_rn_above_one(model),
     ]
+    emulated = emulation(written, surface, shape)
     return Export(
         target="crsp",
         title="CRSP (Colorado Rockfall Simulation Program), 2-D",
-        files={
-            "cells.csv": cells_csv(model, surface),
-            "rock.csv": rock_csv(model, shape),
-            "start.csv": start_csv(model),
-        },
+        files=files,
         mapped=mapped,
         unmapped=_unmapped(model),
         units=_units(),
         mismatches=mismatches,
-        notes=_notes(model),
+        notes=_notes(model) + effects_account(model, "CRSP", EFFECT_RULES),
         how_to_use=HOW_TO_USE,
+        translation=_translation_lines(model, emulated),
+        sources=list(SOURCES),
+        unconfirmed=list(UNCONFIRMED),
     )
+
+
+def crsp_law(model: Model) -> list[str]:
+    """Why ``model``'s law cannot be written in CRSP's terms as it is (empty: it
+    can): CRSP always scales Rn by ``1 / (1 + (v/K)^2)`` with K = 30 ft/s.
+
+    Examples
+    --------
+    >>> from fieldkit.model.model_file import model_from_dict
+    >>> m = model_from_dict({"profile": {"x_m": [0, 10], "z_m": [5, 0],
+    ...   "material": "rock"}, "materials": {"rock": {"e_n": 0.3, "e_t": 0.8,
+    ...   "friction_deg": 25}}, "body": {"mass_kg": 100, "radius_m": 0.2},
+    ...   "seeder": {"x_m": 1, "z_m": 6}})
+    >>> crsp_law(m)[0][:48]
+    'the calibrated model has no velocity scaling of '
+    """
+    reasons = []
+    params = model.effects.get("velocity_scaled_restitution")
+    k = None if params is None else float(params["k_mps"])
+    if k is None or not math.isfinite(k):
+        reasons.append(
+            "the calibrated model has no velocity scaling of e_n, but CRSP scales "
+            "Rn by 1 / (1 + (v/K)^2) with K = 30 ft/s (thesis §7.3.4)"
+        )
+    elif not math.isclose(k, CRSP_K_MPS, rel_tol=1e-9):
+        reasons.append(
+            f"velocity_scaled_restitution.k_mps = {k:.4g} m/s ({m_to_ft(k):.4g} "
+            "ft/s), but CRSP scales Rn with K = 30 ft/s (9.144 m/s)"
+        )
+    for law in RESTITUTION_LAWS:
+        if law in model.effects and law not in (
+            "velocity_scaled_restitution",
+            "rotation_friction",
+        ):
+            reasons.append(f"{law}: CRSP has no such law")
+    low, high = COEFFICIENT_RANGE
+    for name, material in model.materials.items():
+        for field, target in (("e_n", "Rn"), ("e_t", "Rt")):
+            value = getattr(material, field)
+            if not low < value <= high:
+                reasons.append(
+                    f"materials.{name}.{field} = {value:.4g} is outside CRSP's "
+                    f"{target} range (0, 1]"
+                )
+    return reasons
+
+
+def normal_factor(v_mps: np.ndarray) -> np.ndarray:
+    """CRSP's scaling of Rn at normal impact speeds: ``1 / (1 + (v/K)^2)``, K =
+    30 ft/s (:data:`CRSP_K_MPS`)."""
+    return 1.0 / (1.0 + (np.asarray(v_mps, float) / CRSP_K_MPS) ** 2)
+
+
+def crsp_model(
+    model: Model,
+) -> tuple[Model, dict[str, tuple[Coefficient, Coefficient]], list[str], list[str]]:
+    """The model with CRSP's Rn, Rt per material, as the cells hold them (3
+    decimals): as calibrated when the law is CRSP's (:func:`crsp_law`), else
+    fitted in (0, 1] under CRSP's law; with the reasons and the loud lines of
+    materials no simulated rock touched."""
+    reasons = crsp_law(model)
+    if not reasons:
+        materials = {
+            name: replace(m, e_n=round(m.e_n, 3), e_t=round(m.e_t, 3))
+            for name, m in model.materials.items()
+        }
+        return replace(model, materials=materials), {}, [], []
+    coefficients, loud = fit_coefficients(
+        model,
+        "CRSP",
+        normal_factor,
+        FIT_RANGE,
+        FIT_RANGE,
+        fit_rt="rotation_friction" not in model.effects,
+    )
+    coefficients = {
+        name: tuple(replace(c, written=round(c.written, 3)) for c in pair)
+        for name, pair in coefficients.items()
+    }
+    return with_coefficients(model, coefficients), coefficients, reasons, loud
+
+
+def emulation(
+    written: Model, surface: dict[str, tuple[float, float, float]], shape: str
+) -> Model:
+    """fieldkit's model of CRSP's law with the values written.
+
+    Each material: e_n = Rn, e_t = Rt (single values: no SD), the roughness as
+    ``roughness_m = S`` (CRSP's angle ``atan(S/r)`` as fieldkit's dip SD), velocity
+    scaling at K = 30 ft/s, the body's gyration that of CRSP's shape; friction,
+    core and seeder as calibrated (CRSP has no friction input: fieldkit needs one
+    to slide). What fieldkit cannot express: CRSP's f(F) and SF on Rt, its own
+    rotation, rolling and stopping, the distribution of its angle draws.
+    """
+    materials = {}
+    for name, m in written.materials.items():
+        s_ft, rt, rn = surface[name]
+        materials[name] = replace(
+            m,
+            e_n=rn,
+            e_t=rt,
+            e_n_sd=0.0,
+            e_t_sd=0.0,
+            roughness_m=s_ft * M_PER_FT,
+            roughness_deg_sd=0.0,
+        )
+    effects = {"velocity_scaled_restitution": {"k_mps": CRSP_K_MPS}}
+    if any(s_ft > 0.0 for s_ft, _, _ in surface.values()):
+        effects["slope_roughness"] = {"scale": 1.0}
+    ratio = SPHERE_K_OVER_R if shape == "sphere" else AXIS_K_OVER_R
+    body = replace(written.body, gyration_m=ratio * written.body.radius_m)
+    return replace(written, materials=materials, effects=effects, body=body)
+
+
+def check_written(
+    written: Model, surface: dict[str, tuple[float, float, float]]
+) -> None:
+    """Every numeric field written against :data:`RANGES`.
+
+    Raises
+    ------
+    fieldkit.export.lumped.WrittenOutOfRange
+        A value outside its range (an exporter bug).
+    """
+    for name, (s_ft, rt, rn) in surface.items():
+        RANGES["S"].check(s_ft, f"{name} cells")
+        RANGES["Rt"].check(rt, f"{name} cells")
+        RANGES["Rn"].check(rn, f"{name} cells")
+    body = written.body
+    density = sphere_density_kg_m3(body.mass_kg, body.radius_m) / KG_M3_PER_PCF
+    RANGES["density"].check(round(density, 2), "rock")
+    RANGES["diameter"].check(round(float(m_to_ft(2.0 * body.radius_m)), 3), "rock")
+
+
+def _translation_lines(model: Model, emulated: Model) -> list[str]:
+    return [
+        *translation_error(model, emulated).lines(),
+        "",
+        "The emulation (fieldkit cannot run CRSP): CRSP's Rn scaling at K = 30 "
+        "ft/s, Rn and Rt as single values per cell, S as the roughness angle "
+        "atan(S/r) (a normal dip SD in fieldkit; CRSP's own draw within that angle "
+        "is not confirmed), the shape's moment of inertia. It keeps Rt constant "
+        "(CRSP scales it by f(F) and SF, whose form was not available) and uses "
+        "the calibrated friction angles for sliding (CRSP has none): CRSP's "
+        "tangential rebounds, rolling and stopping will differ beyond this table.",
+    ]
+
+
+def _fit_lines(
+    reasons: list[str], coefficients: dict[str, tuple[Coefficient, Coefficient]]
+) -> list[str]:
+    if not reasons:
+        return []
+    out = [
+        "The calibrated law cannot be written in CRSP's terms ("
+        + "; ".join(reasons)
+        + "): each material's Rn, Rt are the values in (0, 1] whose rebounds under "
+        "CRSP's law are closest (least squares) to the calibrated model's "
+        "simulated impacts on it; see the translation error"
+    ]
+    for coefficient in (c for pair in coefficients.values() for c in pair):
+        if coefficient.clipped:
+            out.append(
+                f"{coefficient.name}: the least-squares value under CRSP's law is "
+                f"{coefficient.unclipped:.4g}, outside CRSP's range (0, 1]: "
+                f"{coefficient.written:.3f} is written"
+            )
+    return out
+
+
+#: How CRSP takes every effect of the registry (README "Notes").
+EFFECT_RULES: dict[str, tuple[bool, str]] = {
+    "velocity_scaled_restitution": (
+        True,
+        "CRSP's own scaling of Rn (K = 30 ft/s); another K, or no scaling, is "
+        "fitted in range under CRSP's law",
+    ),
+    "slope_roughness": (True, "each cell's S = r tan(dip SD)"),
+    "rotation_friction": (
+        False,
+        "CRSP computes the rotation itself (w = v_T / r and the shape's moment of "
+        "inertia, thesis §7.3.7); fieldkit's contact friction and coupling have no "
+        "CRSP input",
+    ),
+    "angle_dependent_restitution": (
+        False,
+        "CRSP's Rn depends on the impact velocity (eq. 7.1), not on the impact "
+        "angle (eq. 5.4): Rn, Rt are fitted in range to the rebounds it realises",
+    ),
+    "air_drag": (False, "CRSP is a lumped-mass model without air drag (thesis §7.2)"),
+    "mass_loss": (False, "CRSP's rock keeps its mass (no breakage)"),
+    "tree_impacts": (False, "no tree-impact input was found for CRSP 4.0"),
+}
 
 
 def m_to_ft(value_m: float | np.ndarray) -> float | np.ndarray:
@@ -224,83 +495,64 @@ def start_csv(model: Model) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _check_coefficients(model: Model) -> None:
-    """Rt in (0, 1]; Rn too, except that a model with velocity scaling of e_n may
-    carry Rn > 1: CRSP scales Rn by 1 / (1 + (v/K)^2) itself (thesis §7.3.4), so
-    such an Rn is what the scaled law was calibrated with (RocFall's rule too)."""
-    low, high = COEFFICIENT_RANGE
-    scaled = "velocity_scaled_restitution" in model.effects
-    for name, material in model.materials.items():
-        for field, target in (("e_n", "Rn"), ("e_t", "Rt")):
-            value = getattr(material, field)
-            top = math.inf if (field == "e_n" and scaled) else high
-            if not low < value <= top:
-                why = (
-                    " (a coefficient above 1 adds energy at every impact; Rn above "
-                    "1 is exported only for a model with velocity scaling of e_n, "
-                    "velocity_scaled_restitution, which CRSP applies itself)"
-                    if value > high
-                    else ""
-                )
-                raise ArgumentError(
-                    f"materials.{name}.{field} = {value:g} is outside CRSP's {target} "
-                    f"range ({low:g}, {high:g}]{why}",
-                    source="model",
-                )
-
-
-def _rn_above_one(model: Model) -> list[str]:
-    """Mismatch lines for Rn > 1 written with CRSP's own velocity scaling."""
-    out = []
-    for name, material in model.materials.items():
-        if material.e_n > COEFFICIENT_RANGE[1]:
-            v = CRSP_K_MPS * math.sqrt(material.e_n - 1.0)
-            out.append(
-                f"{name} Rn = {material.e_n:.4g} > 1, written as calibrated with "
-                f"velocity scaling: with CRSP's K = 30 ft/s the scaled Rn is below 1 "
-                f"for normal impact speeds above {m_to_ft(v):.3g} ft/s "
-                f"({v:.3g} m/s); whether CRSP 4.0 accepts an Rn above 1 is not "
-                "confirmed (its manual could not be read)"
-            )
-    return out
-
-
 def _surface(model: Model, name: str) -> tuple[float, float, float]:
-    """(S [ft], Rt, Rn) of material ``name``."""
+    """(S [ft], Rt, Rn) of material ``name`` as the cells hold them (S to 0.01 ft,
+    Rt and Rn to 3 decimals)."""
     material = model.materials[name]
     return (
-        float(m_to_ft(_roughness_s_m(model, name))),
-        material.e_t,
-        material.e_n,
+        round(float(m_to_ft(roughness_s_m(model, name))), 2),
+        round(material.e_t, 3),
+        round(material.e_n, 3),
     )
 
 
-def _roughness_s_m(model: Model, name: str) -> float:
-    """CRSP's S [m] giving the roughness angle fieldkit's ``roughness_m`` gives.
+def roughness_s_m(model: Model, name: str) -> float:
+    """CRSP's S [m] whose roughness angle ``atan(S / r)`` is fieldkit's dip SD.
 
-    ``slope_roughness`` off: 0 (the calibrated model used no roughness). On with
-    ``scale``: ``r tan(scale atan(s / r))`` (= ``s`` at scale 1), so that
-    ``atan(S / r)`` is fieldkit's CRSP-part of the dip spread.
+    ``slope_roughness`` off: 0 (the calibrated model used no roughness). On:
+    ``r tan(scale hypot(atan(s / r), roughness_deg_sd))``
+    (:func:`fieldkit.model.effects.slope_roughness.dip_sd_rad`; ``s`` itself at
+    scale 1 without a dip SD).
+
+    Raises
+    ------
+    ArgumentError
+        An angle of 89 deg or more: no S gives it.
+
+    Examples
+    --------
+    >>> from fieldkit.model.model_file import model_from_dict
+    >>> m = model_from_dict({"profile": {"x_m": [0, 10], "z_m": [5, 0],
+    ...   "material": "rock"}, "materials": {"rock": {"e_n": 0.3, "e_t": 0.8,
+    ...   "friction_deg": 25, "roughness_deg_sd": 35}}, "effects":
+    ...   {"slope_roughness": {}}, "body": {"mass_kg": 3750, "radius_m": 0.725},
+    ...   "seeder": {"x_m": 1, "z_m": 6}})
+    >>> round(roughness_s_m(m, "rock"), 4)   # 0.725 tan(35 deg) = 0.725 * 0.70021
+    0.5077
     """
-    s = model.materials[name].roughness_m
+    material = model.materials[name]
     effect = model.effects.get("slope_roughness")
-    if effect is None or s == 0.0:
+    if effect is None:
         return 0.0
     scale = float(effect.get("scale", 1.0))
     r = model.body.radius_m
-    angle = scale * math.atan(s / r)
+    angle = float(dip_sd_rad(material.roughness_m, material.roughness_deg_sd, r, scale))
     if angle >= math.radians(89.0):
         raise ArgumentError(
-            f"materials.{name}.roughness_m = {s:g} m at slope_roughness.scale = "
-            f"{scale:g} is a roughness angle of {math.degrees(angle):.0f} deg: CRSP's "
-            "S = r tan(angle) needs an angle below 89 deg",
+            f"materials.{name}.roughness_m = {material.roughness_m:g} m, "
+            f"roughness_deg_sd = {material.roughness_deg_sd:g} deg at "
+            f"slope_roughness.scale = {scale:g} is a roughness angle of "
+            f"{math.degrees(angle):.0f} deg: CRSP's S = r tan(angle) needs an angle "
+            "below 89 deg",
             source="model",
         )
     return r * math.tan(angle)
 
 
 def _mapped_materials(
-    model: Model, surface: dict[str, tuple[float, float, float]]
+    model: Model,
+    surface: dict[str, tuple[float, float, float]],
+    coefficients: dict[str, tuple[Coefficient, Coefficient]],
 ) -> tuple[list[Mapped], list[str]]:
     mapped: list[Mapped] = []
     mismatches: list[str] = []
@@ -308,35 +560,44 @@ def _mapped_materials(
     for name, material in model.materials.items():
         s_ft, rt, rn = surface[name]
         key = f"materials.{name}"
-        mapped.append(
-            Mapped(
-                with_error(model, f"{key}.e_n", material.e_n),
-                f"{name} cells: Rn = {rn:.3f}",
-                "as calibrated; CRSP scales it by the impact velocity (eq. 7.1)",
+        fitted = dict(zip(("e_n", "e_t"), coefficients.get(name, ()), strict=False))
+        for field, target, value, how in (
+            ("e_n", "Rn", rn, "CRSP scales it by the impact velocity (eq. 7.1)"),
+            ("e_t", "Rt", rt, "CRSP scales it by f(F) and SF: see the mismatch"),
+        ):
+            how = (
+                f"written {fitted[field].text()}, fitted under CRSP's law; {how}"
+                if field in fitted
+                else f"as calibrated; {how}"
             )
-        )
-        mapped.append(
-            Mapped(
-                with_error(model, f"{key}.e_t", material.e_t),
-                f"{name} cells: Rt = {rt:.3f}",
-                "as calibrated; CRSP scales it by f(F) and SF: see the mismatch",
-            )
-        )
-        if material.roughness_m > 0.0:
-            how = _roughness_how(model, scale)
             mapped.append(
                 Mapped(
-                    with_error(model, f"{key}.roughness_m", material.roughness_m, "m"),
-                    f"{name} cells: S = {s_ft:.2f} ft",
+                    with_error(model, f"{key}.{field}", getattr(material, field)),
+                    f"{name} cells: {target} = {value:.3f}",
                     how,
                 )
             )
-        if "slope_roughness" in model.effects and scale != 1.0 and s_ft > 0.0:
+        if "slope_roughness" in model.effects:
+            mapped.append(
+                Mapped(
+                    with_error(model, f"{key}.roughness_m", material.roughness_m, "m")
+                    + ", "
+                    + with_error(
+                        model,
+                        f"{key}.roughness_deg_sd",
+                        material.roughness_deg_sd,
+                        "deg",
+                    ),
+                    f"{name} cells: S = {s_ft:.2f} ft",
+                    _roughness_how(model, scale),
+                )
+            )
+        if "slope_roughness" in model.effects and s_ft > 0.0:
             mismatches.append(
-                f"{name}: S was written so that CRSP's roughness angle atan(S/r) "
-                f"equals fieldkit's scaled one (slope_roughness.scale = {scale:g}); "
-                "CRSP draws the impact angle within its own limits, fieldkit from a "
-                "normal distribution: the spreads agree in size, not in shape."
+                f"{name}: S = {s_ft:.2f} ft was written so that CRSP's roughness "
+                "angle atan(S/r) equals fieldkit's dip SD; CRSP draws the impact "
+                "angle within its own limits, fieldkit from a normal distribution: "
+                "the spreads agree in size, not in shape."
             )
     return mapped, mismatches
 
@@ -363,7 +624,7 @@ def _mapped_geometry(model: Model) -> list[Mapped]:
             Mapped(
                 f"effect slope_roughness (scale = {scale:g})",
                 "each cell's S (CRSP always applies its roughness)",
-                "the CRSP part atan(s/r) only; roughness_deg_sd: see below",
+                "S = r tan(dip SD): roughness_m and roughness_deg_sd together",
             )
         )
     return out
@@ -372,9 +633,10 @@ def _mapped_geometry(model: Model) -> list[Mapped]:
 def _roughness_how(model: Model, scale: float) -> str:
     if "slope_roughness" not in model.effects:
         return "slope_roughness off in the model: S = 0"
-    if scale == 1.0:
-        return "S = roughness_m / 0.3048"
-    return f"S = r tan({scale:g} atan(s/r)) / 0.3048 (slope_roughness.scale)"
+    return (
+        f"S = r tan({scale:g} hypot(atan(roughness_m / r), roughness_deg_sd)) / "
+        "0.3048: CRSP's roughness angle atan(S/r) is fieldkit's dip SD (eq. 7.4)"
+    )
 
 
 def _mapped_rock(
@@ -432,32 +694,18 @@ def _mapped_rock(
 
 def _velocity_scaling(model: Model) -> tuple[list[Mapped], list[str]]:
     effect = model.effects.get("velocity_scaled_restitution")
-    if effect is not None:
-        k = float(effect.get("k_mps", CRSP_K_MPS))
-        if math.isclose(k, CRSP_K_MPS, rel_tol=1e-3):
-            return [
-                Mapped(
-                    with_error(model, "velocity_scaled_restitution.k_mps", k, "m/s"),
-                    "CRSP's own scaling of Rn (K = 30 ft/s)",
-                    "the same eq. 7.1 and K",
-                )
-            ], []
-        return [], [
-            f"velocity_scaled_restitution.k_mps = {k:.4g} m/s "
-            f"({m_to_ft(k):.4g} ft/s), but CRSP scales Rn with K = 30 ft/s "
-            "(9.144 m/s, thesis §7.3.4; whether CRSP 4.0 lets K be changed is not "
-            "confirmed): CRSP's rebounds at impact speeds near K differ from the "
-            "model's; recalibrate Rn in CRSP."
-        ]
-    return [], [
-        "The calibrated model has no velocity scaling of e_n (velocity_scaled_"
-        "restitution off), but CRSP scales Rn by 1 / (1 + (v/K)^2) with K = 30 ft/s "
-        "(thesis §7.3.4, eq. 7.1; whether CRSP 4.0 can switch it off is not "
-        "confirmed): at a normal impact speed of 30 ft/s (9.1 m/s) CRSP's normal "
-        "rebound is half the model's. "
-        "Recalibrate Rn in CRSP, or calibrate fieldkit with velocity_scaled_"
-        "restitution at k_mps = 9.144 before exporting."
-    ]
+    k = float(effect["k_mps"]) if effect is not None else math.inf
+    what = (
+        with_error(model, "velocity_scaled_restitution.k_mps", k, "m/s")
+        if math.isfinite(k)
+        else "velocity_scaled_restitution off"
+    )
+    how = (
+        "the same eq. 7.1 and K"
+        if math.isclose(k, CRSP_K_MPS, rel_tol=1e-9)
+        else "Rn fitted in range under CRSP's scaling (see the residual mismatch)"
+    )
+    return [Mapped(what, "CRSP's own scaling of Rn (K = 30 ft/s)", how)], []
 
 
 def _rt_mismatch() -> str:
@@ -498,20 +746,6 @@ def _unmapped(model: Model) -> list[tuple[str, str]]:
                     "from the roughness S and the random impact angle",
                 )
             )
-        if material.roughness_deg_sd > 0.0:
-            r = model.body.radius_m
-            hint = r * math.tan(math.radians(material.roughness_deg_sd))
-            out.append(
-                (
-                    f"{key}.roughness_deg_sd = {material.roughness_deg_sd:g} deg",
-                    "RocFall's SD of the segment dip has no CRSP input and is not "
-                    "converted: CRSP's S is a maximum variation within one radius, "
-                    "not an SD. For reference, S = r tan(sd) would be "
-                    f"{hint:.3g} m ({m_to_ft(hint):.3g} ft) for this rock; the "
-                    f"cells carry S from roughness_m only "
-                    f"({material.roughness_m:g} m)",
-                )
-            )
     out += _unmapped_effects(model)
     if model.trees is not None:
         out.append(("trees", "no tree-impact input was found for CRSP 4.0"))
@@ -534,22 +768,14 @@ def _unmapped(model: Model) -> list[tuple[str, str]]:
 
 
 def _unmapped_effects(model: Model) -> list[tuple[str, str]]:
-    reasons = {
-        "rotation_friction": "CRSP computes the rotation itself (w = v_T / r and the "
-        "shape's moment of inertia, thesis §7.3.7); fieldkit's contact friction and "
-        "coupling have no CRSP input",
-        "angle_dependent_restitution": "CRSP's Rn depends on the impact velocity "
-        "(eq. 7.1), not on the impact angle (eq. 5.4)",
-        "air_drag": "CRSP is a lumped-mass model without air drag (thesis §7.2)",
-        "mass_loss": "CRSP's rock keeps its mass (no breakage)",
-        "tree_impacts": "no tree-impact input was found for CRSP 4.0",
-    }
     out = []
     for name, params in model.effects.items():
-        why = reasons.get(name) or not_a_law(name, "CRSP")
-        if why:
-            values = ", ".join(f"{k} = {v:g}" for k, v in params.items())
-            out.append((f"effect {name} ({values})", why))
+        mapped, why = EFFECT_RULES.get(name, (False, ""))
+        if mapped:
+            continue
+        why = why or not_a_law(name, "CRSP") or no_rule(name, "CRSP")
+        values = ", ".join(f"{k} = {v:g}" for k, v in params.items())
+        out.append((f"effect {name} ({values})", why))
     return out
 
 
@@ -566,15 +792,12 @@ def _units() -> list[str]:
 
 
 def _notes(model: Model) -> list[str]:
-    notes = [f"Source: {s}." for s in SOURCES]
-    notes += [
-        "Not confirmed (the manual's body was not available): CRSP 4.0's accepted "
-        "ranges of Rn, Rt and S, its largest number of cells, its coordinate "
-        "convention (the cells keep the model's frame: x = chainage from the "
-        "profile's start, y = elevation, negative values as in the model) and its "
-        "start-zone form. fieldkit refuses only Rn or Rt outside (0, 1] and S below "
-        "0; check the values against CRSP's input screen.",
+    return [
+        "Ranges checked on every value written: "
+        + "; ".join(r.text() for r in RANGES.values())
+        + ". Check the values against CRSP's input screen.",
+        "The cells keep the model's frame: x = chainage from the profile's start, "
+        "y = elevation, negative values as in the model.",
         f"The cells follow the model's {len(model.profile.material)} profile "
         "segments one to one; nothing was merged or split.",
     ]
-    return notes

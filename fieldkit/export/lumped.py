@@ -85,6 +85,9 @@ class Coefficient:
         Why the value is not a fit to the material's own impacts ("" when it is).
     unclipped
         The least-squares value before the range clipped it (NaN: not fitted).
+    clipped
+        Whether the target's range moved the fitted value (rounding to the
+        target's precision does not count).
     """
 
     name: str
@@ -94,11 +97,7 @@ class Coefficient:
     n: int
     unfitted: str = ""
     unclipped: float = math.nan
-
-    @property
-    def clipped(self) -> bool:
-        """Whether the target's range moved the fitted value."""
-        return math.isfinite(self.unclipped) and self.written != self.unclipped
+    clipped: bool = False
 
     def text(self) -> str:
         """``written (spread s over n impacts)`` for a README's target column."""
@@ -230,7 +229,14 @@ def fit_coefficients(
                 "simulated impacts on the other materials"
             )
             rn = Coefficient(
-                f"{key}.e_n", material.e_n, fit.value, math.nan, 0, why, fit.unclipped
+                f"{key}.e_n",
+                material.e_n,
+                fit.value,
+                math.nan,
+                0,
+                why,
+                fit.unclipped,
+                fit.clipped,
             )
         else:
             why = (
@@ -259,7 +265,7 @@ def fit_coefficients(
 
 def _coefficient(name: str, calibrated: float, fit) -> Coefficient:
     return Coefficient(
-        name, calibrated, fit.value, fit.spread, fit.n, "", fit.unclipped
+        name, calibrated, fit.value, fit.spread, fit.n, "", fit.unclipped, fit.clipped
     )
 
 
@@ -267,7 +273,8 @@ def _clipped(
     name: str, value: float, bounds: tuple[float, float], why: str
 ) -> Coefficient:
     lo, hi = bounds
-    return Coefficient(name, value, float(min(max(value, lo), hi)), math.nan, 0, why)
+    written = float(min(max(value, lo), hi))
+    return Coefficient(name, value, written, math.nan, 0, why, value, written != value)
 
 
 def with_coefficients(

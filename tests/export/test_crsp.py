@@ -4,15 +4,19 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import math
 from dataclasses import replace
 
 import pytest
 
 from fieldkit.errors import ArgumentError
-from fieldkit.export.crsp import export_crsp
+from fieldkit.export.crsp import check_written, export_crsp
+from fieldkit.export.lumped import WrittenOutOfRange
 from fieldkit.export.site import site_from_section
 from fieldkit.model.model_file import model_from_dict
+
+PATH_START = "surveys/tornado_mountain/model_path_start.json"
 
 
 def rows(text: str) -> list[dict[str, str]]:
@@ -53,12 +57,17 @@ def test_cells_are_the_profile_segments(tornado):
         assert float(cell["end_x_ft"]) == pytest.approx(x[j + 1] / 0.3048, abs=0.005)
         assert float(cell["end_y_ft"]) == pytest.approx(z[j + 1] / 0.3048, abs=0.005)
         assert cell["material"] == tornado.profile.material[j]
-    # Thesis Table 7-1, site 4: rock e_N 0.75, e_T 0.59; colluvium 1.00, 0.62.
-    surface = {c["material"]: (c["Rn"], c["Rt"], c["S_ft"]) for c in cells}
-    assert surface == {
-        "rock": ("0.750", "0.590", "0.00"),
-        "colluvium": ("1.000", "0.620", "0.00"),
-    }
+    # Thesis Table 7-1, site 4: rock e_N 0.75, e_T 0.59, dip SD 35 deg; colluvium
+    # 1.00, 0.62, no roughness. Table 7-1 has no velocity scaling, CRSP always
+    # scales Rn: the in-range Rn under CRSP's law is clipped at 1 for both (least
+    # squares far above 1). Before issue 19 the cells held the constant-law Rn
+    # (0.750, 1.000) and S = 0 although rock's dip SD is 35 deg; now
+    # S = 0.725 tan(35 deg) = 0.50765 m = 1.6655 ft.
+    surface = {c["material"]: (c["Rn"], c["S_ft"]) for c in cells}
+    assert surface == {"rock": ("1.000", "1.67"), "colluvium": ("1.000", "0.00")}
+    rt = {c["material"]: float(c["Rt"]) for c in cells}
+    assert rt["rock"] == pytest.approx(0.59, abs=0.002)
+    assert rt["colluvium"] == pytest.approx(0.62, abs=0.002)
     # Consecutive cells join: each ends where the next begins.
     for a, b in zip(cells, cells[1:], strict=False):
         assert (a["end_x_ft"], a["end_y_ft"]) == (b["begin_x_ft"], b["begin_y_ft"])
@@ -99,23 +108,58 @@ def test_start_in_feet(tornado):
     ("field", "value", "target"),
     [("e_t", 1.2, "Rt"), ("e_n", 0.0, "Rn"), ("e_n", 1.0001, "Rn")],
 )
-def test_coefficients_outside_crsp_refused(field, value, target):
-    model = model_from_dict(small(**{field: value}))
-    with pytest.raises(ArgumentError) as error:
-        export_crsp(model)
-    message = str(error.value)
-    assert "\n" not in message
-    assert f"materials.talus.{field} = {value:g}" in message
-    assert f"CRSP's {target} range (0, 1]" in message
+def test_coefficients_outside_crsp_are_fitted_in_range(field, value, target):
+    # before issue 19: refused; now the in-range values under CRSP's law, said
+    data = small(**{field: value})
+    data["effects"] = {"velocity_scaled_restitution": {}}
+    export = export_crsp(model_from_dict(data))
+    cell = rows(export.files["cells.csv"])[0]
+    assert 0.0 < float(cell["Rn"]) <= 1.0 and 0.0 < float(cell["Rt"]) <= 1.0
+    said = f"materials.talus.{field} = {value:.4g} is outside CRSP's {target} range"
+    assert any(said in m for m in export.mismatches), export.mismatches
 
 
-def test_rn_above_one_with_velocity_scaling_is_written_with_its_mismatch():
+def test_rn_above_one_with_velocity_scaling_is_fitted_in_range():
+    # before issue 19 "1.250" was written (documented range: up to 1)
     data = small(e_n=1.25)
     data["effects"] = {"velocity_scaled_restitution": {}}
     export = export_crsp(model_from_dict(data))
-    assert rows(export.files["cells.csv"])[0]["Rn"] == "1.250"
-    # scaled Rn = 1.25 / (1 + (v/K)^2) < 1 for v > K sqrt(0.25) = 15 ft/s (K 30 ft/s)
-    assert any("above 15 ft/s" in m for m in export.mismatches), export.mismatches
+    assert rows(export.files["cells.csv"])[0]["Rn"] == "1.000"
+    assert any(
+        "materials.talus.e_n: the least-squares value under CRSP's law is" in m
+        for m in export.mismatches
+    ), export.mismatches
+
+
+def test_check_written_refuses_a_value_out_of_range():
+    surface = {"talus": (0.0, 0.85, 1.25)}
+    with pytest.raises(WrittenOutOfRange, match=r"talus cells: Rn = 1.25 outside"):
+        check_written(model_from_dict(small()), surface)
+
+
+def test_calibrated_tornado_through_the_cli(cli, repo, tmp_path):
+    data = json.loads((repo / PATH_START).read_text())
+    data["materials"]["colluvium"]["e_n"] = 1.18581256337219
+    data["materials"]["bench"]["e_n"] = 0.83
+    data["effects"]["velocity_scaled_restitution"] = {"k_mps": 13.2440621510482}
+    path = tmp_path / "calibrated.json"
+    path.write_text(json.dumps(data))
+    out = tmp_path / "crsp"
+    r = cli("export", path, "--to", "crsp", "-o", out)
+    assert r.exit_code == 0, r.output
+    for name in ("cells.csv", "rock.csv", "start.csv", "README.md"):
+        assert f"wrote {out / name}" in r.output
+    cells = rows((out / "cells.csv").read_text())
+    for cell in cells:  # before issue 19: colluvium Rn 1.186
+        assert 0.0 < float(cell["Rn"]) <= 1.0 and 0.0 < float(cell["Rt"]) <= 1.0
+    s_ft = {c["material"]: c["S_ft"] for c in cells}
+    assert s_ft == {"rock": "1.67", "colluvium": "0.00", "bench": "0.00"}
+    readme = (out / "README.md").read_text()
+    assert "## Translation error: calibrated model vs the target's law" in readme
+    assert "| runout p50 |" in readme and "p95 total energy at" in readme
+    assert "materials.colluvium.e_n: the least-squares value under CRSP's law" in readme
+    assert "## Sources of the target's rules" in readme
+    assert "## Unconfirmed" in readme and "f(F) and SF" in readme
 
 
 def test_restitution_of_one_is_accepted():
@@ -149,16 +193,23 @@ def test_roughness_s_in_feet_and_its_effect():
 def test_tornado_account(tornado):
     export = export_crsp(tornado)
     unmapped = dict(export.unmapped)
-    # RocFall's dip SD has no CRSP input: said, with S = r tan(35 deg) = 0.508 m.
-    reason = unmapped["materials.rock.roughness_deg_sd = 35 deg"]
-    assert "0.508 m" in reason
+    # RocFall's dip SD is CRSP's roughness angle: S = r tan(35 deg) = 1.67 ft
+    # (before issue 19 it was listed as not converted, and S = 0 was written)
+    assert "materials.rock.roughness_deg_sd = 35 deg" not in " ".join(unmapped)
+    assert any(
+        "roughness_deg_sd = 35 deg" in m.fieldkit and "S = 1.67 ft" in m.target
+        for m in export.mapped
+    )
     assert "materials.rock.friction_deg = 2.86 deg" in unmapped
-    assert export.mismatches[0].startswith("Rt is not CRSP's tangential restitution")
-    assert any("velocity_scaled_restitution off" in m for m in export.mismatches)
+    assert any(m.startswith("Rt is not CRSP's tangential") for m in export.mismatches)
+    assert export.mismatches[0].startswith("The calibrated law cannot be written")
+    assert "the calibrated model has no velocity scaling" in export.mismatches[0]
     assert any("1 ft = 0.3048 m" in u for u in export.units)
     assert any("16.018463" in u for u in export.units)
     readme = export.readme("model.json")
-    assert "| materials.rock.e_n = 0.75 | rock cells: Rn = 0.750 |" in readme
+    assert (
+        "| materials.rock.e_n = 0.75 | rock cells: Rn = 1.000 | written 1 (" in readme
+    )
 
 
 def test_velocity_scaling_and_effects_crsp_lacks():
