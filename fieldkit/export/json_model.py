@@ -12,8 +12,10 @@ from __future__ import annotations
 import math
 
 from fieldkit.export.fitted import fitted_parameters, with_error
+from fieldkit.export.lumped import effects_account
 from fieldkit.export.result import Export, Mapped
 from fieldkit.export.site import ExportSite
+from fieldkit.model.effects import registry
 from fieldkit.model.model_file import Model, model_to_dict
 from fieldkit.outputs import json_text
 
@@ -52,6 +54,11 @@ def export_json(model: Model, site: ExportSite | None = None) -> Export:
                 Mapped(with_error(model, name, value), f"parameters.json: {name}")
             )
     n_fitted = sum(r["fit"] is not None for r in rows)
+    # the model file carries every effect of the registry, on or off
+    rules = {
+        spec.name: (True, "model.json's effects (with its parameters when on)")
+        for spec in registry.EFFECTS
+    }
     return Export(
         target="json",
         title="fieldkit model (JSON)",
@@ -66,6 +73,14 @@ def export_json(model: Model, site: ExportSite | None = None) -> Export:
             "(correlations, bootstrap, held-out scores) are in model.json's "
             "provenance",
             "every other parameter is the base model's value, not fitted",
+            *effects_account(model, "json", rules),
+        ],
+        sources=[
+            "fieldkit's model file: docs/architecture.md 'Model file (contract)', "
+            "read by fieldkit.model.model_file.read_model",
+        ],
+        unconfirmed=[
+            "nothing: model.json is fieldkit's own format, read back unchanged"
         ],
         how_to_use=(
             "`fieldkit simulate model.json`, `fieldkit fit ... --model model.json`: "

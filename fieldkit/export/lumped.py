@@ -49,11 +49,14 @@ def not_a_law(name: str, target: str) -> str:
     >>> not_a_law("air_drag", "CRSP")
     ''
     """
-    spec = registry.effect(name)
+    return _not_a_law(registry.effect(name), target)
+
+
+def _not_a_law(spec: registry.EffectSpec, target: str) -> str:
     if spec.is_law:
         return ""
     return (
-        f"{name} is a statistical alternative ({spec.physics}), not a physical "
+        f"{spec.name} is a statistical alternative ({spec.physics}), not a physical "
         f"law: {target} has no such law; a model that needs it is not described "
         "by any law a target program has"
     )
@@ -440,7 +443,7 @@ def effects_account(
         state = "on" if spec.name in model.effects else "off"
         rule = rules.get(spec.name)
         if rule is None:
-            why = not_a_law(spec.name, target) or no_rule(spec.name, target)
+            why = _not_a_law(spec, target) or no_rule(spec.name, target)
             text = f"not mapped: {why}"
         else:
             mapped, how = rule
