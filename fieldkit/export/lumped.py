@@ -20,12 +20,17 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 import numpy as np
 
 from fieldkit.export.translation import (
     IMPACT_ROCKS,
     IMPACT_SEED,
+    SEARCH_ROCKS,
+    SEARCH_SEED,
+    Search,
+    closest_in_range,
     fit_scaled,
     realised_impacts,
 )
@@ -91,6 +96,9 @@ class Coefficient:
     clipped
         Whether the target's range moved the fitted value (rounding to the
         target's precision does not count).
+    impact_level
+        The impact-level value the behaviour search (:func:`closest_behaviour`)
+        started from (NaN: no search; ``written`` is the impact-level value).
     """
 
     name: str
@@ -101,13 +109,19 @@ class Coefficient:
     unfitted: str = ""
     unclipped: float = math.nan
     clipped: bool = False
+    impact_level: float = math.nan
 
     def text(self) -> str:
         """``written (spread s over n impacts)`` for a README's target column."""
         if self.n and math.isfinite(self.spread):
+            searched = (
+                f"; behaviour search from the impact-level {self.impact_level:.4g}"
+                if math.isfinite(self.impact_level)
+                else ""
+            )
             return (
                 f"{self.written:.4g} (spread {self.spread:.2g} of the {self.n} "
-                "impacts' own rebound ratio around it)"
+                f"impacts' own rebound ratio around it{searched})"
             )
         return f"{self.written:.4g} ({self.unfitted})"
 
@@ -264,6 +278,78 @@ def fit_coefficients(
             f"export tests them: check {name} in {target} before relying on it"
         )
     return out, lines
+
+
+def closest_behaviour(
+    model: Model,
+    coefficients: dict[str, tuple[Coefficient, Coefficient]],
+    emulate: Callable[[dict[str, tuple[Coefficient, Coefficient]]], Model],
+    normal_factor: Callable[[np.ndarray], np.ndarray],
+    rn_range: tuple[float, float],
+    rt_range: tuple[float, float],
+    precision: Callable[[float], float],
+    *,
+    rocks: int = ROCKS,
+    seed: int = SEED,
+) -> tuple[dict[str, tuple[Coefficient, Coefficient]], Search]:
+    """The in-range Rn, Rt whose emulation behaves closest to ``model``.
+
+    The impact-level values of :func:`fit_coefficients` are the start of
+    :func:`fieldkit.export.translation.closest_in_range` over every coefficient
+    fitted to impacts of its own (a material no rock touched keeps its value):
+    the least-squares pair is dominated by the many slow impacts, while runout and
+    design energies are set by the fast ones. Each value found is rounded to what
+    the target's file holds (``precision``) and carries its own spread over the
+    material's impacts at that value.
+
+    Parameters
+    ----------
+    emulate
+        coefficients -> fieldkit's model of the target's law with them.
+    normal_factor, rn_range, rt_range
+        As for :func:`fit_coefficients`.
+    precision
+        A value -> the value as the target's file holds it.
+    """
+    names = [
+        (name, i)
+        for name, pair in coefficients.items()
+        for i in (0, 1)
+        if pair[i].n > 0
+    ]
+    ranges = (rn_range, rt_range)
+
+    def with_values(values) -> dict[str, tuple[Coefficient, Coefficient]]:
+        out = {name: list(pair) for name, pair in coefficients.items()}
+        for (name, i), value in zip(names, values, strict=True):
+            out[name][i] = replace(out[name][i], written=float(value))
+        return {name: (pair[0], pair[1]) for name, pair in out.items()}
+
+    search = closest_in_range(
+        model,
+        lambda values: emulate(with_values(values)),
+        [coefficients[name][i].written for name, i in names],
+        [ranges[i][0] for _, i in names],
+        [ranges[i][1] for _, i in names],
+    )
+    impacts = realised_impacts(model, rocks, seed)
+    out = {name: list(pair) for name, pair in coefficients.items()}
+    for (name, i), value in zip(names, search.values, strict=True):
+        rows = impacts[impacts["material"] == name]
+        if i == 0:
+            vi = -rows["vin_mps"].to_numpy(float)
+            vf, factor = rows["vfn_mps"].to_numpy(float), normal_factor(vi)
+        else:
+            vi, vf = rows["vit_mps"].to_numpy(float), rows["vft_mps"].to_numpy(float)
+            factor = np.ones_like(vi)
+        written = precision(value)
+        x = factor * vi
+        spread = math.sqrt(float(np.sum((vf - written * x) ** 2) / np.sum(x * x)))
+        c = out[name][i]
+        out[name][i] = replace(
+            c, written=written, spread=spread, impact_level=c.written
+        )
+    return {name: (pair[0], pair[1]) for name, pair in out.items()}, search
 
 
 def _coefficient(name: str, calibrated: float, fit) -> Coefficient:
@@ -450,3 +536,43 @@ def effects_account(
             text = f"mapped: {how}" if mapped else f"not mapped: {how}"
         out.append(f"effect {spec.name} ({state} in this model): {text}")
     return out
+
+
+class Written(NamedTuple):
+    """What an exporter writes in place of a law it cannot take.
+
+    Attributes
+    ----------
+    model
+        The calibrated model with the target's law and the written values.
+    coefficients
+        Per material the written (Rn, Rt) (empty: written as calibrated).
+    reasons
+        Why the calibrated law could not be written as it is.
+    loud
+        The lines of materials no simulated rock touched.
+    search
+        The behaviour search (:func:`closest_behaviour`), or None.
+    """
+
+    model: Model
+    coefficients: dict[str, tuple[Coefficient, Coefficient]]
+    reasons: list[str]
+    loud: list[str]
+    search: Search | None
+
+
+def search_line(search: Search | None, target: str) -> list[str]:
+    """The README line saying what the behaviour search did ([] without one)."""
+    if search is None:
+        return []
+    return [
+        f"The written Rn, Rt are the values in {target}'s ranges whose emulation "
+        "behaves closest to the calibrated model (runout p50/p95, p95 energy and "
+        "bounce height at the analysis points; summed squared log ratios "
+        f"{search.gap:.3g}, from {search.start_gap:.3g} at the impact-level "
+        f"least-squares values; {search.evaluations} emulations of "
+        f"{SEARCH_ROCKS} rocks on their own random stream, seed {SEARCH_SEED}, "
+        "apart from the translation error's). A value far from the impact-level "
+        "one trades rebound accuracy for design behaviour: its spread says how far"
+    ]

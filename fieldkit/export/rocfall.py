@@ -55,8 +55,10 @@ public; the blocks follow the fields of its dialogs.
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass, replace
+from functools import lru_cache
 
 import numpy as np
 from scipy.stats import norm, truncnorm
@@ -67,17 +69,20 @@ from fieldkit.export.lumped import (
     RESTITUTION_LAWS,
     Coefficient,
     DocumentedRange,
+    Written,
+    closest_behaviour,
     effects_account,
     fit_coefficients,
     no_rule,
     not_a_law,
+    search_line,
     with_coefficients,
 )
 from fieldkit.export.result import Export, Mapped
 from fieldkit.export.site import ExportSite
 from fieldkit.export.translation import translation_error
-from fieldkit.model.model_file import Model
-from fieldkit.outputs import csv_text
+from fieldkit.model.model_file import Model, model_from_dict, model_to_dict
+from fieldkit.outputs import csv_text, json_text
 
 #: RocFall distribution ids (the issue's list; RocFall3 help "Random Variables").
 DISTRIBUTIONS: dict[int, str] = {
@@ -404,21 +409,23 @@ def normal_factor(v_mps: np.ndarray) -> np.ndarray:
     return 1.0 / (1.0 + (np.asarray(v_mps, float) / ROCFALL_K_MPS) ** 2)
 
 
-def rocfall_model(
-    model: Model,
-) -> tuple[Model, dict[str, tuple[Coefficient, Coefficient]], list[str], list[str]]:
+def rocfall_model(model: Model) -> Written:
     """The model as RocFall is given it, from which the files are written.
 
-    Returns
-    -------
-    written, coefficients, reasons, loud
-        ``written``: ``model`` with RocFall's law (velocity scaling at
-        :data:`ROCFALL_K_MPS` when the model scales, no other rebound law) and the
-        written Rn, Rt; ``coefficients``: per material the fitted (Rn, Rt) (empty
-        when the model's law is RocFall's and it is written as calibrated);
-        ``reasons``: why it was fitted; ``loud``: the lines of materials no
-        simulated rock touched.
+    ``Written.model`` is ``model`` with RocFall's law (velocity scaling at
+    :data:`ROCFALL_K_MPS` when the model scales, no other rebound law) and the
+    written Rn, Rt: as calibrated when the law is RocFall's (:func:`rocfall_law`),
+    else the in-range values whose emulation behaves closest to the calibrated
+    model, searched from the impact-level least-squares values
+    (:func:`fieldkit.export.lumped.closest_behaviour`), each rounded to the 15
+    significant digits the file holds. Cached per model (the search simulates).
     """
+    return _rocfall_model(json_text(model_to_dict(model)))
+
+
+@lru_cache(maxsize=8)
+def _rocfall_model(text: str) -> Written:
+    model = model_from_dict(json.loads(text))
     scaled, reasons = rocfall_law(model)
     effects = {
         name: params
@@ -428,22 +435,34 @@ def rocfall_model(
     if scaled:
         effects["velocity_scaled_restitution"] = {"k_mps": ROCFALL_K_MPS}
     if not reasons:
-        return replace(model, effects=effects), {}, [], []
+        return Written(replace(model, effects=effects), {}, [], [], None)
+    factor = normal_factor if scaled else np.ones_like
+    ranges = ((0.0, RESTITUTION_MAX), (0.0, RESTITUTION_MAX))
     coefficients, loud = fit_coefficients(
         model,
         "RocFall",
-        normal_factor if scaled else np.ones_like,
-        (0.0, RESTITUTION_MAX),
-        (0.0, RESTITUTION_MAX),
+        factor,
+        *ranges,
         fit_rt="rotation_friction" not in model.effects,
+    )
+
+    def emulate(values: dict[str, tuple[Coefficient, Coefficient]]) -> Model:
+        return replace(with_coefficients(model, values), effects=effects)
+
+    coefficients, search = closest_behaviour(
+        model,
+        coefficients,
+        emulate,
+        factor,
+        *ranges,
+        precision=lambda v: float(number(v)),
     )
     # the value RocFall is given is the value in the file (15 significant digits)
     coefficients = {
         name: tuple(replace(c, written=float(number(c.written))) for c in pair)
         for name, pair in coefficients.items()
     }
-    written = with_coefficients(model, coefficients)
-    return replace(written, effects=effects), coefficients, reasons, loud
+    return Written(emulate(coefficients), coefficients, reasons, loud, search)
 
 
 def material_distributions(model: Model) -> dict[str, dict[str, Distribution]]:
@@ -598,7 +617,7 @@ def export_rocfall(model: Model, site: ExportSite | None = None) -> Export:
     """
     del site
     check_rocfall(model)
-    written, coefficients, reasons, loud = rocfall_model(model)
+    written, coefficients, reasons, loud, search = rocfall_model(model)
     files = {
         "materials.txt": materials_text(written),
         "rock_type.txt": rock_type_text(written),
@@ -610,7 +629,12 @@ def export_rocfall(model: Model, site: ExportSite | None = None) -> Export:
     mapped, mismatches = _mapped_materials(model, written, coefficients)
     mapped += _mapped_rest(model, written)
     unmapped = _unmapped(model)
-    mismatches = [*loud, *_fit_lines(reasons, coefficients), *mismatches]
+    mismatches = [
+        *loud,
+        *_fit_lines(reasons, coefficients),
+        *search_line(search, "RocFall"),
+        *mismatches,
+    ]
     mismatches += _mismatches_rest(model)
     emulated = emulation(files, model)
     return Export(
