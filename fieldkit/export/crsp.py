@@ -44,8 +44,10 @@ impact; S >= 0; a positive density and diameter) and says so in the README.
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import replace
+from functools import lru_cache
 
 import numpy as np
 
@@ -55,18 +57,21 @@ from fieldkit.export.lumped import (
     RESTITUTION_LAWS,
     Coefficient,
     DocumentedRange,
+    Written,
+    closest_behaviour,
     effects_account,
     fit_coefficients,
     no_rule,
     not_a_law,
+    search_line,
     with_coefficients,
 )
 from fieldkit.export.result import Export, Mapped
 from fieldkit.export.site import ExportSite
 from fieldkit.export.translation import translation_error
 from fieldkit.model.effects.slope_roughness import dip_sd_rad
-from fieldkit.model.model_file import Model
-from fieldkit.outputs import csv_text
+from fieldkit.model.model_file import Model, model_from_dict, model_to_dict
+from fieldkit.outputs import csv_text, json_text
 from fieldkit.physics.bodies import sphere_density_kg_m3
 
 #: Metres in one international foot (exact).
@@ -182,7 +187,7 @@ def export_crsp(model: Model, site: ExportSite | None = None) -> Export:
     1,0.00,100.00,100.00,0.00,1.00,0.850,0.350,rock
     """
     del site
-    written, coefficients, reasons, loud = crsp_model(model)
+    written, coefficients, reasons, loud, search = crsp_model(model)
     surface = {name: _surface(written, name) for name in written.materials}
     shape, shape_note = rock_shape(model.body.radius_m, model.body.gyration_m)
     files = {
@@ -198,6 +203,7 @@ def export_crsp(model: Model, site: ExportSite | None = None) -> Export:
     mismatches = [
         *loud,
         *_fit_lines(reasons, coefficients),
+        *search_line(search, "CRSP"),
         _rt_mismatch(),
         *mismatches,
         *rock_mismatch,
@@ -271,20 +277,26 @@ def normal_factor(v_mps: np.ndarray) -> np.ndarray:
     return 1.0 / (1.0 + (np.asarray(v_mps, float) / CRSP_K_MPS) ** 2)
 
 
-def crsp_model(
-    model: Model,
-) -> tuple[Model, dict[str, tuple[Coefficient, Coefficient]], list[str], list[str]]:
+def crsp_model(model: Model) -> Written:
     """The model with CRSP's Rn, Rt per material, as the cells hold them (3
-    decimals): as calibrated when the law is CRSP's (:func:`crsp_law`), else
-    fitted in (0, 1] under CRSP's law; with the reasons and the loud lines of
-    materials no simulated rock touched."""
+    decimals): as calibrated when the law is CRSP's (:func:`crsp_law`), else the
+    values in (0, 1] whose emulation behaves closest to the calibrated model,
+    searched from the impact-level least-squares values under CRSP's law
+    (:func:`fieldkit.export.lumped.closest_behaviour`); with the reasons and the
+    loud lines of materials no simulated rock touched. Cached per model."""
+    return _crsp_model(json_text(model_to_dict(model)))
+
+
+@lru_cache(maxsize=8)
+def _crsp_model(text: str) -> Written:
+    model = model_from_dict(json.loads(text))
     reasons = crsp_law(model)
     if not reasons:
         materials = {
             name: replace(m, e_n=round(m.e_n, 3), e_t=round(m.e_t, 3))
             for name, m in model.materials.items()
         }
-        return replace(model, materials=materials), {}, [], []
+        return Written(replace(model, materials=materials), {}, [], [], None)
     coefficients, loud = fit_coefficients(
         model,
         "CRSP",
@@ -293,11 +305,30 @@ def crsp_model(
         FIT_RANGE,
         fit_rt="rotation_friction" not in model.effects,
     )
+    shape, _ = rock_shape(model.body.radius_m, model.body.gyration_m)
+
+    def emulate(values: dict[str, tuple[Coefficient, Coefficient]]) -> Model:
+        written = with_coefficients(model, values)
+        surface = {name: _surface(written, name) for name in written.materials}
+        return emulation(written, surface, shape)
+
+    coefficients, search = closest_behaviour(
+        model,
+        coefficients,
+        emulate,
+        normal_factor,
+        FIT_RANGE,
+        FIT_RANGE,
+        precision=lambda v: round(v, 3),
+        search_rt=False,
+    )
     coefficients = {
         name: tuple(replace(c, written=round(c.written, 3)) for c in pair)
         for name, pair in coefficients.items()
     }
-    return with_coefficients(model, coefficients), coefficients, reasons, loud
+    return Written(
+        with_coefficients(model, coefficients), coefficients, reasons, loud, search
+    )
 
 
 def emulation(

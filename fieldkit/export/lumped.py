@@ -30,9 +30,11 @@ from fieldkit.export.translation import (
     SEARCH_ROCKS,
     SEARCH_SEED,
     Search,
+    behaviour_gap,
     closest_in_range,
     fit_scaled,
     realised_impacts,
+    translation_error,
 )
 from fieldkit.model.effects import registry
 from fieldkit.model.model_file import Model
@@ -280,6 +282,36 @@ def fit_coefficients(
     return out, lines
 
 
+#: The held-out behaviour gap a search must cut, as a fraction of the impact-level
+#: values' gap, for its values to be written (else the impact-level values are).
+MIN_GAIN = 0.2
+
+
+@dataclass(frozen=True)
+class Behaviour:
+    """A behaviour search and its check on an independent random stream.
+
+    Attributes
+    ----------
+    search
+        :func:`fieldkit.export.translation.closest_in_range`'s outcome.
+    held_out_start, held_out_found
+        :func:`fieldkit.export.translation.behaviour_gap` of the impact-level and
+        of the searched values on the translation error's own stream.
+    accepted
+        Whether the searched values are written (the held-out gap fell by at
+        least :data:`MIN_GAIN` of the impact-level one).
+    searched
+        The coefficients searched, e.g. ``["materials.talus.e_n"]``.
+    """
+
+    search: Search
+    held_out_start: float
+    held_out_found: float
+    accepted: bool
+    searched: tuple[str, ...]
+
+
 def closest_behaviour(
     model: Model,
     coefficients: dict[str, tuple[Coefficient, Coefficient]],
@@ -289,18 +321,22 @@ def closest_behaviour(
     rt_range: tuple[float, float],
     precision: Callable[[float], float],
     *,
+    search_rt: bool = True,
     rocks: int = ROCKS,
     seed: int = SEED,
-) -> tuple[dict[str, tuple[Coefficient, Coefficient]], Search]:
+) -> tuple[dict[str, tuple[Coefficient, Coefficient]], Behaviour]:
     """The in-range Rn, Rt whose emulation behaves closest to ``model``.
 
     The impact-level values of :func:`fit_coefficients` are the start of
     :func:`fieldkit.export.translation.closest_in_range` over every coefficient
-    fitted to impacts of its own (a material no rock touched keeps its value):
-    the least-squares pair is dominated by the many slow impacts, while runout and
-    design energies are set by the fast ones. Each value found is rounded to what
-    the target's file holds (``precision``) and carries its own spread over the
-    material's impacts at that value.
+    fitted to impacts of its own (a material no rock touched keeps its value;
+    Rt only with ``search_rt``): the least-squares pair is dominated by the many
+    slow impacts, while runout and design energies are set by the fast ones. The
+    values found are written only if they also behave closer on the translation
+    error's independent stream, by at least :data:`MIN_GAIN` (a search over
+    quantities the values hardly move fits noise and wanders off); then each is
+    rounded to what the target's file holds (``precision``) and carries its own
+    spread over the material's impacts at that value.
 
     Parameters
     ----------
@@ -310,11 +346,14 @@ def closest_behaviour(
         As for :func:`fit_coefficients`.
     precision
         A value -> the value as the target's file holds it.
+    search_rt
+        False: Rt keeps its impact-level value (the target's tangential law is
+        not what fieldkit emulates, so behaviour cannot inform it).
     """
     names = [
         (name, i)
         for name, pair in coefficients.items()
-        for i in (0, 1)
+        for i in ((0, 1) if search_rt else (0,))
         if pair[i].n > 0
     ]
     ranges = (rn_range, rt_range)
@@ -322,7 +361,7 @@ def closest_behaviour(
     def with_values(values) -> dict[str, tuple[Coefficient, Coefficient]]:
         out = {name: list(pair) for name, pair in coefficients.items()}
         for (name, i), value in zip(names, values, strict=True):
-            out[name][i] = replace(out[name][i], written=float(value))
+            out[name][i] = replace(out[name][i], written=precision(float(value)))
         return {name: (pair[0], pair[1]) for name, pair in out.items()}
 
     search = closest_in_range(
@@ -332,6 +371,20 @@ def closest_behaviour(
         [ranges[i][0] for _, i in names],
         [ranges[i][1] for _, i in names],
     )
+    start_gap = behaviour_gap(translation_error(model, emulate(coefficients)))
+    found_gap = behaviour_gap(
+        translation_error(model, emulate(with_values(search.values)))
+    )
+    accepted = found_gap <= (1.0 - MIN_GAIN) * start_gap
+    record = Behaviour(
+        search,
+        start_gap,
+        found_gap,
+        accepted,
+        tuple(coefficients[name][i].name for name, i in names),
+    )
+    if not accepted:
+        return coefficients, record
     impacts = realised_impacts(model, rocks, seed)
     out = {name: list(pair) for name, pair in coefficients.items()}
     for (name, i), value in zip(names, search.values, strict=True):
@@ -349,7 +402,7 @@ def closest_behaviour(
         out[name][i] = replace(
             c, written=written, spread=spread, impact_level=c.written
         )
-    return {name: (pair[0], pair[1]) for name, pair in out.items()}, search
+    return {name: (pair[0], pair[1]) for name, pair in out.items()}, record
 
 
 def _coefficient(name: str, calibrated: float, fit) -> Coefficient:
@@ -559,20 +612,31 @@ class Written(NamedTuple):
     coefficients: dict[str, tuple[Coefficient, Coefficient]]
     reasons: list[str]
     loud: list[str]
-    search: Search | None
+    search: Behaviour | None
 
 
-def search_line(search: Search | None, target: str) -> list[str]:
+def search_line(behaviour: Behaviour | None, target: str) -> list[str]:
     """The README line saying what the behaviour search did ([] without one)."""
-    if search is None:
+    if behaviour is None:
         return []
+    search = behaviour.search
+    what = ", ".join(behaviour.searched)
+    head = (
+        f"Behaviour search over {what} in {target}'s ranges (runout p50/p95, p95 "
+        "energy and bounce height at the analysis points; summed squared log "
+        f"ratios; {search.evaluations} emulations of {SEARCH_ROCKS} rocks, seed "
+        f"{SEARCH_SEED}): {search.start_gap:.3g} at the impact-level least-squares "
+        f"values, {search.gap:.3g} at the values found; on the translation error's "
+        f"own stream {behaviour.held_out_start:.3g} and "
+        f"{behaviour.held_out_found:.3g}. "
+    )
+    if behaviour.accepted:
+        return [
+            head + "The values found are written: they trade rebound accuracy for "
+            "design behaviour, and each one's spread says how far"
+        ]
     return [
-        f"The written Rn, Rt are the values in {target}'s ranges whose emulation "
-        "behaves closest to the calibrated model (runout p50/p95, p95 energy and "
-        "bounce height at the analysis points; summed squared log ratios "
-        f"{search.gap:.3g}, from {search.start_gap:.3g} at the impact-level "
-        f"least-squares values; {search.evaluations} emulations of "
-        f"{SEARCH_ROCKS} rocks on their own random stream, seed {SEARCH_SEED}, "
-        "apart from the translation error's). A value far from the impact-level "
-        "one trades rebound accuracy for design behaviour: its spread says how far"
+        head + f"The impact-level values are written: the values found do not cut "
+        f"the independent gap by {100 * MIN_GAIN:.0f} % (a search the quantities "
+        "hardly respond to fits noise)"
     ]

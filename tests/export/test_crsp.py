@@ -124,7 +124,7 @@ def test_rn_above_one_with_velocity_scaling_is_fitted_in_range():
     data = small(e_n=1.25)
     data["effects"] = {"velocity_scaled_restitution": {}}
     export = export_crsp(model_from_dict(data))
-    assert rows(export.files["cells.csv"])[0]["Rn"] == "1.000"
+    assert 0.0 < float(rows(export.files["cells.csv"])[0]["Rn"]) <= 1.0
     assert any(
         "materials.talus.e_n: the least-squares value under CRSP's law is" in m
         for m in export.mismatches
@@ -163,8 +163,28 @@ def test_calibrated_tornado_through_the_cli(cli, repo, tmp_path):
 
 
 def test_restitution_of_one_is_accepted():
-    cells = rows(export_crsp(model_from_dict(small(e_n=1.0))).files["cells.csv"])
-    assert cells[0]["Rn"] == "1.000"
+    # CRSP's own law (velocity scaling at K = 30 ft/s) with Rn = 1: as calibrated
+    data = small(e_n=1.0)
+    data["effects"] = {"velocity_scaled_restitution": {}}
+    export = export_crsp(model_from_dict(data))
+    assert rows(export.files["cells.csv"])[0]["Rn"] == "1.000"
+    assert not any("cannot be written" in m for m in export.mismatches)
+
+
+def test_behaviour_search_is_checked_on_an_independent_stream():
+    # e_n = 1.0 without scaling: CRSP's scaled Rn at 1 behaves differently; the
+    # search's Rn is written only if it also cuts the translation error's gap
+    export = export_crsp(model_from_dict(small(e_n=1.0)))
+    line = next(m for m in export.mismatches if m.startswith("Behaviour search"))
+    assert "over materials.talus.e_n in CRSP's ranges" in line
+    start, found = (
+        float(x) for x in line.split("own stream ")[1].split(". ")[0].split(" and ")
+    )
+    rn = float(rows(export.files["cells.csv"])[0]["Rn"])
+    if found <= 0.8 * start:
+        assert "The values found are written" in line and rn < 1.0
+    else:
+        assert "The impact-level values are written" in line
 
 
 def test_roughness_s_in_feet_and_its_effect():
