@@ -138,9 +138,11 @@ def test_a_model_file_without_what_a_model_needs(cli, tmp_path, fails):
     assert not (tmp_path / "x").exists()
 
 
-@pytest.mark.parametrize("target", ["rocfall", "crsp", "rstone"])
+@pytest.mark.parametrize("target", ["rstone"])
 def test_values_the_target_refuses_leave_nothing_behind(cli, tmp_path, fails, target):
-    # e_t = 1.05 on the colluvium: every restitution-pair target refuses Rt > 1
+    # e_t = 1.05 on the colluvium: r.stone refuses Rt > 1 (RocFall and CRSP write
+    # the in-range values under their own law instead, issue 19:
+    # tests/export/test_rocfall.py, test_crsp.py)
     data = json.loads(TABLE_7_1.read_text())
     data["materials"]["colluvium"]["e_t"] = 1.05
     bad = tmp_path / "bad.json"
