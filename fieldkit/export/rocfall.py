@@ -722,9 +722,10 @@ def _fit_lines(
     out = [
         "The calibrated law cannot be written in RocFall's terms ("
         + "; ".join(reasons)
-        + "): each material's Rn, Rt are the values in [0, 1] whose rebounds under "
-        "RocFall's law are closest (least squares) to the calibrated model's "
-        "simulated impacts on it; see the translation error"
+        + "): each material's Rn, Rt start as the values in [0, 1] whose rebounds "
+        "under RocFall's law are closest (least squares) to the calibrated model's "
+        "simulated impacts on it, then the behaviour search below decides; see the "
+        "translation error"
     ]
     for coefficient in (c for pair in coefficients.values() for c in pair):
         if coefficient.clipped:
