@@ -13,6 +13,19 @@ calibrated model's simulated impacts of each material,
           e_t = \\frac{\\sum v_{fT} v_{iT}}{\\sum v_{iT}^2},
 
 (the unweighted ``fieldkit fit`` of a constant-e_n, e_t model), and says so.
+
+The same machinery serves targets with a law of their own (RocFall's and CRSP's
+velocity scaling of Rn): :func:`fit_coefficients` fits each material's Rn, Rt
+under the target's law within its documented range
+(:func:`fieldkit.export.translation.fit_scaled`), :func:`closest_behaviour`
+searches from there for the values whose emulation behaves closest to the
+calibrated model, written only when they also do so on an independent stream.
+A written value carries its own spread over the impacts, never the calibrated
+parameter's standard error (:func:`with_coefficients`). A material no simulated
+rock touched is not written with its raw value: its own calibrated law is
+evaluated at the normal speeds of all simulated impacts (when it depends on the
+normal speed only; else the value is clipped to the range), and a line says so
+loudly. :class:`DocumentedRange` checks every value an exporter writes.
 """
 
 from __future__ import annotations
