@@ -165,7 +165,7 @@ def export(
                 site = site_from_section(model, cellsize_m=cellsize, rows=rows)
             result = chosen.export(model, site)
         files = dict(result.files)
-        if site is not None:
+        if site is not None and not any(n.startswith("site:") for n in result.notes):
             result.notes.insert(0, f"grid: {site.description}")
         files["README.md"] = result.readme(str(model_file))
         for name in files:

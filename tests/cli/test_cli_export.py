@@ -54,8 +54,10 @@ def test_grid_files_share_the_extruded_grid(cli, tmp_path):
     grids = [read_dem(p) for p in sorted(out.glob("*.asc"))]
     assert len(grids) >= 2
     for g in grids:
-        assert g.shape == grids[0].shape == (3, 140)  # 700 m of profile / 5 m
-        assert g.x_m[0] == grids[0].x_m[0] == 2.5
+        # 700 m of profile / 5 m, 3 rows; padded by 2 cells north, south and west so
+        # the seeder's column lies inside Rockyfor3D's active area
+        assert g.shape == grids[0].shape == (7, 142)
+        assert g.x_m[0] == grids[0].x_m[0] == -7.5
 
 
 def test_grid_target_on_a_dem(cli, tmp_path):
