@@ -44,6 +44,10 @@ def test_every_target_writes_its_files_and_a_readme(cli, tmp_path, target, extra
     files = {p.name for p in out.iterdir()} - {"README.md"}
     assert files and all(f"`{name}`" in readme for name in files)
     assert f"{target}:" in r.output
+    if target == "rockyfor3d":  # source cells inside Rockyfor3D's active area
+        source = read_dem(out / "rockdensity.asc").values > 0
+        assert source.any() and not source[:2].any() and not source[-2:].any()
+        assert not source[:, :2].any() and not source[:, -2:].any()
 
 
 def test_grid_files_share_the_extruded_grid(cli, tmp_path):
