@@ -382,3 +382,15 @@ def test_cells_without_ground_are_nodata(cli, tmp_path):
     assert grids["rockdensity.asc"].values[2, 2] > 0  # the release cell
     assert (grids["soiltype.asc"].values[np.isfinite(grids["dem.asc"].values)]
             == 4).all()  # fmt: skip
+
+
+def test_design_values_the_emulation_never_reaches_are_named(cli, tmp_path):
+    # Table 7-1 (e_n 1.0 on colluvium, no velocity scaling): the calibrated rocks run
+    # past 600 m; under Rockyfor3D's law (colluvium Rn 0.38) none reaches the
+    # analysis point, so its energy row has no emulated value -- said, not dropped.
+    _, _, readme = _export(cli, tmp_path / "o", TABLE_7_1, "--extrude",
+                           "--cellsize", "10", "--rows", "3")  # fmt: skip
+    section = readme.split("## Translation error")[1].split("\n## ")[0]
+    assert "| no rock crossed |" in section
+    assert "Not reached under Rockyfor3D's law" in section
+    assert "p95 total energy at" in section.split("Not reached")[1]
