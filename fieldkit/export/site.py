@@ -172,16 +172,15 @@ def release_cells(grid: DemGrid, releases: Releases) -> np.ndarray:
     xx, yy = np.meshgrid(grid.x_m, grid.y_m)
     for polygon in releases.polygons:
         outside = [
-            number
+            (number, problem)
             for (x, y), number in zip(polygon.xy_m, polygon.rows, strict=True)
-            if _cell_of(grid, float(x), float(y))[2].startswith("outside")
+            if (problem := _cell_of(grid, float(x), float(y))[2]).startswith("outside")
         ]
         if outside:
             bad.append(
                 (
-                    ", ".join(f"row {n}" for n in outside),
-                    f"polygon {polygon.name}: vertex outside the grid "
-                    f"({grid.extent_text()})",
+                    ", ".join(f"row {n}" for n, _ in outside),
+                    f"polygon {polygon.name}: vertex {outside[0][1]}",
                 )
             )
             continue
@@ -215,7 +214,7 @@ def release_cells(grid: DemGrid, releases: Releases) -> np.ndarray:
         raise InputFileError(
             f"{len(bad)} release"
             + ("" if len(bad) == 1 else "s")
-            + f" with no ground in the DEM {grid.source}: "
+            + f" with no cell on ground in the DEM {grid.source}: "
             + "; ".join(f"{where}: {what}" for where, what in bad[:MAX_LISTED])
             + (f"; and {more} more" if more > 0 else ""),
             source=releases.source,

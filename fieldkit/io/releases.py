@@ -100,6 +100,15 @@ def read_releases(path: str | PathLike[str]) -> Releases:
         "a release file needs plan coordinates in columns x, y (e.g. x_m, y_m)",
     )
     polygon = table.find(POLYGON_ALIASES, "polygon")
+    for column in found.values():
+        if column.unit is None:
+            header = column.header.strip()
+            raise InputFileError(
+                f"column '{header}' has no length unit: name it in the header "
+                f"('{header}_m', '{header}_ft'), in the DEM's coordinate system",
+                source=table.source,
+                where="row 1",
+            )
     factors = {k: length_factor(table, c, None) for k, c in found.items()}
     points, point_rows = [], []
     vertices: dict[str, list[tuple[float, float, int]]] = {}

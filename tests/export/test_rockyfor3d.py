@@ -331,8 +331,8 @@ def test_releases_off_the_dem_are_named_by_row(cli, tmp_path, fails, digest):
     out = tmp_path / "o"
     r = cli("export", TSCHAMUT, "--to", "rockyfor3d", "-o", out, "--dem", TERRAIN,
             "--releases", bad)  # fmt: skip
-    fails(r, "releases.csv", "2 releases with no ground", "row 3: (-500, 3) outside",
-          "row 5: (30, 999) outside")  # fmt: skip
+    fails(r, "releases.csv", "2 releases with no cell on ground",
+          "row 3: (-500, 3) outside", "row 5: (30, 999) outside")  # fmt: skip
     assert r.exit_code == 1
     assert not out.exists() and digest(bad) == before
 
@@ -394,3 +394,26 @@ def test_design_values_the_emulation_never_reaches_are_named(cli, tmp_path):
     assert "| no rock crossed |" in section
     assert "Not reached under Rockyfor3D's law" in section
     assert "p95 total energy at" in section.split("Not reached")[1]
+
+
+@pytest.mark.parametrize(
+    ("text", "words"),
+    [
+        ("x,y\n33.4,236.67\n", ["row 1", "column 'x' has no length unit", "x_m"]),
+        ("a_m,b_m\n1,2\n", ["row 1", "columns x, y", "have: a_m, b_m"]),
+        ("x_m,y_m,polygon\n0,250,A\n500,250,A\n0,260,A\n",
+         ["row 3: polygon A: vertex outside the grid (x -35..180 m"]),
+        ("x_m,y_m,polygon\n0,250,A\n0.5,250,A\n0,250.5,A\n",
+         ["rows 2-4", "polygon A holds no cell centre"]),
+        ("x_m,y_m,polygon\n0,250,A\n0.5,250,A\n",
+         ["rows 2-3", "2 distinct vertices", "at least 3"]),
+    ],
+)  # fmt: skip
+def test_bad_release_files_refused_in_one_line(cli, tmp_path, fails, text, words):
+    bad = tmp_path / "releases.csv"
+    bad.write_text(text)
+    out = tmp_path / "o"
+    r = cli("export", TSCHAMUT, "--to", "ramms", "-o", out, "--dem", TERRAIN,
+            "--releases", bad)  # fmt: skip
+    fails(r, "releases.csv", *words)
+    assert r.exit_code == 1 and not out.exists()
