@@ -644,7 +644,13 @@ def _mapped(
                 f"Rt = 1 / (1 + MOH / R), R = {block.radius_m:.4g} m, inverted at the "
                 "65th / 20th / 5th percentile of the realised e_t (the middle of the "
                 "top 70 %, the next 20 % and the lowest 10 %): Rockyfor3D's Rt then "
-                f"has mean {mean:.3f} and SD {sd:.3f}",
+                f"has mean {mean:.3f} and SD {sd:.3f}"
+                + (
+                    f"; heights above Rockyfor3D's {RG_MAX_M:g} m written as "
+                    f"{RG_MAX_M:g} m (e_t near 0)"
+                    if max(h.values()) >= RG_MAX_M
+                    else ""
+                ),
             )
         )
     return out

@@ -417,3 +417,16 @@ def test_bad_release_files_refused_in_one_line(cli, tmp_path, fails, text, words
             "--releases", bad)  # fmt: skip
     fails(r, "releases.csv", *words)
     assert r.exit_code == 1 and not out.exists()
+
+
+def test_obstacle_heights_beyond_rockyfor3d_range_are_capped_and_said(cli, tmp_path):
+    # e_t = 0.002 (r = 0.5 m): h = 0.5 (1/0.002 - 1) = 249.5 m > Rockyfor3D's 100 m
+    data = json.loads(_one_material(tmp_path).read_text())
+    data["materials"]["ground"]["e_t"] = 0.002
+    model = tmp_path / "low_et.json"
+    model.write_text(json.dumps(data))
+    _, grids, readme = _export(cli, tmp_path / "o", model, "--extrude",
+                               "--cellsize", "2")  # fmt: skip
+    ground = np.isfinite(grids["dem.asc"].values)
+    assert (grids["rg10.asc"].values[ground] == 100).all()
+    assert "heights above Rockyfor3D's 100 m written as 100 m" in readme
