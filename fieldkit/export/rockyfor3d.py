@@ -478,7 +478,7 @@ def export_rockyfor3d(model: Model, site: ExportSite | None = None) -> Export:
         mapped=_mapped(
             model, site, unpadded, present, soil, soil_why, realised, rg, block
         ),  # fmt: skip
-        unmapped=_unmapped(model, present),
+        unmapped=_unmapped(model, site, present),
         units=[
             "lengths in metres as Rockyfor3D reads them (DEM, d1-d3, rg70/rg20/rg10;"
             " fieldkit's SI unchanged)",
@@ -680,7 +680,9 @@ EFFECT_REASONS = {
 }
 
 
-def _unmapped(model: Model, present: list[str]) -> list[tuple[str, str]]:
+def _unmapped(
+    model: Model, site: ExportSite, present: list[str]
+) -> list[tuple[str, str]]:
     out = []
     for name in present:
         m = model.materials[name]
@@ -707,12 +709,30 @@ def _unmapped(model: Model, present: list[str]) -> list[tuple[str, str]]:
         )
     )
     s = model.seeder
+    height = float(s.z_m - model.profile.ground_z(s.x_m))
+    where = f"above the ground at chainage {s.x_m:g} m"
+    source = site.release & ground_cells(site)
+    if site.grid.source.endswith("(section extruded)"):
+        # the source cells' elevation is the profile's at their centre, not at the
+        # seeder: the fall to keep is from the seeder down to them
+        height = float(s.z_m - np.mean(site.grid.values[source]))
+        where = "above the source cells (the section's elevation at their centres)"
+    speed = math.hypot(s.vx_mps, s.vz_mps)
     out.append(
         (
-            f"seeder velocity (vx {s.vx_mps:g}, vz {s.vz_mps:g} m/s; SDs "
-            f"{s.vx_sd_mps:g}, {s.vz_sd_mps:g} m/s)",
-            "no grid takes a release velocity; the closest is the run's additional "
-            "initial fall height (§2.5), left to the user",
+            f"seeder: {height:.3g} m {where}; "
+            f"velocity vx {s.vx_mps:g}, vz {s.vz_mps:g} m/s (SDs {s.vx_sd_mps:g}, "
+            f"{s.vz_sd_mps:g} m/s)",
+            "no grid takes a release height or velocity: the source cells start "
+            "blocks on the DEM. Set the run's additional initial fall height (§2.5) "
+            f"to {height:.3g} m to keep the seeder's fall"
+            + (
+                f"; the release speed {speed:.3g} m/s has no Rockyfor3D input "
+                f"(a fall of v^2 / 2g = {speed**2 / (2 * 9.81):.3g} m more gives it "
+                "as a vertical speed)"
+                if speed > 0
+                else ""
+            ),
         )
     )
     for spec in registry.EFFECTS:

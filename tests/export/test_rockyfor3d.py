@@ -430,3 +430,17 @@ def test_obstacle_heights_beyond_rockyfor3d_range_are_capped_and_said(cli, tmp_p
     ground = np.isfinite(grids["dem.asc"].values)
     assert (grids["rg10.asc"].values[ground] == 100).all()
     assert "heights above Rockyfor3D's 100 m written as 100 m" in readme
+
+
+def test_the_seeder_fall_to_the_source_cells_is_stated(cli, tmp_path):
+    # The extruded source cells lie at the section's elevation at their centre
+    # (chainage 2.5 m), 10.6 m below the ground under the seeder (chainage 0 m):
+    # the fall Rockyfor3D needs is seeder z - z(2.5 m), by hand from the model file.
+    data = json.loads(PATH_START.read_text())
+    profile, seeder = data["profile"], data["seeder"]
+    fall = seeder["z_m"] - np.interp(2.5, profile["x_m"], profile["z_m"])
+    assert fall == pytest.approx(0.725 + 34 / 8 * 2.5, abs=1e-6)  # 11.35 m
+    r, _, readme = _export(cli, tmp_path / "o", PATH_START, "--extrude",
+                           "--cellsize", "5")  # fmt: skip
+    assert f"additional initial fall height (§2.5) to {fall:.3g} m" in readme
+    assert "additional initial fall height" in r.stdout
