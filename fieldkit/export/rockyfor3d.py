@@ -477,7 +477,7 @@ def export_rockyfor3d(model: Model, site: ExportSite | None = None) -> Export:
         files,
         mapped=_mapped(
             model, site, unpadded, present, soil, soil_why, realised, rg, block
-        ),  # fmt: skip
+        ),
         unmapped=_unmapped(model, site, present),
         units=[
             "lengths in metres as Rockyfor3D reads them (DEM, d1-d3, rg70/rg20/rg10;"
