@@ -118,6 +118,9 @@ def export(
 
         fieldkit export surveys/tornado_mountain/model_rocfall_table_7_1.json \\
           --to rocfall -o out/rocfall
+        fieldkit export examples/tschamut/model_base.json --to rockyfor3d \\
+          --dem tests/data/tschamut2014/terrain.asc \\
+          --releases tests/data/tschamut2014/release_points.csv -o out/r3d
     """
     from fieldkit.export.site import site_from_dem, site_from_section
     from fieldkit.export.targets import target

@@ -444,3 +444,17 @@ def test_the_seeder_fall_to_the_source_cells_is_stated(cli, tmp_path):
                            "--cellsize", "5")  # fmt: skip
     assert f"additional initial fall height (§2.5) to {fall:.3g} m" in readme
     assert "additional initial fall height" in r.stdout
+
+
+def test_help_documents_the_release_file_and_its_example_runs(
+    cli, repo_copy, shell_commands, run_shell
+):
+    r = cli("export", "--help")
+    text = " ".join(r.output.replace("│", " ").split())
+    assert "--releases" in text and "polygon" in text and "(x_m, y_m)" in text
+    lines = [c for c in shell_commands(r.output) if "--releases" in c]
+    assert len(lines) == 1
+    code, output = run_shell(lines[0], repo_copy)
+    assert code == 0, output
+    source = read_dem(repo_copy / "out/r3d/rockdensity.asc").values > 0
+    assert source.sum() == 14 and not source[:2].any() and not source[:, :2].any()
