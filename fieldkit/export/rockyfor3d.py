@@ -491,7 +491,6 @@ def export_rockyfor3d(model: Model, site: ExportSite | None = None) -> Export:
         how_to_use=HOW_TO_USE,
         translation=[
             *translation.lines(),
-            *_lost(translation),
             "",
             "fieldkit's emulation of Rockyfor3D's law: per material e_n = the soil "
             "type's mean Rn with the SD of a uniform draw over its range (a normal "
@@ -506,25 +505,6 @@ def export_rockyfor3d(model: Model, site: ExportSite | None = None) -> Export:
         sources=SOURCES,
         unconfirmed=UNCONFIRMED,
     )
-
-
-def _lost(translation) -> list[str]:
-    """A line naming the quantities the emulation never reaches (no emulated rock
-    crosses the point): the largest difference above leaves them out."""
-    lost = [
-        r.quantity
-        for r in translation.rows
-        if math.isfinite(r.calibrated) and not math.isfinite(r.emulated)
-    ]
-    if not lost:
-        return []
-    return [
-        "",
-        "Not reached under Rockyfor3D's law with the values written (no emulated "
-        "rock crosses the point, so the largest difference above leaves them out): "
-        + "; ".join(lost)
-        + ". The design values there are lost, not merely changed.",
-    ]
 
 
 def _check_active(source: np.ndarray) -> None:
