@@ -23,6 +23,7 @@ FLAGS = {
     "output": "-o",
     "dem": "--dem",
     "release_xy": "--release",
+    "releases": "--releases",
     "cellsize_m": "--cellsize",
     "rows": "--rows",
     "model_file": "MODEL",
@@ -63,6 +64,19 @@ def export(
         str | None,
         typer.Option("--release", help="With --dem: the release point X,Y."),
     ] = None,
+    releases: Annotated[
+        Path | None,
+        typer.Option(
+            "--releases",
+            help="With --dem, instead of --release: a CSV of release points and/or "
+            "polygons in the DEM's coordinates. Columns x, y with their unit "
+            "(x_m, y_m) and optionally polygon: rows with a polygon name are that "
+            "polygon's vertices in order (the cells whose centre lies inside it "
+            "release rocks); rows without one are points (the cell holding each "
+            "point releases rocks). A release off the DEM or on nodata is refused, "
+            "naming its rows.",
+        ),
+    ] = None,
     extrude: Annotated[
         bool,
         typer.Option(
@@ -97,17 +111,21 @@ def export(
     Each target's folder holds its files and a README.md: what was mapped to what,
     what could not be mapped and why, the units converted, and the mismatch left
     where a class or category had to be chosen. Grid targets (rockyfor3d, ramms,
-    rstone) are written on a DEM (--dem with --release) or on the model's own
-    section extruded across (--extrude).
+    rstone) are written on a DEM (--dem with --release, or --releases for many
+    release cells) or on the model's own section extruded across (--extrude).
 
     Example (from the repository root):
 
         fieldkit export surveys/tornado_mountain/model_rocfall_table_7_1.json \\
           --to rocfall -o out/rocfall
+        fieldkit export examples/tschamut/model_base.json --to rockyfor3d \\
+          --dem tests/data/tschamut2014/terrain.asc \\
+          --releases tests/data/tschamut2014/release_points.csv -o out/r3d
     """
     from fieldkit.export.site import site_from_dem, site_from_section
     from fieldkit.export.targets import target
     from fieldkit.io.dem import read_dem
+    from fieldkit.io.releases import read_releases
     from fieldkit.model.model_file import read_model
 
     chosen = target(to)
@@ -123,8 +141,14 @@ def export(
         )
     if release is not None and dem is None:
         raise ArgumentError("the release point goes with a DEM", source="release_xy")
+    if releases is not None and dem is None:
+        raise ArgumentError("the release file goes with a DEM", source="releases")
+    if release is not None and releases is not None:
+        raise ArgumentError(
+            "give the release point or a release file, not both", source="releases"
+        )
     _refuse_full_folder(output, force)
-    inputs = [model_file] + ([dem] if dem is not None else [])
+    inputs = [model_file] + [p for p in (dem, releases) if p is not None]
     with OutputSet(inputs=inputs) as outputs:
         outputs.confine(output)
         model = read_model(model_file, outputs=outputs)
@@ -134,12 +158,17 @@ def export(
                 point = (
                     parse_point(release, "--release") if release is not None else None
                 )
-                site = site_from_dem(model, read_dem(dem), point)
+                site = site_from_dem(
+                    model,
+                    read_dem(dem),
+                    point,
+                    releases=read_releases(releases) if releases else None,
+                )
             elif extrude:
                 site = site_from_section(model, cellsize_m=cellsize, rows=rows)
             result = chosen.export(model, site)
         files = dict(result.files)
-        if site is not None:
+        if site is not None and not any(n.startswith("site:") for n in result.notes):
             result.notes.insert(0, f"grid: {site.description}")
         files["README.md"] = result.readme(str(model_file))
         for name in files:

@@ -48,6 +48,7 @@ from fieldkit.export.fitted import with_error
 from fieldkit.export.lumped import not_a_law
 from fieldkit.export.result import Export, Mapped
 from fieldkit.export.site import ExportSite, checked_site
+from fieldkit.model.effects import registry
 from fieldkit.model.model_file import Model
 from fieldkit.outputs import csv_text
 
@@ -156,7 +157,53 @@ def export_ramms(model: Model, site: ExportSite | None = None) -> Export:
         mismatches=_mismatches(picks),
         notes=_notes(site),
         how_to_use=HOW_TO_USE,
+        translation=TRANSLATION,
+        sources=SOURCES,
+        unconfirmed=UNCONFIRMED,
     )
+
+
+#: Why the README gives no translation error (no invented number).
+TRANSLATION = [
+    "Not measured. RAMMS::ROCKFALL's law -- a rigid polyhedral rock, plastic normal "
+    "impacts (epsilon = 0) and a ground friction that grows with the slip the rock "
+    "makes (mu_min to mu_max, kappa, beta), chosen per terrain category -- cannot be "
+    "emulated by fieldkit's 2-D lumped-mass model, whose rebound is a restitution "
+    "pair; and the categories' intermediate parameters are not confirmed (below). "
+    "fieldkit gives no number it did not measure: run RAMMS with the recommended "
+    "category and its neighbour and compare its runout with the calibrated model's "
+    "(`fieldkit simulate` on the same section).",
+]
+
+SOURCES = [
+    "RAMMS::ROCKFALL User Manual v1.5 (2013) and v1.6 (2015), WSL Institute for Snow "
+    "and Avalanche Research SLF: title pages and contents seen only (sections on "
+    "the DEM, friction parameters and terrain).",
+    "ofuhrer/rust_rockfall, docs/archive/ramms_gap_analysis.md (a public review of "
+    "the RAMMS manual and papers): DEM import as ESRI ASCII, GeoTIFF or ASCII XYZ; "
+    "terrain, forest and material polygons by shapefile; deterministic ground "
+    "categories.",
+    "An unattributed public research note summarising Bartelt et al. (2016) and the "
+    "RAMMS ground table (secondary; its repository could not be identified): mu_max "
+    "= 2 for every category; the softest category mu_min 0.20, beta 50, kappa 1, "
+    "drag 0.9 and the hardest 0.80, 200, 4, 0.3 (named there 'moor' and 'bedrock'; "
+    "taken here as Extra Soft and Extra Hard); epsilon = 0.",
+    "Leine et al. (2014) Simulation of rockfall trajectories with consideration of "
+    "rock shape, doi:10.1007/s11044-013-9393-4; Lu et al. (2019) Modelling rockfall "
+    "impact with scarring in compactable soils, doi:10.1007/s10346-019-01238-z (the "
+    "slip-dependent friction, scarring).",
+]
+
+UNCONFIRMED = [
+    "mu_min, beta, kappa and drag of Soft, Medium Soft, Medium, Medium Hard and Hard "
+    "(left blank in terrain_categories.csv).",
+    "the exact ground descriptions RAMMS gives per category: the keyword table "
+    "from material names to categories is fieldkit's judgement, not RAMMS's.",
+    "whether RAMMS reads a category raster (fieldkit assumes polygons only).",
+    "the extreme categories' parameters rest on a secondary source; verify them "
+    "against the manual.",
+    "no RAMMS run was made with these files.",
+]
 
 
 HOW_TO_USE = """\
@@ -358,18 +405,43 @@ def _unmapped(model: Model) -> list[tuple[str, str]]:
             "release cells of the site are stated in the notes",
         )
     )
-    for name, params in model.effects.items():
-        values = ", ".join(f"{k} = {v:g}" for k, v in params.items())
+    for spec in registry.EFFECTS:
+        params = model.effects.get(spec.name)
+        state = (
+            "on: " + ", ".join(f"{k} = {v:g}" for k, v in params.items())
+            if params is not None
+            else "off in this model"
+        )
         out.append(
             (
-                f"effect {name} ({values})",
-                not_a_law(name, "RAMMS")
-                or "a lumped-mass effect: RAMMS's rigid-body contact has no such "
-                "parameter"
-                + (" (forest is set in RAMMS by polygons)" if "tree" in name else ""),
+                f"effect {spec.name} ({state})",
+                not_a_law(spec.name, "RAMMS")
+                or EFFECT_REASONS.get(
+                    spec.name,
+                    "a lumped-mass effect: RAMMS's rigid-body contact has no such "
+                    "parameter",
+                ),
             )
         )
     return out
+
+
+#: Why each effect of the registry has no RAMMS input (a statistical alternative
+#: is said so by :func:`~fieldkit.export.lumped.not_a_law`).
+EFFECT_REASONS = {
+    "angle_dependent_restitution": "RAMMS has no restitution coefficient: the "
+    "rebound at any angle comes from the rigid rock's shape, rotation and the "
+    "slip-dependent ground friction",
+    "velocity_scaled_restitution": "RAMMS has no restitution coefficient to scale; "
+    "its impacts are plastic (epsilon = 0) whatever the speed",
+    "rotation_friction": "RAMMS computes rotation from the rigid rock's contact "
+    "(its own friction law, mu_min to mu_max); no lumped coupling parameter",
+    "slope_roughness": "RAMMS's roughness comes from the DEM and the rock's shape; "
+    "no random dip input",
+    "mass_loss": "RAMMS's rock keeps its shape and mass during a run",
+    "tree_impacts": "forest is set in RAMMS by polygons (not written)",
+    "air_drag": "RAMMS's flight has no drag input",
+}
 
 
 def _mismatches(
@@ -415,26 +487,4 @@ def _notes(site: ExportSite) -> list[str]:
     return [
         f"Site: {site.description}.",
         f"Release cells (centres, m): {release}{more}.",
-        "Source: RAMMS::ROCKFALL User Manual v1.5 (2013) and v1.6 (2015), WSL "
-        "Institute for Snow and Avalanche Research SLF: title pages and contents "
-        "seen only (sections on the DEM, friction parameters and terrain).",
-        "Source: a public review of the RAMMS manual and papers "
-        "(github.com/ofuhrer/rust_rockfall, docs/archive/ramms_gap_analysis.md): "
-        "DEM import as ESRI ASCII, GeoTIFF or ASCII XYZ; terrain, forest and "
-        "material polygons by shapefile; deterministic ground categories.",
-        "Source: an unattributed public research note summarising Bartelt et al. "
-        "(2016) and the RAMMS ground table (secondary; its repository could not be "
-        "identified; verify against the manual): mu_max = 2 for every category; "
-        "the softest category mu_min 0.20, beta 50, kappa 1, drag 0.9 and the "
-        "hardest 0.80, 200, 4, 0.3 (named there 'moor' and 'bedrock'; taken here "
-        "as Extra Soft and Extra Hard); epsilon = 0 (every normal impact "
-        "plastic, Bartelt et al. 2016).",
-        "Not confirmed: mu_min, beta, kappa and drag of Soft, Medium Soft, Medium, "
-        "Medium Hard and Hard (left blank in terrain_categories.csv), the exact "
-        "ground descriptions RAMMS gives per category, and whether RAMMS reads a "
-        "category raster (fieldkit assumes polygons only).",
-        "Also: Leine et al. (2014) Simulation of rockfall trajectories with "
-        "consideration of rock shape, doi:10.1007/s11044-013-9393-4; Lu et al. "
-        "(2019) Modelling rockfall impact with scarring in compactable soils, "
-        "doi:10.1007/s10346-019-01238-z (the slip-dependent friction, scarring).",
     ]

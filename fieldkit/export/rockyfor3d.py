@@ -14,48 +14,47 @@ Rockyfor3D reads a folder of ESRI ASCII grids that all share the header of
 * ``soiltype.asc``: 0-7, the class that fixes the range of the normal coefficient of
   restitution Rn (:data:`SOIL_TYPES`).
 
+Rockyfor3D's own rules, checked here (ecorisQ's input plugin, QGIS-RF3D
+``rockyfor3d_inputs_algorithm.py``): source cells in the two outer rows or columns
+of the grid are not simulated -- the site is padded (:func:`~fieldkit.export.site.
+pad_site`) so that every source cell lies at least :data:`EDGE_CELLS` cells inside,
+and the export checks it; rockdensity lies in :data:`DENSITY_RANGE_KG_M3`;
+rg70/rg20/rg10 in 0-100 m; soiltype 0-7; blshape 0-4.
+
 The translation:
 
-* **soiltype**: the calibrated e_n (eq. 4.6) goes to the class whose mean Rn is
-  nearest (:func:`nearest_soil_type`; a tie goes to the higher Rn, the livelier
-  rebounds: the conservative side for a hazard map). The README lists the class
-  means and the mismatch ``|e_n - class mean|`` of every material.
-* **rg70/rg20/rg10**: fieldkit's roughness is a random local dip ``delta ~ N(0,
-  sigma)`` at each impact (``slope_roughness``, eq. 7.4: ``sigma`` from
-  ``roughness_m`` and ``roughness_deg_sd``). Read back through eq. 7.4, a dip
-  ``delta`` is an asperity of height ``h = r tan|delta|`` within a block radius
-  ``r``; the heights met in the lowest 70 %, the next 20 % and the top 10 % of
-  impacts are represented by the medians of those bands: the 35th, 80th and 95th
-  percentiles of the half-normal ``|delta|`` (:func:`obstacle_heights`). Without
-  ``slope_roughness`` the ground is smooth in fieldkit: 0 m.
+* **soiltype** from the ground the material *is* (:func:`soil_type`): the first
+  keyword of :data:`SOIL_KEYWORDS` in the material's name (rock, cliff, bedrock ->
+  6; weathered rock -> 5; talus, colluvium -> 4; scree, bench -> 3; soil, meadow
+  -> 2; deep fine soil -> 1; ...), a fixed order from soft to hard, so a harder
+  ground never gets a softer class. Only a name with no keyword is placed by its
+  realised e_n (the nearest class mean of 1-6, a monotone rule), and says so. The
+  calibrated e_n is not used where a description exists: a lumped e_n grows at
+  shallow impacts (eq. 5.4) and with velocity scaling, so thesis Table 7-1 has e_n
+  1.0 on colluvium and 0.75 on rock -- the nearest-Rn rule put colluvium on
+  bedrock.
+* **rg70/rg20/rg10** from the calibrated e_t (:func:`obstacle_heights`): the e_t
+  the calibrated model realises on its simulated impacts and the impacts' own
+  spread (:func:`fieldkit.export.translation.fit_scaled`), inverted through
+  Rockyfor3D's rule ``Rt = 1 / (1 + MOH / R)`` (:func:`rt_of_height`; MOH the
+  obstacle height drawn from rg70/rg20/rg10 with probabilities 0.7/0.2/0.1, R the
+  block radius): the three heights are those of the Rt at the middle of each
+  band of the realised e_t distribution (its 65th, 20th and 5th percentiles).
 * **block**: fieldkit's body is a sphere of its contact radius ``r``, so ``d1 = d2
-  = d3 = 2 r``, ``blshape`` 3, and ``rockdensity = mass / (pi/6 (2r)^3)`` so the
-  sphere Rockyfor3D builds has the model's mass (:func:`sphere_block`).
-* **not written**: Rockyfor3D computes its tangential coefficient Rt from the
-  obstacle heights and the block size (Dorren 2016, §3.3), so the calibrated e_t is
-  not an input; nor are the friction angle, the SDs, the release velocity or the
-  effects other than ``slope_roughness`` (the README lists them).
-
-Sources
--------
-* Dorren, L.K.A. (2016). Rockyfor3D (v5.2) revealed - Transparent description of the
-  complete 3D rockfall model. ecorisQ paper (www.ecorisq.org), 32 p.: the input
-  grids (§2.1), the soil types and their Rn (Table 1), the rebound (§3.3).
-* Nicolet, P. (NGU, 2021). PimpMyRockyfor, ``CreateFeatureClass.py``
-  (github.com/pierrick-nicolet/PimpMyRockyfor): the grid names and units
-  (rockdensity kg/m³; d1 height, d2 width, d3 length [m]; rg70/rg20/rg10 [m]) and
-  the blshape (0-4) and soiltype (0-7) code lists, read in this session.
-
-The Rn ranges of :data:`SOIL_TYPES` are those of Table 1 as recalled: the stored
-copies of the manual found while writing this module showed its contents, not the
-table, so the README says to check them against the manual of the Rockyfor3D
-version used (v6.0 has been released since v5.2).
+  = d3 = 2 r``, ``blshape`` 3, and ``rockdensity = mass / (pi/6 (2r)^3)``. A density
+  outside :data:`DENSITY_RANGE_KG_M3` is clamped to the range and the diameter
+  changed so the block keeps the model's mass (the energy a design reads), and the
+  README says so (:func:`sphere_block`).
+* **translation error**: fieldkit simulates the calibrated model and its emulation
+  of Rockyfor3D's law with the values written (:func:`emulated_model`) on the
+  calibrated model's section, and the README tabulates the difference.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+import re
+from dataclasses import dataclass, replace
 from statistics import NormalDist
 
 import numpy as np
@@ -63,16 +62,28 @@ import numpy as np
 from fieldkit.errors import ArgumentError
 from fieldkit.export.ascii_grid import ascii_grid_text
 from fieldkit.export.fitted import with_error
-from fieldkit.export.lumped import lumped_equivalent
 from fieldkit.export.result import Export, Mapped
-from fieldkit.export.site import ExportSite, checked_site, ground_cells
-from fieldkit.model.effects.slope_roughness import dip_sd_rad
-from fieldkit.model.materials import Material
+from fieldkit.export.site import ExportSite, checked_site, ground_cells, pad_site
+from fieldkit.export.translation import (
+    IMPACT_ROCKS,
+    IMPACT_SEED,
+    fit_scaled,
+    realised_impacts,
+    translation_error,
+)
+from fieldkit.model.effects import registry
 from fieldkit.model.model_file import Body, Model
 from fieldkit.physics.bodies import sphere_density_kg_m3
 
 TARGET = "rockyfor3d"
 TITLE = "Rockyfor3D (ecorisQ)"
+
+#: Rockyfor3D does not simulate source cells in the two outer rows or columns.
+EDGE_CELLS = 2
+#: Rockyfor3D's range of rockdensity [kg/m³] (QGIS-RF3D's field constraints).
+DENSITY_RANGE_KG_M3 = (2000, 3400)
+#: Rockyfor3D's range of rg70/rg20/rg10 [m] (QGIS-RF3D's field constraints).
+RG_MAX_M = 100.0
 
 
 @dataclass(frozen=True)
@@ -88,6 +99,11 @@ class SoilType:
     def label(self) -> str:
         """``"6 (bedrock)"``."""
         return f"{self.code} ({self.description})"
+
+    @property
+    def rn_sd(self) -> float:
+        """SD of a uniform draw over the class range, ``(max - min) / sqrt(12)``."""
+        return (self.rn_max - self.rn_min) / math.sqrt(12.0)
 
 
 #: Rockyfor3D soil types (Dorren 2016, Table 1): Rn range and mean per class.
@@ -117,101 +133,278 @@ SOIL_TYPES: tuple[SoilType, ...] = (
     SoilType(7, "asphalt road", 0.32, 0.38, 0.35),
 )
 
-#: Obstacle-height grids -> the quantile of |delta| that represents their band.
-RG_QUANTILES: tuple[tuple[str, float], ...] = (
-    ("rg70", 0.35),
-    ("rg20", 0.80),
-    ("rg10", 0.95),
+#: Ground-description keywords -> soil type code, with the reason: fieldkit's
+#: reading of Table 1's class descriptions (the longest keyword found wins).
+SOIL_KEYWORDS: tuple[tuple[tuple[str, ...], int, str], ...] = (
+    (
+        ("river", "swamp", "marsh", "bog", "lake", "water"),
+        0,
+        "water or a swamp: a rock penetrates it completely",
+    ),
+    (
+        ("deep soil", "fine soil", "humus", "peat"),
+        1,
+        "deep fine soil",
+    ),
+    (
+        ("soil", "topsoil", "meadow", "grass", "pasture", "sand", "gravel"),
+        2,
+        "fine soil of less than ~1 m on the slope, or a sand/gravel mix",
+    ),
+    (
+        ("scree", "bench", "ballast", "fill", "forest road", "compact soil"),
+        3,
+        "scree < ~10 cm, compact soil with small fragments, a (railway or road) "
+        "bench of ballast or fill",
+    ),
+    (
+        ("talus", "colluvium", "debris", "boulder", "boulders", "moraine", "till"),
+        4,
+        "talus > ~10 cm, or compact soil with large rock fragments",
+    ),
+    (
+        ("weathered rock", "weak rock", "fractured rock", "rock with soil"),
+        5,
+        "bedrock with a thin weathered or soil cover",
+    ),
+    (
+        ("bedrock", "rock", "cliff", "outcrop", "ledge", "rock face"),
+        6,
+        "bare rock",
+    ),
+    (("asphalt", "pavement", "paved road"), 7, "asphalt road"),
 )
 
-#: Largest dip a roughness may reach (at the rg10 quantile) and still be a height.
-MAX_DIP_DEG = 89.0
+#: Obstacle-height grids -> their probability in Rockyfor3D's draw, and the
+#: quantile of the realised e_t that stands for their band (its middle).
+RG_BANDS: tuple[tuple[str, float, float], ...] = (
+    ("rg70", 0.70, 0.65),
+    ("rg20", 0.20, 0.20),
+    ("rg10", 0.10, 0.05),
+)
+#: Smallest Rt an obstacle height is inverted from (Rt -> 0 needs an infinite one).
+MIN_RT = 1.0 / (1.0 + RG_MAX_M / 0.01)
 
 
-def nearest_soil_type(e_n: float) -> SoilType:
-    """The soil type whose mean Rn is nearest ``e_n``; a tie goes to the higher Rn.
+def soil_type(name: str, e_n: float) -> tuple[SoilType, str]:
+    """The soil type of material ``name`` and why (module docstring).
 
-    Distances equal to 1e-9 are ties (0.255 lies halfway between 0.23 and 0.28).
+    The longest keyword of :data:`SOIL_KEYWORDS` found in the name (words split at
+    anything but letters and digits) gives the class; a name with none gets the
+    class of 1-6 whose mean Rn is nearest ``e_n`` (ties to the higher), said so.
 
     Examples
     --------
-    >>> nearest_soil_type(0.75).code, nearest_soil_type(0.255).code
-    (6, 2)
-    >>> nearest_soil_type(0.34).label()
-    '7 (asphalt road)'
+    >>> soil_type("rock", 0.75)[0].code, soil_type("colluvium", 1.0)[0].code
+    (6, 4)
+    >>> soil_type("upper_cliff", 0.2)[0].code, soil_type("railway-bench", 1.0)[0].code
+    (6, 3)
+    >>> soil_type("weathered rock", 0.9)[0].code, soil_type("m1", 0.41)
+    (5, (SoilType(code=5, description='bedrock with thin weathered material or soil \
+cover', rn_min=0.39, rn_max=0.47, rn_mean=0.43), 'no ground description in the name: \
+the class of 1-6 whose mean Rn is nearest its realised e_n 0.41 (rename the material \
+to choose by description)'))
     """
-    return min(SOIL_TYPES, key=lambda s: (round(abs(e_n - s.rn_mean), 9), -s.rn_mean))
+    text = " " + re.sub(r"[^a-z0-9]+", " ", name.lower()) + " "
+    keywords = sorted(
+        ((k, code, why) for keys, code, why in SOIL_KEYWORDS for k in keys),
+        key=lambda item: -len(item[0]),
+    )
+    for keyword, code, why in keywords:
+        if f" {keyword} " in text:
+            return SOIL_TYPES[code], f"'{keyword}' in the name: {why}"
+    candidates = [s for s in SOIL_TYPES if 1 <= s.code <= 6]
+    best = min(candidates, key=lambda s: (round(abs(e_n - s.rn_mean), 9), -s.rn_mean))
+    return best, (
+        "no ground description in the name: the class of 1-6 whose mean Rn is "
+        f"nearest its realised e_n {e_n:.3g} (rename the material to choose by "
+        "description)"
+    )
 
 
-def obstacle_heights(
-    dip_sd_deg: float, radius_m: float, *, name: str = "material"
-) -> dict[str, float]:
-    """Heights [m] of the obstacles met in 70, 20 and 10 % of impacts.
-
-    ``h = radius_m * tan(|delta|_q)`` at the quantiles ``q`` of
-    :data:`RG_QUANTILES`, with ``|delta|`` half-normal of scale ``dip_sd_deg``
-    (module docstring).
-
-    Raises
-    ------
-    ArgumentError
-        A dip SD so large that the rg10 dip reaches :data:`MAX_DIP_DEG`.
+def rt_of_height(height_m: float, radius_m: float) -> float:
+    """Rockyfor3D's tangential coefficient for an obstacle of ``height_m`` and a
+    block of ``radius_m``: ``Rt = 1 / (1 + MOH / R)`` (module docstring).
 
     Examples
     --------
-    >>> {k: round(v, 4) for k, v in obstacle_heights(10.0, 1.0).items()}
-    {'rg70': 0.0794, 'rg20': 0.2275, 'rg10': 0.3561}
+    >>> rt_of_height(0.0, 0.5), rt_of_height(0.5, 0.5)
+    (1.0, 0.5)
+    """
+    return 1.0 / (1.0 + height_m / radius_m)
+
+
+def obstacle_heights(e_t: float, spread: float, radius_m: float) -> dict[str, float]:
+    """rg70/rg20/rg10 [m] whose Rt (:func:`rt_of_height`) are the realised e_t at
+    the middle of each band: ``Rt_q = e_t + spread z_q`` at the quantiles of
+    :data:`RG_BANDS`, clipped to ``[MIN_RT, 1]``, ``h = R (1 / Rt_q - 1)``.
+
+    Examples
+    --------
+    >>> {k: round(v, 4) for k, v in obstacle_heights(0.62, 0.04, 0.725).items()}
+    {'rg70': 0.416, 'rg20': 0.5115, 'rg10': 0.5832}
+    >>> obstacle_heights(1.0, 0.0, 0.5)
+    {'rg70': 0.0, 'rg20': 0.0, 'rg10': 0.0}
     """
     out = {}
-    for key, q in RG_QUANTILES:
-        dip = dip_sd_deg * NormalDist().inv_cdf(0.5 + 0.5 * q)
-        if dip >= MAX_DIP_DEG:
-            raise ArgumentError(
-                f"materials.{name}: a dip SD of {dip_sd_deg:.3g} deg (slope_roughness) "
-                f"makes the {key} dip {dip:.3g} deg; Rockyfor3D's obstacle heights "
-                f"need dips below {MAX_DIP_DEG:g} deg",
-                source="model",
-            )
-        out[key] = radius_m * math.tan(math.radians(dip))
+    for key, _, q in RG_BANDS:
+        rt = min(max(e_t + spread * NormalDist().inv_cdf(q), MIN_RT), 1.0)
+        out[key] = min(radius_m * (1.0 / rt - 1.0), RG_MAX_M)
     return out
 
 
-def sphere_block(body: Body) -> tuple[float, int]:
-    """``(diameter [m], density [kg/m³])`` of the sphere that stands for the body.
-
-    Diameter ``2 r``; density ``mass / (pi/6 d^3)`` rounded to a whole number.
-
-    Raises
-    ------
-    ArgumentError
-        A density that rounds to 0 (Rockyfor3D would see no source cell).
+def rt_mixture(heights: dict[str, float], radius_m: float) -> tuple[float, float]:
+    """Mean and SD of Rockyfor3D's Rt over its draw of the three heights.
 
     Examples
     --------
-    >>> sphere_block(Body(mass_kg=3750.0, radius_m=0.725, gyration_m=0.46))
-    (1.45, 2349)
+    >>> [round(v, 4) for v in rt_mixture({"rg70": 0, "rg20": 0, "rg10": 0}, 1.0)]
+    [1.0, 0.0]
     """
-    diameter = 2.0 * body.radius_m
-    density = round(sphere_density_kg_m3(body.mass_kg, body.radius_m))
-    if density < 1:
-        raise ArgumentError(
-            f"body: mass_kg {body.mass_kg:g} in a sphere of radius_m "
-            f"{body.radius_m:g} is a density below 1 kg/m3; Rockyfor3D's rockdensity "
-            "must be > 0 in a source cell",
-            source="model",
-        )
-    return diameter, density
+    rts = np.array([rt_of_height(heights[k], radius_m) for k, _, _ in RG_BANDS])
+    weights = np.array([w for _, w, _ in RG_BANDS])
+    mean = float(np.sum(weights * rts))
+    return mean, float(math.sqrt(np.sum(weights * (rts - mean) ** 2)))
 
 
-def _dip_sd_deg(model: Model, material: Material) -> float:
-    """fieldkit's SD of the local dip [deg] for the body (0 without the effect)."""
-    if "slope_roughness" not in model.effects:
-        return 0.0
-    scale = model.effects["slope_roughness"].get("scale", 1.0)
-    sd = dip_sd_rad(
-        material.roughness_m, material.roughness_deg_sd, model.body.radius_m, scale
+@dataclass(frozen=True)
+class Block:
+    """The sphere written for Rockyfor3D: diameter, density, and what changed."""
+
+    diameter_m: float
+    density_kg_m3: int
+    note: str
+
+    @property
+    def radius_m(self) -> float:
+        return self.diameter_m / 2.0
+
+
+def sphere_block(body: Body) -> Block:
+    """The sphere that stands for the body, its density in Rockyfor3D's range.
+
+    Diameter ``2 r`` and density ``mass / (pi/6 d^3)`` (a whole number) when that
+    lies in :data:`DENSITY_RANGE_KG_M3`; otherwise the density is clamped to the
+    range and the diameter is the one that keeps the body's mass,
+    ``(6 m / (pi rho))^(1/3)`` -- stated in :attr:`Block.note`.
+
+    Examples
+    --------
+    >>> b = sphere_block(Body(mass_kg=3750.0, radius_m=0.725, gyration_m=0.46))
+    >>> b.diameter_m, b.density_kg_m3, b.note
+    (1.45, 2349, '')
+    >>> b = sphere_block(Body(mass_kg=100.0, radius_m=0.5, gyration_m=0.3))
+    >>> round(b.diameter_m, 4), b.density_kg_m3
+    (0.4571, 2000)
+    """
+    low, high = DENSITY_RANGE_KG_M3
+    density = sphere_density_kg_m3(body.mass_kg, body.radius_m)
+    if low <= round(density) <= high:
+        return Block(2.0 * body.radius_m, round(density), "")
+    clamped = low if density < low else high
+    diameter = (6.0 * body.mass_kg / (math.pi * clamped)) ** (1.0 / 3.0)
+    return Block(
+        diameter,
+        clamped,
+        f"the model's sphere (r = {body.radius_m:g} m, {body.mass_kg:g} kg) has a "
+        f"density of {density:.0f} kg/m³, outside Rockyfor3D's rockdensity range "
+        f"{low}-{high} kg/m³: clamped to {clamped} kg/m³ in a sphere of diameter "
+        f"{diameter:.4g} m, which keeps the model's mass ({body.mass_kg:g} kg); "
+        f"the diameter differs from 2 r = {2 * body.radius_m:.4g} m by "
+        f"{100 * (diameter / (2 * body.radius_m) - 1):+.1f} %",
     )
-    return math.degrees(sd)
+
+
+@dataclass(frozen=True)
+class Realised:
+    """A material's realised e_n and e_t with the impacts' own spread."""
+
+    e_n: float
+    e_n_spread: float
+    e_t: float
+    e_t_spread: float
+    impacts: int
+    note: str
+
+
+def realised_pairs(model: Model, names: list[str]) -> dict[str, Realised]:
+    """Each material's realised e_n, e_t (:func:`fit_scaled`, range 0-1) on the
+    calibrated model's own simulated impacts; a material with none keeps its
+    calibrated e_n, e_t and their SDs as spreads, and :attr:`Realised.note` says
+    so (naming the laws that then act on it unseen)."""
+    frame = realised_impacts(model)
+    laws = [
+        s.name
+        for s in registry.EFFECTS
+        if s.changes_rebound and s.name in model.effects
+    ]
+    out = {}
+    for name in names:
+        rows = frame[frame["material"] == name]
+        n = fit_scaled(
+            -rows["vin_mps"].to_numpy(), rows["vfn_mps"].to_numpy(), 1.0, 0, 1
+        )
+        t = fit_scaled(
+            rows["vit_mps"].to_numpy(), rows["vft_mps"].to_numpy(), 1.0, 0, 1
+        )
+        m = model.materials[name]
+        if n.n < 2 or t.n < 2:
+            out[name] = Realised(
+                m.e_n,
+                m.e_n_sd,
+                m.e_t,
+                m.e_t_sd,
+                0,
+                f"no simulated impact on {name} ({IMPACT_ROCKS} rocks, seed "
+                f"{IMPACT_SEED}): its calibrated e_n {m.e_n:.3g}, e_t {m.e_t:.3g} and "
+                f"their SDs are used as they are"
+                + (f", without {', '.join(laws)}" if laws else ""),
+            )
+            continue
+        clipped = [
+            f"{what} {s.unclipped:.3g} clipped to {s.value:.3g}"
+            for what, s in (("e_n", n), ("e_t", t))
+            if s.clipped
+        ]
+        out[name] = Realised(
+            n.value,
+            n.spread,
+            t.value,
+            t.spread,
+            t.n,
+            f"{t.n} impacts on {name} of {IMPACT_ROCKS} simulated rocks (seed "
+            f"{IMPACT_SEED})"
+            + (f"; least-squares {', '.join(clipped)} (range 0-1)" if clipped else ""),
+        )
+    return out
+
+
+def emulated_model(
+    model: Model,
+    soil: dict[str, SoilType],
+    rg: dict[str, dict[str, float]],
+    block: Block,
+) -> Model:
+    """fieldkit's emulation of Rockyfor3D's law with the values written: per
+    material ``e_n`` the soil type's mean Rn with the SD of a uniform draw over its
+    range, ``e_t`` the mean and SD of Rt over the draw of rg70/rg20/rg10
+    (:func:`rt_mixture`), no effect (Rockyfor3D has none of fieldkit's), the
+    calibrated friction (Rockyfor3D has no friction input; fieldkit's core needs
+    one) and the written block's radius and mass."""
+    materials = dict(model.materials)
+    for name, s in soil.items():
+        mean, sd = rt_mixture(rg[name], block.radius_m)
+        materials[name] = replace(
+            materials[name], e_n=s.rn_mean, e_n_sd=s.rn_sd, e_t=mean, e_t_sd=sd
+        )
+    body = model.body
+    if block.radius_m != body.radius_m:
+        body = replace(
+            body,
+            radius_m=block.radius_m,
+            gyration_m=min(body.gyration_m, block.radius_m),
+        )
+    return replace(model, materials=materials, effects={}, body=body)
 
 
 def export_rockyfor3d(model: Model, site: ExportSite | None = None) -> Export:
@@ -220,20 +413,34 @@ def export_rockyfor3d(model: Model, site: ExportSite | None = None) -> Export:
     Raises
     ------
     ArgumentError
-        No site (a grid target), a site without a release cell on ground, a body
-        or a roughness Rockyfor3D cannot take (:func:`sphere_block`,
-        :func:`obstacle_heights`).
+        No site (a grid target), a site without a release cell on ground, or one
+        that cannot be padded so every source cell lies :data:`EDGE_CELLS` cells
+        inside the grid.
     """
     site = checked_site(site, TARGET)
-    model, lumped = lumped_equivalent(model, TARGET)
+    unpadded = site
+    try:
+        site = pad_site(site, EDGE_CELLS)
+    except ArgumentError as error:
+        raise ArgumentError(
+            f"Rockyfor3D ignores source cells in the {EDGE_CELLS} outer rows and "
+            f"columns, and the release cannot be moved inside: {error.message}",
+            source="site",
+        ) from None
     grid = site.grid
     ground = ground_cells(site)
     source = site.release & ground
+    _check_active(source)
     present = [n for n in model.materials if (site.material[ground] == n).any()]
-    soil = {n: nearest_soil_type(model.materials[n].e_n) for n in present}
-    dip = {n: _dip_sd_deg(model, model.materials[n]) for n in present}
-    rg = {n: obstacle_heights(dip[n], model.body.radius_m, name=n) for n in present}
-    diameter, density = sphere_block(model.body)
+    realised = realised_pairs(model, present)
+    soil, soil_why = {}, {}
+    for n in present:
+        soil[n], soil_why[n] = soil_type(n, realised[n].e_n)
+    block = sphere_block(model.body)
+    rg = {
+        n: obstacle_heights(realised[n].e_t, realised[n].e_t_spread, block.radius_m)
+        for n in present
+    }
 
     def per_material(value) -> np.ndarray:
         out = np.full(grid.shape, np.nan)
@@ -244,28 +451,34 @@ def export_rockyfor3d(model: Model, site: ExportSite | None = None) -> Export:
     def on_source(value: float) -> np.ndarray:
         return np.where(ground, np.where(source, value, 0.0), np.nan)
 
-    block = ascii_grid_text(on_source(diameter), grid, decimals=3)
+    diameter = ascii_grid_text(on_source(block.diameter_m), grid, decimals=3)
     files: dict[str, str | bytes] = {
         "dem.asc": ascii_grid_text(np.where(ground, grid.values, np.nan), grid),
-        "rockdensity.asc": ascii_grid_text(on_source(density), grid, integer=True),
-        "d1.asc": block,
-        "d2.asc": block,
-        "d3.asc": block,
+        "rockdensity.asc": ascii_grid_text(
+            on_source(block.density_kg_m3), grid, integer=True
+        ),
+        "d1.asc": diameter,
+        "d2.asc": diameter,
+        "d3.asc": diameter,
         "blshape.asc": ascii_grid_text(on_source(3), grid, integer=True),
         "soiltype.asc": ascii_grid_text(
             per_material(lambda n: soil[n].code), grid, integer=True
         ),
     }
-    for key, _ in RG_QUANTILES:
+    for key, _, _ in RG_BANDS:
         files[f"{key}.asc"] = ascii_grid_text(
             per_material(lambda n, k=key: rg[n][k]), grid, decimals=3
         )
+    emulated = emulated_model(model, soil, rg, block)
+    translation = translation_error(model, emulated)
     return Export(
         TARGET,
         TITLE,
         files,
-        mapped=_mapped(model, site, present, soil, dip, rg, diameter, density),
-        unmapped=_unmapped(model, present),
+        mapped=_mapped(
+            model, site, unpadded, present, soil, soil_why, realised, rg, block
+        ),
+        unmapped=_unmapped(model, site, present),
         units=[
             "lengths in metres as Rockyfor3D reads them (DEM, d1-d3, rg70/rg20/rg10;"
             " fieldkit's SI unchanged)",
@@ -273,10 +486,73 @@ def export_rockyfor3d(model: Model, site: ExportSite | None = None) -> Export:
             "soiltype (0-7) and blshape (0-4) are codes; NODATA_value -9999 where "
             "the site has no ground",
         ],
-        mismatches=[*lumped, *_mismatches(model, present, soil, diameter, density)],
+        mismatches=_mismatches(model, present, soil, realised, block),
         notes=_notes(model, site, present),
         how_to_use=HOW_TO_USE,
+        translation=[
+            *translation.lines(),
+            "",
+            "fieldkit's emulation of Rockyfor3D's law: per material e_n = the soil "
+            "type's mean Rn with the SD of a uniform draw over its range (a normal "
+            "draw in fieldkit), e_t = the mean and SD of Rt = 1 / (1 + MOH / R) over "
+            "Rockyfor3D's draw of rg70 / rg20 / rg10 (0.7 / 0.2 / 0.1, R = "
+            f"{block.radius_m:.4g} m); no effect; the calibrated friction angle in "
+            "fieldkit's sliding phase; on the calibrated model's 2-D section, not "
+            "the 3-D grid. Rockyfor3D's own rebound geometry, its 3-D spreading and "
+            "its stopping rules are not emulated, so this measures what the values "
+            "written lose, not a Rockyfor3D run.",
+        ],
+        sources=SOURCES,
+        unconfirmed=UNCONFIRMED,
     )
+
+
+def _check_active(source: np.ndarray) -> None:
+    """Refuse a source grid with a source cell in Rockyfor3D's ignored edge band,
+    or none inside its active area (the check the padding must pass)."""
+    active = np.zeros(source.shape, bool)
+    e = EDGE_CELLS
+    active[e:-e, e:-e] = True
+    if (source & ~active).any() or not (source & active).any():
+        raise ArgumentError(
+            f"Rockyfor3D simulates no source cell within {e} cells of the grid's "
+            f"edge: {int((source & ~active).sum())} of {int(source.sum())} source "
+            "cells lie there",
+            source="site",
+        )
+
+
+SOURCES = [
+    "ecorisQ, QGIS-RF3D (github.com/ecorisQ/QGIS-RF3D), rockyfor3d_inputs_algorithm.py"
+    ": the field constraints (rockdensity 2000-3400 kg/m³, blshape 0-4, soiltype "
+    "0-7, rg70/rg20/rg10 0-100 m) and the check that source cells in the two outer "
+    "rows or columns 'will not be taken into account in the simulation'; README.md "
+    "of the same repository.",
+    "Dorren, L.K.A. (2016). Rockyfor3D (v5.2) revealed - Transparent description of "
+    "the complete 3D rockfall model. ecorisQ paper (www.ecorisq.org): the input "
+    "grids (§2.1), the soil types and their Rn (Table 1), the rebound and Rt from "
+    "the obstacle heights (§3.3).",
+    "Nicolet, P. (NGU, 2021). PimpMyRockyfor, CreateFeatureClass.py "
+    "(github.com/pierrick-nicolet/PimpMyRockyfor): grid names and units, the "
+    "blshape and soiltype code lists.",
+]
+
+UNCONFIRMED = [
+    "Rt = 1 / (1 + MOH / R), with MOH drawn from rg70 / rg20 / rg10 with "
+    "probabilities 0.7 / 0.2 / 0.1 and R the block radius: Rockyfor3D's rule as "
+    "recalled from Dorren (2016) §3.3; no stored document (QGIS-RF3D, "
+    "PimpMyRockyfor, the manual's contents pages) gives the formula, so the obstacle "
+    "heights inverted from e_t rest on it unconfirmed.",
+    "the Rn ranges and means of the soil types (Table 1 of the v5.2 manual as "
+    "recalled; the stored copies showed its contents, not the table): check them "
+    "against the manual of your Rockyfor3D version (v6.0 has been released since).",
+    "whether Rockyfor3D scales Rn with the impact speed or angle, and how it "
+    "deviates the rebound direction: not emulated.",
+    "the keyword table from ground descriptions to soil types is fieldkit's reading "
+    "of Table 1's class descriptions, not ecorisQ's.",
+    "no Rockyfor3D run was made with these files: they follow the documented format "
+    "and the input plugin's checks.",
+]
 
 
 HOW_TO_USE = """\
@@ -288,9 +564,12 @@ settings of the run (§2.5), not grids: set them there. No forest or net grids a
 written, so the run is without forest and nets."""
 
 
-def _mapped(model, site, present, soil, dip, rg, diameter, density) -> list[Mapped]:
+def _mapped(
+    model, site, unpadded, present, soil, soil_why, realised, rg, block
+) -> list[Mapped]:
     body = model.body
     n_source = int((site.release & ground_cells(site)).sum())
+    padded = site is not unpadded
     out = [
         Mapped(
             "site terrain (DEM or extruded profile)",
@@ -301,69 +580,92 @@ def _mapped(model, site, present, soil, dip, rg, diameter, density) -> list[Mapp
             "seeder (where rocks start)",
             f"{n_source} source "
             + ("cell" if n_source == 1 else "cells")
-            + ": rockdensity > 0",
-            "the release cells of the site (above)",
+            + f": rockdensity > 0, every one at least {EDGE_CELLS} cells inside the "
+            "grid (Rockyfor3D ignores the outer two rows and columns)",
+            "the release cells of the site (above)"
+            + ("; the grid was padded to keep them inside" if padded else ""),
         ),
         Mapped(
             with_error(model, "body.radius_m", body.radius_m, "m"),
-            f"d1.asc = d2.asc = d3.asc = {diameter:.4g} m; blshape.asc = 3 "
+            f"d1.asc = d2.asc = d3.asc = {block.diameter_m:.4g} m; blshape.asc = 3 "
             "(spherical) in the source cells, 0 elsewhere",
-            "fieldkit's body is a sphere of its contact radius: diameter 2 r on "
+            block.note
+            or "fieldkit's body is a sphere of its contact radius: diameter 2 r on "
             "every axis",
         ),
         Mapped(
             with_error(model, "body.mass_kg", body.mass_kg, "kg"),
-            f"rockdensity.asc = {density} kg/m³ in the source cells, 0 elsewhere",
-            f"mass / (pi/6 d^3) with d = {diameter:.4g} m: Rockyfor3D's sphere has "
-            "the model's mass",
+            f"rockdensity.asc = {block.density_kg_m3} kg/m³ in the source cells, 0 "
+            "elsewhere",
+            f"mass / (pi/6 d^3) with d = {block.diameter_m:.4g} m: Rockyfor3D's "
+            "sphere has the model's mass",
         ),
     ]
     for name in present:
-        m, s = model.materials[name], soil[name]
+        m, s, r = model.materials[name], soil[name], realised[name]
         out.append(
             Mapped(
-                with_error(model, f"materials.{name}.e_n", m.e_n),
+                f"material {name} ("
+                + with_error(model, f"materials.{name}.e_n", m.e_n)
+                + f"; realised e_n {r.e_n:.3f}, spread {r.e_n_spread:.3f})",
                 f"soiltype.asc = {s.label()}: Rn {s.rn_min:.2f}-{s.rn_max:.2f}, "
                 f"mean {s.rn_mean:.2f}",
-                f"nearest class mean (ties to the higher Rn); abs(e_n - mean) = "
-                f"{abs(m.e_n - s.rn_mean):.2f}",
+                f"by the ground it is: {soil_why[name]}",
             )
         )
         h = rg[name]
+        mean, sd = rt_mixture(h, block.radius_m)
         out.append(
             Mapped(
-                f"materials.{name}: roughness_m = {m.roughness_m:g} m, "
-                f"roughness_deg_sd = {m.roughness_deg_sd:g} deg -> dip SD "
-                f"{dip[name]:.3g} deg",
+                with_error(model, f"materials.{name}.e_t", m.e_t)
+                + f"; realised e_t {r.e_t:.3f}, spread {r.e_t_spread:.3f} ({r.note})",
                 f"rg70 / rg20 / rg10 = {h['rg70']:.3f} / {h['rg20']:.3f} / "
                 f"{h['rg10']:.3f} m",
-                f"h = r tan(abs(delta)) (eq. 7.4 read back, r = {body.radius_m:g} m) "
-                "at the 35th / 80th / 95th percentile of abs(delta), half-normal"
-                "(dip SD): the medians of the lowest 70 %, the next 20 % and the top "
-                "10 % of impacts"
+                f"Rt = 1 / (1 + MOH / R), R = {block.radius_m:.4g} m, inverted at the "
+                "65th / 20th / 5th percentile of the realised e_t (the middle of the "
+                "top 70 %, the next 20 % and the lowest 10 %): Rockyfor3D's Rt then "
+                f"has mean {mean:.3f} and SD {sd:.3f}"
                 + (
-                    ""
-                    if "slope_roughness" in model.effects
-                    else "; slope_roughness is off, so fieldkit's ground is smooth: 0 m"
+                    f"; heights above Rockyfor3D's {RG_MAX_M:g} m written as "
+                    f"{RG_MAX_M:g} m (e_t near 0)"
+                    if max(h.values()) >= RG_MAX_M
+                    else ""
                 ),
             )
         )
     return out
 
 
-def _unmapped(model: Model, present: list[str]) -> list[tuple[str, str]]:
+#: Why each effect of the registry is, or is not, carried into Rockyfor3D.
+EFFECT_REASONS = {
+    "angle_dependent_restitution": "Rockyfor3D draws Rn within the soil type's range "
+    "whatever the impact angle; the realised e_n it produces is compared with the "
+    "class (mismatch below), the soil type itself follows the ground description",
+    "velocity_scaled_restitution": "Rockyfor3D draws Rn within the soil type's range; "
+    "the realised e_n the scaling produces is compared with the class (mismatch "
+    "below), the soil type itself follows the ground description",
+    "rotation_friction": "Rockyfor3D computes Rt from the obstacle heights; the "
+    "tangential rebound this coupling realises is in the realised e_t that "
+    "rg70/rg20/rg10 are inverted from",
+    "slope_roughness": "Rockyfor3D's roughness inputs (rg70/rg20/rg10) carry its Rt "
+    "(written from the realised e_t); fieldkit's random local dip has no input of its "
+    "own -- Rockyfor3D's rebound geometry on the DEM applies",
+    "mass_loss": "Rockyfor3D's block keeps its volume during a run (its volume "
+    "variation is a setting of the run, §2.5, not fragmentation)",
+    "tree_impacts": "Rockyfor3D's forest inputs (tree file or nrtrees/dbh grids, "
+    "§2.2) are not written: the run is without forest",
+    "air_drag": "Rockyfor3D's flight is a parabola; it has no drag input",
+    "affine_rebound": "a statistical alternative of the diagnosis, not a law: "
+    "Rockyfor3D has no such law",
+}
+
+
+def _unmapped(
+    model: Model, site: ExportSite, present: list[str]
+) -> list[tuple[str, str]]:
     out = []
     for name in present:
         m = model.materials[name]
-        out.append(
-            (
-                with_error(model, f"materials.{name}.e_t", m.e_t),
-                "Rockyfor3D computes its tangential coefficient Rt at each rebound "
-                "from the obstacle heights (rg70/rg20/rg10) and the block size "
-                "(Dorren 2016, §3.3): it takes no Rt input, so the calibrated e_t "
-                "is not written; the roughness it is computed from is (rg70/rg20/rg10)",
-            )
-        )
         out.append(
             (
                 with_error(model, f"materials.{name}.friction_deg", m.friction_deg),
@@ -373,10 +675,10 @@ def _unmapped(model: Model, present: list[str]) -> list[tuple[str, str]]:
         )
         out.append(
             (
-                f"materials.{name}: e_n_sd = {m.e_n_sd:g}, e_t_sd = {m.e_t_sd:g}, "
-                f"friction_deg_sd = {m.friction_deg_sd:g}",
-                "Rockyfor3D draws Rn within the range of the soil type (Table 1), "
-                "not from a calibrated SD",
+                f"materials.{name}: roughness_m = {m.roughness_m:g} m, "
+                f"roughness_deg_sd = {m.roughness_deg_sd:g} deg",
+                "fieldkit's random local dip (slope_roughness) has no Rockyfor3D "
+                "input: rg70/rg20/rg10 carry Rt, written from the realised e_t",
             )
         )
     out.append(
@@ -387,23 +689,49 @@ def _unmapped(model: Model, present: list[str]) -> list[tuple[str, str]]:
         )
     )
     s = model.seeder
+    height = float(s.z_m - model.profile.ground_z(s.x_m))
+    where = f"above the ground at chainage {s.x_m:g} m"
+    source = site.release & ground_cells(site)
+    if site.grid.source.endswith("(section extruded)"):
+        # the source cells' elevation is the profile's at their centre, not at the
+        # seeder: the fall to keep is from the seeder down to them
+        height = float(s.z_m - np.mean(site.grid.values[source]))
+        where = "above the source cells (the section's elevation at their centres)"
+    speed = math.hypot(s.vx_mps, s.vz_mps)
     out.append(
         (
-            f"seeder velocity (vx {s.vx_mps:g}, vz {s.vz_mps:g} m/s; SDs "
-            f"{s.vx_sd_mps:g}, {s.vz_sd_mps:g} m/s)",
-            "no grid takes a release velocity; the closest is the run's additional "
-            "initial fall height (§2.5), left to the user",
+            f"seeder: {height:.3g} m {where}; "
+            f"velocity vx {s.vx_mps:g}, vz {s.vz_mps:g} m/s (SDs {s.vx_sd_mps:g}, "
+            f"{s.vz_sd_mps:g} m/s)",
+            "no grid takes a release height or velocity: the source cells start "
+            "blocks on the DEM. Set the run's additional initial fall height (§2.5) "
+            f"to {height:.3g} m to keep the seeder's fall"
+            + (
+                f"; the release speed {speed:.3g} m/s has no Rockyfor3D input "
+                f"(a fall of v^2 / 2g = {speed**2 / (2 * 9.81):.3g} m more gives it "
+                "as a vertical speed)"
+                if speed > 0
+                else ""
+            ),
         )
     )
-    for name in model.effects:
-        if name != "slope_roughness":
-            out.append(
-                (
-                    f"effect {name}",
+    for spec in registry.EFFECTS:
+        state = (
+            "on: "
+            + ", ".join(f"{k} = {v:g}" for k, v in model.effects[spec.name].items())
+            if spec.name in model.effects
+            else "off in this model"
+        )
+        out.append(
+            (
+                f"effect {spec.name} ({state})",
+                EFFECT_REASONS.get(
+                    spec.name,
                     "Rockyfor3D has its own rebound and energy-loss rules (§3.3); "
                     "none of its inputs takes this effect",
-                )
+                ),
             )
+        )
     if model.trees is not None:
         out.append(
             (
@@ -423,54 +751,44 @@ def _unmapped(model: Model, present: list[str]) -> list[tuple[str, str]]:
     return out
 
 
-def _mismatches(model, present, soil, diameter, density) -> list[str]:
+def _mismatches(model, present, soil, realised, block) -> list[str]:
     means = ", ".join(f"{s.code}: {s.rn_mean:.2f}" for s in SOIL_TYPES)
     out = [f"soil-type class means used (Rn, Dorren 2016 Table 1): {means}"]
     for name in present:
-        e_n, s = model.materials[name].e_n, soil[name]
-        inside = s.rn_min <= e_n <= s.rn_max
+        r, s = realised[name], soil[name]
+        inside = s.rn_min <= r.e_n <= s.rn_max
         out.append(
-            f"{name}: e_n = {e_n:.3g} -> soiltype {s.label()}, mean Rn "
-            f"{s.rn_mean:.2f}: mismatch {abs(e_n - s.rn_mean):.2f}; e_n is "
+            f"{name}: realised e_n {r.e_n:.3g} (spread {r.e_n_spread:.3g}) -> soiltype "
+            f"{s.label()}, Rn {s.rn_min:.2f}-{s.rn_max:.2f}: e_n is "
             + (
-                f"inside the class range {s.rn_min:.2f}-{s.rn_max:.2f}"
+                "inside the class range"
                 if inside
-                else f"outside the class range {s.rn_min:.2f}-{s.rn_max:.2f}"
+                else f"outside the class range by "
+                f"{min(abs(r.e_n - s.rn_min), abs(r.e_n - s.rn_max)):.2f}"
                 + (
-                    ": no Rockyfor3D soil type reaches it"
-                    if e_n > max(t.rn_max for t in SOIL_TYPES)
+                    " (no Rockyfor3D soil type reaches it)"
+                    if r.e_n > max(t.rn_max for t in SOIL_TYPES)
                     else ""
                 )
             )
+            + "; the translation error below gives what this costs"
         )
-    volume = math.pi / 6.0 * diameter**3
-    mass = density * volume
+        if r.impacts == 0:
+            out.append(f"{name}: {r.note}")
+    mass = block.density_kg_m3 * math.pi / 6.0 * block.diameter_m**3
     out.append(
-        f"body: a sphere of diameter {diameter:.4g} m (fieldkit's contact sphere); a "
-        "block of another shape (e.g. measured axes) changes d1-d3 and blshape, and "
-        "rockdensity must then be recomputed for the mass. The whole-number "
-        f"density {density} kg/m³ gives {mass:.5g} kg for {model.body.mass_kg:g} kg "
-        f"({100 * (mass / model.body.mass_kg - 1):+.2f} %)"
+        f"body: a sphere of diameter {block.diameter_m:.4g} m; a block of another "
+        "shape (e.g. measured axes) changes d1-d3 and blshape, and rockdensity must "
+        "then be recomputed for the mass. The whole-number density "
+        f"{block.density_kg_m3} kg/m³ gives {mass:.5g} kg for {model.body.mass_kg:g} "
+        f"kg ({100 * (mass / model.body.mass_kg - 1):+.2f} %)"
+        + (f". {block.note}" if block.note else "")
     )
     return out
 
 
 def _notes(model: Model, site: ExportSite, present: list[str]) -> list[str]:
-    out = [
-        f"site: {site.description}",
-        "format: Dorren, L.K.A. (2016), Rockyfor3D (v5.2) revealed - Transparent "
-        "description of the complete 3D rockfall model, ecorisQ paper "
-        "(www.ecorisq.org), §2.1 input grids, Table 1 soil types; grid names, units "
-        "and the blshape/soiltype code lists as in P. Nicolet's PimpMyRockyfor "
-        "(NGU, 2021, github.com/pierrick-nicolet/PimpMyRockyfor).",
-        "not confirmed: the Rn ranges and means of the soil types are Table 1 of the "
-        "v5.2 manual as recalled when this exporter was written (the stored copies "
-        "of the manual showed its contents, not the table): check them against the "
-        "manual of your Rockyfor3D version (v6.0 has been released since) before "
-        "relying on the soiltype choice.",
-        "no Rockyfor3D run was made with these files: they follow the documented "
-        "format.",
-    ]
+    out = [f"site: {site.description}"]
     missing = [n for n in model.materials if n not in present]
     if missing:
         out.append(

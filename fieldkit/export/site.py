@@ -6,7 +6,8 @@ is either
 
 * a DEM the user gives (:func:`site_from_dem`): every cell takes the model's one
   material (a model with several has no plan map of them -- refused, naming them),
-  and rocks start in the cell of a release point the user gives; or
+  and rocks start in the cell of a release point the user gives, or in the cells
+  of a release file's points and polygons (:mod:`fieldkit.io.releases`); or
 * the section extruded across (:func:`site_from_section`): columns along the chainage
   (x = chainage), a few rows across with the same ground, each cell the material of
   the segment under its centre, rocks starting in the cells of the seeder's
@@ -20,8 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fieldkit.errors import ArgumentError
-from fieldkit.io.dem import INSIDE, MAX_DEM_CELLS, DemGrid
+from fieldkit.errors import ArgumentError, InputFileError
+from fieldkit.io.dem import MAX_DEM_CELLS, DemGrid
+from fieldkit.io.releases import Releases, cells_inside
 from fieldkit.model.model_file import Model
 
 
@@ -48,14 +50,39 @@ class ExportSite:
 
 
 def site_from_dem(
-    model: Model, grid: DemGrid, release_xy: tuple[float, float] | None
+    model: Model,
+    grid: DemGrid,
+    release_xy: tuple[float, float] | None = None,
+    *,
+    releases: Releases | None = None,
 ) -> ExportSite:
     """A site on the user's DEM (module docstring).
+
+    Rocks start in the cell holding the release point ``release_xy``, or in the
+    cells of ``releases`` (:func:`fieldkit.io.releases.read_releases`): the cell
+    holding each of its points and every cell whose centre lies inside one of its
+    polygons. Give one of the two.
 
     Raises
     ------
     ArgumentError
-        A model with several materials; no release point, or one outside the DEM.
+        A model with several materials; no release, or both; ``release_xy`` off
+        the DEM or on a nodata cell.
+    InputFileError
+        A release of ``releases`` off the DEM or on nodata (every such row named,
+        in one line), or a polygon holding no cell centre.
+
+    Examples
+    --------
+    >>> from fieldkit.model.model_file import model_from_dict
+    >>> m = model_from_dict({"profile": {"x_m": [0, 20], "z_m": [10, 0],
+    ...   "material": "talus"}, "materials": {"talus": {"e_n": 0.3, "e_t": 0.8,
+    ...   "friction_deg": 30}}, "body": {"mass_kg": 100, "radius_m": 0.2},
+    ...   "seeder": {"x_m": 1, "z_m": 11}})
+    >>> g = DemGrid.from_corner(np.zeros((3, 4)), x_left_m=0, y_top_m=15,
+    ...                         cellsize_m=5)
+    >>> np.argwhere(site_from_dem(m, g, (19.9, 0.1)).release).tolist()
+    [[2, 3]]
     """
     if len(model.materials) != 1:
         raise ArgumentError(
@@ -64,35 +91,135 @@ def site_from_dem(
             "its own section (`extrude`) or give a one-material model",
             source="dem",
         )
-    if release_xy is None:
+    if (release_xy is None) == (releases is None):
         raise ArgumentError(
-            "a DEM site needs the release point (x, y) in the DEM's grid: the "
-            "model's seeder is a chainage on its own profile",
-            source="release_xy",
-        )
-    x, y = (float(v) for v in release_xy)
-    _, _, _, status = grid.sample(x, y)
-    if status[0] != INSIDE:
-        raise ArgumentError(
-            f"the release ({x:g}, {y:g}) has no ground in the DEM {grid.source}: "
-            + grid.problem_at(x, y, int(status[0])),
+            "a DEM site needs the release point (x, y) in the DEM's grid, or a "
+            "file of `releases`, one of the two: the model's seeder is a chainage "
+            "on its own profile",
             source="release_xy",
         )
     name = next(iter(model.materials))
     valid = np.isfinite(grid.values)
     material = np.where(valid, name, "").astype(object)
     release = np.zeros(grid.shape, bool)
-    col = int(np.argmin(np.abs(grid.x_m - x)))
-    row = int(np.argmin(np.abs(grid.y_m - y)))
-    release[row, col] = True
+    if release_xy is not None:
+        x, y = (float(v) for v in release_xy)
+        row, col, problem = _cell_of(grid, x, y)
+        if problem:
+            raise ArgumentError(
+                f"the release ({x:g}, {y:g}) has no ground in the DEM "
+                f"{grid.source}: {problem}",
+                source="release_xy",
+            )
+        release[row, col] = True
+        where = f"release cell at ({grid.x_m[col]:.10g}, {grid.y_m[row]:.10g})"
+    else:
+        release = release_cells(grid, releases)
+        where = (
+            f"{int(release.sum())} release cells from {releases.source} "
+            f"({releases.summary()})"
+        )
     return ExportSite(
         grid,
         material,
         release,
         f"the DEM {grid.source} ({grid.shape[1]} x {grid.shape[0]} cells of "
-        f"{grid.cellsize_m:g} m); material {name} everywhere; release cell at "
-        f"({grid.x_m[col]:.10g}, {grid.y_m[row]:.10g})",
+        f"{grid.cellsize_m:g} m); material {name} everywhere; {where}",
     )
+
+
+def _cell_of(grid: DemGrid, x: float, y: float) -> tuple[int, int, str]:
+    """``(row, column, "")`` of the cell holding ``(x, y)``, or a problem text: off
+    the grid (its extent given) or on a nodata cell (1-based row and column)."""
+    col = math.floor((x - (grid.x_m[0] - grid.dx_m / 2)) / grid.dx_m)
+    row = math.floor(((grid.y_m[0] + grid.dy_m / 2) - y) / grid.dy_m)
+    nrows, ncols = grid.shape
+    if not (0 <= row < nrows and 0 <= col < ncols):
+        x0, y0 = grid.x_m[0] - grid.dx_m / 2, grid.y_m[-1] - grid.dy_m / 2
+        return (
+            -1,
+            -1,
+            f"outside the grid (x {x0:g}..{x0 + ncols * grid.dx_m:g} m, "
+            f"y {y0:g}..{y0 + nrows * grid.dy_m:g} m)",
+        )
+    if not np.isfinite(grid.values[row, col]):
+        return row, col, f"a nodata cell (grid row {row + 1}, column {col + 1})"
+    return row, col, ""
+
+
+#: Bad releases listed in full in one error line; more are counted.
+MAX_LISTED = 10
+
+
+def release_cells(grid: DemGrid, releases: Releases) -> np.ndarray:
+    """``(nrows, ncols)`` bool: the cells of ``releases`` on ``grid``.
+
+    Raises
+    ------
+    InputFileError
+        Naming, in one line, every point (row) off the grid or on a nodata cell,
+        every polygon with a vertex off the grid (its rows) or a nodata cell whose
+        centre is inside it, and a polygon that holds no cell centre.
+    """
+    release = np.zeros(grid.shape, bool)
+    bad: list[tuple[str, str]] = []
+    for (x, y), number in zip(releases.points_m, releases.point_rows, strict=True):
+        row, col, problem = _cell_of(grid, float(x), float(y))
+        if problem:
+            bad.append((f"row {number}", f"({x:g}, {y:g}) {problem}"))
+        else:
+            release[row, col] = True
+    xx, yy = np.meshgrid(grid.x_m, grid.y_m)
+    for polygon in releases.polygons:
+        outside = [
+            (number, problem)
+            for (x, y), number in zip(polygon.xy_m, polygon.rows, strict=True)
+            if (problem := _cell_of(grid, float(x), float(y))[2]).startswith("outside")
+        ]
+        if outside:
+            bad.append(
+                (
+                    ", ".join(f"row {n}" for n, _ in outside),
+                    f"polygon {polygon.name}: vertex {outside[0][1]}",
+                )
+            )
+            continue
+        inside = cells_inside(polygon.xy_m, xx, yy)
+        if not inside.any():
+            bad.append(
+                (
+                    polygon.rows_text(),
+                    f"polygon {polygon.name} holds no cell centre of the DEM "
+                    f"(cells of {grid.cellsize_m:g} m): draw it larger, or give "
+                    "its cells as points",
+                )
+            )
+            continue
+        nodata = np.argwhere(inside & ~np.isfinite(grid.values))
+        if nodata.size:
+            cells = ", ".join(f"({r + 1}, {c + 1})" for r, c in nodata[:MAX_LISTED])
+            extra = len(nodata) - MAX_LISTED
+            more = f" and {extra} more" if extra > 0 else ""
+            bad.append(
+                (
+                    polygon.rows_text(),
+                    f"polygon {polygon.name} covers {len(nodata)} nodata cells "
+                    f"(grid row, column): {cells}{more}",
+                )
+            )
+            continue
+        release |= inside
+    if bad:
+        more = len(bad) - MAX_LISTED
+        raise InputFileError(
+            f"{len(bad)} release"
+            + ("" if len(bad) == 1 else "s")
+            + f" with no cell on ground in the DEM {grid.source}: "
+            + "; ".join(f"{where}: {what}" for where, what in bad[:MAX_LISTED])
+            + (f"; and {more} more" if more > 0 else ""),
+            source=releases.source,
+        )
+    return release
 
 
 def site_from_section(

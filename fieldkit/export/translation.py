@@ -228,8 +228,19 @@ class Translation:
     exited: tuple[float, float]
 
     @property
+    def unreached(self) -> list[str]:
+        """Quantities one model gives and the other cannot (no rock of it crosses
+        the analysis point): :attr:`worst_percent` leaves them out."""
+        return [
+            r.quantity
+            for r in self.rows
+            if math.isfinite(r.calibrated) != math.isfinite(r.emulated)
+        ]
+
+    @property
     def worst_percent(self) -> float:
-        """The largest |difference| in percent of the calibrated value."""
+        """The largest |difference| in percent of the calibrated value, over the
+        quantities both models give (see :attr:`unreached`)."""
         values = [abs(r.percent) for r in self.rows if math.isfinite(r.percent)]
         return max(values) if values else math.nan
 
@@ -247,7 +258,14 @@ class Translation:
             "fieldkit on the calibrated model's own section: the calibrated model, and "
             "fieldkit's emulation of the target's law with the values written here. "
             f"Analysis points at chainage {points}{where}. Largest difference: "
-            f"{self.worst_percent:.1f} % of the calibrated value.",
+            f"{self.worst_percent:.1f} % of the calibrated value"
+            + (
+                " among the quantities both give; **not given by one of the two** "
+                "(no rock of it crosses the point: the design value there is lost, "
+                f"not merely changed): {'; '.join(self.unreached)}."
+                if self.unreached
+                else "."
+            ),
             "",
             "| quantity | calibrated model | target's law, values written | difference "
             "| beyond 2 SE |",

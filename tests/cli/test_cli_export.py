@@ -44,6 +44,10 @@ def test_every_target_writes_its_files_and_a_readme(cli, tmp_path, target, extra
     files = {p.name for p in out.iterdir()} - {"README.md"}
     assert files and all(f"`{name}`" in readme for name in files)
     assert f"{target}:" in r.output
+    if target == "rockyfor3d":  # source cells inside Rockyfor3D's active area
+        source = read_dem(out / "rockdensity.asc").values > 0
+        assert source.any() and not source[:2].any() and not source[-2:].any()
+        assert not source[:, :2].any() and not source[:, -2:].any()
 
 
 def test_grid_files_share_the_extruded_grid(cli, tmp_path):
@@ -54,8 +58,10 @@ def test_grid_files_share_the_extruded_grid(cli, tmp_path):
     grids = [read_dem(p) for p in sorted(out.glob("*.asc"))]
     assert len(grids) >= 2
     for g in grids:
-        assert g.shape == grids[0].shape == (3, 140)  # 700 m of profile / 5 m
-        assert g.x_m[0] == grids[0].x_m[0] == 2.5
+        # 700 m of profile / 5 m, 3 rows; padded by 2 cells north, south and west so
+        # the seeder's column lies inside Rockyfor3D's active area
+        assert g.shape == grids[0].shape == (7, 142)
+        assert g.x_m[0] == grids[0].x_m[0] == -7.5
 
 
 def test_grid_target_on_a_dem(cli, tmp_path):

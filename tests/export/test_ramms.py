@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,7 +13,10 @@ from fieldkit.errors import ArgumentError
 from fieldkit.export.ramms import category_at, export_ramms, recommend
 from fieldkit.export.site import site_from_dem, site_from_section
 from fieldkit.io.dem import DemGrid, read_dem
+from fieldkit.model.effects import registry
 from fieldkit.model.model_file import model_from_dict
+
+REPO = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="module")
@@ -172,3 +176,44 @@ def test_nodata_cells_of_a_dem_stay_nodata(tmp_path):
     assert np.isnan(back.values[0, 2])
     assert back.values[1].tolist() == [2.0, 1.0, 0.0]
     assert (back.x_m[0], back.y_m[0]) == (102.5, 17.5)
+
+
+# ------------------------------------------- through the command line (issue 19)
+
+TSCHAMUT = REPO / "examples/tschamut/model_base.json"
+TERRAIN = REPO / "tests/data/tschamut2014/terrain.asc"
+RELEASES = REPO / "tests/data/tschamut2014/release_points.csv"
+TABLE_7_1 = REPO / "surveys/tornado_mountain/model_rocfall_table_7_1.json"
+
+
+def test_readme_says_no_translation_error_and_lists_every_effect(cli, tmp_path):
+    out = tmp_path / "o"
+    r = cli("export", TABLE_7_1, "--to", "ramms", "-o", out, "--extrude",
+            "--cellsize", "10", "--rows", "3")  # fmt: skip
+    assert r.exit_code == 0, r.output
+    readme = (out / "README.md").read_text(encoding="utf-8")
+    section = readme.split("## Translation error: calibrated model vs the target's "
+                           "law")[1].split("\n## ")[0]  # fmt: skip
+    # RAMMS's rigid-body law cannot be emulated: said plainly, and no number given
+    assert "Not measured" in section and "cannot be emulated" in section
+    assert "| runout p50" not in section and "%" not in section
+    for spec in registry.EFFECTS:
+        assert f"effect {spec.name} (" in readme, spec.name
+    sources = readme.split("## Sources of the target's rules")[1].split("\n## ")[0]
+    assert "ramms_gap_analysis.md" in sources and "User Manual" in sources
+    unconfirmed = readme.split("## Unconfirmed")[1].split("\n## ")[0]
+    assert "mu_min, beta, kappa and drag of Soft" in unconfirmed
+    for name in ("dem.asc", "terrain_category.asc", "terrain_categories.csv"):
+        assert f"wrote {out / name}" in r.stdout.splitlines()
+
+
+def test_tschamut_release_file_on_the_real_dem(cli, tmp_path):
+    out = tmp_path / "o"
+    r = cli("export", TSCHAMUT, "--to", "ramms", "-o", out, "--dem", TERRAIN,
+            "--releases", RELEASES)  # fmt: skip
+    assert r.exit_code == 0, r.output
+    readme = (out / "README.md").read_text(encoding="utf-8")
+    # 80 points in 14 cells; RAMMS's DEM is the site's, not padded
+    assert "14 release cells from" in readme and "(80 points)" in readme
+    assert read_dem(out / "dem.asc").shape == read_dem(TERRAIN).shape
+    assert "Release cells (centres, m): (" in readme and "and 4 more" in readme

@@ -1,30 +1,34 @@
-"""Rockyfor3D export: grids re-read, code domains, the soil-type choice, the block.
+"""Rockyfor3D export through the command line: files a Rockyfor3D run takes as
+meant -- source cells inside its active area, rockdensity in its range, soil types
+by the ground, obstacle heights from the calibrated e_t -- and the README's account.
 
-References are hand computations and the format (Dorren 2016, §2.1, Table 1), not
-the exporter's output: e.g. the Tornado block 3750 kg in a sphere of r = 0.725 m is
-3750 / (pi/6 * 1.45^3) = 3750 / 1.596256 = 2349.2 kg/m3.
+References are hand computations and the target's documented rules, not the
+exporter's output: e.g. the Tornado block 3750 kg in a sphere of r = 0.725 m is
+3750 / (pi/6 * 1.45^3) = 3750 / 1.596256 = 2349.2 kg/m3; Rockyfor3D ignores source
+cells in the two outer rows and columns (ecorisQ QGIS-RF3D).
 """
 
 from __future__ import annotations
 
+import json
 import math
-from dataclasses import replace
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy.stats import halfnorm
+from scipy.stats import norm
 
-from fieldkit.errors import ArgumentError
-from fieldkit.export.rockyfor3d import (
-    SOIL_TYPES,
-    export_rockyfor3d,
-    nearest_soil_type,
-    obstacle_heights,
-    sphere_block,
-)
-from fieldkit.export.site import site_from_dem, site_from_section
+from fieldkit.export.rockyfor3d import obstacle_heights, rt_of_height, soil_type
 from fieldkit.io.dem import DemGrid, read_dem
-from fieldkit.model.model_file import model_from_dict, read_model
+from fieldkit.model.effects import registry
+
+REPO = Path(__file__).resolve().parents[2]
+TABLE_7_1 = REPO / "surveys/tornado_mountain/model_rocfall_table_7_1.json"
+PATH_START = REPO / "surveys/tornado_mountain/model_path_start.json"
+TSCHAMUT = REPO / "examples/tschamut/model_base.json"
+TERRAIN = REPO / "tests/data/tschamut2014/terrain.asc"
+RELEASES = REPO / "tests/data/tschamut2014/release_points.csv"
 
 GRIDS = (
     "dem.asc",
@@ -41,206 +45,416 @@ GRIDS = (
 HEADER_KEYS = ["ncols", "nrows", "xllcorner", "yllcorner", "cellsize", "NODATA_value"]
 
 
-def _one_material(e_n=0.4, **extra):
-    material = {"e_n": e_n, "e_t": 0.8, "friction_deg": 30, **extra}
-    return model_from_dict(
-        {
-            "profile": {"x_m": [0, 40], "z_m": [30, 0], "material": "ground"},
-            "materials": {"ground": material},
-            "body": {"mass_kg": 100, "radius_m": 0.5},
-            "seeder": {"x_m": 1, "z_m": 31},
-            "effects": {"slope_roughness": {}},
-        }
+def _export(cli, out, model, *args):
+    r = cli("export", model, "--to", "rockyfor3d", "-o", out, *args)
+    assert r.exit_code == 0, r.output
+    grids = {name: read_dem(out / name) for name in GRIDS}
+    readme = (out / "README.md").read_text(encoding="utf-8")
+    return r, grids, readme
+
+
+def _assert_sources_active(grids) -> np.ndarray:
+    """Every source cell >= 2 cells inside the grid, and at least one."""
+    source = grids["rockdensity.asc"].values > 0
+    assert source.any()
+    active = np.zeros(source.shape, bool)
+    active[2:-2, 2:-2] = True
+    assert not (source & ~active).any()
+    return source
+
+
+def _one_material(tmp_path, name="ground", e_n=0.4, mass=100.0, radius=0.5):
+    path = tmp_path / "m.json"
+    path.write_text(
+        json.dumps(
+            {
+                "profile": {"x_m": [0, 40], "z_m": [30, 0], "material": name},
+                "materials": {name: {"e_n": e_n, "e_t": 0.8, "friction_deg": 30}},
+                "body": {"mass_kg": mass, "radius_m": radius},
+                "seeder": {"x_m": 1, "z_m": 31},
+            }
+        )
     )
+    return path
 
 
-def test_a_grid_target_needs_a_site(tornado):
-    with pytest.raises(ArgumentError, match="rockyfor3d needs a grid site"):
-        export_rockyfor3d(tornado, None)
+# -------------------------------------------------- item 1: sources are released
 
 
-def test_tornado_section_grids_reread(tornado, tmp_path, written_grids):
-    site = site_from_section(tornado, cellsize_m=10, rows=3)
-    export = export_rockyfor3d(tornado, site)
-    assert sorted(export.files) == sorted(GRIDS)
-    grids = written_grids(export, tmp_path)
-    for name, text in export.files.items():
-        keys = [line.split()[0] for line in text.splitlines()[:6]]
-        assert keys == HEADER_KEYS, name
-    # 700 m of profile in 10 m cells from x = 0; 3 rows centred on y = 0.
+def test_extruded_sources_lie_inside_the_active_area(cli, tmp_path):
+    # Before: the seeder column (chainage 2.5 m) was column 0 of a 5-row grid, so
+    # all 5 source cells lay in the ignored edge band and Rockyfor3D released none.
+    r, grids, readme = _export(cli, tmp_path / "o", TABLE_7_1, "--extrude",
+                               "--cellsize", "5")  # fmt: skip
+    source = _assert_sources_active(grids)
+    # 5 rows + 2 + 2 padded; 140 columns + 2 padded on the west (the east is far)
+    assert grids["dem.asc"].shape == (9, 142)
+    assert np.argwhere(source).tolist() == [[row, 2] for row in range(2, 7)]
+    # the padded cells continue the edge: column 0-1 at the first column's height
+    dem = grids["dem.asc"].values
+    np.testing.assert_allclose(dem[:, 0], dem[4, 2], atol=1e-3)
+    assert grids["dem.asc"].x_m[2] == 2.5  # the original first column is unmoved
+    assert "padded by 2 north, 2 south, 2 west" in readme
+    assert "5 source cells" in readme
+    for line in ("wrote " + str(tmp_path / "o" / name) for name in GRIDS):
+        assert line in r.stdout.splitlines()
+
+
+def test_dem_release_on_the_edge_is_padded_inside(cli, tmp_path):
+    # (-34, 300): column 0, row 3 of Tschamut's DEM -- in the ignored band before.
+    _, grids, readme = _export(cli, tmp_path / "o", TSCHAMUT, "--dem", TERRAIN,
+                               "--release", "-34,300")  # fmt: skip
+    source = _assert_sources_active(grids)
+    assert np.argwhere(source).tolist() == [[3, 2]]
+    assert grids["dem.asc"].shape == (46, 45)
+    assert grids["dem.asc"].x_m[0] == -42.5
+    assert "padded by 2 west" in readme
+
+
+def test_a_release_that_cannot_be_padded_is_refused(cli, tmp_path, fails, monkeypatch):
+    # With a cell limit of 100: 2 rows x 40 columns of 1 m fit (80); padded (2 rows
+    # north and south; the seeder's column 1 needs 1 more on the west) to 6 x 41 =
+    # 246 cells they do not -- refused in one line, nothing written.
+    monkeypatch.setattr("fieldkit.export.site.MAX_DEM_CELLS", 100)
+    model = _one_material(tmp_path)
+    out = tmp_path / "o"
+    r = cli("export", model, "--to", "rockyfor3d", "-o", out, "--extrude",
+            "--cellsize", "1", "--rows", "2")  # fmt: skip
+    fails(r, "Rockyfor3D ignores source cells", "outer rows", "6 x 41 cells")
+    assert not out.exists()
+
+
+def test_rockdensity_out_of_range_is_clamped_keeping_the_mass(cli, tmp_path):
+    # 100 kg in a sphere of r = 0.5 m: 100 / 0.523599 = 191 kg/m3 < 2000. Clamped
+    # to 2000 with d = (6 * 100 / (pi * 2000))^(1/3) = 0.095493^(1/3) = 0.45708 m.
+    _, grids, readme = _export(cli, tmp_path / "o", _one_material(tmp_path),
+                               "--extrude", "--cellsize", "2")  # fmt: skip
+    source = _assert_sources_active(grids)
+    density = grids["rockdensity.asc"].values
+    assert set(np.unique(density[source])) == {2000}
+    assert (density[~source] == 0).all()
+    np.testing.assert_allclose(grids["d1.asc"].values[source], 0.457, atol=5e-4)
+    assert "density of 191 kg/m³, outside Rockyfor3D's rockdensity range" in readme
+    assert "clamped to 2000 kg/m³" in readme
+
+
+def test_tornado_block_by_hand(cli, tmp_path):
+    _, grids, _ = _export(cli, tmp_path / "o", TABLE_7_1, "--extrude",
+                          "--cellsize", "10", "--rows", "3")  # fmt: skip
+    source = _assert_sources_active(grids)
+    volume = math.pi / 6 * 1.45**3
+    assert volume == pytest.approx(1.596256, abs=1e-6)
+    assert set(np.unique(grids["rockdensity.asc"].values[source])) == {2349}
+    for name in ("d1.asc", "d2.asc", "d3.asc"):
+        np.testing.assert_allclose(grids[name].values, source * 1.45)
+    np.testing.assert_array_equal(grids["blshape.asc"].values, source * 3)
+
+
+def test_grids_share_one_header(cli, tmp_path):
+    out = tmp_path / "o"
+    _, grids, readme = _export(cli, out, TABLE_7_1, "--extrude", "--cellsize", "10",
+                               "--rows", "3")  # fmt: skip
     dem = grids["dem.asc"]
-    assert dem.shape == (3, 70)
-    assert dem.cellsize_m == 10
-    assert dem.x_m[0] - 5 == 0 and dem.y_m[-1] - 5 == -15
     for name, grid in grids.items():
+        head = (out / name).read_text().splitlines()[:6]
+        assert [line.split()[0] for line in head] == HEADER_KEYS, name
         assert grid.shape == dem.shape, name
         np.testing.assert_array_equal(grid.x_m, dem.x_m)
         np.testing.assert_array_equal(grid.y_m, dem.y_m)
-    # Column centres 5, 15, 25 m on the profile (z 350 -> 316 -> 295 -> 280).
-    np.testing.assert_allclose(dem.values[:, 0], 350 - 34 * 5 / 8, atol=1e-3)
-    np.testing.assert_allclose(dem.values[:, 2], 316 - 21 * 17 / 20, atol=1e-3)
-    np.testing.assert_allclose(dem.values, site.grid.values, atol=5e-4)
-
-
-def test_tornado_codes_block_and_source_cells(tornado, tmp_path, written_grids):
-    grids = written_grids(
-        export_rockyfor3d(tornado, site_from_section(tornado, cellsize_m=10, rows=3)),
-        tmp_path,
-    )
-    source = np.zeros((3, 70), bool)
-    source[:, 0] = True  # the seeder at chainage 0: the first column
-    soil = grids["soiltype.asc"].values
-    shape = grids["blshape.asc"].values
-    assert set(np.unique(soil)) <= set(range(8))
-    assert set(np.unique(shape)) <= set(range(5))
-    # rock e_n 0.75 and colluvium e_n 1.00: both nearest bedrock's mean 0.53.
-    assert (soil == 6).all()
-    np.testing.assert_array_equal(shape, np.where(source, 3, 0))
-    np.testing.assert_array_equal(grids["rockdensity.asc"].values, source * 2349)
-    for name in ("d1.asc", "d2.asc", "d3.asc"):
-        np.testing.assert_allclose(grids[name].values, source * 1.45)
-
-
-def test_tornado_obstacle_heights(tornado, tmp_path, written_grids):
-    grids = written_grids(
-        export_rockyfor3d(tornado, site_from_section(tornado, cellsize_m=10, rows=3)),
-        tmp_path,
-    )
-    # Rock (x < 28 m: columns 0-2) has a dip SD of 35 deg; colluvium 0.
-    # rg70 by hand: 35 deg x 0.45376 (normal quantile 0.675) = 15.88 deg,
-    # 0.725 m x tan(15.88 deg) = 0.2063 m.
-    rock = np.zeros((3, 70), bool)
-    rock[:, :3] = True
-    for key, q in (("rg70", 0.35), ("rg20", 0.80), ("rg10", 0.95)):
-        h = 0.725 * math.tan(math.radians(35.0 * halfnorm.ppf(q)))
-        np.testing.assert_allclose(
-            grids[f"{key}.asc"].values, rock * round(h, 3), atol=1e-9
-        )
-    assert grids["rg70.asc"].values[0, 0] == pytest.approx(0.206)
-
-
-@pytest.mark.parametrize(
-    ("e_n", "code"),
-    [
-        (0.75, 6),
-        (1.0, 6),
-        (0.23, 1),
-        (0.255, 2),  # halfway 0.23 / 0.28: the higher
-        (0.305, 3),  # halfway 0.28 / 0.33
-        (0.34, 7),  # halfway 0.33 (scree) / 0.35 (asphalt)
-        (0.365, 4),  # halfway 0.35 / 0.38
-        (0.48, 6),  # halfway 0.43 / 0.53
-        (0.115, 1),  # halfway 0 / 0.23
-        (0.05, 0),
-        (0.29, 2),
-    ],
-)
-def test_nearest_soil_type_hand_cases(e_n, code):
-    assert nearest_soil_type(e_n).code == code
-
-
-def test_soil_type_table_is_consistent():
-    assert [s.code for s in SOIL_TYPES] == list(range(8))
-    means = {s.code: s.rn_mean for s in SOIL_TYPES}
-    assert means == {
-        0: 0,
-        1: 0.23,
-        2: 0.28,
-        3: 0.33,
-        4: 0.38,
-        5: 0.43,
-        6: 0.53,
-        7: 0.35,
-    }
-    for s in SOIL_TYPES:  # each mean is the middle of its range
-        assert s.rn_mean == pytest.approx((s.rn_min + s.rn_max) / 2)
-
-
-def test_mismatch_and_unmapped_rt_are_reported(tornado):
-    export = export_rockyfor3d(tornado, site_from_section(tornado, cellsize_m=10))
-    text = "\n".join(export.mismatches)
-    assert "6: 0.53" in text and "7: 0.35" in text  # the class means used
-    assert (
-        "rock: e_n = 0.75 -> soiltype 6 (bedrock), mean Rn 0.53: mismatch 0.22" in text
-    )
-    assert (
-        "colluvium: e_n = 1 -> soiltype 6 (bedrock), mean Rn 0.53: mismatch 0.47"
-        in text
-    )
-    assert "no Rockyfor3D soil type reaches it" in text  # 1.0 > 0.58
-    unmapped = dict(export.unmapped)
-    assert "Rt" in unmapped["materials.rock.e_t = 0.59"]
-    assert "Rt" in unmapped["materials.colluvium.e_t = 0.62"]
-    readme = export.readme("model.json")
+    # Column centres 5, 15, 25 m on the profile (z 350 -> 316 -> 295 -> 280),
+    # behind 2 padded columns.
+    np.testing.assert_allclose(dem.values[:, 2], 350 - 34 * 5 / 8, atol=1e-3)
+    np.testing.assert_allclose(dem.values[:, 4], 316 - 21 * 17 / 20, atol=1e-3)
     assert all(f"* `{name}`" in readme for name in GRIDS)
 
 
-def test_tornado_block_by_hand(tornado):
-    diameter, density = sphere_block(tornado.body)
-    assert diameter == pytest.approx(1.45)
-    volume = math.pi / 6 * 1.45**3  # 1.596256 m3
-    assert volume == pytest.approx(1.596256, abs=1e-6)
-    assert density == 2349 == round(3750 / volume)
+# ------------------------------- item 2: soil types follow the ground described
 
 
-def test_obstacle_heights_from_roughness_m():
-    # roughness_m = r tan(10 deg): eq. 7.4 gives a dip SD of exactly 10 deg.
-    model = _one_material(roughness_m=0.5 * math.tan(math.radians(10.0)))
-    export = export_rockyfor3d(model, site_from_section(model, cellsize_m=2))
-    rg10 = float(export.files["rg10.asc"].splitlines()[6].split()[0])
-    assert rg10 == pytest.approx(0.5 * math.tan(math.radians(10 * 1.959964)), abs=5e-4)
-    assert obstacle_heights(0.0, 0.5) == {"rg70": 0.0, "rg20": 0.0, "rg10": 0.0}
-    with pytest.raises(ArgumentError, match="materials.ground: a dip SD of 50"):
-        obstacle_heights(50.0, 0.5, name="ground")  # rg10 dip 98 deg
+def test_soil_types_follow_the_ground_not_the_lumped_e_n(cli, tmp_path):
+    # Before: nearest mean Rn put rock (e_n 0.75) and colluvium (e_n 1.0) both on
+    # bedrock (6). Rock is bedrock (6), colluvium talus/compact soil with large
+    # fragments (4), the railway bench ballast (3).
+    _, grids, readme = _export(cli, tmp_path / "o", PATH_START, "--extrude",
+                               "--cellsize", "10", "--rows", "3")  # fmt: skip
+    soil = grids["soiltype.asc"].values
+    x = grids["dem.asc"].x_m
+    # rock up to x = 28 m, colluvium to 587.2 m, the bench after (segment ends)
+    assert (soil[:, (x > 0) & (x < 28)] == 6).all()
+    assert (soil[:, (x > 30) & (x < 580)] == 4).all()
+    assert (soil[:, x > 590] == 3).all()
+    assert "'colluvium' in the name" in readme
+    assert "'bench' in the name" in readme
 
 
-def test_roughness_without_the_effect_is_smooth():
-    model = _one_material(roughness_deg_sd=20.0)
-    model = replace(model, effects={})
-    export = export_rockyfor3d(model, site_from_section(model, cellsize_m=2))
-    for key in ("rg70", "rg20", "rg10"):
-        values = {
-            v
-            for line in export.files[f"{key}.asc"].splitlines()[6:]
-            for v in line.split()
-        }
-        assert values == {"0"}
+@pytest.mark.parametrize(
+    ("name", "code"),
+    [
+        ("cliff", 6),
+        ("bedrock", 6),
+        ("weathered rock", 5),  # the longer keyword wins over "rock"
+        ("talus", 4),
+        ("upper_colluvium", 4),
+        ("scree", 3),
+        ("meadow", 2),
+        ("deep soil", 1),
+        ("swamp", 0),
+        ("asphalt", 7),
+    ],
+)
+def test_soil_type_by_description(name, code):
+    assert soil_type(name, 1.0)[0].code == code  # whatever the lumped e_n
 
 
-def test_cells_without_ground_are_nodata(tmp_path, written_grids):
+def test_soil_types_are_monotone_in_hardness():
+    # soft -> hard descriptions never get a softer class (Rn range) than the one before
+    order = ["swamp", "deep soil", "meadow", "scree", "talus", "weathered rock", "rock"]
+    means = [soil_type(n, 0.5)[0].rn_mean for n in order]
+    assert means == sorted(means)
+    # without a description: by realised e_n, monotone too (class means 0.23 .. 0.53)
+    codes = [soil_type("m1", e)[0].rn_mean for e in np.linspace(0.0, 1.2, 49)]
+    assert codes == sorted(codes)
+    assert soil_type("m1", 0.41)[0].code == 5  # nearest 0.43
+    assert "no ground description" in soil_type("m1", 0.41)[1]
+
+
+# ---------------------------------- item 3: rg70/rg20/rg10 from the calibrated e_t
+
+
+def test_obstacle_heights_invert_the_calibrated_e_t(cli, tmp_path):
+    # Before: rg = 0 on the colluvium (90 % of the path) and e_t discarded.
+    _, grids, readme = _export(cli, tmp_path / "o", TABLE_7_1, "--extrude",
+                               "--cellsize", "10", "--rows", "3")  # fmt: skip
+    ground = np.isfinite(grids["dem.asc"].values)
+    x = grids["dem.asc"].x_m
+    colluvium = ground & (x > 30)[None, :]
+    # realised e_t on the colluvium is the calibrated 0.62 (no law changes it) with
+    # the impacts' spread ~ e_t_sd 0.04; Rt = 1 / (1 + h / R), R = 0.725 m. By hand:
+    # rg70 at Rt = 0.62 + 0.04 z(0.65) = 0.6354: h = 0.725 (1/0.6354 - 1) = 0.416 m.
+    for key, q in (("rg70", 0.65), ("rg20", 0.20), ("rg10", 0.05)):
+        h = grids[f"{key}.asc"].values[colluvium]
+        assert h.min() == h.max() > 0
+        rt = rt_of_height(float(h[0]), 0.725)
+        assert rt == pytest.approx(0.62 + 0.04 * norm.ppf(q), abs=0.006), key
+    assert grids["rg70.asc"].values[colluvium][0] == pytest.approx(0.416, abs=0.01)
+    # the obstacles grow from rg70 to rg10 and stay in Rockyfor3D's 0-100 m
+    rg = [grids[f"{k}.asc"].values[ground] for k in ("rg70", "rg20", "rg10")]
+    assert (rg[0] <= rg[1]).all() and (rg[1] <= rg[2]).all()
+    assert (rg[2] <= 100).all()
+    assert "Rt = 1 / (1 + MOH / R)" in readme
+    assert obstacle_heights(1.0, 0.0, 0.5) == {"rg70": 0, "rg20": 0, "rg10": 0}
+
+
+# ------------------------ item 4: lumped values with their own spread, no fallback
+
+
+def test_realised_values_carry_the_impacts_spread(cli, tmp_path):
+    _, _, readme = _export(cli, tmp_path / "o", PATH_START, "--extrude",
+                           "--cellsize", "10", "--rows", "3")  # fmt: skip
+    # velocity-scaled colluvium e_n 1.0: realised below 1, with its spread (the
+    # impacts' own scatter, ~0.1), not a fit's standard error (~0.001)
+    found = re.search(
+        r"realised e_n (\d\.\d+), spread (\d\.\d+)\) \| soiltype.asc = 4", readme
+    )
+    assert found, readme
+    e_n, spread = map(float, found.groups())
+    assert 0.5 < e_n < 1.0 and 0.05 < spread < 0.3
+    # the bench has no simulated impact: said, with what is written instead
+    assert "no simulated impact on bench" in readme
+    assert "without velocity_scaled_restitution" in readme
+
+
+# ------------------------- items 5 and 7: translation error, effects, sources
+
+
+def test_readme_gives_the_translation_error_and_every_effect(cli, tmp_path):
+    _, _, readme = _export(cli, tmp_path / "o", PATH_START, "--extrude",
+                           "--cellsize", "10", "--rows", "3")  # fmt: skip
+    section = readme.split("## Translation error: calibrated model vs the target's "
+                           "law")[1].split("\n## ")[0]  # fmt: skip
+    rows = [line for line in section.splitlines() if line.startswith("| runout p")]
+    assert len(rows) == 2
+    assert "| p95 total energy at" in section and "| p95 bounce height at" in section
+    assert "fieldkit's emulation of Rockyfor3D's law" in section
+    for spec in registry.EFFECTS:
+        assert f"effect {spec.name} (" in readme, spec.name
+    sources = readme.split("## Sources of the target's rules")[1].split("\n## ")[0]
+    assert (
+        "ecorisQ/QGIS-RF3D" in sources and "rockyfor3d_inputs_algorithm.py" in sources
+    )
+    unconfirmed = readme.split("## Unconfirmed")[1].split("\n## ")[0]
+    assert "Rt = 1 / (1 + MOH / R)" in unconfirmed
+
+
+# ------------------------------------------ item 6: many release cells on a DEM
+
+
+def test_tschamut_release_points_give_their_cells(cli, tmp_path):
+    _, grids, readme = _export(cli, tmp_path / "o", TSCHAMUT, "--dem", TERRAIN,
+                               "--releases", RELEASES)  # fmt: skip
+    source = _assert_sources_active(grids)
+    # 80 release points in 14 cells: cell (row, col) = (floor((315 - y) / 5),
+    # floor((x + 35) / 5)) on the 5 m grid whose upper-left corner is (-35, 315);
+    # all far from the edge, so the grid is not padded.
+    assert grids["dem.asc"].shape == (46, 43)
+    cells = {(int((315 - y) // 5), int((x + 35) // 5)) for x, y in _points()}
+    assert len(cells) == 14
+    assert {tuple(c) for c in np.argwhere(source).tolist()} == cells
+    assert set(np.unique(grids["rockdensity.asc"].values[source])) == {2987}
+    assert "14 release cells from" in readme and "(80 points)" in readme
+
+
+def _points():
+    lines = RELEASES.read_text().splitlines()
+    head = lines[0].split(",")
+    ix, iy = head.index("x_m"), head.index("y_m")
+    return [(float(r.split(",")[ix]), float(r.split(",")[iy])) for r in lines[1:]]
+
+
+def test_a_release_polygon_gives_the_cells_whose_centre_is_inside(cli, tmp_path):
+    # a rectangle from (10, 230) to (31, 246): centres x 12.5, 17.5, 22.5, 27.5 and
+    # y 232.5, 237.5, 242.5 -> rows (315 - y) // 5 = 14, 15, 16; cols 9-12: 12 cells
+    polygon = tmp_path / "area.csv"
+    polygon.write_text("x_m;y_m;polygon\n10;230;A\n31;230;A\n31;246;A\n10;246;A\n")
+    _, grids, readme = _export(cli, tmp_path / "o", TSCHAMUT, "--dem", TERRAIN,
+                               "--releases", polygon)  # fmt: skip
+    source = _assert_sources_active(grids)
+    expected = {(r, c) for r in (14, 15, 16) for c in (9, 10, 11, 12)}
+    assert {tuple(c) for c in np.argwhere(source).tolist()} == expected
+    assert "12 release cells" in readme and "polygon A (4 vertices)" in readme
+
+
+def test_releases_off_the_dem_are_named_by_row(cli, tmp_path, fails, digest):
+    bad = tmp_path / "releases.csv"
+    bad.write_text("id,x_m,y_m\na,33.4,236.67\nb,-500,3\nc,30,250\nd,30,999\n")
+    before = digest(bad)
+    out = tmp_path / "o"
+    r = cli("export", TSCHAMUT, "--to", "rockyfor3d", "-o", out, "--dem", TERRAIN,
+            "--releases", bad)  # fmt: skip
+    fails(r, "releases.csv", "2 releases with no cell on ground",
+          "row 3: (-500, 3) outside", "row 5: (30, 999) outside")  # fmt: skip
+    assert r.exit_code == 1
+    assert not out.exists() and digest(bad) == before
+
+
+def test_a_polygon_on_nodata_is_named(cli, tmp_path, fails):
+    values = np.full((8, 8), 50.0) - np.arange(8)[None, :]
+    values[3, 4] = np.nan
+    dem = tmp_path / "dem.asc"
+    rows = "\n".join(" ".join("-9999" if np.isnan(v) else f"{v:g}" for v in row)
+                     for row in values)  # fmt: skip
+    dem.write_text("ncols 8\nnrows 8\nxllcorner 0\nyllcorner 0\ncellsize 10\n"
+                   f"NODATA_value -9999\n{rows}\n")  # fmt: skip
+    polygon = tmp_path / "area.csv"
+    polygon.write_text("x_m,y_m,polygon\n30,30,P\n60,30,P\n60,60,P\n30,60,P\n")
+    out = tmp_path / "o"
+    r = cli("export", _one_material(tmp_path), "--to", "rockyfor3d", "-o", out,
+            "--dem", dem, "--releases", polygon)  # fmt: skip
+    fails(r, "area.csv", "rows 2-5", "polygon P covers 1 nodata cells", "(4, 5)")
+    assert not out.exists()
+
+
+def test_release_and_releases_together_are_refused(cli, tmp_path, fails):
+    r = cli("export", TSCHAMUT, "--to", "rockyfor3d", "-o", tmp_path / "o", "--dem",
+            TERRAIN, "--release", "33.4,236.67", "--releases", RELEASES)  # fmt: skip
+    fails(r, "--releases", "not both")
+    r = cli("export", TSCHAMUT, "--to", "rockyfor3d", "-o", tmp_path / "o",
+            "--extrude", "--releases", RELEASES)  # fmt: skip
+    fails(r, "--releases", "goes with a DEM")
+
+
+def test_cells_without_ground_are_nodata(cli, tmp_path):
     values = np.array([[30.0, 25.0, 20.0], [29.0, np.nan, 19.0], [28.0, 23.0, 18.0]])
     grid = DemGrid.from_corner(values, x_left_m=0, y_top_m=30, cellsize_m=10)
-    model = _one_material()
-    grids = written_grids(
-        export_rockyfor3d(model, site_from_dem(model, grid, (5.0, 25.0))), tmp_path
+    dem = tmp_path / "dem.asc"
+    dem.write_text(
+        "ncols 3\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 10\nNODATA_value -9999\n"
+        "30 25 20\n29 -9999 19\n28 23 18\n"
     )
+    _, grids, _ = _export(cli, tmp_path / "o", _one_material(tmp_path, "talus"),
+                          "--dem", dem, "--release", "5,25")  # fmt: skip
+    _assert_sources_active(grids)
+    assert grid.shape == (3, 3)
     for name, g in grids.items():
-        assert np.isnan(g.values[1, 1]), name
-        assert np.isfinite(np.delete(g.values.ravel(), 4)).all(), name
-    assert grids["rockdensity.asc"].values[0, 0] > 0  # the release cell
-    assert grids["soiltype.asc"].values[0, 0] == 4  # e_n 0.40: nearest 0.38
+        assert g.shape == (5, 5), name  # padded by 2 north and 2 west
+        assert np.isnan(g.values[3, 3]), name
+        assert np.isfinite(np.delete(g.values.ravel(), 18)).all(), name
+    assert grids["rockdensity.asc"].values[2, 2] > 0  # the release cell
+    assert (grids["soiltype.asc"].values[np.isfinite(grids["dem.asc"].values)]
+            == 4).all()  # fmt: skip
 
 
-def test_tschamut_dem_site(repo, tmp_path, written_grids):
-    model = read_model(repo / "examples/tschamut/model_base.json")
-    terrain = read_dem(repo / "tests/data/tschamut2014/terrain.asc")
-    site = site_from_dem(model, terrain, (33.4, 236.67))  # release v004
-    grids = written_grids(export_rockyfor3d(model, site), tmp_path)
-    head = (repo / "tests/data/tschamut2014/terrain.asc").read_text().splitlines()[:6]
-    assert [line.split()[0].lower() for line in head] == [
-        k.lower() for k in HEADER_KEYS
-    ]
-    for name, g in grids.items():
-        assert g.shape == (46, 43), name
-        np.testing.assert_allclose(g.x_m, terrain.x_m)
-        np.testing.assert_allclose(g.y_m, terrain.y_m)
-    np.testing.assert_allclose(grids["dem.asc"].values, terrain.values, atol=5e-4)
-    # Cell centres x = -32.5 + 5 i, y = 312.5 - 5 j: (32.5, 237.5) is (j 15, i 13).
-    source = np.zeros((46, 43), bool)
-    source[15, 13] = True
-    # 69 kg in a sphere of r 0.176667 m: 0.353334^3 = 0.0441120, x pi/6 = 0.0230967
-    # m3, 69 / 0.0230967 = 2987.4 kg/m3.
-    np.testing.assert_array_equal(grids["rockdensity.asc"].values, source * 2987)
-    assert (grids["soiltype.asc"].values == 6).all()  # meadow e_n 1.00
-    # meadow: dip SD 8 deg -> rg70 = 0.176667 tan(8 x 0.45376 deg) = 0.0112 m.
-    assert (grids["rg70.asc"].values == 0.011).all()
+def test_design_values_the_emulation_never_reaches_are_named(cli, tmp_path):
+    # Table 7-1 (e_n 1.0 on colluvium, no velocity scaling): the calibrated rocks run
+    # past 600 m; under Rockyfor3D's law (colluvium Rn 0.38) none reaches the
+    # analysis point, so its energy row has no emulated value -- said, not dropped.
+    _, _, readme = _export(cli, tmp_path / "o", TABLE_7_1, "--extrude",
+                           "--cellsize", "10", "--rows", "3")  # fmt: skip
+    section = readme.split("## Translation error")[1].split("\n## ")[0]
+    assert "| no rock crossed |" in section
+    assert "**not given by one of the two**" in section
+    assert "p95 total energy at" in section.split("not given by one of the two")[1]
+
+
+@pytest.mark.parametrize(
+    ("text", "words"),
+    [
+        ("x,y\n33.4,236.67\n", ["row 1", "column 'x' has no length unit", "x_m"]),
+        ("a_m,b_m\n1,2\n", ["row 1", "columns x, y", "have: a_m, b_m"]),
+        ("x_m,y_m,polygon\n0,250,A\n500,250,A\n0,260,A\n",
+         ["row 3: polygon A: vertex outside the grid (x -35..180 m"]),
+        ("x_m,y_m,polygon\n0,250,A\n0.5,250,A\n0,250.5,A\n",
+         ["rows 2-4", "polygon A holds no cell centre"]),
+        ("x_m,y_m,polygon\n0,250,A\n0.5,250,A\n",
+         ["rows 2-3", "2 distinct vertices", "at least 3"]),
+    ],
+)  # fmt: skip
+def test_bad_release_files_refused_in_one_line(cli, tmp_path, fails, text, words):
+    bad = tmp_path / "releases.csv"
+    bad.write_text(text)
+    out = tmp_path / "o"
+    r = cli("export", TSCHAMUT, "--to", "ramms", "-o", out, "--dem", TERRAIN,
+            "--releases", bad)  # fmt: skip
+    fails(r, "releases.csv", *words)
+    assert r.exit_code == 1 and not out.exists()
+
+
+def test_obstacle_heights_beyond_rockyfor3d_range_are_capped_and_said(cli, tmp_path):
+    # e_t = 0.002 (r = 0.5 m): h = 0.5 (1/0.002 - 1) = 249.5 m > Rockyfor3D's 100 m
+    data = json.loads(_one_material(tmp_path).read_text())
+    data["materials"]["ground"]["e_t"] = 0.002
+    model = tmp_path / "low_et.json"
+    model.write_text(json.dumps(data))
+    _, grids, readme = _export(cli, tmp_path / "o", model, "--extrude",
+                               "--cellsize", "2")  # fmt: skip
+    ground = np.isfinite(grids["dem.asc"].values)
+    assert (grids["rg10.asc"].values[ground] == 100).all()
+    assert "heights above Rockyfor3D's 100 m written as 100 m" in readme
+
+
+def test_the_seeder_fall_to_the_source_cells_is_stated(cli, tmp_path):
+    # The extruded source cells lie at the section's elevation at their centre
+    # (chainage 2.5 m), 10.6 m below the ground under the seeder (chainage 0 m):
+    # the fall Rockyfor3D needs is seeder z - z(2.5 m), by hand from the model file.
+    data = json.loads(PATH_START.read_text())
+    profile, seeder = data["profile"], data["seeder"]
+    fall = seeder["z_m"] - np.interp(2.5, profile["x_m"], profile["z_m"])
+    assert fall == pytest.approx(0.725 + 34 / 8 * 2.5, abs=1e-6)  # 11.35 m
+    r, _, readme = _export(cli, tmp_path / "o", PATH_START, "--extrude",
+                           "--cellsize", "5")  # fmt: skip
+    assert f"additional initial fall height (§2.5) to {fall:.3g} m" in readme
+    assert "additional initial fall height" in r.stdout
+
+
+def test_help_documents_the_release_file_and_its_example_runs(
+    cli, repo_copy, shell_commands, run_shell
+):
+    r = cli("export", "--help")
+    text = " ".join(r.output.replace("│", " ").split())
+    assert "--releases" in text and "polygon" in text and "(x_m, y_m)" in text
+    lines = [c for c in shell_commands(r.output) if "--releases" in c]
+    assert len(lines) == 1
+    code, output = run_shell(lines[0], repo_copy)
+    assert code == 0, output
+    source = read_dem(repo_copy / "out/r3d/rockdensity.asc").values > 0
+    assert source.sum() == 14 and not source[:2].any() and not source[:, :2].any()

@@ -113,3 +113,17 @@ def test_default_points_avoid_the_section_end():
     )
     t = translation_error(m, m, rocks=100)
     assert all(1 < x < 118.8 for x in t.at_m)
+
+
+def test_a_value_one_model_never_reaches_is_named_not_dropped():
+    from fieldkit.export.translation import Row, Translation
+
+    rows = [
+        Row("runout p50", "m", 100.0, 1.0, 101.0, 1.0),
+        Row("p95 total energy at 90.0 m", "kJ", 50.0, 2.0, float("nan"), float("nan")),
+    ]
+    t = Translation(rows, (90.0,), 10, 0, True, (0.0, 0.0))
+    assert t.unreached == ["p95 total energy at 90.0 m"]
+    assert t.worst_percent == pytest.approx(1.0)
+    text = "\n".join(t.lines())
+    assert "not given by one of the two" in text and "90.0 m" in text.split("lost")[1]
