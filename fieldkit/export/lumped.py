@@ -271,10 +271,14 @@ def fit_coefficients(
                 fit.clipped,
             )
         else:
+            because = (
+                "no simulated rock struck anything"
+                if vin_all.size < 2
+                else "its calibrated law depends on more than the normal speed"
+            )
             why = (
-                f"NO SIMULATED IMPACT on {name} ({rocks} rocks, seed {seed}) and its "
-                "calibrated law depends on more than the normal speed: the "
-                f"calibrated e_n clipped to {target}'s range"
+                f"NO SIMULATED IMPACT on {name} ({rocks} rocks, seed {seed}) and "
+                f"{because}: the calibrated e_n clipped to {target}'s range"
             )
             rn = _clipped(f"{key}.e_n", material.e_n, rn_range, why)
         rt = _clipped(
@@ -337,8 +341,9 @@ def closest_behaviour(
     search_rt: bool = True,
     rocks: int = ROCKS,
     seed: int = SEED,
-) -> tuple[dict[str, tuple[Coefficient, Coefficient]], Behaviour]:
-    """The in-range Rn, Rt whose emulation behaves closest to ``model``.
+) -> tuple[dict[str, tuple[Coefficient, Coefficient]], Behaviour | None]:
+    """The in-range Rn, Rt whose emulation behaves closest to ``model`` (None
+    for the search when no coefficient was fitted to impacts of its own).
 
     The impact-level values of :func:`fit_coefficients` are the start of
     :func:`fieldkit.export.translation.closest_in_range` over every coefficient
@@ -370,6 +375,8 @@ def closest_behaviour(
         if pair[i].n > 0
     ]
     ranges = (rn_range, rt_range)
+    if not names:  # no material was struck: nothing to search
+        return coefficients, None
 
     def with_values(values) -> dict[str, tuple[Coefficient, Coefficient]]:
         out = {name: list(pair) for name, pair in coefficients.items()}

@@ -260,3 +260,19 @@ def test_calibrated_values_carry_their_standard_error():
 def test_site_is_ignored(tornado):
     site = site_from_section(tornado, cellsize_m=50, rows=2)
     assert export_crsp(tornado, site).files == export_crsp(tornado).files
+
+
+def test_no_rock_strikes_anything_clips_and_says_so(cli, tmp_path):
+    # the seeder throws every rock past the section's end: nothing to fit or
+    # search; e_n 1.3 is clipped to 1 and said, never written raw
+    data = small(e_n=1.3)
+    data["seeder"] = {"x_m": 30.0, "z_m": 1.0, "vx_mps": 20.0}
+    path = tmp_path / "m.json"
+    path.write_text(json.dumps(data))
+    out = tmp_path / "out"
+    r = cli("export", path, "--to", "crsp", "-o", out)
+    assert r.exit_code == 0, r.output
+    assert rows((out / "cells.csv").read_text())[0]["Rn"] == "1.000"
+    readme = " ".join((out / "README.md").read_text().split())
+    assert "talus: NO SIMULATED IMPACT on it" in readme
+    assert "no simulated rock struck anything" in readme
