@@ -76,18 +76,20 @@ def export(
         typer.Option(
             "--cellsize",
             help="With --extrude: cell size in metres, > 0 (default the profile "
-            "length / 500, at least 0.5 m); the grid may have at most "
+            "length / 500, at least 0.5 m; rstone: a whole number, default 5 m or "
+            "the length / 500 rounded up); the grid may have at most "
             f"{MAX_DEM_CELLS:,} cells, as a DEM.",
         ),
     ] = None,
     rows: Annotated[
-        int,
+        int | None,
         typer.Option(
             "--rows",
-            help="With --extrude: cells across, 2 or more (rows x columns at most "
+            help="With --extrude: cells across, 2 or more (default 5; rstone: 61, "
+            "one release cell in the middle row; rows x columns at most "
             f"{MAX_DEM_CELLS:,} cells, as a DEM).",
         ),
-    ] = 5,
+    ] = None,
     force: Annotated[
         bool, typer.Option("--force", help="Write into a folder that is not empty.")
     ] = False,
@@ -105,7 +107,7 @@ def export(
         fieldkit export surveys/tornado_mountain/model_rocfall_table_7_1.json \\
           --to rocfall -o out/rocfall
     """
-    from fieldkit.export.site import site_from_dem, site_from_section
+    from fieldkit.export.site import site_from_dem
     from fieldkit.export.targets import target
     from fieldkit.io.dem import read_dem
     from fieldkit.model.model_file import read_model
@@ -136,7 +138,10 @@ def export(
                 )
                 site = site_from_dem(model, read_dem(dem), point)
             elif extrude:
-                site = site_from_section(model, cellsize_m=cellsize, rows=rows)
+                given = {"cellsize_m": cellsize, "rows": rows}
+                site = chosen.extrude(
+                    model, **{k: v for k, v in given.items() if v is not None}
+                )
             result = chosen.export(model, site)
         files = dict(result.files)
         if site is not None:
