@@ -63,7 +63,9 @@ def import_results(
     )
 
     if source != "rstone":
-        raise ArgumentError(f"unknown program {source!r} (known: rstone)", source="source")
+        raise ArgumentError(
+            f"unknown program {source!r} (known: rstone)", source="source"
+        )
     if not folder.is_dir():
         raise ArgumentError(f"{folder} is not a folder", source="folder")
     inputs = [folder / RECORD, *(folder / f"{g}.asc" for g in GRIDS)]
@@ -81,6 +83,7 @@ def import_results(
             "distance": distance,
             "trajectories_stated": results.stated,
             "trajectories_traced": results.traced,
+            "counter_on_source_cells": results.on_sources,
             "runout_m": runout,
             "edge_counts": edges,
             "left_the_grid": {s: edges[s] for s in sides},

@@ -64,7 +64,7 @@ import numpy as np
 from fieldkit.errors import ArgumentError
 from fieldkit.export.ascii_grid import ascii_grid_text
 from fieldkit.export.fitted import with_error
-from fieldkit.export.lumped import lumped_equivalent
+from fieldkit.export.lumped import not_a_law
 from fieldkit.export.result import Export, Mapped
 from fieldkit.export.site import (
     ExportSite,
@@ -73,6 +73,7 @@ from fieldkit.export.site import (
     pad_site,
     site_from_section,
 )
+from fieldkit.export.translation import fit_scaled, realised_impacts, translation_error
 from fieldkit.io.dem import DemGrid
 from fieldkit.model.materials import Material
 from fieldkit.model.model_file import Model
@@ -355,6 +356,184 @@ def start_speed_mps(model: Model, height_m: float) -> float:
     return math.sqrt(s.vx_mps**2 + s.vz_mps**2 + 2.0 * G_MPS2 * height_m)
 
 
+def friction_read(tan_written: float) -> float:
+    """The friction r.stone uses for a written ``tan(beta)``: GDAL hands the
+    3-decimal value over as a 32-bit float, r.stone keeps ``(long)(value * 1000)``
+    thousandths (``ReadRasterToLongMatrix``, ``stone.c``).
+
+    Examples
+    --------
+    >>> friction_read(0.35), friction_read(0.05)
+    (0.349, 0.05)
+    """
+    value = float(np.float32(round(tan_written, 3))) * 1000.0
+    return math.floor(value + 1e-12) / 1000.0 if value >= 0 else 0.0
+
+
+def typical_slope_deg(model: Model, name: str) -> float:
+    """The length-weighted mean dip [deg] of ``name``'s segments of the profile
+    (0 for a material on no segment)."""
+    x = np.asarray(model.profile.x_m, float)
+    z = np.asarray(model.profile.z_m, float)
+    dx = np.diff(x)
+    dip = np.degrees(np.arctan(np.abs(np.diff(z)) / dx))
+    mine = np.asarray(model.profile.material, dtype=object) == name
+    if not mine.any():
+        return 0.0
+    return float(np.sum(dip[mine] * dx[mine]) / np.sum(dx[mine]))
+
+
+def emulated_model(
+    model: Model,
+    options: dict[str, float],
+    release_x_m: float,
+    names: list[str] | None = None,
+) -> Model:
+    """fieldkit's model of r.stone's law with the values written for ``model``.
+
+    On ``model``'s own section: each material the constant pair at the written
+    whole percents (``nrest/100``, ``trest/100``) with r.stone's draw SD
+    ``2 range / 100``; the friction angle phi' with ``g cos(psi) tan(phi')`` equal
+    to r.stone's rolling deceleration ``g sin(beta)`` on the material's typical
+    slope psi (:func:`typical_slope_deg`), ``tan(beta)`` as r.stone reads it
+    (:func:`friction_read`); no effect, no roughness, no trees (r.stone has none);
+    the seeder where r.stone starts, on the ground at ``release_x_m`` (one body
+    radius above it), launched horizontally at ``start_vel`` with no spread.
+    """
+    from dataclasses import replace
+
+    names = list(model.materials) if names is None else names
+    materials = dict(model.materials)
+    sd_n = 2 * options["vrest_stoch_range"] / 100
+    sd_t = 2 * options["hrest_stoch_range"] / 100
+    sd_f = 2 * options["frict_stoch_range"] / 100
+    for name in names:
+        m = model.materials[name]
+        tan_beta = friction_read(math.tan(math.radians(m.friction_deg)))
+        psi = math.radians(typical_slope_deg(model, name))
+        tan_phi = math.sin(math.atan(tan_beta)) / math.cos(psi)
+        phi = math.degrees(math.atan(tan_phi))
+        materials[name] = replace(
+            m,
+            e_n=percent(m.e_n) / 100,
+            e_t=percent(m.e_t) / 100,
+            friction_deg=phi,
+            e_n_sd=sd_n,
+            e_t_sd=sd_t,
+            friction_deg_sd=math.degrees(sd_f * math.cos(math.radians(phi)) ** 2),
+            roughness_m=0.0,
+            roughness_deg_sd=0.0,
+        )
+    ground = float(np.interp(release_x_m, model.profile.x_m, model.profile.z_m))
+    seeder = replace(
+        model.seeder,
+        x_m=float(release_x_m),
+        z_m=ground + model.body.radius_m,
+        vx_mps=float(options["start_vel"]),
+        vz_mps=0.0,
+        omega_radps=0.0,
+        x_sd_m=0.0,
+        z_sd_m=0.0,
+        vx_sd_mps=0.0,
+        vz_sd_mps=0.0,
+        omega_sd_radps=0.0,
+        x_max_m=None,
+        height_m=None,
+    )
+    return replace(model, materials=materials, effects={}, trees=None, seeder=seeder)
+
+
+def constant_pair(model: Model, name: str) -> bool:
+    """Whether ``name``'s calibrated law is r.stone's: a constant pair in [0, 1],
+    no effect, no roughness (the values are then written as calibrated)."""
+    m = model.materials[name]
+    return (
+        not model.effects
+        and m.roughness_m == 0
+        and m.roughness_deg_sd == 0
+        and 0 <= m.e_n <= 1
+        and 0 <= m.e_t <= 1
+    )
+
+
+def rstone_pairs(model: Model, names: list[str]) -> tuple[Model, list[str], list[str]]:
+    """``model`` with each material's e_n, e_t (and their SDs) the in-range
+    constant pair closest under r.stone's law, and what was done.
+
+    A material whose calibrated law is already r.stone's (:func:`constant_pair`)
+    keeps its values. Any other -- an impact law, roughness, a coefficient above
+    1 -- takes the pair in [0, 1] minimising the squared rebound error over the
+    impacts on it of the calibrated model's own simulation
+    (:func:`~fieldkit.export.translation.realised_impacts`,
+    :func:`~fieldkit.export.translation.fit_scaled` with ``f = 1``), and as SDs
+    the impacts' own spread around it (what r.stone's random draw should carry,
+    not the fit's standard error). A material with no simulated impact keeps its
+    calibrated values clipped to [0, 1], stated in the mismatches and as
+    unconfirmed.
+
+    Returns
+    -------
+    model, mismatches, unconfirmed
+    """
+    from dataclasses import replace
+
+    todo = [n for n in names if not constant_pair(model, n)]
+    if not todo:
+        return model, [], []
+    impacts = realised_impacts(model)
+    materials = dict(model.materials)
+    lines, open_ = [], []
+    laws = ", ".join(model.effects) or "no effect"
+    for name in todo:
+        m = model.materials[name]
+        rows = impacts[impacts["material"] == name]
+        n_fit = fit_scaled(np.abs(rows["vin_mps"]), rows["vfn_mps"], 1.0, 0.0, 1.0)
+        t_fit = fit_scaled(rows["vit_mps"], rows["vft_mps"], 1.0, 0.0, 1.0)
+        if n_fit.n == 0 or t_fit.n == 0:
+            e_n, e_t = min(max(m.e_n, 0.0), 1.0), min(max(m.e_t, 0.0), 1.0)
+            materials[name] = replace(m, e_n=e_n, e_t=e_t)
+            text = (
+                f"{name}: no simulated impact on it (the calibrated model's own "
+                f"{len(impacts.path_id.unique()) if len(impacts) else 0}-rock "
+                f"simulation): e_n {m.e_n:.4g}, e_t {m.e_t:.4g} written as "
+                f"calibrated, clipped to r.stone's [0, 1] ({e_n:.4g}, {e_t:.4g}); "
+                f"its law ({laws}; roughness {m.roughness_deg_sd:g} deg) is not "
+                "translated"
+            )
+            lines.append(text)
+            open_.append(text)
+            continue
+        materials[name] = replace(
+            m,
+            e_n=n_fit.value,
+            e_t=t_fit.value,
+            e_n_sd=n_fit.spread,
+            e_t_sd=t_fit.spread,
+            roughness_m=0.0,
+            roughness_deg_sd=0.0,
+        )
+        clipped = [
+            f"{k} {f.unclipped:.3f} clipped to {f.value:g}"
+            for k, f in (("e_n", n_fit), ("e_t", t_fit))
+            if f.clipped
+        ]
+        lines.append(
+            f"{name}: r.stone's law is a constant pair; the calibrated e_n "
+            f"{m.e_n:.4g}, e_t {m.e_t:.4g} with {laws} (roughness "
+            f"{m.roughness_deg_sd:g} deg) are written as the in-range pair closest "
+            f"over the {n_fit.n} impacts on {name} of the calibrated model's own "
+            f"simulation: e_n {n_fit.value:.3f}, e_t {t_fit.value:.3f} (least "
+            "squares in [0, 1]"
+            + (f"; {'; '.join(clipped)}" if clipped else "")
+            + f"), SDs their impacts' own spread {n_fit.spread:.3f}, "
+            f"{t_fit.spread:.3f}"
+            + "".join(
+                f"; {w}" for w in (not_a_law(e, TARGET) for e in model.effects) if w
+            )  # fmt: skip
+        )
+    return replace(model, materials=materials), lines, open_
+
+
 def _check(model: Model, names: list[str]) -> None:
     """Refuse coefficients r.stone cannot take (one line naming the value)."""
     for name in names:
@@ -407,11 +586,12 @@ def export_rstone(
         )
     site, resampled = whole_metre_site(site)
     site = pad_site(site, EDGE_CELLS)
-    model, lumped = lumped_equivalent(model, TARGET)
+    calibrated = model
     grid = site.grid
     ground = ground_cells(site)
     source = site.release & ground
     present = [n for n in model.materials if (site.material[ground] == n).any()]
+    model, fitted, open_ = rstone_pairs(model, present)
     _check(model, present)
     offset = dem_offset_m(grid.values[ground])
     dem = np.where(ground, grid.values + offset, np.nan)
@@ -455,12 +635,19 @@ def export_rstone(
         model, site, source, per_cell, offset, chainage, options
     )
     traced = per_cell * n_source
+    release_x = (
+        float(np.mean(grid.x_m[np.nonzero(source)[1]]))
+        if chainage is not None
+        else model.seeder.x_m
+    )
+    emulated = emulated_model(model, options, release_x, present)
+    translation = translation_error(calibrated, emulated)
     return Export(
         TARGET,
         TITLE,
         files,
         mapped=_mapped(model, site, present, offset, per_cell, options),
-        unmapped=_unmapped(model, present),
+        unmapped=_unmapped(calibrated, present),
         units=[
             "nrest, trest: e_n and e_t x 100, whole percent (rounded half up)",
             "friction: tan(friction_deg), dimensionless, 3 decimals (r.stone reads "
@@ -476,14 +663,32 @@ def export_rstone(
             "whole m, both truncated (stone.c MarkVelo, MarkQuota)",
         ],
         mismatches=[
-            *lumped,
+            *fitted,
             *([resampled] if resampled else []),
             *_mismatches(model, present, offset, options),
         ],
         notes=_notes(site, traced, n_source, per_cell, chainage is not None),
         how_to_use=_how_to_use(options, traced),
+        translation=[*translation.lines(), "", emulation_text(release_x)],
         sources=SOURCES,
-        unconfirmed=UNCONFIRMED,
+        unconfirmed=[*UNCONFIRMED, *open_],
+    )
+
+
+def emulation_text(release_x_m: float) -> str:
+    """What fieldkit's emulation of r.stone's law is (the README's translation
+    section): :func:`emulated_model`."""
+    return (
+        "The emulation of r.stone's law: each material the constant pair at the "
+        "written whole percents with r.stone's draw SD 2 range / 100; no effect, no "
+        "roughness; the friction angle phi' whose fieldkit deceleration g cos(psi) "
+        "tan(phi') equals r.stone's rolling deceleration g sin(beta) on the "
+        "material's typical slope psi (its segments' length-weighted mean dip), "
+        "tan(beta) as r.stone reads it (thousandths); the rock launched "
+        f"horizontally at start_vel from the ground at chainage {release_x_m:.1f} m, "
+        "as r.stone starts it. fieldkit's flight, impact and sliding kernels stand "
+        "for r.stone's: its switch to rolling (a bounce shorter than 3 m and slower "
+        "than 5 m/s) and its 5 m steps are not emulated."
     )
 
 
@@ -722,21 +927,18 @@ def _unmapped(model: Model, present: list[str]) -> list[tuple[str, str]]:
         for n in present
         if model.materials[n].roughness_m > 0 or model.materials[n].roughness_deg_sd > 0
     ]
-    if rough or "slope_roughness" in model.effects:
+    if rough:
         out.append(
             (
                 "slope roughness ("
-                + (
-                    ", ".join(_roughness_text(n, model.materials[n]) for n in rough)
-                    or "none in the materials"
-                )
+                + ", ".join(_roughness_text(n, model.materials[n]) for n in rough)
                 + ")",
-                "r.stone has no roughness input: its ground is the DEM's triangles",
+                "r.stone has no roughness input (its ground is the DEM's triangles): "
+                "what it does to the rebounds is folded into the fitted constant "
+                "pair (see the mismatches)",
             )
         )
-    for name in model.effects:
-        if name != "slope_roughness":
-            out.append((f"effect {name}", "r.stone has no such process or parameter"))
+    out += effect_lines(model)
     if model.trees is not None:
         out.append(("trees", "r.stone has no trees"))
     out.append(
@@ -749,6 +951,48 @@ def _unmapped(model: Model, present: list[str]) -> list[tuple[str, str]]:
             "compiled into it",
         )
     )
+    return out
+
+
+#: Why r.stone has no place for each effect that does not change the rebound pair.
+NO_PROCESS = {
+    "slope_roughness": "r.stone has no roughness input: its ground is the DEM's "
+    "triangles (stone.c NewPlane)",
+    "mass_loss": "r.stone's block is a point whose mass never enters its kinematics: "
+    "no fragmentation or mass loss",
+    "tree_impacts": "r.stone has no forest or tree input",
+    "air_drag": "r.stone's flight is a drag-free parabola (Parab, points.c)",
+}
+
+
+def effect_lines(model: Model) -> list[tuple[str, str]]:
+    """Every registered effect (:data:`fieldkit.model.effects.registry.EFFECTS`),
+    active in ``model`` or not, and what r.stone does with it."""
+    from fieldkit.model.effects import registry
+
+    out = []
+    for spec in registry.EFFECTS:
+        active = spec.name in model.effects
+        state = "active in the model" if active else "not in the model"
+        if spec.changes_rebound or spec.name == "slope_roughness":
+            why = (
+                "r.stone's only impact law is a constant pair per cell (Bounce, "
+                "points.c): "
+                + (
+                    "its rebounds are folded into the in-range constant pair fitted "
+                    "to the calibrated model's own impacts, which no longer varies "
+                    "as the effect makes it"
+                    if active
+                    else "an active one would be folded into the fitted constant pair"
+                )
+            )
+            if spec.name == "slope_roughness":
+                why = NO_PROCESS[spec.name] + "; " + why
+            reason = not_a_law(spec.name, TARGET)
+            why += f"; {reason}" if reason and active else ""
+        else:
+            why = NO_PROCESS.get(spec.name, "r.stone has no such process or parameter")
+        out.append((f"effect {spec.name} ({state})", why))
     return out
 
 

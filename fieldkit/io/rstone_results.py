@@ -85,9 +85,26 @@ class RstoneResults:
 
     @property
     def traced(self) -> int:
-        """Trajectories r.stone traced: the counter over the source cells (every
-        trajectory's first path point is its source cell's centre)."""
-        return int(sum(self.counter[s["row"], s["col"]] for s in self.record["sources"]))
+        """Trajectories r.stone traced, as far as the counter shows: each source
+        cell's count, at most the trajectories it started (every trajectory's
+        first path point is its source cell's centre; a count above that is
+        other cells' trajectories passing through), summed over the source cells.
+        Equal to :attr:`stated` when every source cell started all its stones (a
+        stone r.stone never starts, e.g. on the grid's edge row, leaves its cell
+        short unless others pass through it)."""
+        return int(
+            sum(
+                min(self.counter[s["row"], s["col"]], s["trajectories"])
+                for s in self.record["sources"]
+            )
+        )
+
+    @property
+    def on_sources(self) -> int:
+        """The counter summed over the source cells (own and passing trajectories)."""
+        return int(
+            sum(self.counter[s["row"], s["col"]] for s in self.record["sources"])
+        )
 
     def edge_counts(self) -> dict[str, int]:
         """Counter summed over the grid's outer rows and columns: trajectories
@@ -241,7 +258,7 @@ def along_path(results: RstoneResults) -> tuple[pd.DataFrame, str]:
     height = np.full(n, np.nan)
     np.fmax.at(speed, index.ravel(), results.maxvel_mps.ravel())
     np.fmax.at(height, index.ravel(), results.maxdz_m.ravel())
-    traced = max(results.traced, 1)
+    traced = max(results.stated, 1)
     envelope = np.maximum.accumulate(counts[::-1])[::-1]
     mass = float(results.record["mass_kg"])
     table = pd.DataFrame(
