@@ -46,13 +46,18 @@ def import_results(
     (runout percentiles, trajectories stated and traced, trajectories that reached
     the grid's edge).
 
-    Example (from the repository root, with GRASS GIS and r.stone installed):
+    Example (from the repository root): the bundled grids of a real r.stone run
+    (GRASS 8.2.1) on the Tornado Mountain export,
+
+        fieldkit import-results tests/data/rstone_tornado --from rstone \\
+          -o out/rstone_results
+
+    made with (the last two lines in a shell with GRASS GIS and r.stone):
 
         fieldkit export surveys/tornado_mountain/model_rocfall_table_7_1.json \\
           --to rstone --extrude -o out/rstone
         grass -c XY /tmp/grassdb/xy -e
         grass /tmp/grassdb/xy/PERMANENT --exec bash out/rstone/run_rstone.sh
-        fieldkit import-results out/rstone --from rstone -o out/rstone_results
     """
     from fieldkit.io.rstone_results import (
         GRIDS,

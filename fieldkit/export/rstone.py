@@ -730,7 +730,7 @@ r.stone --overwrite {rasters} \\
     {args} \\
     {outputs}
 for name in {" ".join(OUTPUT_GRIDS)}; do
-    r.out.gdal -c --overwrite --quiet input="$name" output="$name.asc" \\
+    r.out.gdal -c -m --overwrite --quiet input="$name" output="$name.asc" \\
         format=AAIGrid type=Int32 nodata=-1
 done
 """

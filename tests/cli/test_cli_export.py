@@ -138,16 +138,28 @@ def test_a_model_file_without_what_a_model_needs(cli, tmp_path, fails):
     assert not (tmp_path / "x").exists()
 
 
-@pytest.mark.parametrize("target", ["rocfall", "crsp", "rstone"])
-def test_values_the_target_refuses_leave_nothing_behind(cli, tmp_path, fails, target):
-    # e_t = 1.05 on the colluvium: every restitution-pair target refuses Rt > 1
+@pytest.mark.parametrize(
+    ("target", "field", "value"),
+    [
+        ("rocfall", "e_t", 1.05),
+        ("crsp", "e_t", 1.05),
+        # r.stone writes the in-range pair closest under its law for e_t > 1
+        # (issue 19); what it refuses is a rolling friction tan above 1.
+        ("rstone", "friction_deg", 50),
+    ],
+)
+def test_values_the_target_refuses_leave_nothing_behind(
+    cli, tmp_path, fails, target, field, value
+):
+    # e_t = 1.05 on the colluvium: RocFall and CRSP refuse Rt > 1
     data = json.loads(TABLE_7_1.read_text())
-    data["materials"]["colluvium"]["e_t"] = 1.05
+    data["materials"]["colluvium"][field] = value
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps(data))
     out = tmp_path / "x"
     extra = ["--extrude"] if target == "rstone" else []
-    fails(cli("export", bad, "--to", target, "-o", out, *extra), "colluvium", "1.05")
+    r = cli("export", bad, "--to", target, "-o", out, *extra)
+    fails(r, "colluvium", f"{value:g}")
     assert not out.exists()
 
 
