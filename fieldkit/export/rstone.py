@@ -443,6 +443,79 @@ def emulated_model(
     return replace(model, materials=materials, effects={}, trees=None, seeder=seeder)
 
 
+def emulated_runouts(
+    model: Model, record: dict, grid: DemGrid | None = None, *, seed: int = 0
+) -> tuple[np.ndarray, np.ndarray]:
+    """fieldkit's emulation of an r.stone run: the runout of each trajectory the
+    export's ``record`` (:data:`RECORD`) starts, and the end of its section.
+
+    The values written (``record["written"]``, ``record["options"]``) under
+    :func:`emulated_model`. On an extruded section: ``model``'s own section, the
+    rocks launched at the release column's chainage. On a DEM (``grid``): for
+    each source cell, the steepest-descent section from its centre
+    (:func:`~fieldkit.model.dem_profile.steepest_descent_line`, half-cell steps)
+    continued straight to the grid's edge where it ends in a pit or a flat, as
+    ``fieldkit fit-paths`` cuts Tschamut's runs
+    (:func:`~fieldkit.fit.path_sections.extend_to_edge`), its trajectories
+    launched at chainage 0; a runout is then the plan distance of the rock's
+    stop on that line from the nearest source cell's centre, as
+    ``import-results`` measures r.stone's (:mod:`fieldkit.io.rstone_results`).
+    A runout equal to its section's end is censored (the rock left the
+    section).
+
+    Raises
+    ------
+    ArgumentError
+        A DEM record without ``grid``.
+    """
+    from dataclasses import replace
+
+    from fieldkit.fit.path_sections import extend_to_edge
+    from fieldkit.model.dem_profile import steepest_descent_line
+    from fieldkit.model.profile import Profile
+    from fieldkit.model.simulate import simulate
+
+    materials = dict(model.materials)
+    for name, values in record["written"].items():
+        materials[name] = replace(materials[name], **values)
+    written = replace(model, materials=materials)
+    options = record["options"]
+    names = list(record["written"])
+    rng = np.random.default_rng(seed)
+    if record["extruded"]:
+        x = float(np.mean([s["x_m"] for s in record["sources"]]))
+        emulated = emulated_model(written, options, x, names)
+        result = simulate(emulated, int(record["trajectories"]), rng)
+        runout = np.asarray(result.runout_x_m, float)
+        return runout, np.full(runout.shape, float(model.profile.x_m[-1]))
+    if grid is None:
+        raise ArgumentError("a DEM record needs its DEM to emulate", source="grid")
+    runouts, ends = [], []
+    sx = np.array([s["x_m"] for s in record["sources"]])
+    sy = np.array([s["y_m"] for s in record["sources"]])
+
+    def from_sources(line, chainage: np.ndarray) -> np.ndarray:
+        px = np.interp(chainage, line.chainage_m, line.plan_x_m)
+        py = np.interp(chainage, line.chainage_m, line.plan_y_m)
+        return np.hypot(px[:, None] - sx, py[:, None] - sy).min(axis=1)
+
+    for s in record["sources"]:
+        step = grid.cellsize_m / 2
+        line = extend_to_edge(
+            grid, steepest_descent_line(grid, (s["x_m"], s["y_m"]), step), step
+        )
+        profile = Profile.from_arrays(
+            line.chainage_m, line.z_m, [names[0]] * (line.z_m.size - 1)
+        )
+        on_line = replace(written, profile=profile)
+        emulated = emulated_model(on_line, options, 0.0, names)
+        result = simulate(emulated, int(s["trajectories"]), rng)
+        x = np.asarray(result.runout_x_m, float)
+        runouts.append(from_sources(line, x))
+        ends.append(from_sources(line, np.full(x.shape, line.length_m)))
+    return np.concatenate(runouts), np.concatenate(ends)
+
+
 def constant_pair(model: Model, name: str) -> bool:
     """Whether ``name``'s calibrated law is r.stone's: a constant pair in [0, 1],
     no effect, no roughness (the values are then written as calibrated)."""
@@ -769,6 +842,16 @@ def record_text(model, site, source, per_cell, offset, chainage, options) -> str
         "start_vel_mps": float(options["start_vel"]),
         "fall_height_m": float(options["fall_height_m"]),
         "model": model.source,
+        "options": {k: float(v) for k, v in options.items()},
+        "written": {
+            name: {
+                "e_n": float(m.e_n),
+                "e_t": float(m.e_t),
+                "friction_deg": float(m.friction_deg),
+            }
+            for name, m in model.materials.items()
+            if (site.material == name).any()
+        },
     }
     return json.dumps(record, indent=1) + "\n"
 
