@@ -1182,7 +1182,9 @@ UNCONFIRMED = [
     "Tornado Mountain's extruded section r.stone and the emulation both run off "
     "the section's end (84 % and 100 %; runout p50 and p95 697.5 m and 700 m, "
     "within one cell); on a Tschamut release area r.stone's runout p50/p95 are "
-    "70/115 m against the emulation's 79.6/87.7 m: they do not agree",
+    "70/115 m against the emulation's 79.6/87.7 m: they do not agree (p50: the "
+    "roll switch, with which the emulation's p50 is 68.5 m; p95: the launch-angle "
+    "spread, without which r.stone's p95 is 90 m)",
     "r.stone ends some trajectories as 'Track overflow' without writing their last "
     "path segment to the grids (points.c TrackPoints, case 0: Parab 'confused' "
     "after 5 steps outside the triangle, or 100000 path points): 239 of 994 on the "
