@@ -418,3 +418,38 @@ def test_cli_import_results_bad_input(cli, tmp_path, fails, damage, words):
     fails(r, *words)
     assert r.exit_code in (1, 2)
     assert not res.exists()
+
+
+def test_cli_a_material_without_impacts_is_stated_not_silent(cli, tmp_path):
+    from fieldkit.model.model_file import write_model
+
+    model = model_from_dict(
+        {
+            "profile": {
+                "x_m": [0, 40, 200, 210],
+                "z_m": [30, 0, 0, 0],
+                "material": ["rock", "meadow", "far"],
+            },
+            "materials": {
+                "rock": {"e_n": 0.3, "e_t": 0.6, "friction_deg": 30},
+                "meadow": {"e_n": 0.2, "e_t": 0.5, "friction_deg": 40},
+                # rough, so not r.stone's constant pair: the pair would be fitted
+                "far": {"e_n": 0.5, "e_t": 0.8, "friction_deg": 30,
+                        "roughness_deg_sd": 5},
+            },
+            "body": {"mass_kg": 100, "radius_m": 0.5},
+            "seeder": {"x_m": 1, "z_m": 31},
+        }
+    )  # fmt: skip
+    model_file = tmp_path / "model.json"
+    write_model(model, model_file)
+    out = tmp_path / "rstone"
+    r = cli("export", model_file, "--to", "rstone", "--extrude", "--rows", "3",
+            "-o", out)  # fmt: skip
+    assert r.exit_code == 0, r.stderr
+    readme = (out / "README.md").read_text()
+    unconfirmed = readme.split("## Unconfirmed")[1]
+    assert "far: no simulated impact on it" in unconfirmed
+    assert "written as calibrated, clipped to r.stone's [0, 1] (0.5, 0.8)" in readme
+    nrest = read_dem(out / "nrest.asc").values
+    assert 50 in nrest[1]  # the far cells: the calibrated 0.5, as stated
