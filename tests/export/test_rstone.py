@@ -453,3 +453,14 @@ def test_cli_a_material_without_impacts_is_stated_not_silent(cli, tmp_path):
     assert "written as calibrated, clipped to r.stone's [0, 1] (0.5, 0.8)" in readme
     nrest = read_dem(out / "nrest.asc").values
     assert 50 in nrest[1]  # the far cells: the calibrated 0.5, as stated
+
+
+def test_doctests():
+    import doctest
+
+    import fieldkit.export.rstone as export_module
+    import fieldkit.io.rstone_results as results_module
+
+    for module in (export_module, results_module):
+        result = doctest.testmod(module)
+        assert result.attempted > 0 and result.failed == 0, module.__name__
