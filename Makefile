@@ -4,7 +4,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test test-all bench bench-diagnose lint video clean
+.PHONY: demo test test-all test-rstone bench bench-diagnose lint video clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -25,6 +25,12 @@ test: $(STAMP)
 ## Everything, including tests marked slow.
 test-all: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python -m pytest -q -n auto -m ''
+
+## The real r.stone on fieldkit's exports (tests/export/test_rstone_real.py, slow):
+## needs GRASS GIS and r.stone (tools/r.stone/install.sh), skipped with the reason
+## otherwise; about 15 s.
+test-rstone: $(STAMP)
+	MPLBACKEND=Agg $(BIN)/python -m pytest -q -p no:xdist -m '' tests/export/test_rstone_real.py
 
 ## Speed and memory figures (printed, not asserted); bench_diagnose_power runs its
 ## short setting here (a few tables per condition, ~3 min on 2 cores), and

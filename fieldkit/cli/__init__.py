@@ -35,6 +35,7 @@ from fieldkit.cli import (
     fit,
     impact,
     import_model,
+    import_results,
     profile,
     reduce,
     simulate,
@@ -86,6 +87,7 @@ app.command("fit")(fit.fit)
 app.command("diagnose")(diagnose.diagnose)
 app.command("export")(export.export)
 app.command("import-model")(import_model.import_model)
+app.command("import-results")(import_results.import_results)
 
 # typer bundles its own click; reach its base exception through a public class.
 _USAGE_ERRORS = next(

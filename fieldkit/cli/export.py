@@ -90,18 +90,20 @@ def export(
         typer.Option(
             "--cellsize",
             help="With --extrude: cell size in metres, > 0 (default the profile "
-            "length / 500, at least 0.5 m); the grid may have at most "
+            "length / 500, at least 0.5 m; rstone: a whole number, default 5 m or "
+            "the length / 500 rounded up); the grid may have at most "
             f"{MAX_DEM_CELLS:,} cells, as a DEM.",
         ),
     ] = None,
     rows: Annotated[
-        int,
+        int | None,
         typer.Option(
             "--rows",
-            help="With --extrude: cells across, 2 or more (rows x columns at most "
+            help="With --extrude: cells across, 2 or more (default 5; rstone: 61, "
+            "one release cell in the middle row; rows x columns at most "
             f"{MAX_DEM_CELLS:,} cells, as a DEM).",
         ),
-    ] = 5,
+    ] = None,
     force: Annotated[
         bool, typer.Option("--force", help="Write into a folder that is not empty.")
     ] = False,
@@ -122,7 +124,7 @@ def export(
           --dem tests/data/tschamut2014/terrain.asc \\
           --releases tests/data/tschamut2014/release_points.csv -o out/r3d
     """
-    from fieldkit.export.site import site_from_dem, site_from_section
+    from fieldkit.export.site import site_from_dem
     from fieldkit.export.targets import target
     from fieldkit.io.dem import read_dem
     from fieldkit.io.releases import read_releases
@@ -165,7 +167,10 @@ def export(
                     releases=read_releases(releases) if releases else None,
                 )
             elif extrude:
-                site = site_from_section(model, cellsize_m=cellsize, rows=rows)
+                given = {"cellsize_m": cellsize, "rows": rows}
+                site = chosen.extrude(
+                    model, **{k: v for k, v in given.items() if v is not None}
+                )
             result = chosen.export(model, site)
         files = dict(result.files)
         if site is not None and not any(n.startswith("site:") for n in result.notes):

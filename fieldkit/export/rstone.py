@@ -46,8 +46,8 @@ Sources
   DEM and friction as thousandths, nrest/trest as whole numbers; ``GetRandVElas``,
   ``GetRandHElas``, ``GetRandFrict``: /100, /1000, Gaussian SD ``2 range / 100``,
   draws clipped to [0, 1]), ``points.c`` (``Bounce``, ``Roll``), ``utils.c``
-  (``pivIsValid``), ``fixed_parameters.c`` (5 m flight and roll steps, rolling below
-  5 m/s or after bounces shorter than 3 m, stochastic runs on).
+  (``pivIsValid``), ``fixed_parameters.c`` (5 m flight and roll steps; rolling
+  when a bounce is shorter than 3 m and slower than 5 m/s; stochastic runs on).
 * Guzzetti, F., Crosta, G., Detti, R., Agliardi, F. (2002). STONE: a computer
   program for the three-dimensional simulation of rock-falls. Computers &
   Geosciences 28(9), 1079-1093.
@@ -55,16 +55,26 @@ Sources
 
 from __future__ import annotations
 
+import json
 import math
+import shlex
 
 import numpy as np
 
 from fieldkit.errors import ArgumentError
 from fieldkit.export.ascii_grid import ascii_grid_text
 from fieldkit.export.fitted import with_error
-from fieldkit.export.lumped import lumped_equivalent
+from fieldkit.export.lumped import not_a_law
 from fieldkit.export.result import Export, Mapped
-from fieldkit.export.site import ExportSite, checked_site, ground_cells
+from fieldkit.export.site import (
+    ExportSite,
+    checked_site,
+    ground_cells,
+    pad_site,
+    site_from_section,
+)
+from fieldkit.export.translation import fit_scaled, realised_impacts, translation_error
+from fieldkit.io.dem import DemGrid
 from fieldkit.model.materials import Material
 from fieldkit.model.model_file import Model
 
@@ -83,6 +93,31 @@ STEP_M = 5.0
 
 #: Elevations r.stone takes as ground: above 0 m, at most 9999 m (stone.c NewPlane).
 MAX_ELEVATION_M = 9999.0
+
+#: Standard gravity [m/s²], as r.stone's G (stone.h) and fieldkit's kernel.
+G_MPS2 = 9.81
+
+#: Cells every release cell keeps from the grid's edge: r.stone never starts a
+#: stone whose first triangle needs a cell beyond the edge (``NewPlane`` in
+#: ``stone.c`` fails on the north row and east column, ``TrackPoints`` in
+#: ``points.c`` then skips every stone of the cell).
+EDGE_CELLS = 1
+
+#: The extruded strip for r.stone: rows across (an odd number: the one release
+#: cell in the middle row). Measured with the real r.stone (GRASS 8.2.1) on
+#: Tornado Mountain's Table 7-1 model, 5 m cells, ang_stoch_range 10, 1000
+#: trajectories: the counter grid's rows reached lie 14 rows (70 m) either side of
+#: the release row at most; 61 rows (±150 m) hold twice that.
+DEFAULT_ROWS = 61
+
+#: The record of the grid written beside the rasters, read by ``import-results``.
+RECORD = "fieldkit_export.json"
+
+#: The script the README's recipe runs inside a GRASS session.
+SCRIPT = "run_rstone.sh"
+
+#: r.stone's output grids as the script exports them (ESRI ASCII, whole numbers).
+OUTPUT_GRIDS = ("counter", "maxvel", "maxdz")
 
 
 def percent(value: float) -> int:
@@ -132,6 +167,446 @@ def dem_offset_m(elevations: np.ndarray) -> float:
     return 0.0 if lowest > 0 else float(math.ceil(1.0 - lowest))
 
 
+def section_site(
+    model: Model, *, cellsize_m: float | None = None, rows: int | None = None
+) -> ExportSite:
+    """The model's section extruded for r.stone: whole-metre cells, one release cell.
+
+    r.stone stores the cell size as a C ``short`` (``typeGeometry.cell`` in
+    ``stone.h``, set from the region in ``ReadInputRasters``, ``stone.c``): a
+    1.5 m grid runs as 1 m. So the cell is a whole number of metres, by default
+    the profile length / 500 rounded up and at least r.stone's 5 m flight and
+    roll step (:data:`STEP_M`); ``rows`` across (default :data:`DEFAULT_ROWS`, a
+    strip measured to hold the lateral spread of r.stone's launch angles); the
+    one release cell is the seeder's column in the middle row, so every
+    trajectory starts on the section's centre line.
+
+    Raises
+    ------
+    ArgumentError
+        ``cellsize_m`` not a whole number of metres >= 1, ``rows`` not a whole
+        number >= 3 (or what :func:`~fieldkit.export.site.site_from_section`
+        refuses).
+
+    Examples
+    --------
+    >>> from fieldkit.model.model_file import model_from_dict
+    >>> m = model_from_dict({"profile": {"x_m": [0, 100], "z_m": [60, 0],
+    ...   "material": "rock"}, "materials": {"rock": {"e_n": 0.3, "e_t": 0.8,
+    ...   "friction_deg": 25}}, "body": {"mass_kg": 100, "radius_m": 0.2},
+    ...   "seeder": {"x_m": 1, "z_m": 61}})
+    >>> s = section_site(m)
+    >>> s.grid.cellsize_m, s.grid.shape, np.argwhere(s.release).tolist()
+    (5.0, (61, 20), [[30, 0]])
+    """
+    if cellsize_m is None:
+        length = float(model.profile.x_m[-1] - model.profile.x_m[0])
+        cellsize_m = max(STEP_M, float(math.ceil(length / 500.0)))
+    cell = float(cellsize_m)
+    if not (math.isfinite(cell) and cell >= 1 and cell == math.floor(cell)):
+        raise ArgumentError(
+            f"cellsize_m must be a whole number of metres >= 1 for r.stone (got "
+            f"{cell:g}): r.stone stores the cell size as a whole number (a C short), "
+            f"so {cell:g} m would run as {max(0, math.floor(cell)):g} m; give e.g. "
+            f"{max(math.ceil(cell), 1):g} (default {STEP_M:g}, r.stone's step)",
+            source="cellsize_m",
+        )
+    rows = DEFAULT_ROWS if rows is None else rows
+    if isinstance(rows, bool) or not isinstance(rows, int) or rows < 3:
+        raise ArgumentError(
+            f"rows must be a whole number >= 3 for r.stone (got {rows})", source="rows"
+        )
+    site = site_from_section(model, cellsize_m=cell, rows=rows)
+    release = np.zeros_like(site.release)
+    middle = rows // 2
+    release[middle] = site.release[middle]
+    column = int(np.flatnonzero(release[middle])[0])
+    return ExportSite(
+        site.grid,
+        site.material,
+        release,
+        f"the model's 2-D section extruded to {rows} rows of {site.grid.shape[1]} "
+        f"cells of {cell:g} m (x = chainage, y across, the same ground in every "
+        f"row); one release cell, row {middle + 1} (the middle), at chainage "
+        f"{site.grid.x_m[column]:.10g} m",
+    )
+
+
+def whole_metre_site(site: ExportSite) -> tuple[ExportSite, str]:
+    """``site`` on cells of a whole number of metres, and what was done ("" if
+    nothing): a site whose cell is not whole is resampled (bilinear) to the next
+    whole metre above its cell, over the same extent.
+
+    r.stone stores the cell size as a whole number (:func:`section_site`).
+    Elevations are the bilinear surface of the old grid at the new cell centres
+    (cells whose interpolation touches nodata have none); materials and release
+    cells take the old cell under the new centre.
+
+    Examples
+    --------
+    >>> g = DemGrid.from_corner(np.arange(30.0).reshape(3, 10) * 1.0,
+    ...     x_left_m=0, y_top_m=7.5, cellsize_m=2.5)
+    >>> release = np.zeros((3, 10), bool); release[1, 1] = True
+    >>> s = ExportSite(g, np.full((3, 10), "rock", object), release, "test")
+    >>> w, how = whole_metre_site(s)
+    >>> w.grid.cellsize_m, w.grid.shape, np.argwhere(w.release).tolist()
+    (3.0, (2, 8), [[1, 1]])
+    >>> how.split(":")[0]
+    'cells of 2.5 m resampled (bilinear) to 3 m'
+    """
+    g = site.grid
+    cell = g.cellsize_m
+    if cell == math.floor(cell) and cell >= 1:
+        return site, ""
+    new = float(max(1, math.ceil(cell)))
+    width = g.shape[1] * g.dx_m
+    height = g.shape[0] * g.dy_m
+    ncols, nrows = int(width // new), int(height // new)
+    if ncols < 2 or nrows < 2:
+        raise ArgumentError(
+            f"the grid of {g.shape[1]} x {g.shape[0]} cells of {cell:g} m is too small "
+            f"to resample to r.stone's whole-metre cells of {new:g} m",
+            source="site",
+        )
+    left = float(g.x_m[0] - g.dx_m / 2)
+    top = float(g.y_m[0] + g.dy_m / 2)
+    x = left + new * (np.arange(ncols) + 0.5)
+    y = top - new * (np.arange(nrows) + 0.5)
+    xx, yy = np.meshgrid(x, y)
+    z, _, _, _ = g.sample(xx.ravel(), yy.ravel())
+    col = np.clip(np.floor((xx - left) / g.dx_m).astype(int), 0, g.shape[1] - 1)
+    row = np.clip(np.floor((top - yy) / g.dy_m).astype(int), 0, g.shape[0] - 1)
+    grid = DemGrid.from_corner(
+        z.reshape(nrows, ncols),
+        x_left_m=left,
+        y_top_m=top,
+        cellsize_m=new,
+        crs=g.crs,
+        source=g.source,
+        notes=g.notes,
+    )
+    release = np.zeros((nrows, ncols), bool)
+    for r, c in np.argwhere(site.release):  # every release cell keeps one
+        rr = min(nrows - 1, int((g.y_m[0] + g.dy_m / 2 - g.y_m[r]) // new))
+        cc = min(ncols - 1, int((g.x_m[c] - left) // new))
+        release[rr, cc] = True
+    how = (
+        f"cells of {cell:g} m resampled (bilinear) to {new:g} m: r.stone stores the "
+        "cell size as a whole number of metres (a C short), so it would run the "
+        f"grid as {math.floor(cell):g} m cells"
+    )
+    return (
+        ExportSite(
+            grid,
+            site.material[row, col],
+            release,
+            f"{site.description}; {how}",
+        ),
+        how,
+    )
+
+
+def extruded_chainage_m(model: Model, site: ExportSite) -> np.ndarray | None:
+    """The chainage of each column when ``site`` is ``model``'s section extruded
+    (every row the profile's elevation at the column centres: x is the chainage),
+    else None."""
+    g = site.grid
+    x = np.asarray(model.profile.x_m, float)
+    if g.x_m[0] < x[0] or g.x_m[-1] > x[-1]:
+        # padded columns continue the edge: the section's own columns are inside
+        inside = (g.x_m >= x[0]) & (g.x_m <= x[-1])
+    else:
+        inside = np.ones(g.shape[1], bool)
+    z = np.interp(g.x_m, x, model.profile.z_m)
+    values = g.values
+    if not np.isfinite(values).all():
+        return None
+    same_rows = np.allclose(values, values[0:1], atol=1e-9)
+    on_profile = np.allclose(values[0, inside], z[inside], atol=1e-6)
+    return g.x_m.copy() if same_rows and on_profile else None
+
+
+def fall_height_m(model: Model, site: ExportSite) -> float:
+    """How far the seeder lies above the ground r.stone starts from [m], >= 0.
+
+    On an extruded section, the seeder's height above the mean elevation of the
+    release cells (r.stone starts a stone at its cell's centre, on the ground);
+    on a DEM, the seeder's height above the model's own profile at its chainage
+    (the release point is the user's, on ground).
+    """
+    s = model.seeder
+    if extruded_chainage_m(model, site) is not None:
+        ground = float(np.mean(site.grid.values[site.release]))
+    else:
+        ground = float(np.interp(s.x_m, model.profile.x_m, model.profile.z_m))
+    return max(0.0, s.z_m - ground)
+
+
+def start_speed_mps(model: Model, height_m: float) -> float:
+    """r.stone's start speed keeping the seeder's fall height: the speed at the
+    ground, ``sqrt(vx² + vz² + 2 g h)`` (energy conserved over the fall).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as N
+    >>> round(start_speed_mps(N(seeder=N(vx_mps=3.0, vz_mps=0.0)), 10.6), 3)
+    14.73
+    """
+    s = model.seeder
+    return math.sqrt(s.vx_mps**2 + s.vz_mps**2 + 2.0 * G_MPS2 * height_m)
+
+
+def friction_read(tan_written: float) -> float:
+    """The friction r.stone uses for a written ``tan(beta)``: GDAL hands the
+    3-decimal value over as a 32-bit float, r.stone keeps ``(long)(value * 1000)``
+    thousandths (``ReadRasterToLongMatrix``, ``stone.c``).
+
+    Examples
+    --------
+    >>> friction_read(0.35), friction_read(0.05)
+    (0.349, 0.05)
+    """
+    value = float(np.float32(round(tan_written, 3))) * 1000.0
+    return math.floor(value + 1e-12) / 1000.0 if value >= 0 else 0.0
+
+
+def typical_slope_deg(model: Model, name: str) -> float:
+    """The length-weighted mean dip [deg] of ``name``'s segments of the profile
+    (0 for a material on no segment)."""
+    x = np.asarray(model.profile.x_m, float)
+    z = np.asarray(model.profile.z_m, float)
+    dx = np.diff(x)
+    dip = np.degrees(np.arctan(np.abs(np.diff(z)) / dx))
+    mine = np.asarray(model.profile.material, dtype=object) == name
+    if not mine.any():
+        return 0.0
+    return float(np.sum(dip[mine] * dx[mine]) / np.sum(dx[mine]))
+
+
+def emulated_model(
+    model: Model,
+    options: dict[str, float],
+    release_x_m: float,
+    names: list[str] | None = None,
+) -> Model:
+    """fieldkit's model of r.stone's law with the values written for ``model``.
+
+    On ``model``'s own section: each material the constant pair at the written
+    whole percents (``nrest/100``, ``trest/100``) with r.stone's draw SD
+    ``2 range / 100``; the friction angle phi' with ``g cos(psi) tan(phi')`` equal
+    to r.stone's rolling deceleration ``g sin(beta)`` on the material's typical
+    slope psi (:func:`typical_slope_deg`), ``tan(beta)`` as r.stone reads it
+    (:func:`friction_read`); no effect, no roughness, no trees (r.stone has none);
+    the seeder where r.stone starts, on the ground at ``release_x_m`` (one body
+    radius above it), launched horizontally at ``start_vel`` with no spread.
+    """
+    from dataclasses import replace
+
+    names = list(model.materials) if names is None else names
+    materials = dict(model.materials)
+    sd_n = 2 * options["vrest_stoch_range"] / 100
+    sd_t = 2 * options["hrest_stoch_range"] / 100
+    sd_f = 2 * options["frict_stoch_range"] / 100
+    for name in names:
+        m = model.materials[name]
+        tan_beta = friction_read(math.tan(math.radians(m.friction_deg)))
+        psi = math.radians(typical_slope_deg(model, name))
+        tan_phi = math.sin(math.atan(tan_beta)) / math.cos(psi)
+        phi = math.degrees(math.atan(tan_phi))
+        materials[name] = replace(
+            m,
+            e_n=percent(m.e_n) / 100,
+            e_t=percent(m.e_t) / 100,
+            friction_deg=phi,
+            e_n_sd=sd_n,
+            e_t_sd=sd_t,
+            friction_deg_sd=math.degrees(sd_f * math.cos(math.radians(phi)) ** 2),
+            roughness_m=0.0,
+            roughness_deg_sd=0.0,
+        )
+    ground = float(np.interp(release_x_m, model.profile.x_m, model.profile.z_m))
+    seeder = replace(
+        model.seeder,
+        x_m=float(release_x_m),
+        z_m=ground + model.body.radius_m,
+        vx_mps=float(options["start_vel"]),
+        vz_mps=0.0,
+        omega_radps=0.0,
+        x_sd_m=0.0,
+        z_sd_m=0.0,
+        vx_sd_mps=0.0,
+        vz_sd_mps=0.0,
+        omega_sd_radps=0.0,
+        x_max_m=None,
+        height_m=None,
+    )
+    return replace(model, materials=materials, effects={}, trees=None, seeder=seeder)
+
+
+def emulated_runouts(
+    model: Model, record: dict, grid: DemGrid | None = None, *, seed: int = 0
+) -> tuple[np.ndarray, np.ndarray]:
+    """fieldkit's emulation of an r.stone run: the runout of each trajectory the
+    export's ``record`` (:data:`RECORD`) starts, and whether it left its section
+    at the lower end (a censored runout).
+
+    The values written (``record["written"]``, ``record["options"]``) under
+    :func:`emulated_model`. On an extruded section: ``model``'s own section, the
+    rocks launched at the release column's chainage. On a DEM (``grid``): for
+    each source cell, the steepest-descent section from its centre
+    (:func:`~fieldkit.model.dem_profile.steepest_descent_line`, half-cell steps)
+    continued straight to the grid's edge where it ends in a pit or a flat, as
+    ``fieldkit fit-paths`` cuts Tschamut's runs
+    (:func:`~fieldkit.fit.path_sections.extend_to_edge`), its trajectories
+    launched at chainage 0; a runout is then the plan distance of the rock's
+    stop on that line from the nearest source cell's centre, as
+    ``import-results`` measures r.stone's (:mod:`fieldkit.io.rstone_results`).
+    A rock that reaches its section's end leaves it (its runout is censored).
+
+    Raises
+    ------
+    ArgumentError
+        A DEM record without ``grid``.
+    """
+    from dataclasses import replace
+
+    from fieldkit.fit.path_sections import extend_to_edge
+    from fieldkit.model.dem_profile import steepest_descent_line
+    from fieldkit.model.profile import Profile
+    from fieldkit.model.simulate import simulate
+
+    materials = dict(model.materials)
+    for name, values in record["written"].items():
+        materials[name] = replace(materials[name], **values)
+    written = replace(model, materials=materials)
+    options = record["options"]
+    names = list(record["written"])
+    rng = np.random.default_rng(seed)
+    if record["extruded"]:
+        x = float(np.mean([s["x_m"] for s in record["sources"]]))
+        emulated = emulated_model(written, options, x, names)
+        result = simulate(emulated, int(record["trajectories"]), rng)
+        runout = np.asarray(result.runout_x_m, float)
+        return runout, runout >= float(model.profile.x_m[-1]) - 1e-9
+    if grid is None:
+        raise ArgumentError("a DEM record needs its DEM to emulate", source="grid")
+    runouts, ends = [], []
+    sx = np.array([s["x_m"] for s in record["sources"]])
+    sy = np.array([s["y_m"] for s in record["sources"]])
+
+    def from_sources(line, chainage: np.ndarray) -> np.ndarray:
+        px = np.interp(chainage, line.chainage_m, line.plan_x_m)
+        py = np.interp(chainage, line.chainage_m, line.plan_y_m)
+        return np.hypot(px[:, None] - sx, py[:, None] - sy).min(axis=1)
+
+    for s in record["sources"]:
+        step = grid.cellsize_m / 2
+        line = extend_to_edge(
+            grid, steepest_descent_line(grid, (s["x_m"], s["y_m"]), step), step
+        )
+        profile = Profile.from_arrays(
+            line.chainage_m, line.z_m, [names[0]] * (line.z_m.size - 1)
+        )
+        on_line = replace(written, profile=profile)
+        emulated = emulated_model(on_line, options, 0.0, names)
+        result = simulate(emulated, int(s["trajectories"]), rng)
+        x = np.asarray(result.runout_x_m, float)
+        runouts.append(from_sources(line, x))
+        ends.append(x >= line.length_m - 1e-9)
+    return np.concatenate(runouts), np.concatenate(ends)
+
+
+def constant_pair(model: Model, name: str) -> bool:
+    """Whether ``name``'s calibrated law is r.stone's: a constant pair in [0, 1],
+    no effect, no roughness (the values are then written as calibrated)."""
+    m = model.materials[name]
+    return (
+        not model.effects
+        and m.roughness_m == 0
+        and m.roughness_deg_sd == 0
+        and 0 <= m.e_n <= 1
+        and 0 <= m.e_t <= 1
+    )
+
+
+def rstone_pairs(model: Model, names: list[str]) -> tuple[Model, list[str], list[str]]:
+    """``model`` with each material's e_n, e_t (and their SDs) the in-range
+    constant pair closest under r.stone's law, and what was done.
+
+    A material whose calibrated law is already r.stone's (:func:`constant_pair`)
+    keeps its values. Any other -- an impact law, roughness, a coefficient above
+    1 -- takes the pair in [0, 1] minimising the squared rebound error over the
+    impacts on it of the calibrated model's own simulation
+    (:func:`~fieldkit.export.translation.realised_impacts`,
+    :func:`~fieldkit.export.translation.fit_scaled` with ``f = 1``), and as SDs
+    the impacts' own spread around it (what r.stone's random draw should carry,
+    not the fit's standard error). A material with no simulated impact keeps its
+    calibrated values clipped to [0, 1], stated in the mismatches and as
+    unconfirmed.
+
+    Returns
+    -------
+    model, mismatches, unconfirmed
+    """
+    from dataclasses import replace
+
+    todo = [n for n in names if not constant_pair(model, n)]
+    if not todo:
+        return model, [], []
+    impacts = realised_impacts(model)
+    materials = dict(model.materials)
+    lines, open_ = [], []
+    laws = ", ".join(model.effects) or "no effect"
+    for name in todo:
+        m = model.materials[name]
+        rows = impacts[impacts["material"] == name]
+        n_fit = fit_scaled(np.abs(rows["vin_mps"]), rows["vfn_mps"], 1.0, 0.0, 1.0)
+        t_fit = fit_scaled(rows["vit_mps"], rows["vft_mps"], 1.0, 0.0, 1.0)
+        if n_fit.n == 0 or t_fit.n == 0:
+            e_n, e_t = min(max(m.e_n, 0.0), 1.0), min(max(m.e_t, 0.0), 1.0)
+            materials[name] = replace(m, e_n=e_n, e_t=e_t)
+            text = (
+                f"{name}: no simulated impact on it (the calibrated model's own "
+                f"{len(impacts.path_id.unique()) if len(impacts) else 0}-rock "
+                f"simulation): e_n {m.e_n:.4g}, e_t {m.e_t:.4g} written as "
+                f"calibrated, clipped to r.stone's [0, 1] ({e_n:.4g}, {e_t:.4g}); "
+                f"its law ({laws}; roughness {m.roughness_deg_sd:g} deg) is not "
+                "translated"
+            )
+            lines.append(text)
+            open_.append(text)
+            continue
+        materials[name] = replace(
+            m,
+            e_n=n_fit.value,
+            e_t=t_fit.value,
+            e_n_sd=n_fit.spread,
+            e_t_sd=t_fit.spread,
+            roughness_m=0.0,
+            roughness_deg_sd=0.0,
+        )
+        clipped = [
+            f"{k} {f.unclipped:.3f} clipped to {f.value:g}"
+            for k, f in (("e_n", n_fit), ("e_t", t_fit))
+            if f.clipped
+        ]
+        lines.append(
+            f"{name}: r.stone's law is a constant pair; the calibrated e_n "
+            f"{m.e_n:.4g}, e_t {m.e_t:.4g} with {laws} (roughness "
+            f"{m.roughness_deg_sd:g} deg) are written as the in-range pair closest "
+            f"over the {n_fit.n} impacts on {name} of the calibrated model's own "
+            f"simulation: e_n {n_fit.value:.3f}, e_t {t_fit.value:.3f} (least "
+            "squares in [0, 1]"
+            + (f"; {'; '.join(clipped)}" if clipped else "")
+            + f"), SDs their impacts' own spread {n_fit.spread:.3f}, "
+            f"{t_fit.spread:.3f}"
+            + "".join(
+                f"; {w}" for w in (not_a_law(e, TARGET) for e in model.effects) if w
+            )  # fmt: skip
+        )
+    return replace(model, materials=materials), lines, open_
+
+
 def _check(model: Model, names: list[str]) -> None:
     """Refuse coefficients r.stone cannot take (one line naming the value)."""
     for name in names:
@@ -155,14 +630,19 @@ def _check(model: Model, names: list[str]) -> None:
 def export_rstone(
     model: Model, site: ExportSite | None = None, *, rocks: int = DEFAULT_ROCKS
 ) -> Export:
-    """r.stone's input rasters for ``model`` on ``site`` (module docstring).
+    """r.stone's input rasters for ``model`` on ``site`` (module docstring), the
+    script that runs them (:data:`SCRIPT`) and the record of the grid
+    (:data:`RECORD`) that ``fieldkit import-results --from rstone`` reads.
 
     Parameters
     ----------
     model
         The calibrated model.
     site
-        The grid (required: a grid target).
+        The grid (required: a grid target); :func:`section_site` extrudes the
+        model's section as r.stone needs it. A grid whose cell is not a whole
+        number of metres is resampled (:func:`whole_metre_site`), one whose
+        release cells touch the edge padded (:data:`EDGE_CELLS`), both stated.
     rocks
         Trajectories in all, shared over the release cells (at least 1 a cell).
 
@@ -173,15 +653,18 @@ def export_rstone(
         friction angle above 45 deg, or a DEM whose relief exceeds 9998 m.
     """
     site = checked_site(site, TARGET)
-    model, lumped = lumped_equivalent(model, TARGET)
     if isinstance(rocks, bool) or not isinstance(rocks, int) or rocks < 1:
         raise ArgumentError(
             f"rocks must be a whole number >= 1 (got {rocks})", source="rocks"
         )
+    site, resampled = whole_metre_site(site)
+    site = pad_site(site, EDGE_CELLS)
+    calibrated = model
     grid = site.grid
     ground = ground_cells(site)
     source = site.release & ground
     present = [n for n in model.materials if (site.material[ground] == n).any()]
+    model, fitted, open_ = rstone_pairs(model, present)
     _check(model, present)
     offset = dem_offset_m(grid.values[ground])
     dem = np.where(ground, grid.values + offset, np.nan)
@@ -191,7 +674,10 @@ def export_rstone(
             f"r.stone takes elevations in (0, {MAX_ELEVATION_M:g}] m as ground",
             source="site",
         )
-    per_cell = max(1, round(rocks / int(source.sum())))
+    n_source = int(source.sum())
+    per_cell = max(1, round(rocks / n_source))
+    height = fall_height_m(model, site)
+    options = _options(model, present, height)
 
     def per_material(value) -> np.ndarray:
         out = np.full(grid.shape, np.nan)
@@ -215,14 +701,26 @@ def export_rstone(
             grid,
             decimals=3,
         ),
+        SCRIPT: run_script(options),
     }
-    options = _options(model, present)
+    chainage = extruded_chainage_m(model, site)
+    files[RECORD] = record_text(
+        model, site, source, per_cell, offset, chainage, options
+    )
+    traced = per_cell * n_source
+    release_x = (
+        float(np.mean(grid.x_m[np.nonzero(source)[1]]))
+        if chainage is not None
+        else model.seeder.x_m
+    )
+    emulated = emulated_model(model, options, release_x, present)
+    translation = translation_error(calibrated, emulated)
     return Export(
         TARGET,
         TITLE,
         files,
         mapped=_mapped(model, site, present, offset, per_cell, options),
-        unmapped=_unmapped(model, present),
+        unmapped=_unmapped(calibrated, present),
         units=[
             "nrest, trest: e_n and e_t x 100, whole percent (rounded half up)",
             "friction: tan(friction_deg), dimensionless, 3 decimals (r.stone reads "
@@ -230,12 +728,132 @@ def export_rstone(
             f"dem: metres (fieldkit's SI), raised by {offset:g} m"
             if offset
             else "dem: metres (fieldkit's SI), as given",
+            f"cell size: {grid.cellsize_m:g} m, a whole number (r.stone stores it "
+            "as a C short)",
             "sources: numbers of trajectories; start_vel, stop_vel in m/s",
+            "results (counter, maxvel, maxdz): trajectories through a cell, the "
+            "largest speed in whole m/s and the largest height above the ground in "
+            "whole m, both truncated (stone.c MarkVelo, MarkQuota)",
         ],
-        mismatches=[*lumped, *_mismatches(model, present, offset, options)],
-        notes=_notes(site),
-        how_to_use=_how_to_use(options),
+        mismatches=[
+            *fitted,
+            *([resampled] if resampled else []),
+            *_mismatches(model, present, offset, options),
+        ],
+        notes=_notes(site, traced, n_source, per_cell, chainage is not None),
+        how_to_use=_how_to_use(options, traced),
+        translation=[*translation.lines(), "", emulation_text(release_x)],
+        sources=SOURCES,
+        unconfirmed=[*UNCONFIRMED, *open_],
     )
+
+
+def emulation_text(release_x_m: float) -> str:
+    """What fieldkit's emulation of r.stone's law is (the README's translation
+    section): :func:`emulated_model`."""
+    return (
+        "The emulation of r.stone's law: each material the constant pair at the "
+        "written whole percents with r.stone's draw SD 2 range / 100; no effect, no "
+        "roughness; the friction angle phi' whose fieldkit deceleration g cos(psi) "
+        "tan(phi') equals r.stone's rolling deceleration g sin(beta) on the "
+        "material's typical slope psi (its segments' length-weighted mean dip), "
+        "tan(beta) as r.stone reads it (thousandths); the rock launched "
+        f"horizontally at start_vel from the ground at chainage {release_x_m:.1f} m, "
+        "as r.stone starts it. fieldkit's flight, impact and sliding kernels stand "
+        "for r.stone's: its switch to rolling (a bounce shorter than 3 m and slower "
+        "than 5 m/s) and its 5 m steps are not emulated."
+    )
+
+
+def run_script(options: dict[str, float]) -> str:
+    """The bash script run inside a GRASS session (:func:`_how_to_use`): import
+    the five grids, set the region to the DEM, run r.stone with ``options``, write
+    its three result grids as ESRI ASCII beside the inputs."""
+    o = options
+    args = " ".join(
+        f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
+        for k, v in (
+            ("stoch_funct", 0),
+            ("stoch_funct_ang", 0),
+            ("ang_stoch_range", DEFAULT_ANGLE_RANGE),
+            ("vrest_stoch_range", o["vrest_stoch_range"]),
+            ("hrest_stoch_range", o["hrest_stoch_range"]),
+            ("frict_stoch_range", o["frict_stoch_range"]),
+            ("start_vel", round(float(o["start_vel"]), 3)),
+            ("stop_vel", float(o["stop_vel"])),
+        )
+    )
+    rasters = " ".join(f"{n}={n}" for n in ("dem", "sources", "nrest", "trest",
+                                            "friction"))  # fmt: skip
+    outputs = " ".join(f"{n}={n}" for n in OUTPUT_GRIDS)
+    return f"""#!/usr/bin/env bash
+# r.stone on the files beside this script, written by fieldkit export --to rstone.
+# Run it inside a GRASS GIS session (8.2), e.g. in a new XY project:
+#   grass -c XY /tmp/grassdb/xy -e
+#   grass /tmp/grassdb/xy/PERMANENT --exec bash {shlex.quote(SCRIPT)}
+# It writes counter.asc, maxvel.asc and maxdz.asc here (ESRI ASCII, nodata -1)
+# for `fieldkit import-results --from rstone`.
+set -euo pipefail
+cd "$(dirname "$0")"
+for name in dem sources nrest trest friction; do
+    r.in.gdal -o --overwrite --quiet input="$name.asc" output="$name"
+done
+g.region raster=dem
+r.stone --overwrite {rasters} \\
+    {args} \\
+    {outputs}
+for name in {" ".join(OUTPUT_GRIDS)}; do
+    r.out.gdal -c -m --overwrite --quiet input="$name" output="$name.asc" \\
+        format=AAIGrid type=Int32 nodata=-1
+done
+"""
+
+
+def record_text(model, site, source, per_cell, offset, chainage, options) -> str:
+    """The JSON record of the grid (:data:`RECORD`) that ``import-results`` reads:
+    the grid's geometry, the source cells and their trajectories, the DEM offset,
+    the body's mass, and the chainage of each column for an extruded section."""
+    g = site.grid
+    cells = [
+        {
+            "row": int(r),
+            "col": int(c),
+            "x_m": float(g.x_m[c]),
+            "y_m": float(g.y_m[r]),
+            "trajectories": int(per_cell),
+        }
+        for r, c in np.argwhere(source)
+    ]
+    record = {
+        "target": TARGET,
+        "grid": {
+            "ncols": int(g.shape[1]),
+            "nrows": int(g.shape[0]),
+            "x_left_m": float(g.x_m[0] - g.dx_m / 2),
+            "y_top_m": float(g.y_m[0] + g.dy_m / 2),
+            "cellsize_m": float(g.cellsize_m),
+        },
+        "dem_offset_m": float(offset),
+        "sources": cells,
+        "trajectories": int(per_cell * len(cells)),
+        "extruded": chainage is not None,
+        "chainage_m": None if chainage is None else [float(v) for v in chainage],
+        "mass_kg": float(model.body.mass_kg),
+        "start_vel_mps": float(options["start_vel"]),
+        "fall_height_m": float(options["fall_height_m"]),
+        "model": model.source,
+        "options": {k: float(v) for k, v in options.items()},
+        "written": {
+            name: {
+                "e_n": float(m.e_n),
+                "e_t": float(m.e_t),
+                "friction_deg": float(m.friction_deg),
+            }
+            for name, m in model.materials.items()
+            if (site.material == name).any()
+        },
+    }
+    return json.dumps(record, indent=1) + "\n"
 
 
 def _ranges(m: Material) -> dict[str, int]:
@@ -249,40 +867,47 @@ def _ranges(m: Material) -> dict[str, int]:
     }
 
 
-def _options(model: Model, names: list[str]) -> dict[str, float]:
-    """The r.stone options fieldkit can set (one value per run)."""
+def _options(model: Model, names: list[str], height_m: float) -> dict[str, float]:
+    """The r.stone options fieldkit can set (one value per run), and the fall
+    height the start speed keeps (:func:`start_speed_mps`)."""
     ranges = [_ranges(model.materials[n]) for n in names]
-    speed = math.hypot(model.seeder.vx_mps, model.seeder.vz_mps)
+    speed = start_speed_mps(model, height_m)
     out: dict[str, float] = {k: max(r[k] for r in ranges) for k in ranges[0]}
     out["start_vel"] = round(speed, 3) if speed > 0 else DEFAULT_START_VEL_MPS
     out["stop_vel"] = model.core["stop_speed_mps"]
+    out["fall_height_m"] = height_m
     return out
 
 
-def _how_to_use(options: dict[str, float]) -> str:
-    o = options
+def _how_to_use(options: dict[str, float], traced: int) -> str:
     return f"""\
-In a GRASS GIS project with the DEM's coordinate system (or an XY project, e.g.
-`grass -c dem.asc ~/grassdata/site`), with the add-on installed (`g.extension
-r.stone`), import the five ESRI ASCII grids through GDAL (`-o`: take the project's
-coordinate system) and run r.stone on the DEM's region:
+With GRASS GIS 8.2 and the add-on installed (`g.extension r.stone`, or built from
+its source), make a new XY project and run `{SCRIPT}` (written here) inside it:
 
-    r.in.gdal -o input=dem.asc output=dem
-    r.in.gdal -o input=sources.asc output=sources
-    r.in.gdal -o input=nrest.asc output=nrest
-    r.in.gdal -o input=trest.asc output=trest
-    r.in.gdal -o input=friction.asc output=friction
-    g.region raster=dem
+    grass -c XY ~/grassdata/rstone -e
+    grass ~/grassdata/rstone/PERMANENT --exec bash {SCRIPT}
+
+(`grass -c dem.asc ...` gives a 0 x 0 region on GRASS 8.2.1: use an XY project.)
+The script imports the five ESRI ASCII grids through GDAL (`r.in.gdal -o`), sets
+the region to the DEM, runs r.stone with the values derived from the model (see
+the tables below):
+
     r.stone dem=dem sources=sources nrest=nrest trest=trest friction=friction \\
         stoch_funct=0 stoch_funct_ang=0 ang_stoch_range={DEFAULT_ANGLE_RANGE} \\
-        vrest_stoch_range={o["vrest_stoch_range"]} \\
-        hrest_stoch_range={o["hrest_stoch_range"]} \\
-        frict_stoch_range={o["frict_stoch_range"]} \\
-        start_vel={o["start_vel"]:g} stop_vel={o["stop_vel"]:g} \\
+        vrest_stoch_range={options["vrest_stoch_range"]} \\
+        hrest_stoch_range={options["hrest_stoch_range"]} \\
+        frict_stoch_range={options["frict_stoch_range"]} \\
+        start_vel={options["start_vel"]:g} stop_vel={options["stop_vel"]:g} \\
         counter=counter maxvel=maxvel maxdz=maxdz
 
-`counter` counts the trajectories through each cell. The ranges, start_vel and
-stop_vel are the values derived from the model (see the tables below)."""
+and writes `counter.asc`, `maxvel.asc`, `maxdz.asc` beside the inputs (`r.out.gdal
+format=AAIGrid`). r.stone traces {traced} trajectories; `counter` counts the
+trajectories through each cell. Read the results back with
+
+    fieldkit import-results --from rstone . -o rstone_results
+
+for the runout distribution and the largest speed, energy and height along the
+section (or by distance from the release on a DEM)."""
 
 
 def _mapped(model, site, present, offset, per_cell, options) -> list[Mapped]:
@@ -334,13 +959,19 @@ def _mapped(model, site, present, offset, per_cell, options) -> list[Mapped]:
             "tan units: sec² phi x SD)",
         ),
         Mapped(
-            f"seeder speed hypot(vx, vz) = {math.hypot(s.vx_mps, s.vz_mps):g} m/s",
+            f"seeder speed hypot(vx, vz) = {math.hypot(s.vx_mps, s.vz_mps):g} m/s, "
+            f"{options['fall_height_m']:.3g} m above the ground r.stone starts on",
             f"start_vel = {options['start_vel']:g} m/s",
-            "the launch speed"
+            "the speed at the ground, sqrt(vx² + vz² + 2 g h) with g = 9.81 m/s²: "
+            "r.stone starts a stone on its cell's ground, launched horizontally "
+            "towards the steepest neighbour (points.c TrackPoints), so the fall "
+            "height is kept as speed (energy conserved) rather than as a raised "
+            "cell, which would tilt the triangles around it"
             + (
                 ""
-                if math.hypot(s.vx_mps, s.vz_mps) > 0
-                else f"; the seeder is at rest, so r.stone's default "
+                if options["start_vel"] != DEFAULT_START_VEL_MPS
+                or start_speed_mps(model, options["fall_height_m"]) > 0
+                else f"; the seeder is at rest on the ground, so r.stone's default "
                 f"{DEFAULT_START_VEL_MPS:g} m/s (it needs a speed > 0)"
             ),
         ),
@@ -379,31 +1010,72 @@ def _unmapped(model: Model, present: list[str]) -> list[tuple[str, str]]:
         for n in present
         if model.materials[n].roughness_m > 0 or model.materials[n].roughness_deg_sd > 0
     ]
-    if rough or "slope_roughness" in model.effects:
+    if rough:
         out.append(
             (
                 "slope roughness ("
-                + (
-                    ", ".join(_roughness_text(n, model.materials[n]) for n in rough)
-                    or "none in the materials"
-                )
+                + ", ".join(_roughness_text(n, model.materials[n]) for n in rough)
                 + ")",
-                "r.stone has no roughness input: its ground is the DEM's triangles",
+                "r.stone has no roughness input (its ground is the DEM's triangles): "
+                "what it does to the rebounds is folded into the fitted constant "
+                "pair (see the mismatches)",
             )
         )
-    for name in model.effects:
-        if name != "slope_roughness":
-            out.append((f"effect {name}", "r.stone has no such process or parameter"))
+    out += effect_lines(model)
     if model.trees is not None:
         out.append(("trees", "r.stone has no trees"))
     out.append(
         (
             f"core.slide_vn_mps = {model.core['slide_vn_mps']:g} m/s, max_impacts, "
             "drag_dt_s",
-            "r.stone switches to rolling after bounces shorter than 3 m or below "
-            "5 m/s, constants compiled into it (fixed_parameters.c)",
+            "r.stone switches from flying to rolling when a bounce is shorter than "
+            "3 m and slower than 5 m/s, both (DIST_FLY_ROLL, VEL_FLY_ROLL in "
+            "fixed_parameters.c; the test in TrackPoints, points.c), constants "
+            "compiled into it",
         )
     )
+    return out
+
+
+#: Why r.stone has no place for each effect that does not change the rebound pair.
+NO_PROCESS = {
+    "slope_roughness": "r.stone has no roughness input: its ground is the DEM's "
+    "triangles (stone.c NewPlane)",
+    "mass_loss": "r.stone's block is a point whose mass never enters its kinematics: "
+    "no fragmentation or mass loss",
+    "tree_impacts": "r.stone has no forest or tree input",
+    "air_drag": "r.stone's flight is a drag-free parabola (Parab, points.c)",
+}
+
+
+def effect_lines(model: Model) -> list[tuple[str, str]]:
+    """Every registered effect (:data:`fieldkit.model.effects.registry.EFFECTS`),
+    active in ``model`` or not, and what r.stone does with it."""
+    from fieldkit.model.effects import registry
+
+    out = []
+    for spec in registry.EFFECTS:
+        active = spec.name in model.effects
+        state = "active in the model" if active else "not in the model"
+        if spec.changes_rebound or spec.name == "slope_roughness":
+            why = (
+                "r.stone's only impact law is a constant pair per cell (Bounce, "
+                "points.c): "
+                + (
+                    "its rebounds are folded into the in-range constant pair fitted "
+                    "to the calibrated model's own impacts, which no longer varies "
+                    "as the effect makes it"
+                    if active
+                    else "an active one would be folded into the fitted constant pair"
+                )
+            )
+            if spec.name == "slope_roughness":
+                why = NO_PROCESS[spec.name] + "; " + why
+            reason = not_a_law(spec.name, TARGET)
+            why += f"; {reason}" if reason and active else ""
+        else:
+            why = NO_PROCESS.get(spec.name, "r.stone has no such process or parameter")
+        out.append((f"effect {spec.name} ({state})", why))
     return out
 
 
@@ -466,9 +1138,70 @@ def _mismatches(model, present, offset, options) -> list[str]:
     return out
 
 
-def _notes(site: ExportSite) -> list[str]:
+#: The documents r.stone's rules come from (README "Sources").
+SOURCES = [
+    "OSGeo/grass-addons src/raster/r.stone/main.c (main): the options, their "
+    "defaults (ang_stoch_range 10, start_vel 1, stop_vel 3) and types",
+    "OSGeo/grass-addons src/raster/r.stone/stone.h (typeGeometry): the cell size "
+    "and the grid's rows and columns are C shorts (whole metres, at most 32767)",
+    "OSGeo/grass-addons src/raster/r.stone/stone.c (ReadInputRasters: DEM and "
+    "friction read as thousandths, nrest/trest as whole numbers, the cell from the "
+    "region; NewPlane: a triangle needing a cell beyond the grid or above 9999 m "
+    "stops the stone; GetRandAngle, GetRandVElas, GetRandHElas, GetRandFrict: "
+    "Gaussian SD 2 range / 100, draws clipped to [0, 1]; MarkPath, MarkVelo, "
+    "MarkQuota: the counter, maxvel and maxdz grids, speeds and heights in whole "
+    "units)",
+    "OSGeo/grass-addons src/raster/r.stone/points.c (TrackPoints: a stone starts "
+    "at its cell's centre on the ground, horizontally towards the steepest of the "
+    "8 neighbours, and rolls when a bounce is shorter than 3 m and slower than "
+    "5 m/s; Bounce: nrest/trest multiply the normal and tangential velocity; "
+    "Roll: deceleration g sin(atan(friction)))",
+    "OSGeo/grass-addons src/raster/r.stone/utils.c (pivIsValid: a cell at <= 0 m "
+    "is no ground)",
+    "OSGeo/grass-addons src/raster/r.stone/fixed_parameters.c (DIST_FLY_ROLL "
+    "3 m, VEL_FLY_ROLL 5 m/s, FLY_INT_TAB and ROLL_INT_TAB 5 m, STOCH_FLAG 1)",
+    "r.stone manual (grass.osgeo.org/grass-devel/manuals/addons/r.stone.html)",
+    "Guzzetti, Crosta, Detti, Agliardi (2002), STONE: a computer program for the "
+    "three-dimensional simulation of rock-falls, Computers & Geosciences 28(9), "
+    "1079-1093",
+]
+
+#: What the sources leave open (README "Unconfirmed").
+UNCONFIRMED = [
+    "r.stone seeds its random numbers with the constant 1 (random2.c Init_RNG "
+    "with STOCH_FLAG): every run of the same files gives the same trajectories; "
+    "its Monte Carlo error is that of one sample of the traced trajectories",
+    "the counter grid counts a trajectory in the cells of its path points kept "
+    "5 m apart (stone.c Filter, OUTPUT_TAB): a trajectory can skip a cell, so "
+    "runouts read from it are good to about one cell either way",
+    "the lateral spread of the launch angle (ang_stoch_range) is r.stone's "
+    "default, not calibrated: fieldkit's model is a 2-D section",
+    "the translation error is fieldkit's emulation of r.stone's law, not r.stone: "
+    "the emulation does not switch to rolling as r.stone does (at an impact slower "
+    "than 5 m/s). Run in r.stone 8.2.1 (tests/export/test_rstone_real.py): on "
+    "Tornado Mountain's extruded section r.stone and the emulation both run off "
+    "the section's end (84 % and 100 %; runout p50 and p95 697.5 m and 700 m, "
+    "within one cell); on a Tschamut release area r.stone's runout p50/p95 are "
+    "70/115 m against the emulation's 79.6/87.7 m: they do not agree (p50: the "
+    "roll switch, with which the emulation's p50 is 68.5 m; p95: the launch-angle "
+    "spread, without which r.stone's p95 is 90 m)",
+    "r.stone ends some trajectories as 'Track overflow' without writing their last "
+    "path segment to the grids (points.c TrackPoints, case 0: Parab 'confused' "
+    "after 5 steps outside the triangle, or 100000 path points): 239 of 994 on the "
+    "Tschamut area, so its counter grid may end those paths early",
+]
+
+
+def _notes(
+    site: ExportSite, traced: int, n_source: int, per_cell: int, extruded: bool
+) -> list[str]:
     out = [
         f"site: {site.description}",
+        f"trajectories traced: {traced} = {n_source} source "
+        + ("cell" if n_source == 1 else "cells")
+        + f" x {per_cell} (sources.asc, after padding; every source cell lies >= "
+        f"{EDGE_CELLS} cell inside the grid, since r.stone never starts a stone on "
+        "its edge row or column)",
         "format: the r.stone manual (grass.osgeo.org, manuals/addons/r.stone.html) "
         "and its source in OSGeo/grass-addons src/raster/r.stone (main.c, stone.c, "
         "points.c, utils.c, fixed_parameters.c); STONE: Guzzetti et al. (2002), "
@@ -478,8 +1211,17 @@ def _notes(site: ExportSite) -> list[str]:
         "ranges here follow the source.",
         "rasters as ESRI ASCII grids for r.in.gdal (GDAL's AAIGrid driver): integer "
         "grids become CELL maps, the DEM and friction floating-point maps.",
-        "no r.stone run was made with these files: they follow the documented format.",
     ]
+    if extruded:
+        out.append(
+            f"strip: {site.grid.shape[0]} rows across "
+            f"(±{site.grid.shape[0] // 2 * site.grid.cellsize_m:g} m from the "
+            "release row). Measured with r.stone 8.2.1 on Tornado Mountain (5 m "
+            "cells, ang_stoch_range 10, 1000 trajectories): no trajectory passed "
+            "14 rows (70 m) from the release row. A trajectory reaching the strip's "
+            "side stops there (stone.c NewPlane): that is not a runout; "
+            "`fieldkit import-results` reports how many did"
+        )
     if site.grid.cellsize_m < STEP_M:
         out.append(
             f"cells of {site.grid.cellsize_m:g} m are smaller than r.stone's {STEP_M:g}"

@@ -12,8 +12,8 @@ from fieldkit.export.ramms import export_ramms
 from fieldkit.export.result import Export
 from fieldkit.export.rocfall import export_rocfall
 from fieldkit.export.rockyfor3d import export_rockyfor3d
-from fieldkit.export.rstone import export_rstone
-from fieldkit.export.site import ExportSite
+from fieldkit.export.rstone import export_rstone, section_site
+from fieldkit.export.site import ExportSite, site_from_section
 from fieldkit.model.model_file import Model
 
 
@@ -31,12 +31,16 @@ class Target:
         Whether it writes rasters and so needs an :class:`ExportSite`.
     what
         One line for the help.
+    extrude
+        ``(model, cellsize_m=, rows=) -> ExportSite``: the model's section extruded
+        as the target needs it (``None`` arguments: the target's defaults).
     """
 
     name: str
     export: Callable[[Model, ExportSite | None], Export]
     grid: bool
     what: str
+    extrude: Callable[..., ExportSite] = site_from_section
 
 
 #: Target name -> Target, in the order the help lists them.
@@ -47,7 +51,9 @@ TARGETS: dict[str, Target] = {
         Target("crsp", export_crsp, False, "CRSP slope cells (feet) and rock"),
         Target("rockyfor3d", export_rockyfor3d, True, "Rockyfor3D ASCII grids"),
         Target("ramms", export_ramms, True, "RAMMS categories and the DEM"),
-        Target("rstone", export_rstone, True, "r.stone (GRASS GIS) rasters"),
+        Target(
+            "rstone", export_rstone, True, "r.stone (GRASS GIS) rasters", section_site
+        ),
         Target("json", export_json, False, "the model with uncertainties"),
     )
 }

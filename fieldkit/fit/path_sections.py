@@ -298,7 +298,7 @@ def path_sections(
                 where=path_id,
             )
         if section == "descent":
-            out[path_id] = _extend_to_edge(
+            out[path_id] = extend_to_edge(
                 grid, steepest_descent_line(grid, (x, y), step), step
             )
         else:
@@ -343,7 +343,7 @@ def _reach_edge(grid, x0: float, y0: float, ux: float, uy: float) -> float:
     return min(reach) * (1 - 1e-9)
 
 
-def _extend_to_edge(grid, section: Section, step: float) -> Section:
+def extend_to_edge(grid, section: Section, step: float) -> Section:
     """A descent line that ended in a pit or a flat, continued straight along its
     last plan direction to the grid's edge.
 

@@ -28,6 +28,7 @@ COMMANDS = [
     "fit",
     "export",
     "import-model",
+    "import-results",
 ]
 REPO = Path(__file__).resolve().parents[2]
 

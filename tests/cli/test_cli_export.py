@@ -144,18 +144,27 @@ def test_a_model_file_without_what_a_model_needs(cli, tmp_path, fails):
     assert not (tmp_path / "x").exists()
 
 
-@pytest.mark.parametrize("target", ["rstone"])
-def test_values_the_target_refuses_leave_nothing_behind(cli, tmp_path, fails, target):
-    # e_t = 1.05 on the colluvium: r.stone refuses Rt > 1 (RocFall and CRSP write
-    # the in-range values under their own law instead, issue 19:
-    # tests/export/test_rocfall.py, test_crsp.py)
+@pytest.mark.parametrize(
+    ("target", "field", "value"),
+    [
+        # RocFall and CRSP write the in-range values under their own law instead
+        # of refusing e_t > 1, and so does r.stone (issue 19:
+        # tests/export/test_rocfall.py, test_crsp.py, test_rstone.py); what
+        # r.stone refuses is a rolling friction tan above 1.
+        ("rstone", "friction_deg", 50),
+    ],
+)
+def test_values_the_target_refuses_leave_nothing_behind(
+    cli, tmp_path, fails, target, field, value
+):
     data = json.loads(TABLE_7_1.read_text())
-    data["materials"]["colluvium"]["e_t"] = 1.05
+    data["materials"]["colluvium"][field] = value
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps(data))
     out = tmp_path / "x"
     extra = ["--extrude"] if target == "rstone" else []
-    fails(cli("export", bad, "--to", target, "-o", out, *extra), "colluvium", "1.05")
+    r = cli("export", bad, "--to", target, "-o", out, *extra)
+    fails(r, "colluvium", f"{value:g}")
     assert not out.exists()
 
 

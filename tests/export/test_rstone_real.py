@@ -1,0 +1,208 @@
+"""The real r.stone on fieldkit's exports (issue 19): the README's own commands.
+
+Each test exports a model, runs the export's ``run_rstone.sh`` in a fresh GRASS XY
+project exactly as the README says (``grass -c XY DB/xy -e``, then ``grass
+DB/xy/PERMANENT --exec bash run_rstone.sh``), reads r.stone's grids back with
+``fieldkit import-results --from rstone`` and checks: every trajectory stated is
+traced, none leaves the strip, and r.stone's runout p50/p95 agree with fieldkit's
+emulation of the exported values (:func:`fieldkit.export.rstone.emulated_runouts`)
+within the Monte Carlo error plus one cell: ``|difference| <= 2 SE + cell``, SE
+the difference's (the emulation's percentile SE, and the same for r.stone's
+ensemble of as many trajectories, ``sqrt(2)`` times it).
+
+Needs GRASS GIS 8.2 (``grass``) and r.stone built into it
+(``tools/r.stone/install.sh``); skipped with the reason otherwise. ``make
+test-rstone`` runs only this file. Measured on GRASS 8.2.1 (Debian 12), 2 cores:
+each r.stone run takes about 1 s.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+import subprocess
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from fieldkit.export.rstone import emulated_runouts, export_rstone
+from fieldkit.export.site import ExportSite, site_from_dem
+from fieldkit.io.dem import read_dem
+from fieldkit.model.model_file import read_model
+from fieldkit.model.statistics import percentile_se
+
+INSTALL = "tools/r.stone/install.sh"
+
+
+def _rstone_missing() -> str:
+    grass = shutil.which("grass")
+    if grass is None:
+        return "GRASS GIS is not installed (no `grass` on PATH): run " + INSTALL
+    try:
+        base = subprocess.run(
+            [grass, "--config", "path"], capture_output=True, text=True, timeout=60
+        ).stdout.strip()
+    except (OSError, subprocess.SubprocessError) as exc:
+        return f"`grass --config path` failed: {exc}"
+    if not (Path(base) / "bin" / "r.stone").is_file():
+        return f"r.stone is not built into GRASS ({base}/bin/r.stone): run {INSTALL}"
+    return ""
+
+
+pytestmark = [
+    pytest.mark.slow,
+    pytest.mark.skipif(bool(_rstone_missing()), reason=_rstone_missing() or "ok"),
+]
+
+TORNADO = "surveys/tornado_mountain/model_rocfall_table_7_1.json"
+
+
+def _run_rstone(folder: Path, db: Path) -> float:
+    """The README's recipe in a fresh XY project; returns r.stone's wall time [s]."""
+    subprocess.run(["grass", "-c", "XY", str(db / "xy"), "-e"], check=True,
+                   capture_output=True, timeout=300)  # fmt: skip
+    start = time.perf_counter()
+    done = subprocess.run(
+        ["grass", str(db / "xy" / "PERMANENT"), "--exec", "bash",
+         str(folder / "run_rstone.sh")],
+        capture_output=True, text=True, timeout=600,
+    )  # fmt: skip
+    wall = time.perf_counter() - start
+    assert done.returncode == 0, done.stderr[-2000:]
+    for name in ("counter", "maxvel", "maxdz"):
+        assert (folder / f"{name}.asc").is_file(), name
+    return wall
+
+
+def _import(cli, folder: Path, out: Path) -> tuple[dict, pd.DataFrame, str]:
+    r = cli("import-results", folder, "--from", "rstone", "-o", out)
+    assert r.exit_code == 0, r.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    return summary, pd.read_csv(out / "along.csv"), r.stderr
+
+
+def _agreement(summary: dict, runouts: np.ndarray, cell: float) -> list[str]:
+    """One line per percentile; the failures (beyond 2 SE + one cell)."""
+    lines, failures = [], []
+    for q in (50, 95):
+        emulated, se = percentile_se(runouts, q)
+        rstone = summary["runout_m"][f"p{q}"]
+        tolerance = 2 * math.sqrt(2) * se + cell
+        line = (
+            f"runout p{q}: r.stone {rstone:.1f} m, emulation {emulated:.1f} ± "
+            f"{se:.1f} m, difference {rstone - emulated:+.1f} m (tolerance "
+            f"{tolerance:.1f} m)"
+        )
+        lines.append(line)
+        if abs(rstone - emulated) > tolerance:
+            failures.append(line)
+    print("\n".join(lines))
+    return failures
+
+
+def test_tornado_extruded_in_the_real_rstone(cli, repo, tmp_path):
+    out = tmp_path / "rstone"
+    r = cli("export", repo / TORNADO, "--to", "rstone", "--extrude", "-o", out)
+    assert r.exit_code == 0, r.stderr
+    wall = _run_rstone(out, tmp_path / "grassdb")
+    summary, table, stderr = _import(cli, out, tmp_path / "results")
+    record = json.loads((out / "fieldkit_export.json").read_text())
+    readme = (out / "README.md").read_text()
+    # Every trajectory the README states is traced: the counter of the one source
+    # cell (its trajectories' first path point) equals it.
+    stated = record["trajectories"]
+    assert f"r.stone traces {stated} trajectories" in readme
+    assert summary["trajectories_stated"] == summary["trajectories_traced"] == stated
+    assert summary["counter_on_source_cells"] == stated
+    # The strip holds the lateral spread: no trajectory reaches its outer rows.
+    counter = np.nan_to_num(read_dem(out / "counter.asc").values)
+    rows = np.flatnonzero(counter.sum(axis=1))
+    middle = counter.shape[0] // 2
+    print(f"r.stone wall time {wall:.1f} s; rows reached {rows.min()}..{rows.max()} "
+          f"of {counter.shape[0]} (release row {middle}); east column "
+          f"{summary['edge_counts']['east']} of {stated}")  # fmt: skip
+    assert summary["left_the_grid"] == {"north": 0, "south": 0}
+    assert rows.min() > 0 and rows.max() < counter.shape[0] - 1
+    runouts, left = emulated_runouts(read_model(repo / TORNADO), record)
+    print(f"emulation: {np.mean(left):.1%} leave the section's end; "
+          f"r.stone: {summary['edge_counts']['east'] / stated:.1%} reach the east "
+          "column")  # fmt: skip
+    assert not _agreement(summary, runouts, record["grid"]["cellsize_m"])
+
+
+def _tschamut_area(repo, tmp_path) -> tuple[Path, Path, dict]:
+    """A Tschamut release area on the real DEM (copied into ``tmp_path``): the cells
+    of the 80 runs' release points, the export written as the CLI writes it."""
+    data = repo / "tests" / "data" / "tschamut2014"
+    dem = tmp_path / "terrain.asc"
+    shutil.copyfile(data / "terrain.asc", dem)
+    model = read_model(repo / "examples" / "tschamut" / "model_base.json")
+    grid = read_dem(dem)
+    releases = pd.read_csv(data / "release_points.csv")
+    first = site_from_dem(model, grid, (releases.x_m[0], releases.y_m[0]))
+    release = np.zeros(grid.shape, bool)
+    for x, y in zip(releases.x_m, releases.y_m, strict=True):
+        release[np.argmin(np.abs(grid.y_m - y)), np.argmin(np.abs(grid.x_m - x))] = True
+    site = ExportSite(grid, first.material, release, "Tschamut release area")
+    export = export_rstone(model, site)
+    out = tmp_path / "rstone"
+    out.mkdir()
+    for name, text in export.files.items():
+        (out / name).write_text(text)
+    (out / "README.md").write_text(export.readme("model_base.json"))
+    return out, dem, json.loads((out / "fieldkit_export.json").read_text())
+
+
+@pytest.fixture(scope="module")
+def tschamut_run(repo, tmp_path_factory):
+    from typer.testing import CliRunner
+
+    from fieldkit.cli import app
+
+    tmp_path = tmp_path_factory.mktemp("tschamut")
+    out, dem, record = _tschamut_area(repo, tmp_path)
+    wall = _run_rstone(out, tmp_path / "grassdb")
+    r = CliRunner().invoke(app, ["import-results", str(out), "--from", "rstone",
+                                 "-o", str(tmp_path / "results")])  # fmt: skip
+    assert r.exit_code == 0, r.stderr
+    summary = json.loads((tmp_path / "results" / "summary.json").read_text())
+    return out, dem, record, summary, wall
+
+
+def test_tschamut_area_in_the_real_rstone_traces_every_trajectory(tschamut_run):
+    out, _, record, summary, wall = tschamut_run
+    counter = np.nan_to_num(read_dem(out / "counter.asc").values)
+    # 14 source cells of 71 trajectories (1000 / 14 -> 71): each source cell
+    # counts at least its own (others' trajectories pass through some of them).
+    assert len(record["sources"]) == 14 and record["trajectories"] == 14 * 71
+    for s in record["sources"]:
+        assert counter[s["row"], s["col"]] >= s["trajectories"], s
+    assert summary["trajectories_traced"] == summary["trajectories_stated"] == 994
+    print(f"r.stone wall time {wall:.1f} s; edge counts {summary['edge_counts']}")
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="measured on GRASS 8.2.1: r.stone's runout p50/p95 on the Tschamut area "
+    "are 70/115 m, fieldkit's emulation 79.6/87.7 m (plan distance from the nearest "
+    "source cell). r.stone rolls after a bounce shorter than 3 m and slower than "
+    "5 m/s (fixed_parameters.c, points.c TrackPoints): on the valley floor every "
+    "bounce slower than 5 m/s is shorter than 3 m (v^2/g = 2.55 m at most on flat "
+    "ground); the emulation slides only below a rebound normal speed of "
+    "core.slide_vn_mps (0.5 m/s); with 5 m/s its p50 is 68.5 m. The p95 gap is "
+    "r.stone's launch-angle spread (ang_stoch_range 10, r.stone's default): the "
+    "same files run with ang_stoch_range=0 give p95 90 m (p50 70 m); one "
+    "steepest-descent section per source cell holds no such 3-D paths",
+)
+def test_tschamut_area_runout_agrees_with_the_emulation(tschamut_run):
+    _, dem, record, summary, _ = tschamut_run
+    from fieldkit.model.model_file import read_model as read
+
+    model = read(Path(__file__).parents[2] / "examples/tschamut/model_base.json")
+    runouts, left = emulated_runouts(model, record, read_dem(dem))
+    print(f"emulation: {np.mean(left):.1%} leave the grid")
+    assert not _agreement(summary, runouts, record["grid"]["cellsize_m"])
