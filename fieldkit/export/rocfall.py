@@ -79,22 +79,12 @@ from fieldkit.export.lumped import (
     with_coefficients,
 )
 from fieldkit.export.result import Export, Mapped
+from fieldkit.export.rocfall_keys import DISTRIBUTIONS, ROCK_KEYS
 from fieldkit.export.site import ExportSite
 from fieldkit.export.translation import translation_error
 from fieldkit.model.model_file import Model, model_from_dict, model_to_dict
 from fieldkit.outputs import csv_text, json_text
 
-#: RocFall distribution ids (the issue's list; RocFall3 help "Random Variables").
-DISTRIBUTIONS: dict[int, str] = {
-    1: "none",
-    2: "normal",
-    3: "uniform",
-    4: "triangular",
-    5: "beta",
-    6: "exponential",
-    7: "lognormal",
-    8: "gamma",
-}
 #: Truncation of a normal each side of the mean, in SDs (the stated convention).
 TRUNCATION_SD = 3.0
 #: RocFall's documented upper bound on Rn and Rt (Rocscience help, FAQ).
@@ -195,20 +185,6 @@ UNCONFIRMED = (
     "when RocFall redraws the slope roughness (per rock or per impact)",
     "how RocFall's lumped-mass 'consider rotational velocity' changes Rt",
 )
-#: Material keys -> (fieldkit field, unit written in the key).
-MATERIAL_KEYS: dict[str, tuple[str, str]] = {
-    "rn": ("e_n", ""),
-    "rt": ("e_t", ""),
-    "friction angle": ("friction_deg", "deg"),
-    "slope roughness sd": ("roughness_deg_sd", "deg"),
-}
-#: Rock-type keys -> (fieldkit seeder/body field, SD field, unit).
-ROCK_KEYS: dict[str, tuple[str, str, str]] = {
-    "mass": ("mass_kg", "mass_sd_kg", "kg"),
-    "initial horizontal velocity": ("vx_mps", "vx_sd_mps", "m/s"),
-    "initial vertical velocity": ("vz_mps", "vz_sd_mps", "m/s"),
-    "initial rotational velocity": ("omega_radps", "omega_sd_radps", "rad/s"),
-}
 FILES = (
     "materials.txt",
     "rock_type.txt",

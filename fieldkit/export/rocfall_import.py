@@ -38,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from fieldkit.errors import ArgumentError, InputFileError
-from fieldkit.export.rocfall import DISTRIBUTIONS, MATERIAL_KEYS, ROCK_KEYS
+from fieldkit.export.rocfall_keys import DISTRIBUTIONS, MATERIAL_KEYS, ROCK_KEYS
 from fieldkit.io.profile_csv import check_profile_vertices
 from fieldkit.model.materials import MATERIAL_FIELDS, check_material_name
 from fieldkit.model.model_file import CORE_DEFAULTS, Model, model_from_dict

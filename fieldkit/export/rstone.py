@@ -64,7 +64,15 @@ import numpy as np
 from fieldkit.errors import ArgumentError
 from fieldkit.export.ascii_grid import ascii_grid_text
 from fieldkit.export.fitted import with_error
-from fieldkit.export.lumped import not_a_law
+from fieldkit.export.lumped import (
+    Behaviour,
+    Coefficient,
+    closest_behaviour,
+    fit_coefficients,
+    not_a_law,
+    search_line,
+    with_coefficients,
+)
 from fieldkit.export.result import Export, Mapped
 from fieldkit.export.site import (
     ExportSite,
@@ -73,7 +81,7 @@ from fieldkit.export.site import (
     pad_site,
     site_from_section,
 )
-from fieldkit.export.translation import fit_scaled, realised_impacts, translation_error
+from fieldkit.export.translation import translation_error
 from fieldkit.io.dem import DemGrid
 from fieldkit.model.materials import Material
 from fieldkit.model.model_file import Model
@@ -85,8 +93,15 @@ TITLE = "r.stone (GRASS GIS)"
 DEFAULT_ROCKS = 1000
 
 #: r.stone's defaults for what fieldkit does not calibrate (main.c).
-DEFAULT_ANGLE_RANGE = 10
+DEFAULT_ANGLE_RANGE = 0
 DEFAULT_START_VEL_MPS = 1.0
+
+#: The smallest e_n written: r.stone takes nrest 0 for water, a stop
+#: (points.c Bounce), not a rebound law.
+NREST_MIN = 0.01
+
+#: r.stone's switch from flying to rolling [m/s] (fixed_parameters.c VEL_FLY_ROLL).
+ROLL_SPEED_MPS = 5.0
 
 #: r.stone's flight and roll step [m] (fixed_parameters.c): not above the cell size.
 STEP_M = 5.0
@@ -440,7 +455,10 @@ def emulated_model(
         x_max_m=None,
         height_m=None,
     )
-    return replace(model, materials=materials, effects={}, trees=None, seeder=seeder)
+    core = {**model.core, "slide_vn_mps": ROLL_SPEED_MPS}
+    return replace(
+        model, materials=materials, effects={}, trees=None, seeder=seeder, core=core
+    )
 
 
 def emulated_runouts(
@@ -529,82 +547,82 @@ def constant_pair(model: Model, name: str) -> bool:
     )
 
 
-def rstone_pairs(model: Model, names: list[str]) -> tuple[Model, list[str], list[str]]:
+def rstone_pairs(
+    model: Model, names: list[str], release_x_m: float, height_m: float
+) -> tuple[Model, list[str], list[str], Behaviour | None]:
     """``model`` with each material's e_n, e_t (and their SDs) the in-range
     constant pair closest under r.stone's law, and what was done.
 
-    A material whose calibrated law is already r.stone's (:func:`constant_pair`)
-    keeps its values. Any other -- an impact law, roughness, a coefficient above
-    1 -- takes the pair in [0, 1] minimising the squared rebound error over the
-    impacts on it of the calibrated model's own simulation
-    (:func:`~fieldkit.export.translation.realised_impacts`,
-    :func:`~fieldkit.export.translation.fit_scaled` with ``f = 1``), and as SDs
-    the impacts' own spread around it (what r.stone's random draw should carry,
-    not the fit's standard error). A material with no simulated impact keeps its
-    calibrated values clipped to [0, 1], stated in the mismatches and as
-    unconfirmed.
+    Materials whose calibrated law is already r.stone's (:func:`constant_pair`,
+    all of them) keep their values. Otherwise every material takes the pair in
+    [0, 1] (e_n at least :data:`NREST_MIN`) minimising the squared rebound
+    error over its impacts in the calibrated model's own simulation
+    (:func:`fieldkit.export.lumped.fit_coefficients` with ``f = 1``); from there
+    :func:`fieldkit.export.lumped.closest_behaviour` searches the pairs whose
+    emulation under r.stone's law (:func:`emulated_model`) behaves closest to the
+    calibrated model (runout, design energy and bounce height), written only if
+    they also do so on an independent stream, in whole percent. The SDs are the
+    impacts' own spread around the written value (what r.stone's random draw
+    should carry, not the fit's standard error); roughness goes (r.stone has
+    none). A material no simulated rock touched is said loudly
+    (:func:`~fieldkit.export.lumped.fit_coefficients`).
 
     Returns
     -------
-    model, mismatches, unconfirmed
+    model, mismatches, unconfirmed, search
     """
     from dataclasses import replace
 
-    todo = [n for n in names if not constant_pair(model, n)]
-    if not todo:
-        return model, [], []
-    impacts = realised_impacts(model)
-    materials = dict(model.materials)
-    lines, open_ = [], []
-    laws = ", ".join(model.effects) or "no effect"
-    for name in todo:
-        m = model.materials[name]
-        rows = impacts[impacts["material"] == name]
-        n_fit = fit_scaled(np.abs(rows["vin_mps"]), rows["vfn_mps"], 1.0, 0.0, 1.0)
-        t_fit = fit_scaled(rows["vit_mps"], rows["vft_mps"], 1.0, 0.0, 1.0)
-        if n_fit.n == 0 or t_fit.n == 0:
-            e_n, e_t = min(max(m.e_n, 0.0), 1.0), min(max(m.e_t, 0.0), 1.0)
-            materials[name] = replace(m, e_n=e_n, e_t=e_t)
-            text = (
-                f"{name}: no simulated impact on it (the calibrated model's own "
-                f"{len(impacts.path_id.unique()) if len(impacts) else 0}-rock "
-                f"simulation): e_n {m.e_n:.4g}, e_t {m.e_t:.4g} written as "
-                f"calibrated, clipped to r.stone's [0, 1] ({e_n:.4g}, {e_t:.4g}); "
-                f"its law ({laws}; roughness {m.roughness_deg_sd:g} deg) is not "
-                "translated"
+    if all(constant_pair(model, n) for n in names):
+        return model, [], [], None
+    ranges = ((NREST_MIN, 1.0), (0.0, 1.0))
+    coefficients, loud = fit_coefficients(model, "r.stone", np.ones_like, *ranges)
+
+    def written(values: dict[str, tuple[Coefficient, Coefficient]]) -> Model:
+        out = with_coefficients(model, values)
+        materials = dict(out.materials)
+        for name, (rn, rt) in values.items():
+            m = materials[name]
+            materials[name] = replace(
+                m,
+                e_n_sd=rn.spread if math.isfinite(rn.spread) else m.e_n_sd,
+                e_t_sd=rt.spread if math.isfinite(rt.spread) else m.e_t_sd,
+                roughness_m=0.0,
+                roughness_deg_sd=0.0,
             )
-            lines.append(text)
-            open_.append(text)
-            continue
-        materials[name] = replace(
-            m,
-            e_n=n_fit.value,
-            e_t=t_fit.value,
-            e_n_sd=n_fit.spread,
-            e_t_sd=t_fit.spread,
-            roughness_m=0.0,
-            roughness_deg_sd=0.0,
+        return replace(out, materials=materials)
+
+    def emulate(values: dict[str, tuple[Coefficient, Coefficient]]) -> Model:
+        w = written(values)
+        return emulated_model(w, _options(w, names, height_m), release_x_m, names)
+
+    coefficients, search = closest_behaviour(
+        model, coefficients, emulate, np.ones_like, *ranges,
+        precision=lambda v: percent(v) / 100,
+    )  # fmt: skip
+    laws = ", ".join(model.effects) or "no effect"
+    lines = [
+        f"{name}: r.stone's law is a constant pair; the calibrated e_n "
+        f"{model.materials[name].e_n:.4g}, e_t {model.materials[name].e_t:.4g} with "
+        f"{laws} (roughness {model.materials[name].roughness_deg_sd:g} deg) are "
+        f"written as e_n {rn.text()}, e_t {rt.text()}"
+        + "".join(
+            f"; {c.name.rsplit('.', 1)[1]}: the least-squares value {c.unclipped:.3f} "
+            "under r.stone's law lies outside its range and was clipped to "
+            f"{min(max(c.unclipped, lo), hi):g}"
+            for c, (lo, hi) in zip((rn, rt), ranges, strict=True)
+            if c.clipped and c.n
         )
-        clipped = [
-            f"{k} {f.unclipped:.3f} clipped to {f.value:g}"
-            for k, f in (("e_n", n_fit), ("e_t", t_fit))
-            if f.clipped
-        ]
-        lines.append(
-            f"{name}: r.stone's law is a constant pair; the calibrated e_n "
-            f"{m.e_n:.4g}, e_t {m.e_t:.4g} with {laws} (roughness "
-            f"{m.roughness_deg_sd:g} deg) are written as the in-range pair closest "
-            f"over the {n_fit.n} impacts on {name} of the calibrated model's own "
-            f"simulation: e_n {n_fit.value:.3f}, e_t {t_fit.value:.3f} (least "
-            "squares in [0, 1]"
-            + (f"; {'; '.join(clipped)}" if clipped else "")
-            + f"), SDs their impacts' own spread {n_fit.spread:.3f}, "
-            f"{t_fit.spread:.3f}"
-            + "".join(
-                f"; {w}" for w in (not_a_law(e, TARGET) for e in model.effects) if w
-            )  # fmt: skip
-        )
-    return replace(model, materials=materials), lines, open_
+        + "".join(f"; {w}" for w in (not_a_law(e, TARGET) for e in model.effects) if w)
+        for name, (rn, rt) in coefficients.items()
+        if name in names
+    ]
+    return (
+        written(coefficients),
+        [*lines, *loud, *search_line(search, TARGET)],
+        list(loud),
+        search,
+    )
 
 
 def _check(model: Model, names: list[str]) -> None:
@@ -664,7 +682,14 @@ def export_rstone(
     ground = ground_cells(site)
     source = site.release & ground
     present = [n for n in model.materials if (site.material[ground] == n).any()]
-    model, fitted, open_ = rstone_pairs(model, present)
+    chainage = extruded_chainage_m(model, site)
+    release_x = (
+        float(np.mean(grid.x_m[np.nonzero(source)[1]]))
+        if chainage is not None
+        else model.seeder.x_m
+    )
+    height = fall_height_m(model, site)
+    model, fitted, open_, _ = rstone_pairs(model, present, release_x, height)
     _check(model, present)
     offset = dem_offset_m(grid.values[ground])
     dem = np.where(ground, grid.values + offset, np.nan)
@@ -676,7 +701,6 @@ def export_rstone(
         )
     n_source = int(source.sum())
     per_cell = max(1, round(rocks / n_source))
-    height = fall_height_m(model, site)
     options = _options(model, present, height)
 
     def per_material(value) -> np.ndarray:
@@ -703,16 +727,10 @@ def export_rstone(
         ),
         SCRIPT: run_script(options),
     }
-    chainage = extruded_chainage_m(model, site)
     files[RECORD] = record_text(
         model, site, source, per_cell, offset, chainage, options
     )
     traced = per_cell * n_source
-    release_x = (
-        float(np.mean(grid.x_m[np.nonzero(source)[1]]))
-        if chainage is not None
-        else model.seeder.x_m
-    )
     emulated = emulated_model(model, options, release_x, present)
     translation = translation_error(calibrated, emulated)
     return Export(
@@ -760,8 +778,10 @@ def emulation_text(release_x_m: float) -> str:
         "tan(beta) as r.stone reads it (thousandths); the rock launched "
         f"horizontally at start_vel from the ground at chainage {release_x_m:.1f} m, "
         "as r.stone starts it. fieldkit's flight, impact and sliding kernels stand "
-        "for r.stone's: its switch to rolling (a bounce shorter than 3 m and slower "
-        "than 5 m/s) and its 5 m steps are not emulated."
+        "for r.stone's; its switch to rolling (a bounce shorter than 3 m and slower "
+        "than 5 m/s) is approximated by fieldkit's switch to sliding at a rebound "
+        f"normal speed below {ROLL_SPEED_MPS:g} m/s (core.slide_vn_mps), and its 5 m "
+        "steps are not emulated."
     )
 
 
@@ -1000,9 +1020,13 @@ def _unmapped(model: Model, present: list[str]) -> list[tuple[str, str]]:
             "angle drawn with ang_stoch_range; only the speed is mapped (start_vel)",
         ),
         (
-            f"lateral spread (ang_stoch_range = {DEFAULT_ANGLE_RANGE}, r.stone's "
-            "default)",
-            "fieldkit's model is a 2-D section: it calibrates no spread across it",
+            f"lateral spread (ang_stoch_range = {DEFAULT_ANGLE_RANGE}, not r.stone's "
+            "default 10)",
+            "fieldkit's model is a 2-D section: it calibrates no spread across it, so "
+            "none is written; r.stone's default 10 would add one nobody calibrated "
+            "(on the Tschamut release area it moves r.stone's runout p95 from 90 m "
+            "to 115 m, p50 unchanged at 70 m): set ang_stoch_range in run_rstone.sh "
+            "if your site's spread is known",
         ),
     ]
     rough = [
@@ -1174,17 +1198,19 @@ UNCONFIRMED = [
     "the counter grid counts a trajectory in the cells of its path points kept "
     "5 m apart (stone.c Filter, OUTPUT_TAB): a trajectory can skip a cell, so "
     "runouts read from it are good to about one cell either way",
-    "the lateral spread of the launch angle (ang_stoch_range) is r.stone's "
-    "default, not calibrated: fieldkit's model is a 2-D section",
+    "the lateral spread of the launch angle is written as 0 (ang_stoch_range): "
+    "fieldkit's model is a 2-D section and calibrates none; what a site's real "
+    "spread is stays open",
     "the translation error is fieldkit's emulation of r.stone's law, not r.stone: "
-    "the emulation does not switch to rolling as r.stone does (at an impact slower "
-    "than 5 m/s). Run in r.stone 8.2.1 (tests/export/test_rstone_real.py): on "
-    "Tornado Mountain's extruded section r.stone and the emulation both run off "
-    "the section's end (84 % and 100 %; runout p50 and p95 697.5 m and 700 m, "
-    "within one cell); on a Tschamut release area r.stone's runout p50/p95 are "
-    "70/115 m against the emulation's 79.6/87.7 m: they do not agree (p50: the "
-    "roll switch, with which the emulation's p50 is 68.5 m; p95: the launch-angle "
-    "spread, without which r.stone's p95 is 90 m)",
+    "the emulation approximates r.stone's switch to rolling (a bounce shorter than "
+    "3 m and slower than 5 m/s) by sliding below a 5 m/s rebound normal speed. "
+    "Checked in r.stone 8.2.1 (tests/export/test_rstone_real.py): on Tornado "
+    "Mountain's extruded section r.stone and the emulation both run off the "
+    "section's end (runout p50 and p95 within one cell; a degenerate check); on "
+    "a Tschamut release area (14 cells, 994 trajectories) r.stone's runout p50/p95 "
+    "are 70/90 m against the emulation's 68.5 ± 1.1/85.5 m, within 2 SE plus one "
+    "cell (without the roll-switch approximation the emulation gave 79.6/87.7 m; "
+    "with r.stone's default ang_stoch_range 10, r.stone gave 70/115 m)",
     "r.stone ends some trajectories as 'Track overflow' without writing their last "
     "path segment to the grids (points.c TrackPoints, case 0: Parab 'confused' "
     "after 5 steps outside the triangle, or 100000 path points): 239 of 994 on the "
@@ -1217,8 +1243,10 @@ def _notes(
             f"strip: {site.grid.shape[0]} rows across "
             f"(±{site.grid.shape[0] // 2 * site.grid.cellsize_m:g} m from the "
             "release row). Measured with r.stone 8.2.1 on Tornado Mountain (5 m "
-            "cells, ang_stoch_range 10, 1000 trajectories): no trajectory passed "
-            "14 rows (70 m) from the release row. A trajectory reaching the strip's "
+            "cells, ang_stoch_range 10, r.stone's default, 1000 trajectories): no "
+            "trajectory passed 14 rows (70 m) from the release row; with the "
+            "ang_stoch_range 0 written here the spread is smaller still. A "
+            "trajectory reaching the strip's "
             "side stops there (stone.c NewPlane): that is not a runout; "
             "`fieldkit import-results` reports how many did"
         )

@@ -185,19 +185,11 @@ def test_tschamut_area_in_the_real_rstone_traces_every_trajectory(tschamut_run):
     print(f"r.stone wall time {wall:.1f} s; edge counts {summary['edge_counts']}")
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="measured on GRASS 8.2.1: r.stone's runout p50/p95 on the Tschamut area "
-    "are 70/115 m, fieldkit's emulation 79.6/87.7 m (plan distance from the nearest "
-    "source cell). r.stone rolls after a bounce shorter than 3 m and slower than "
-    "5 m/s (fixed_parameters.c, points.c TrackPoints): on the valley floor every "
-    "bounce slower than 5 m/s is shorter than 3 m (v^2/g = 2.55 m at most on flat "
-    "ground); the emulation slides only below a rebound normal speed of "
-    "core.slide_vn_mps (0.5 m/s); with 5 m/s its p50 is 68.5 m. The p95 gap is "
-    "r.stone's launch-angle spread (ang_stoch_range 10, r.stone's default): the "
-    "same files run with ang_stoch_range=0 give p95 90 m (p50 70 m); one "
-    "steepest-descent section per source cell holds no such 3-D paths",
-)
+# Before the emulation approximated r.stone's roll switch (a bounce shorter than
+# 3 m and slower than 5 m/s: fieldkit now slides below a 5 m/s rebound normal
+# speed) and before the export wrote ang_stoch_range 0 (fieldkit calibrates no
+# lateral spread), r.stone gave 70/115 m against the emulation's 79.6/87.7 m
+# (measured on GRASS 8.2.1); the test failed then.
 def test_tschamut_area_runout_agrees_with_the_emulation(tschamut_run):
     _, dem, record, summary, _ = tschamut_run
     from fieldkit.model.model_file import read_model as read
