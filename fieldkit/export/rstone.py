@@ -58,6 +58,7 @@ from __future__ import annotations
 import json
 import math
 import shlex
+from dataclasses import replace
 
 import numpy as np
 
@@ -74,6 +75,7 @@ from fieldkit.export.lumped import (
     with_coefficients,
 )
 from fieldkit.export.result import Export, Mapped
+from fieldkit.export.rstone_law import RstoneLaw
 from fieldkit.export.site import (
     ExportSite,
     checked_site,
@@ -100,16 +102,15 @@ DEFAULT_START_VEL_MPS = 1.0
 #: (points.c Bounce), not a rebound law.
 NREST_MIN = 0.01
 
-#: r.stone's switch from flying to rolling [m/s] (fixed_parameters.c VEL_FLY_ROLL).
-ROLL_SPEED_MPS = 5.0
-
 #: r.stone's flight and roll step [m] (fixed_parameters.c): not above the cell size.
 STEP_M = 5.0
 
 #: Elevations r.stone takes as ground: above 0 m, at most 9999 m (stone.c NewPlane).
 MAX_ELEVATION_M = 9999.0
 
-#: Standard gravity [m/s²], as r.stone's G (stone.h) and fieldkit's kernel.
+#: Standard gravity [m/s²], fieldkit's kernel's: the seeder's fall to the ground
+#: r.stone starts on happens in fieldkit's world (r.stone's own G, 9.805 m/s² in
+#: stone.h, is :data:`fieldkit.export.rstone_law.G_MPS2`).
 G_MPS2 = 9.81
 
 #: Cells every release cell keeps from the grid's edge: r.stone never starts a
@@ -385,17 +386,24 @@ def friction_read(tan_written: float) -> float:
     return math.floor(value + 1e-12) / 1000.0 if value >= 0 else 0.0
 
 
-def typical_slope_deg(model: Model, name: str) -> float:
-    """The length-weighted mean dip [deg] of ``name``'s segments of the profile
-    (0 for a material on no segment)."""
+def cell_centres_m(model: Model, cellsize_m: float | None = None) -> np.ndarray:
+    """Chainages of the cell centres along ``model``'s section, as
+    :func:`section_site` lays its columns (cells of ``cellsize_m``, default
+    :func:`section_site`'s): the vertices of r.stone's planes seen in section.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as N
+    >>> cell_centres_m(N(profile=N(x_m=[0.0, 21.0])), 5.0).tolist()
+    [2.5, 7.5, 12.5, 17.5]
+    """
     x = np.asarray(model.profile.x_m, float)
-    z = np.asarray(model.profile.z_m, float)
-    dx = np.diff(x)
-    dip = np.degrees(np.arctan(np.abs(np.diff(z)) / dx))
-    mine = np.asarray(model.profile.material, dtype=object) == name
-    if not mine.any():
-        return 0.0
-    return float(np.sum(dip[mine] * dx[mine]) / np.sum(dx[mine]))
+    length = float(x[-1] - x[0])
+    if cellsize_m is None:
+        cellsize_m = max(STEP_M, float(math.ceil(length / 500.0)))
+    cell = float(cellsize_m)
+    ncols = max(2, math.floor(length / cell))
+    return x[0] + cell * (np.arange(ncols) + 0.5)
 
 
 def emulated_model(
@@ -403,61 +411,54 @@ def emulated_model(
     options: dict[str, float],
     release_x_m: float,
     names: list[str] | None = None,
-) -> Model:
-    """fieldkit's model of r.stone's law with the values written for ``model``.
+    *,
+    chainage_m: np.ndarray | None = None,
+) -> RstoneLaw:
+    """fieldkit's emulation of r.stone's law with the values written for ``model``:
+    r.stone's own kernel ported along the section
+    (:class:`~fieldkit.export.rstone_law.RstoneLaw`, what is ported and what not:
+    :mod:`fieldkit.export.rstone_law`).
 
-    On ``model``'s own section: each material the constant pair at the written
-    whole percents (``nrest/100``, ``trest/100``) with r.stone's draw SD
-    ``2 range / 100``; the friction angle phi' with ``g cos(psi) tan(phi')`` equal
-    to r.stone's rolling deceleration ``g sin(beta)`` on the material's typical
-    slope psi (:func:`typical_slope_deg`), ``tan(beta)`` as r.stone reads it
-    (:func:`friction_read`); no effect, no roughness, no trees (r.stone has none);
-    the seeder where r.stone starts, on the ground at ``release_x_m`` (one body
-    radius above it), launched horizontally at ``start_vel`` with no spread.
+    The section's vertices are the cell centres at ``chainage_m`` (default
+    :func:`cell_centres_m`), their ground ``model``'s profile there (continued
+    flat beyond its ends, as padded columns); each cell the values written for
+    the material of the profile segment under its centre: nrest and trest in
+    whole percent (:func:`percent`), ``tan(beta)`` as r.stone reads it
+    (:func:`friction_read`); the spread ranges, ``start_vel`` and ``stop_vel``
+    of ``options``; the rocks start on the ground at ``release_x_m``; energies
+    with the body's mass. ``names`` is accepted for the callers' symmetry: every
+    material of ``model`` is taken as written.
     """
-    from dataclasses import replace
-
-    names = list(model.materials) if names is None else names
-    materials = dict(model.materials)
-    sd_n = 2 * options["vrest_stoch_range"] / 100
-    sd_t = 2 * options["hrest_stoch_range"] / 100
-    sd_f = 2 * options["frict_stoch_range"] / 100
-    for name in names:
-        m = model.materials[name]
-        tan_beta = friction_read(math.tan(math.radians(m.friction_deg)))
-        psi = math.radians(typical_slope_deg(model, name))
-        tan_phi = math.sin(math.atan(tan_beta)) / math.cos(psi)
-        phi = math.degrees(math.atan(tan_phi))
-        materials[name] = replace(
-            m,
-            e_n=percent(m.e_n) / 100,
-            e_t=percent(m.e_t) / 100,
-            friction_deg=phi,
-            e_n_sd=sd_n,
-            e_t_sd=sd_t,
-            friction_deg_sd=math.degrees(sd_f * math.cos(math.radians(phi)) ** 2),
-            roughness_m=0.0,
-            roughness_deg_sd=0.0,
-        )
-    ground = float(np.interp(release_x_m, model.profile.x_m, model.profile.z_m))
-    seeder = replace(
-        model.seeder,
-        x_m=float(release_x_m),
-        z_m=ground + model.body.radius_m,
-        vx_mps=float(options["start_vel"]),
-        vz_mps=0.0,
-        omega_radps=0.0,
-        x_sd_m=0.0,
-        z_sd_m=0.0,
-        vx_sd_mps=0.0,
-        vz_sd_mps=0.0,
-        omega_sd_radps=0.0,
-        x_max_m=None,
-        height_m=None,
+    del names
+    x = np.asarray(model.profile.x_m, float)
+    vertices = (
+        cell_centres_m(model) if chainage_m is None else np.asarray(chainage_m, float)
     )
-    core = {**model.core, "slide_vn_mps": ROLL_SPEED_MPS}
-    return replace(
-        model, materials=materials, effects={}, trees=None, seeder=seeder, core=core
+    z = np.interp(vertices, x, model.profile.z_m)
+    segment = np.clip(np.searchsorted(x, vertices, side="right") - 1, 0, x.size - 2)
+    material = np.asarray(model.profile.material, dtype=object)[segment]
+    table = {
+        name: (
+            percent(m.e_n),
+            percent(m.e_t),
+            friction_read(math.tan(math.radians(m.friction_deg))),
+        )
+        for name, m in model.materials.items()
+    }
+    values = np.array([table[name] for name in material], float)
+    return RstoneLaw(
+        x_m=vertices,
+        z_m=z,
+        nrest_pct=values[:, 0].astype(np.int64),
+        trest_pct=values[:, 1].astype(np.int64),
+        friction_tan=values[:, 2],
+        vrest_stoch_range=int(options["vrest_stoch_range"]),
+        hrest_stoch_range=int(options["hrest_stoch_range"]),
+        frict_stoch_range=int(options["frict_stoch_range"]),
+        start_vel_mps=float(options["start_vel"]),
+        stop_vel_mps=float(options["stop_vel"]),
+        release_x_m=float(release_x_m),
+        mass_kg=float(model.body.mass_kg),
     )
 
 
@@ -469,29 +470,30 @@ def emulated_runouts(
     at the lower end (a censored runout).
 
     The values written (``record["written"]``, ``record["options"]``) under
-    :func:`emulated_model`. On an extruded section: ``model``'s own section, the
-    rocks launched at the release column's chainage. On a DEM (``grid``): for
-    each source cell, the steepest-descent section from its centre
-    (:func:`~fieldkit.model.dem_profile.steepest_descent_line`, half-cell steps)
-    continued straight to the grid's edge where it ends in a pit or a flat, as
-    ``fieldkit fit-paths`` cuts Tschamut's runs
-    (:func:`~fieldkit.fit.path_sections.extend_to_edge`), its trajectories
-    launched at chainage 0; a runout is then the plan distance of the rock's
-    stop on that line from the nearest source cell's centre, as
-    ``import-results`` measures r.stone's (:mod:`fieldkit.io.rstone_results`).
-    A rock that reaches its section's end leaves it (its runout is censored).
+    r.stone's law (:func:`emulated_model`). On an extruded section: the columns'
+    chainages (``record["chainage_m"]``) as the vertices of ``model``'s own
+    section, the rocks launched at the release column's chainage. On a DEM
+    (``grid``): for each source cell, the steepest-descent section from its
+    centre (:func:`~fieldkit.model.dem_profile.steepest_descent_line`, half-cell
+    steps) continued straight to the grid's edge where it ends in a pit or a
+    flat, as ``fieldkit fit-paths`` cuts Tschamut's runs
+    (:func:`~fieldkit.fit.path_sections.extend_to_edge`), its vertices every
+    cell along it (plan chainage), its trajectories launched at chainage 0; a
+    runout is then the plan distance of the rock's stop on that line from the
+    nearest source cell's centre, as ``import-results`` measures r.stone's
+    (:mod:`fieldkit.io.rstone_results`). A rock that reaches its section's end
+    leaves it (its runout is censored).
 
     Raises
     ------
     ArgumentError
         A DEM record without ``grid``.
     """
-    from dataclasses import replace
 
     from fieldkit.fit.path_sections import extend_to_edge
     from fieldkit.model.dem_profile import steepest_descent_line
     from fieldkit.model.profile import Profile
-    from fieldkit.model.simulate import simulate
+    from fieldkit.model.results import EXITED_DOWNSLOPE
 
     materials = dict(model.materials)
     for name, values in record["written"].items():
@@ -502,10 +504,12 @@ def emulated_runouts(
     rng = np.random.default_rng(seed)
     if record["extruded"]:
         x = float(np.mean([s["x_m"] for s in record["sources"]]))
-        emulated = emulated_model(written, options, x, names)
-        result = simulate(emulated, int(record["trajectories"]), rng)
+        emulated = emulated_model(
+            written, options, x, names, chainage_m=np.asarray(record["chainage_m"])
+        )
+        result = emulated.simulate(int(record["trajectories"]), rng)
         runout = np.asarray(result.runout_x_m, float)
-        return runout, runout >= float(model.profile.x_m[-1]) - 1e-9
+        return runout, np.asarray(result.state) == EXITED_DOWNSLOPE
     if grid is None:
         raise ArgumentError("a DEM record needs its DEM to emulate", source="grid")
     runouts, ends = [], []
@@ -517,20 +521,23 @@ def emulated_runouts(
         py = np.interp(chainage, line.chainage_m, line.plan_y_m)
         return np.hypot(px[:, None] - sx, py[:, None] - sy).min(axis=1)
 
+    cell = grid.cellsize_m
     for s in record["sources"]:
-        step = grid.cellsize_m / 2
         line = extend_to_edge(
-            grid, steepest_descent_line(grid, (s["x_m"], s["y_m"]), step), step
+            grid, steepest_descent_line(grid, (s["x_m"], s["y_m"]), cell / 2), cell / 2
         )
         profile = Profile.from_arrays(
             line.chainage_m, line.z_m, [names[0]] * (line.z_m.size - 1)
         )
-        on_line = replace(written, profile=profile)
-        emulated = emulated_model(on_line, options, 0.0, names)
-        result = simulate(emulated, int(s["trajectories"]), rng)
-        x = np.asarray(result.runout_x_m, float)
-        runouts.append(from_sources(line, x))
-        ends.append(x >= line.length_m - 1e-9)
+        vertices = np.append(np.arange(0.0, line.length_m, cell), line.length_m)
+        if vertices[-1] - vertices[-2] < 1e-6:
+            vertices = vertices[:-1]
+        emulated = emulated_model(
+            replace(written, profile=profile), options, 0.0, names, chainage_m=vertices
+        )
+        result = emulated.simulate(int(s["trajectories"]), rng)
+        runouts.append(from_sources(line, np.asarray(result.runout_x_m, float)))
+        ends.append(np.asarray(result.state) == EXITED_DOWNSLOPE)
     return np.concatenate(runouts), np.concatenate(ends)
 
 
@@ -547,8 +554,39 @@ def constant_pair(model: Model, name: str) -> bool:
     )
 
 
+def spread_at(c: Coefficient, lo: float, hi: float) -> float:
+    """The impacts' own spread around ``c.written`` (what r.stone's draw carries).
+
+    ``c.spread`` is the spread around the value it was fitted at: the
+    least-squares value clipped to ``[lo, hi]`` for an impact-level coefficient,
+    ``c.written`` once the behaviour search set it (``c.impact_level`` finite).
+    The search moves ``written`` alone, so the spread at a candidate follows from
+    the fit: ``spread(v)² = residual² + (v - unclipped)²``, the residual the
+    least-squares one (:func:`~fieldkit.export.translation.fit_scaled`). So the
+    search emulates the ranges the export then writes. NaN when not fitted.
+
+    Examples
+    --------
+    >>> c = Coefficient("e_n", 0.5, 0.6, 0.1, 10, unclipped=0.6)
+    >>> round(spread_at(c, 0, 1), 6), round(spread_at(replace(c, written=0.9), 0, 1), 6)
+    (0.1, 0.316228)
+    """
+    if not (c.n and math.isfinite(c.spread)):
+        return math.nan
+    if math.isfinite(c.impact_level) or not math.isfinite(c.unclipped):
+        return c.spread
+    fitted = min(max(c.unclipped, lo), hi)
+    residual2 = max(0.0, c.spread**2 - (fitted - c.unclipped) ** 2)
+    return math.sqrt(residual2 + (c.written - c.unclipped) ** 2)
+
+
 def rstone_pairs(
-    model: Model, names: list[str], release_x_m: float, height_m: float
+    model: Model,
+    names: list[str],
+    release_x_m: float,
+    height_m: float,
+    *,
+    chainage_m: np.ndarray | None = None,
 ) -> tuple[Model, list[str], list[str], Behaviour | None]:
     """``model`` with each material's e_n, e_t (and their SDs) the in-range
     constant pair closest under r.stone's law, and what was done.
@@ -559,7 +597,8 @@ def rstone_pairs(
     error over its impacts in the calibrated model's own simulation
     (:func:`fieldkit.export.lumped.fit_coefficients` with ``f = 1``); from there
     :func:`fieldkit.export.lumped.closest_behaviour` searches the pairs whose
-    emulation under r.stone's law (:func:`emulated_model`) behaves closest to the
+    emulation under r.stone's law (:func:`emulated_model`, vertices at
+    ``chainage_m``) behaves closest to the
     calibrated model (runout, design energy and bounce height), written only if
     they also do so on an independent stream, in whole percent. The SDs are the
     impacts' own spread around the written value (what r.stone's random draw
@@ -571,7 +610,6 @@ def rstone_pairs(
     -------
     model, mismatches, unconfirmed, search
     """
-    from dataclasses import replace
 
     if all(constant_pair(model, n) for n in names):
         return model, [], [], None
@@ -583,18 +621,21 @@ def rstone_pairs(
         materials = dict(out.materials)
         for name, (rn, rt) in values.items():
             m = materials[name]
+            sd_n, sd_t = spread_at(rn, *ranges[0]), spread_at(rt, *ranges[1])
             materials[name] = replace(
                 m,
-                e_n_sd=rn.spread if math.isfinite(rn.spread) else m.e_n_sd,
-                e_t_sd=rt.spread if math.isfinite(rt.spread) else m.e_t_sd,
+                e_n_sd=sd_n if math.isfinite(sd_n) else m.e_n_sd,
+                e_t_sd=sd_t if math.isfinite(sd_t) else m.e_t_sd,
                 roughness_m=0.0,
                 roughness_deg_sd=0.0,
             )
         return replace(out, materials=materials)
 
-    def emulate(values: dict[str, tuple[Coefficient, Coefficient]]) -> Model:
+    def emulate(values: dict[str, tuple[Coefficient, Coefficient]]) -> RstoneLaw:
         w = written(values)
-        return emulated_model(w, _options(w, names, height_m), release_x_m, names)
+        return emulated_model(
+            w, _options(w, names, height_m), release_x_m, names, chainage_m=chainage_m
+        )
 
     coefficients, search = closest_behaviour(
         model, coefficients, emulate, np.ones_like, *ranges,
@@ -689,7 +730,12 @@ def export_rstone(
         else model.seeder.x_m
     )
     height = fall_height_m(model, site)
-    model, fitted, open_, _ = rstone_pairs(model, present, release_x, height)
+    vertices = (
+        chainage if chainage is not None else cell_centres_m(model, grid.cellsize_m)
+    )
+    model, fitted, open_, _ = rstone_pairs(
+        model, present, release_x, height, chainage_m=vertices
+    )
     _check(model, present)
     offset = dem_offset_m(grid.values[ground])
     dem = np.where(ground, grid.values + offset, np.nan)
@@ -731,7 +777,7 @@ def export_rstone(
         model, site, source, per_cell, offset, chainage, options
     )
     traced = per_cell * n_source
-    emulated = emulated_model(model, options, release_x, present)
+    emulated = emulated_model(model, options, release_x, present, chainage_m=vertices)
     translation = translation_error(calibrated, emulated)
     return Export(
         TARGET,
@@ -760,28 +806,42 @@ def export_rstone(
         ],
         notes=_notes(site, traced, n_source, per_cell, chainage is not None),
         how_to_use=_how_to_use(options, traced),
-        translation=[*translation.lines(), "", emulation_text(release_x)],
+        translation=[
+            *translation.lines(),
+            "",
+            emulation_text(release_x, grid.cellsize_m),
+        ],
         sources=SOURCES,
         unconfirmed=[*UNCONFIRMED, *open_],
     )
 
 
-def emulation_text(release_x_m: float) -> str:
+def emulation_text(release_x_m: float, cellsize_m: float) -> str:
     """What fieldkit's emulation of r.stone's law is (the README's translation
-    section): :func:`emulated_model`."""
+    section): :func:`emulated_model`, :mod:`fieldkit.export.rstone_law`."""
     return (
-        "The emulation of r.stone's law: each material the constant pair at the "
-        "written whole percents with r.stone's draw SD 2 range / 100; no effect, no "
-        "roughness; the friction angle phi' whose fieldkit deceleration g cos(psi) "
-        "tan(phi') equals r.stone's rolling deceleration g sin(beta) on the "
-        "material's typical slope psi (its segments' length-weighted mean dip), "
-        "tan(beta) as r.stone reads it (thousandths); the rock launched "
-        f"horizontally at start_vel from the ground at chainage {release_x_m:.1f} m, "
-        "as r.stone starts it. fieldkit's flight, impact and sliding kernels stand "
-        "for r.stone's; its switch to rolling (a bounce shorter than 3 m and slower "
-        "than 5 m/s) is approximated by fieldkit's switch to sliding at a rebound "
-        f"normal speed below {ROLL_SPEED_MPS:g} m/s (core.slide_vn_mps), and its 5 m "
-        "steps are not emulated."
+        "The emulation of r.stone's law is a 2-D port of r.stone's own kernel "
+        "(fieldkit.export.rstone_law, from points.c TrackPoints, Parab, Bounce, "
+        "Roll and stone.c) along the section, its vertices the cell centres "
+        f"({cellsize_m:g} m apart), each segment one of r.stone's planes seen in "
+        "section; each cell the values written (nrest, trest in whole percent, "
+        "tan(beta) in thousandths as r.stone reads them). Ported: the launch "
+        f"(horizontal at start_vel from the ground at chainage {release_x_m:.1f} m, "
+        "towards the lower neighbour); flight as a parabola under r.stone's g = "
+        "9.805 m/s² to the ground; at a landing, rolling when the bounce was "
+        "shorter than 3 m and slower than 5 m/s (both), else a bounce: normal "
+        "velocity x -nrest, tangential x trest, each drawn per bounce (Gaussian SD "
+        "2 range / 100, clipped to [0, 1]), a stop below stop_vel; rolling with the "
+        "velocity in the plane, decelerated by g sin(beta) against the motion, "
+        "tan(beta) drawn for each cell entered, 5 m steps with r.stone's 'stop "
+        "between two steps', flight again where a step ends more than 0.01 m above "
+        "the next plane (a convex break), a stop below stop_vel. Not ported: the "
+        "3-D geometry of r.stone's two triangles per cell (lateral components of "
+        "velocity and gravity), the lateral spread of the launch angle "
+        f"(ang_stoch_range, written as {DEFAULT_ANGLE_RANGE}), the 5 m flight steps "
+        "(the parabola's landing is exact), and r.stone's output sampling (its grids "
+        "are marked at path points 5 m apart). Energies use the model's mass "
+        "(r.stone has none), with no rotation."
     )
 
 
@@ -1201,16 +1261,10 @@ UNCONFIRMED = [
     "the lateral spread of the launch angle is written as 0 (ang_stoch_range): "
     "fieldkit's model is a 2-D section and calibrates none; what a site's real "
     "spread is stays open",
-    "the translation error is fieldkit's emulation of r.stone's law, not r.stone: "
-    "the emulation approximates r.stone's switch to rolling (a bounce shorter than "
-    "3 m and slower than 5 m/s) by sliding below a 5 m/s rebound normal speed. "
-    "Checked in r.stone 8.2.1 (tests/export/test_rstone_real.py): on Tornado "
-    "Mountain's extruded section r.stone and the emulation both run off the "
-    "section's end (runout p50 and p95 within one cell; a degenerate check); on "
-    "a Tschamut release area (14 cells, 994 trajectories) r.stone's runout p50/p95 "
-    "are 70/90 m against the emulation's 68.5 ± 1.1/85.5 m, within 2 SE plus one "
-    "cell (without the roll-switch approximation the emulation gave 79.6/87.7 m; "
-    "with r.stone's default ang_stoch_range 10, r.stone gave 70/115 m)",
+    "the translation error is fieldkit's emulation of r.stone's law (a 2-D port "
+    "of its kernel along the section, fieldkit.export.rstone_law), not r.stone: "
+    "the 3-D triangles, the launch-angle spread and the 5 m flight steps are not "
+    "ported. AGREEMENT_TEXT",
     "r.stone ends some trajectories as 'Track overflow' without writing their last "
     "path segment to the grids (points.c TrackPoints, case 0: Parab 'confused' "
     "after 5 steps outside the triangle, or 100000 path points): 239 of 994 on the "

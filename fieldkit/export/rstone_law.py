@@ -229,9 +229,7 @@ def _cross_roll(x, z, at, crossed, speed, height, r, x0, z0, tx, tz, d0, u, acc,
 
 
 @njit(cache=True)
-def run_law(
-    x, z, nrest, trest, frict, sd, start_vel, stop_vel, release_x, keys, at, g
-):
+def run_law(x, z, nrest, trest, frict, sd, start_vel, stop_vel, release_x, keys, at, g):
     """r.stone's law for each rock (module docstring).
 
     Parameters
@@ -488,7 +486,7 @@ class RstoneLaw:
 
     @property
     def start_x_m(self) -> float:
-        """Where the rocks start [m] (:class:`fieldkit.export.translation.Emulation`)."""
+        """Where the rocks start [m] (see ``translation.Emulation``)."""
         return float(self.release_x_m)
 
     @property

@@ -35,6 +35,12 @@ the calibrated model's, and says how far apart the two remain:
 
 The translation error is fieldkit's emulation, not a run of the target: it is
 only as good as the emulation of the target's law, which each exporter states.
+
+An emulation is either a fieldkit :class:`~fieldkit.model.model_file.Model` of the
+target's law (run by :func:`fieldkit.model.simulate.simulate`) or any object of
+the :class:`Emulation` protocol: a kernel of the target's own law (r.stone's,
+:mod:`fieldkit.export.rstone_law`) with a ``simulate`` giving the fields the
+comparison reads (:func:`run`).
 """
 
 from __future__ import annotations
@@ -42,6 +48,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 import pandas as pd
@@ -62,6 +69,41 @@ SEARCH_ROCKS, SEARCH_SEED = 500, 7
 
 #: Fractions of the calibrated rocks passing the default analysis points.
 DEFAULT_PASSING = (0.9, 0.5)
+
+
+@runtime_checkable
+class Emulation(Protocol):
+    """A target's law run by a kernel of its own, not a fieldkit Model.
+
+    ``simulate(rocks, rng, analysis_x_m)`` returns an object with the fields of
+    a :class:`~fieldkit.model.results.SimulationResult` the comparison reads:
+    ``runout_x_m`` (rocks,), ``state`` (rocks,) with
+    :data:`~fieldkit.model.results.EXITED_DOWNSLOPE` etc., and ``analysis``, one
+    :class:`~fieldkit.model.results.AnalysisPoint` per analysis chainage (at
+    least ``crossed``, ``total_j``, ``height_m``). ``start_x_m`` and ``end_x_m``
+    are where its rocks start and its section ends [m] (:func:`default_points`).
+    """
+
+    @property
+    def start_x_m(self) -> float: ...
+
+    @property
+    def end_x_m(self) -> float: ...
+
+    def simulate(self, rocks: int, rng: np.random.Generator, analysis_x_m=()): ...
+
+
+def run(
+    emulated: Model | Emulation,
+    rocks: int,
+    rng: np.random.Generator,
+    analysis_x_m: Sequence[float] = (),
+):
+    """Simulate a Model with fieldkit's :func:`~fieldkit.model.simulate.simulate`,
+    or an :class:`Emulation` with its own ``simulate``."""
+    if isinstance(emulated, Model):
+        return simulate(emulated, rocks, rng, analysis_x_m=analysis_x_m)
+    return emulated.simulate(rocks, rng, analysis_x_m=analysis_x_m)
 
 
 def realised_impacts(
@@ -294,7 +336,7 @@ class Translation:
 
 def translation_error(
     calibrated: Model,
-    emulated: Model,
+    emulated: Model | Emulation,
     *,
     at_m: Sequence[float] | None = None,
     rocks: int = ROCKS,
@@ -308,7 +350,7 @@ def translation_error(
         The calibrated model.
     emulated
         fieldkit's model of the target's law with the exported values, on the
-        same section.
+        same section: a Model, or an :class:`Emulation` (:func:`run`).
     at_m
         Analysis points [m]; default :func:`default_points`.
     rocks, seed
@@ -330,7 +372,7 @@ def translation_error(
     if at_m is None:
         at_m = default_points(calibrated, rocks, seed)
     at = tuple(float(x) for x in at_m)
-    second = simulate(emulated, rocks, np.random.default_rng(seed), analysis_x_m=at)
+    second = run(emulated, rocks, np.random.default_rng(seed), analysis_x_m=at)
     first = simulate(calibrated, rocks, np.random.default_rng(seed), analysis_x_m=at)
     return replace(_compare(first, second, rocks, seed, at), default_at=default_at)
 
@@ -366,16 +408,22 @@ def _compare(first, second, rocks: int, seed: int, at: Sequence[float]) -> Trans
     )
 
 
-def default_points(model: Model, rocks: int = ROCKS, seed: int = SEED) -> list[float]:
+def default_points(
+    model: Model | Emulation, rocks: int = ROCKS, seed: int = SEED
+) -> list[float]:
     """The chainages 90 % and 50 % of ``model``'s rocks pass (:data:`DEFAULT_PASSING`),
     to 0.1 m, leaving out a point at the section's lower end (where rocks that
     leave the section are counted); the point three quarters of the way from the
-    seeder to the end when both fall there.
+    seeder to the end when both fall there. ``model`` a Model or an
+    :class:`Emulation` (from its ``start_x_m`` to its ``end_x_m``).
     """
-    pilot = simulate(model, rocks, np.random.default_rng(seed))
+    pilot = run(model, rocks, np.random.default_rng(seed))
     runout = np.asarray(pilot.runout_x_m, float)
-    start = float(model.seeder.x_m)
-    end = float(model.profile.x_m[-1])
+    if isinstance(model, Model):
+        start = float(model.seeder.x_m)
+        end = float(model.profile.x_m[-1])
+    else:
+        start, end = float(model.start_x_m), float(model.end_x_m)
     margin = 0.01 * (end - start)
     points = sorted(
         {
@@ -464,7 +512,7 @@ class Search:
 
 def closest_in_range(
     calibrated: Model,
-    build: Callable[[Sequence[float]], Model],
+    build: Callable[[Sequence[float]], Model | Emulation],
     start: Sequence[float],
     lo: Sequence[float],
     hi: Sequence[float],
@@ -485,7 +533,8 @@ def closest_in_range(
     Parameters
     ----------
     build
-        values -> fieldkit's model of the target's law with those values.
+        values -> fieldkit's model of the target's law with those values: a
+        Model or an :class:`Emulation` (:func:`run`).
     start, lo, hi
         Starting values (e.g. :func:`fit_scaled`'s) and the target's documented
         ranges.
@@ -521,7 +570,7 @@ def closest_in_range(
         nonlocal count
         count += 1
         values = tuple(float(v) for v in np.clip(x, lo_a, hi_a))
-        emulated = simulate(
+        emulated = run(
             build(values), rocks, np.random.default_rng(seed), analysis_x_m=points
         )
         return behaviour_gap(_compare(reference, emulated, rocks, seed, points))
