@@ -561,11 +561,12 @@ def rstone_pairs(
     :func:`fieldkit.export.lumped.closest_behaviour` searches the pairs whose
     emulation under r.stone's law (:func:`emulated_model`) behaves closest to the
     calibrated model (runout, design energy and bounce height), written only if
-    they also do so on an independent stream, in whole percent. The SDs are the
-    impacts' own spread around the written value (what r.stone's random draw
-    should carry, not the fit's standard error); roughness goes (r.stone has
-    none). A material no simulated rock touched is said loudly
-    (:func:`~fieldkit.export.lumped.fit_coefficients`).
+    they also do so on an independent stream, in whole percent. Each written
+    value is shown with the impacts' own spread around it (not the fit's
+    standard error); r.stone's random draws keep the calibrated SDs, since that
+    spread is mostly the calibrated law's systematic change with impact speed,
+    not scatter; roughness goes (r.stone has none). A material no simulated
+    rock touched is said loudly (:func:`~fieldkit.export.lumped.fit_coefficients`).
 
     Returns
     -------
@@ -579,17 +580,15 @@ def rstone_pairs(
     coefficients, loud = fit_coefficients(model, "r.stone", np.ones_like, *ranges)
 
     def written(values: dict[str, tuple[Coefficient, Coefficient]]) -> Model:
+        # The draw SDs stay the calibrated e_n_sd, e_t_sd: the impacts' spread
+        # around a constant pair is mostly the law's systematic change with impact
+        # speed or angle, which a random draw would turn into noise (the README
+        # shows it beside each written value).
         out = with_coefficients(model, values)
-        materials = dict(out.materials)
-        for name, (rn, rt) in values.items():
-            m = materials[name]
-            materials[name] = replace(
-                m,
-                e_n_sd=rn.spread if math.isfinite(rn.spread) else m.e_n_sd,
-                e_t_sd=rt.spread if math.isfinite(rt.spread) else m.e_t_sd,
-                roughness_m=0.0,
-                roughness_deg_sd=0.0,
-            )
+        materials = {
+            name: replace(m, roughness_m=0.0, roughness_deg_sd=0.0)
+            for name, m in out.materials.items()
+        }
         return replace(out, materials=materials)
 
     def emulate(values: dict[str, tuple[Coefficient, Coefficient]]) -> Model:
