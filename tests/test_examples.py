@@ -125,6 +125,18 @@ def test_example_runs(script, tmp_path):
         # the figures and reports of every stage are linked
         for stage in ("reduce/", "diagnose/", "fit/", "simulate/", "export/"):
             assert any(link.startswith(stage) for link in links), stage
+        # the committed calibrated model is the one the demo's fit writes
+        import json
+
+        made = json.loads((tmp_path / "out" / "calibrated_model.json").read_text())
+        kept = json.loads(
+            (
+                Path(__file__).parents[1]
+                / "surveys/tornado_mountain/model_path_calibrated.json"
+            ).read_text()
+        )
+        for key in ("materials", "effects", "profile", "body", "seeder"):
+            assert made[key] == kept[key], key
 
 
 def test_every_example_has_expectations_or_is_new():

@@ -554,32 +554,6 @@ def constant_pair(model: Model, name: str) -> bool:
     )
 
 
-def spread_at(c: Coefficient, lo: float, hi: float) -> float:
-    """The impacts' own spread around ``c.written`` (what r.stone's draw carries).
-
-    ``c.spread`` is the spread around the value it was fitted at: the
-    least-squares value clipped to ``[lo, hi]`` for an impact-level coefficient,
-    ``c.written`` once the behaviour search set it (``c.impact_level`` finite).
-    The search moves ``written`` alone, so the spread at a candidate follows from
-    the fit: ``spread(v)² = residual² + (v - unclipped)²``, the residual the
-    least-squares one (:func:`~fieldkit.export.translation.fit_scaled`). So the
-    search emulates the ranges the export then writes. NaN when not fitted.
-
-    Examples
-    --------
-    >>> c = Coefficient("e_n", 0.5, 0.6, 0.1, 10, unclipped=0.6)
-    >>> round(spread_at(c, 0, 1), 6), round(spread_at(replace(c, written=0.9), 0, 1), 6)
-    (0.1, 0.316228)
-    """
-    if not (c.n and math.isfinite(c.spread)):
-        return math.nan
-    if math.isfinite(c.impact_level) or not math.isfinite(c.unclipped):
-        return c.spread
-    fitted = min(max(c.unclipped, lo), hi)
-    residual2 = max(0.0, c.spread**2 - (fitted - c.unclipped) ** 2)
-    return math.sqrt(residual2 + (c.written - c.unclipped) ** 2)
-
-
 def rstone_pairs(
     model: Model,
     names: list[str],
@@ -600,11 +574,12 @@ def rstone_pairs(
     emulation under r.stone's law (:func:`emulated_model`, vertices at
     ``chainage_m``) behaves closest to the
     calibrated model (runout, design energy and bounce height), written only if
-    they also do so on an independent stream, in whole percent. The SDs are the
-    impacts' own spread around the written value (what r.stone's random draw
-    should carry, not the fit's standard error); roughness goes (r.stone has
-    none). A material no simulated rock touched is said loudly
-    (:func:`~fieldkit.export.lumped.fit_coefficients`).
+    they also do so on an independent stream, in whole percent. Each written
+    value is shown with the impacts' own spread around it (not the fit's
+    standard error); r.stone's random draws keep the calibrated SDs, since that
+    spread is mostly the calibrated law's systematic change with impact speed,
+    not scatter; roughness goes (r.stone has none). A material no simulated
+    rock touched is said loudly (:func:`~fieldkit.export.lumped.fit_coefficients`).
 
     Returns
     -------
@@ -617,18 +592,15 @@ def rstone_pairs(
     coefficients, loud = fit_coefficients(model, "r.stone", np.ones_like, *ranges)
 
     def written(values: dict[str, tuple[Coefficient, Coefficient]]) -> Model:
+        # The draw SDs stay the calibrated e_n_sd, e_t_sd: the impacts' spread
+        # around a constant pair is mostly the law's systematic change with impact
+        # speed or angle, which a random draw would turn into noise (the README
+        # shows it beside each written value).
         out = with_coefficients(model, values)
-        materials = dict(out.materials)
-        for name, (rn, rt) in values.items():
-            m = materials[name]
-            sd_n, sd_t = spread_at(rn, *ranges[0]), spread_at(rt, *ranges[1])
-            materials[name] = replace(
-                m,
-                e_n_sd=sd_n if math.isfinite(sd_n) else m.e_n_sd,
-                e_t_sd=sd_t if math.isfinite(sd_t) else m.e_t_sd,
-                roughness_m=0.0,
-                roughness_deg_sd=0.0,
-            )
+        materials = {
+            name: replace(m, roughness_m=0.0, roughness_deg_sd=0.0)
+            for name, m in out.materials.items()
+        }
         return replace(out, materials=materials)
 
     def emulate(values: dict[str, tuple[Coefficient, Coefficient]]) -> RstoneLaw:

@@ -24,7 +24,9 @@ seen in section, and this module ports, from ``points.c`` (``TrackPoints``,
   ``trest/100`` and clipped to [0, 1]; a rock slower than ``stop_vel`` after a
   bounce stops. A bounce that leaves no normal velocity (a draw of 0) is
   followed by a further bounce at once (``Parab``'s "bounce forced"), without
-  the roll test and without moving the last bounce point;
+  the roll test and without moving the last bounce point (:data:`MAX_FORCED`
+  such bounces in a row end the track there: r.stone would repeat them
+  forever with a trest draw of 1, or hop on its 0.1 mm rounding);
 * rolling (``Roll``): the velocity projected onto the plane (its normal
   component lost), the point onto the plane; acceleration ``g`` along the plane
   minus ``g sin(beta)`` against the motion, ``tan(beta)`` the cell's friction
@@ -92,6 +94,11 @@ FLY_HEIGHT_M = 0.01
 
 #: Roll points without a flight before r.stone gives up (PATH_ARRAY_SIZE).
 MAX_PATH = 100000
+
+#: Forced bounces in a row (no normal velocity left) after which the port ends
+#: the track where it is: with a trest draw of 1 the speed never falls, and
+#: r.stone would bounce in place forever (or hop on its 0.1 mm rounding).
+MAX_FORCED = 1000
 
 #: Random-stream slots: nrest and trest per bounce, friction per cell entered.
 SLOT_NREST, SLOT_TREST, SLOT_FRICTION = 0, 1, 2
@@ -291,9 +298,15 @@ def run_law(x, z, nrest, trest, frict, sd, start_vel, stop_vel, release_x, keys,
         xw = px
         fly = True
         npath = 0
+        forced = 0
         while True:
             if fly:
                 kind, t, jj = _flight(x, z, g, px, pz, vx, vz, j)
+                forced = forced + 1 if kind == 1 else 0
+                if forced > MAX_FORCED:
+                    state[r] = STOPPED
+                    runout[r] = px
+                    break
                 _cross_flight(x, z, g, at, crossed, speed, height, r, px, pz, vx,
                               vz, t)  # fmt: skip
                 if kind == 2:
