@@ -84,9 +84,14 @@ def test_tornado_section_rasters_reread(tornado, tmp_path, written_grids):
     rock = np.zeros((5, 71), bool)
     rock[:, :4] = True  # the padded column and centres 5, 15, 25 m: x < 28 m is rock
     # The pairs fitted to the calibrated model's own impacts (roughness folded in)
-    # round to the calibrated percents: rock 0.75/0.59, colluvium 1.00/0.62.
-    np.testing.assert_array_equal(grids["nrest.asc"].values, np.where(rock, 75, 100))
-    np.testing.assert_array_equal(grids["trest.asc"].values, np.where(rock, 59, 62))
+    # round to the calibrated percents, rock 0.75/0.59, colluvium 1.00/0.62; under
+    # r.stone's own law (the ported kernel: rolling after short slow bounces) the
+    # behaviour search moves them to rock 0.98/0.97, colluvium 0.93/0.65, which
+    # it writes since they cut the gap on the independent stream (0.0588 ->
+    # 0.000151): the design energy and bounce height at the analysis point then
+    # agree within 1 %.
+    np.testing.assert_array_equal(grids["nrest.asc"].values, np.where(rock, 98, 93))
+    np.testing.assert_array_equal(grids["trest.asc"].values, np.where(rock, 97, 65))
     # tan(2.86 deg) = 0.04996 -> 0.05; tan(19.29 deg) = 0.34999 -> 0.35.
     np.testing.assert_array_equal(
         grids["friction.asc"].values, np.where(rock, 0.05, 0.35)
@@ -120,7 +125,8 @@ def test_tornado_options_and_readme(tornado):
     assert "frict_stoch_range: the materials need 1, 2" in mismatches
     assert "raised by 5 m" in mismatches
     assert "1.059 x fieldkit's" in mismatches  # 1 / cos(19.29 deg) = 1.0595
-    assert "colluvium: nrest 100 % with a draw SD of 0.04" in mismatches
+    assert "rock: nrest 98 % with a draw SD of 0.04" in mismatches
+    assert "behaviour search from the impact-level 0.7509" in mismatches
     unmapped = dict(export.unmapped)
     assert any(k.startswith("slope roughness (rock") for k in unmapped)
     readme = export.readme("model.json")
