@@ -50,7 +50,8 @@ def test_rolling_stop_on_flat_ground_from_speed_v():
     landing = 2.0 * math.sqrt(2.0 / G_MPS2)
     brake = G_MPS2 * math.sin(math.atan(0.5))
     assert result.state[0] == STOPPED and result.impacts_per_rock[0] == 0
-    assert result.runout_x_m[0] == pytest.approx(landing + 2.0**2 / (2 * brake), abs=1e-9)
+    expected = landing + 2.0**2 / (2 * brake)
+    assert result.runout_x_m[0] == pytest.approx(expected, abs=1e-9)
 
 
 def test_energy_is_conserved_with_nrest_and_trest_100_and_no_stop():
