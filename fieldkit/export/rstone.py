@@ -413,6 +413,7 @@ def emulated_model(
     names: list[str] | None = None,
     *,
     chainage_m: np.ndarray | None = None,
+    cell_id: np.ndarray | None = None,
 ) -> RstoneLaw:
     """fieldkit's emulation of r.stone's law with the values written for ``model``:
     r.stone's own kernel ported along the section
@@ -426,8 +427,9 @@ def emulated_model(
     whole percent (:func:`percent`), ``tan(beta)`` as r.stone reads it
     (:func:`friction_read`); the spread ranges, ``start_vel`` and ``stop_vel``
     of ``options``; the rocks start on the ground at ``release_x_m``; energies
-    with the body's mass. ``names`` is accepted for the callers' symmetry: every
-    material of ``model`` is taken as written.
+    with the body's mass. ``cell_id``: the DEM cell of each vertex when the
+    vertices are not cell centres (:func:`tin_section`). ``names`` is accepted
+    for the callers' symmetry: every material of ``model`` is taken as written.
     """
     del names
     x = np.asarray(model.profile.x_m, float)
@@ -459,7 +461,55 @@ def emulated_model(
         stop_vel_mps=float(options["stop_vel"]),
         release_x_m=float(release_x_m),
         mass_kg=float(model.body.mass_kg),
+        cell_id=cell_id,
     )
+
+
+#: Plan spacing [m] of the points of a section through r.stone's triangles
+#: (:func:`tin_section`): the triangles' edges are crossed within it.
+TIN_STEP_M = 0.5
+
+
+def tin_section(
+    grid: DemGrid, plan_x_m: np.ndarray, plan_y_m: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The ground of r.stone's triangles under plan points, and each point's cell.
+
+    r.stone's surface (``NewPlane``, ``stone.c``) is two triangles per square
+    of four cell centres: type 1 with its right angle at the south-west centre
+    (below the diagonal from the south-east to the north-west centre), type 2 at
+    the north-east one; each plane through its three centres' elevations.
+
+    Returns
+    -------
+    z_m, cell_id
+        The elevation on that surface, and the id (``row * ncols + col``) of the
+        cell whose centre is nearest (the cell r.stone reads values from).
+
+    Examples
+    --------
+    >>> g = DemGrid.from_corner(np.array([[4.0, 0.0], [0.0, 0.0]]), x_left_m=0,
+    ...     y_top_m=2, cellsize_m=1)
+    >>> z, cell = tin_section(g, np.array([0.5, 1.0, 1.25]), np.array([1.5, 1.0, 1.25]))
+    >>> z.tolist(), cell.tolist()
+    ([4.0, 2.0, 1.0], [0, 3, 1])
+    """
+    x0, y0, cell = float(grid.x_m[0]), float(grid.y_m[0]), float(grid.cellsize_m)
+    rows, cols = grid.shape
+    px, py = np.asarray(plan_x_m, float), np.asarray(plan_y_m, float)
+    col = np.clip(np.floor((px - x0) / cell).astype(int), 0, cols - 2)
+    south = np.clip(np.floor((y0 - py) / cell).astype(int) + 1, 1, rows - 1)
+    north = south - 1
+    u = (px - grid.x_m[col]) / cell
+    v = (py - grid.y_m[south]) / cell
+    z = grid.values
+    sw, se = z[south, col], z[south, col + 1]
+    nw, ne = z[north, col], z[north, col + 1]
+    first = sw + u * (se - sw) + v * (nw - sw)
+    second = ne + (1 - u) * (nw - ne) + (1 - v) * (se - ne)
+    nearest_col = np.clip(np.floor((px - x0) / cell + 0.5).astype(int), 0, cols - 1)
+    nearest_row = np.clip(np.floor((y0 - py) / cell + 0.5).astype(int), 0, rows - 1)
+    return np.where(v <= 1 - u, first, second), nearest_row * cols + nearest_col
 
 
 def emulated_runouts(
@@ -477,8 +527,10 @@ def emulated_runouts(
     centre (:func:`~fieldkit.model.dem_profile.steepest_descent_line`, half-cell
     steps) continued straight to the grid's edge where it ends in a pit or a
     flat, as ``fieldkit fit-paths`` cuts Tschamut's runs
-    (:func:`~fieldkit.fit.path_sections.extend_to_edge`), its vertices every
-    cell along it (plan chainage), its trajectories launched at chainage 0; a
+    (:func:`~fieldkit.fit.path_sections.extend_to_edge`), its ground the section
+    through r.stone's triangles (:func:`tin_section`, points every
+    :data:`TIN_STEP_M` of plan chainage, each with its cell's values and
+    friction draw), its trajectories launched at chainage 0; a
     runout is then the plan distance of the rock's stop on that line from the
     nearest source cell's centre, as ``import-results`` measures r.stone's
     (:mod:`fieldkit.io.rstone_results`). A rock that reaches its section's end
@@ -526,14 +578,22 @@ def emulated_runouts(
         line = extend_to_edge(
             grid, steepest_descent_line(grid, (s["x_m"], s["y_m"]), cell / 2), cell / 2
         )
-        profile = Profile.from_arrays(
-            line.chainage_m, line.z_m, [names[0]] * (line.z_m.size - 1)
-        )
-        vertices = np.append(np.arange(0.0, line.length_m, cell), line.length_m)
+        vertices = np.append(np.arange(0.0, line.length_m, TIN_STEP_M), line.length_m)
         if vertices[-1] - vertices[-2] < 1e-6:
             vertices = vertices[:-1]
+        z, cells = tin_section(
+            grid,
+            np.interp(vertices, line.chainage_m, line.plan_x_m),
+            np.interp(vertices, line.chainage_m, line.plan_y_m),
+        )
+        profile = Profile.from_arrays(vertices, z, [names[0]] * (z.size - 1))
         emulated = emulated_model(
-            replace(written, profile=profile), options, 0.0, names, chainage_m=vertices
+            replace(written, profile=profile),
+            options,
+            0.0,
+            names,
+            chainage_m=vertices,
+            cell_id=cells,
         )
         result = emulated.simulate(int(s["trajectories"]), rng)
         runouts.append(from_sources(line, np.asarray(result.runout_x_m, float)))

@@ -120,7 +120,7 @@ def _segment(x, px):
 
 @njit(cache=True)
 def _cell(x, px):
-    """The cell under ``px``: the nearest vertex (vertices are cell centres)."""
+    """The vertex nearest ``px`` (whose cell and values are the point's)."""
     n = x.size
     j = np.searchsorted(x, px, side="right") - 1
     if j < 0:
@@ -236,13 +236,18 @@ def _cross_roll(x, z, at, crossed, speed, height, r, x0, z0, tx, tz, d0, u, acc,
 
 
 @njit(cache=True)
-def run_law(x, z, nrest, trest, frict, sd, start_vel, stop_vel, release_x, keys, at, g):
+def run_law(
+    x, z, cells, nrest, trest, frict, sd, start_vel, stop_vel, release_x, keys, at, g
+):
     """r.stone's law for each rock (module docstring).
 
     Parameters
     ----------
     x, z
-        Vertices (cell centres) of the section [m], x increasing.
+        Vertices of the section [m], x increasing.
+    cells
+        Per vertex: the id of the DEM cell it lies in (a friction draw per cell
+        entered).
     nrest, trest
         Per vertex (cell): restitution in whole percent as r.stone reads them.
     frict
@@ -369,11 +374,11 @@ def run_law(x, z, nrest, trest, frict, sd, start_vel, stop_vel, release_x, keys,
             while True:
                 cx = x[j] + d * tx
                 c = _cell(x, cx)
-                if c != lcell:
+                if cells[c] != lcell:
                     fc = _clip01(frict[c] + sd[2] * normal(key, nf, SLOT_FRICTION))
                     nf += 1
                     f = math.sin(math.atan(fc)) * g
-                    lcell = c
+                    lcell = cells[c]
                 dirn = 0.0
                 if u > 0.0:
                     dirn = 1.0
@@ -470,6 +475,10 @@ class RstoneLaw:
         Where the rocks start, on the ground [m].
     mass_kg
         The rock's mass for energies (r.stone itself has none).
+    cell_id
+        Per vertex, the DEM cell it lies in (None: every vertex a cell centre,
+        its own cell). A point takes the values of its nearest vertex and draws
+        a new friction when that vertex's cell differs from the last one's.
     """
 
     x_m: np.ndarray
@@ -484,6 +493,7 @@ class RstoneLaw:
     stop_vel_mps: float
     release_x_m: float
     mass_kg: float
+    cell_id: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         x = np.asarray(self.x_m, float)
@@ -491,7 +501,9 @@ class RstoneLaw:
             raise ArgumentError(
                 "x_m must hold at least 2 increasing chainages", source="x_m"
             )
-        for name in ("z_m", "nrest_pct", "trest_pct", "friction_tan"):
+        for name in ("z_m", "nrest_pct", "trest_pct", "friction_tan", "cell_id"):
+            if name == "cell_id" and self.cell_id is None:
+                continue
             if np.shape(getattr(self, name)) != x.shape:
                 raise ArgumentError(
                     f"{name} must have one value per vertex ({x.size})", source=name
@@ -524,9 +536,16 @@ class RstoneLaw:
                 2.0 * self.frict_stoch_range / 100.0,
             ]
         )
+        x = np.ascontiguousarray(self.x_m, float)
+        cells = (
+            np.arange(x.size, dtype=np.int64)
+            if self.cell_id is None
+            else np.ascontiguousarray(self.cell_id, np.int64)
+        )
         runout, state, bounces, crossed, speed, height = run_law(
-            np.ascontiguousarray(self.x_m, float),
+            x,
             np.ascontiguousarray(self.z_m, float),
+            cells,
             np.ascontiguousarray(self.nrest_pct, np.int64),
             np.ascontiguousarray(self.trest_pct, np.int64),
             np.ascontiguousarray(self.friction_tan, float),
