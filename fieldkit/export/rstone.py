@@ -386,22 +386,33 @@ def friction_read(tan_written: float) -> float:
     return math.floor(value + 1e-12) / 1000.0 if value >= 0 else 0.0
 
 
-def cell_centres_m(model: Model, cellsize_m: float | None = None) -> np.ndarray:
-    """Chainages of the cell centres along ``model``'s section, as
-    :func:`section_site` lays its columns (cells of ``cellsize_m``, default
-    :func:`section_site`'s): the vertices of r.stone's planes seen in section.
+def cell_centres_m(
+    model: Model, cellsize_m: float | None = None, origin_m: float | None = None
+) -> np.ndarray:
+    """Chainages of the cell centres along ``model``'s section: the vertices of
+    r.stone's planes seen in section.
+
+    As :func:`section_site` lays its columns (cells of ``cellsize_m``, default
+    :func:`section_site`'s), or, with ``origin_m``, one centre there (where
+    r.stone starts a rock: a release cell's centre) and the others every cell
+    either side of it within the profile.
 
     Examples
     --------
     >>> from types import SimpleNamespace as N
-    >>> cell_centres_m(N(profile=N(x_m=[0.0, 21.0])), 5.0).tolist()
-    [2.5, 7.5, 12.5, 17.5]
+    >>> m = N(profile=N(x_m=[0.0, 21.0]))
+    >>> cell_centres_m(m, 5.0).tolist(), cell_centres_m(m, 5.0, 0.0).tolist()
+    ([2.5, 7.5, 12.5, 17.5], [0.0, 5.0, 10.0, 15.0, 20.0])
     """
     x = np.asarray(model.profile.x_m, float)
     length = float(x[-1] - x[0])
     if cellsize_m is None:
         cellsize_m = max(STEP_M, float(math.ceil(length / 500.0)))
     cell = float(cellsize_m)
+    if origin_m is not None:
+        first = math.ceil((x[0] - origin_m) / cell - 1e-9)
+        last = math.floor((x[-1] - origin_m) / cell + 1e-9)
+        return origin_m + cell * np.arange(first, max(last, first + 1) + 1)
     ncols = max(2, math.floor(length / cell))
     return x[0] + cell * (np.arange(ncols) + 0.5)
 
@@ -763,7 +774,9 @@ def export_rstone(
     )
     height = fall_height_m(model, site)
     vertices = (
-        chainage if chainage is not None else cell_centres_m(model, grid.cellsize_m)
+        chainage
+        if chainage is not None
+        else cell_centres_m(model, grid.cellsize_m, release_x)
     )
     model, fitted, open_, _ = rstone_pairs(
         model, present, release_x, height, chainage_m=vertices

@@ -132,3 +132,18 @@ def test_the_export_readme_states_the_ported_law(cli, repo, tmp_path):
     assert "shorter than 3 m and slower than 5 m/s (both)" in readme
     assert "slide_vn_mps" not in readme.split("## Translation error")[1].split("##")[0]
     assert f"wrote {out / 'README.md'}" in r.stderr + r.stdout
+
+
+def test_a_dem_export_emulates_from_the_release_cell(cli, repo, tmp_path):
+    # Tschamut's seeder lies at chainage 0, the section's first point: the
+    # emulation's cell centres start there (r.stone starts a rock at its release
+    # cell's centre), so its rocks start, run and leave the section's lower end
+    # as the calibrated model's do (none left at the upper end at once).
+    out = tmp_path / "rstone"
+    r = cli("export", repo / "examples/tschamut/model_base.json", "--to", "rstone",
+            "-o", out, "--dem", repo / "tests/data/tschamut2014/terrain.asc",
+            "--release", "30.602,235.28")  # fmt: skip
+    assert r.exit_code == 0, r.stderr
+    readme = (out / "README.md").read_text()
+    assert "| runout p50 | 150 ± 0 m | 150 ± 0 m |" in readme
+    assert "72.4 % (calibrated), 96.5 % (emulated)" in readme
