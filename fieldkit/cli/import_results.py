@@ -49,7 +49,7 @@ def import_results(
     Example (from the repository root): the bundled grids of a real r.stone run
     (GRASS 8.2.1) on the Tornado Mountain export,
 
-        fieldkit import-results tests/data/rstone_tornado --from rstone \\
+        fieldkit import-results examples/rstone_tornado --from rstone \\
           -o out/rstone_results
 
     made with (the last two lines in a shell with GRASS GIS and r.stone):
