@@ -379,7 +379,8 @@ def test_cli_import_results_by_hand(cli, tmp_path):
     res = tmp_path / "results"
     r = cli("import-results", out, "--from", "rstone", "-o", res)
     assert r.exit_code == 0, r.stderr
-    assert r.stdout.count("wrote ") == 2
+    assert r.stdout.count("wrote ") == 3
+    assert (res / "along.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     summary = json.loads((res / "summary.json").read_text())
     assert summary["trajectories_stated"] == summary["trajectories_traced"] == 1000
     # Survival (column chainages 2.5, 7.5, ...): 1, 1, .9, .8(.807 with the north
