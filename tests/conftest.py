@@ -69,7 +69,14 @@ def digest():
 
 
 #: What a fresh clone ships for examples to read, copied into a scratch repository root.
-BUNDLED = ("surveys", "video", "tests/data", "tests/io/data", "examples/tschamut")
+BUNDLED = (
+    "surveys",
+    "video",
+    "tests/data",
+    "tests/io/data",
+    "examples/tschamut",
+    "examples/rstone_tornado",
+)
 
 
 @pytest.fixture()

@@ -64,7 +64,7 @@ EXPECTED = {
         r"json: 3 files",
         r"rockyfor3d: 11 files",
         r"ramms: 4 files",
-        r"rstone: 6 files",
+        r"rstone: 8 files",
         r"mismatch: colluvium: rstone has no velocity_scaled_restitution",
     ],
     # `make demo` (issue 17): the whole loop, one line per step; boulder A has 48

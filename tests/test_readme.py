@@ -17,7 +17,16 @@ REPO = Path(__file__).resolve().parents[1]
 README = (REPO / "README.md").read_text()
 FENCE = re.compile(r"^```(\w*)\n(.*?)^```", re.M | re.S)
 #: Top-level folders a README path may point into.
-TOP = ("fieldkit", "docs", "surveys", "video", "tests", "examples", "benchmarks")
+TOP = (
+    "fieldkit",
+    "docs",
+    "surveys",
+    "video",
+    "tests",
+    "examples",
+    "benchmarks",
+    "tools",
+)
 
 
 def blocks(language: str) -> list[str]:
@@ -45,9 +54,9 @@ def test_shell_blocks_run(repo_copy, shell_commands, run_shell, monkeypatch):
     ran = run_blocks(selected, repo_copy, shell_commands, run_shell, monkeypatch)
     # --version, reduce, impact, fence, view (2), effects, simulate, profile, synth,
     # fit, fit --paths (2), diagnose, synth --track, diagnose (track), synth --survey,
-    # reduce --campaign, diagnose (campaign), export (2), import-model; the video block
-    # runs when slow
-    assert ran == 22
+    # reduce --campaign, diagnose (campaign), export (3), import-model,
+    # import-results; the video block runs when slow
+    assert ran == 24
     # every README command writes under out/ only (issue 17): nothing new at the root
     assert {p.name for p in repo_copy.iterdir()} - before == {"out"}
     out = repo_copy / "out"
@@ -62,6 +71,8 @@ def test_shell_blocks_run(repo_copy, shell_commands, run_shell, monkeypatch):
     assert (out / "boulder_a_path.json").is_file()
     assert (out / "from_rocfall.json").is_file()
     assert (out / "r3d" / "soiltype.asc").is_file()
+    assert (out / "rstone_tschamut" / "run_rstone.sh").is_file()
+    assert (out / "rstone_results" / "summary.json").is_file()
     assert (out / "diagnosis" / "report.md").is_file()
     assert (out / "track_diagnosis" / "report.md").is_file()
     assert (out / "campaign" / "campaign.json").is_file()

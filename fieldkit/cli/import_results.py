@@ -20,7 +20,7 @@ from fieldkit.outputs import OutputSet, write_json, write_text
 FLAGS = {"source": "--from", "output": "-o", "folder": "FOLDER"}
 
 #: What the command writes into ``-o``.
-TABLE, SUMMARY = "along.csv", "summary.json"
+TABLE, SUMMARY, FIGURE = "along.csv", "summary.json", "along.png"
 
 
 @one_line_errors(flags=FLAGS)
@@ -34,7 +34,7 @@ def import_results(
     ],
     source: Annotated[str, typer.Option("--from", help="The program: rstone.")],
     output: Annotated[
-        Path, typer.Option("-o", help=f"Output folder ({TABLE}, {SUMMARY}).")
+        Path, typer.Option("-o", help=f"Output folder ({TABLE}, {SUMMARY}, {FIGURE}).")
     ],
 ) -> None:
     """Read r.stone's result grids back as a fieldkit result.
@@ -49,7 +49,7 @@ def import_results(
     Example (from the repository root): the bundled grids of a real r.stone run
     (GRASS 8.2.1) on the Tornado Mountain export,
 
-        fieldkit import-results tests/data/rstone_tornado --from rstone \\
+        fieldkit import-results examples/rstone_tornado --from rstone \\
           -o out/rstone_results
 
     made with (the last two lines in a shell with GRASS GIS and r.stone):
@@ -66,6 +66,8 @@ def import_results(
         read_rstone_results,
         runout_percentiles,
     )
+    from fieldkit.viz.figure_files import save_png
+    from fieldkit.viz.rstone_figure import rstone_along_figure
 
     if source != "rstone":
         raise ArgumentError(
@@ -108,10 +110,20 @@ def import_results(
                 "(translational: r.stone's block is a point)",
             ],
         }
-        for name in (TABLE, SUMMARY):
+        for name in (TABLE, SUMMARY, FIGURE):
             outputs.plan(output / name, argument="-o")
         write_text(output / TABLE, table.to_csv(index=False), outputs)
         write_json(output / SUMMARY, summary, outputs)
+        save_png(
+            rstone_along_figure(
+                table,
+                distance,
+                f"r.stone: {results.traced} trajectories "
+                f"(runout p50 {runout['p50']:g} m, p95 {runout['p95']:g} m)",
+            ),
+            output / FIGURE,
+            outputs=outputs,
+        )
         written = outputs.commit()
     if results.traced != results.stated:
         warn(
