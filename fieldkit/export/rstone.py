@@ -1311,8 +1311,8 @@ UNCONFIRMED = [
     "the 3-D triangles, the launch-angle spread and the 5 m flight steps are not "
     "ported. Checked in r.stone 8.2.1 (tests/export/test_rstone_real.py): on "
     "Tornado Mountain's path-calibrated model extruded (1000 trajectories, all "
-    "stopping on the section) r.stone's runout p50/p95 are 602.5/612.5 m against "
-    "the emulation's 603.9 ± 0.2/611.8 ± 0.3 m; on a Tschamut release area (14 "
+    "stopping on the section) r.stone's runout p50/p95 are 607.5/617.5 m against "
+    "the emulation's 609.3 ± 0.1/617.3 ± 0.9 m; on a Tschamut release area (14 "
     "cells, 994 trajectories, the emulation on the section through r.stone's "
     "triangles along each cell's steepest descent) 70.0/90.0 m against "
     "72.7 ± 0.4/88.8 ± 1.3 m: both within 2 sqrt(2) SE plus one cell",

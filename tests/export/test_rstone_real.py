@@ -134,8 +134,8 @@ def test_tornado_extruded_in_the_real_rstone(cli, repo, tmp_path):
     print(f"emulation: {np.mean(left):.1%} leave the section's end; "
           f"r.stone: {summary['edge_counts']['east'] / stated:.1%} reach the east "
           "column")  # fmt: skip
-    # Measured on GRASS 8.2.1: r.stone 602.5/612.5 m, the ported law 603.9 ±
-    # 0.2/611.8 ± 0.3 m; every rock stops on the section in both.
+    # Measured on GRASS 8.2.1: r.stone 607.5/617.5 m, the ported law 609.3 ±
+    # 0.1/617.3 ± 0.9 m; every rock stops on the section in both.
     assert not np.any(left) and summary["edge_counts"]["east"] == 0
     assert not _agreement(summary, runouts, record["grid"]["cellsize_m"])
 
