@@ -54,7 +54,7 @@ def import_results(
 
     made with (the last two lines in a shell with GRASS GIS and r.stone):
 
-        fieldkit export surveys/tornado_mountain/model_rocfall_table_7_1.json \\
+        fieldkit export surveys/tornado_mountain/model_path_calibrated.json \\
           --to rstone --extrude -o out/rstone
         grass -c XY /tmp/grassdb/xy -e
         grass /tmp/grassdb/xy/PERMANENT --exec bash out/rstone/run_rstone.sh
