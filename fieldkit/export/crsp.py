@@ -61,6 +61,7 @@ from fieldkit.export.lumped import (
     closest_behaviour,
     effects_account,
     fit_coefficients,
+    fit_lines,
     no_rule,
     not_a_law,
     search_line,
@@ -202,7 +203,7 @@ def export_crsp(model: Model, site: ExportSite | None = None) -> Export:
     mapped += rock_mapped + _mapped_geometry(model) + velocity_mapped
     mismatches = [
         *loud,
-        *_fit_lines(reasons, coefficients),
+        *fit_lines(reasons, coefficients, "CRSP", "(0, 1]", ".3f"),
         *search_line(search, "CRSP"),
         _rt_mismatch(),
         *mismatches,
@@ -395,29 +396,6 @@ def _translation_lines(model: Model, emulated: Model) -> list[str]:
         "the calibrated friction angles for sliding (CRSP has none): CRSP's "
         "tangential rebounds, rolling and stopping will differ beyond this table.",
     ]
-
-
-def _fit_lines(
-    reasons: list[str], coefficients: dict[str, tuple[Coefficient, Coefficient]]
-) -> list[str]:
-    if not reasons:
-        return []
-    out = [
-        "The calibrated law cannot be written in CRSP's terms ("
-        + "; ".join(reasons)
-        + "): each material's Rn, Rt start as the values in (0, 1] whose rebounds "
-        "under CRSP's law are closest (least squares) to the calibrated model's "
-        "simulated impacts on it, then the behaviour search below decides; see the "
-        "translation error"
-    ]
-    for coefficient in (c for pair in coefficients.values() for c in pair):
-        if coefficient.clipped:
-            out.append(
-                f"{coefficient.name}: the least-squares value under CRSP's law is "
-                f"{coefficient.unclipped:.4g}, outside CRSP's range (0, 1]: "
-                f"{coefficient.written:.3f} is written"
-            )
-    return out
 
 
 #: How CRSP takes every effect of the registry (README "Notes").

@@ -660,3 +660,33 @@ def search_line(behaviour: Behaviour | None, target: str) -> list[str]:
         f"the independent gap by {100 * MIN_GAIN:.0f} % (a search the quantities "
         "hardly respond to fits noise)"
     ]
+
+
+def fit_lines(
+    reasons: list[str],
+    coefficients: dict[str, tuple[Coefficient, Coefficient]],
+    target: str,
+    range_text: str,
+    number: str = "g",
+) -> list[str]:
+    """The README lines saying why the calibrated law was not written as it is
+    (``reasons``) and which least-squares values ``target``'s range (``range_text``,
+    e.g. ``"[0, 1]"``) clipped; ``number`` formats the written value."""
+    if not reasons:
+        return []
+    out = [
+        f"The calibrated law cannot be written in {target}'s terms ("
+        + "; ".join(reasons)
+        + f"): each material's Rn, Rt start as the values in {range_text} whose "
+        f"rebounds under {target}'s law are closest (least squares) to the "
+        "calibrated model's simulated impacts on it, then the behaviour search "
+        "below decides; see the translation error"
+    ]
+    for coefficient in (c for pair in coefficients.values() for c in pair):
+        if coefficient.clipped:
+            out.append(
+                f"{coefficient.name}: the least-squares value under {target}'s law "
+                f"is {coefficient.unclipped:.4g}, outside {target}'s range "
+                f"{range_text}: {format(coefficient.written, number)} is written"
+            )
+    return out

@@ -73,6 +73,7 @@ from fieldkit.export.lumped import (
     closest_behaviour,
     effects_account,
     fit_coefficients,
+    fit_lines,
     no_rule,
     not_a_law,
     search_line,
@@ -607,7 +608,7 @@ def export_rocfall(model: Model, site: ExportSite | None = None) -> Export:
     unmapped = _unmapped(model)
     mismatches = [
         *loud,
-        *_fit_lines(reasons, coefficients),
+        *fit_lines(reasons, coefficients, "RocFall", "[0, 1]", "g"),
         *search_line(search, "RocFall"),
         *mismatches,
     ]
@@ -688,29 +689,6 @@ def check_written(written: Model) -> None:
     if k is not None:
         RANGES["k"].check(k, "project settings")
     RANGES["cutoff"].check(written.core["stop_speed_mps"], "project settings")
-
-
-def _fit_lines(
-    reasons: list[str], coefficients: dict[str, tuple[Coefficient, Coefficient]]
-) -> list[str]:
-    if not reasons:
-        return []
-    out = [
-        "The calibrated law cannot be written in RocFall's terms ("
-        + "; ".join(reasons)
-        + "): each material's Rn, Rt start as the values in [0, 1] whose rebounds "
-        "under RocFall's law are closest (least squares) to the calibrated model's "
-        "simulated impacts on it, then the behaviour search below decides; see the "
-        "translation error"
-    ]
-    for coefficient in (c for pair in coefficients.values() for c in pair):
-        if coefficient.clipped:
-            out.append(
-                f"{coefficient.name}: the least-squares value under RocFall's law is "
-                f"{coefficient.unclipped:.4g}, outside RocFall's range [0, 1]: "
-                f"{coefficient.written:g} is written"
-            )
-    return out
 
 
 _HOW_TO_USE = """\
