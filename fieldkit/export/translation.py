@@ -45,17 +45,20 @@ comparison reads (:func:`run`).
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from functools import lru_cache
 from typing import Protocol, runtime_checkable
 
 import numpy as np
 import pandas as pd
 
-from fieldkit.model.model_file import Model
+from fieldkit.model.model_file import Model, model_from_dict, model_to_dict
 from fieldkit.model.simulate import simulate
 from fieldkit.model.statistics import percentile_se
+from fieldkit.outputs import json_text
 
 #: Rocks and seed of the simulation whose impacts the in-range values are fitted to.
 IMPACT_ROCKS, IMPACT_SEED = 400, 0
@@ -129,6 +132,17 @@ def realised_impacts(
     >>> bool((f["vfn_mps"] / -f["vin_mps"]).round(6).eq(0.4).all())
     True
     """
+    return _realised_impacts(_key(model), rocks, seed).copy()
+
+
+def _key(model: Model) -> str:
+    """``model`` as its JSON text: what the caches below are keyed on."""
+    return json_text(model_to_dict(model))
+
+
+@lru_cache(maxsize=8)
+def _realised_impacts(text: str, rocks: int, seed: int) -> pd.DataFrame:
+    model = model_from_dict(json.loads(text))
     result = simulate(model, rocks, np.random.default_rng(seed), record_impacts=True)
     frame = result.impact_table.frame
     columns = ["vin_mps", "vit_mps", "vfn_mps", "vft_mps", "vi_mps"]
@@ -136,6 +150,24 @@ def realised_impacts(
     out["path_id"] = frame["path_id"].to_numpy()
     values = out[columns].to_numpy(float)
     return out[np.isfinite(values).all(axis=1)].reset_index(drop=True)
+
+
+def calibrated_run(
+    model: Model, rocks: int, seed: int, analysis_x_m: Sequence[float] = ()
+):
+    """``simulate(model, rocks, default_rng(seed), analysis_x_m=...)``, kept for
+    the model's next use: an export compares one calibrated model with several
+    emulations (the impact-level values, the searched ones, the README's), each
+    on the same stream, so the calibrated side is simulated once. Read only."""
+    return _calibrated_run(
+        _key(model), rocks, seed, tuple(float(x) for x in analysis_x_m)
+    )
+
+
+@lru_cache(maxsize=16)
+def _calibrated_run(text: str, rocks: int, seed: int, at: tuple[float, ...]):
+    model = model_from_dict(json.loads(text))
+    return simulate(model, rocks, np.random.default_rng(seed), analysis_x_m=at)
 
 
 @dataclass(frozen=True)
@@ -377,7 +409,7 @@ def translation_error(
         at_m = default_points(calibrated, rocks, seed)
     at = tuple(float(x) for x in at_m)
     second = run(emulated, rocks, np.random.default_rng(seed), analysis_x_m=at)
-    first = simulate(calibrated, rocks, np.random.default_rng(seed), analysis_x_m=at)
+    first = calibrated_run(calibrated, rocks, seed, at)
     return replace(
         _compare(first, second, rocks, seed, at, float(calibrated.seeder.x_m)),
         default_at=default_at,
@@ -427,7 +459,11 @@ def default_points(
     seeder to the end when both fall there. ``model`` a Model or an
     :class:`Emulation` (from its ``start_x_m`` to its ``end_x_m``).
     """
-    pilot = run(model, rocks, np.random.default_rng(seed))
+    pilot = (
+        calibrated_run(model, rocks, seed)
+        if isinstance(model, Model)
+        else run(model, rocks, np.random.default_rng(seed))
+    )
     runout = np.asarray(pilot.runout_x_m, float)
     if isinstance(model, Model):
         start = float(model.seeder.x_m)
