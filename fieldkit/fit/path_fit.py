@@ -55,6 +55,12 @@ bootstrap resamples its observed values, which are not independent: the standard
 errors and intervals are then lower bounds (:attr:`PathFitResult.
 stderr_is_lower_bound`).
 
+Beside the bootstrap and the slice, a *profile* of each parameter re-optimises the
+others at each value and tests its excess against the observations' standard error
+and the objective's run-to-run (seed) spread together
+(:mod:`fieldkit.fit.path_profile`, ``profile_points``); it is reported beside the
+90 % interval, not merged into it.
+
 References
 ----------
 Efron, B., Tibshirani, R. J. (1993). An Introduction to the Bootstrap. Chapman & Hall.
@@ -82,6 +88,13 @@ from fieldkit.fit.path_along import (
     AlongObservations,
     observed_along,
     simulated_along,
+)
+from fieldkit.fit.path_profile import (
+    MAX_PROFILE_POINTS,
+    MAX_PROFILE_SEEDS,
+    MIN_PROFILE_SEEDS,
+    PathProfile,
+    profile_objective,
 )
 from fieldkit.fit.path_runs import PathRun, one_kernel_thread, simulated_runouts
 from fieldkit.model.effects import registry
@@ -138,15 +151,25 @@ def _no_step(description: str, total: int | None = None):
     yield lambda done, of: None
 
 
-def check_settings(*, rocks: int, seed: int, bootstrap: int, screen: int) -> None:
+def check_settings(
+    *,
+    rocks: int,
+    seed: int,
+    bootstrap: int,
+    screen: int,
+    profile_points: int = 0,
+    profile_seeds: int = MIN_PROFILE_SEEDS,
+) -> None:
     """Refuse sizes the fit cannot use, before any work is done.
 
     Raises
     ------
     ArgumentError
         ``rocks`` not in 1..MAX_ROCKS, ``seed`` not in 0..MAX_SEED, ``bootstrap``
-        not in 0..MAX_BOOTSTRAP, ``screen`` not in 0..MAX_SCREEN (each names its
-        argument and the limit).
+        not in 0..MAX_BOOTSTRAP, ``screen`` not in 0..MAX_SCREEN,
+        ``profile_points`` not 0 or in 2..MAX_PROFILE_POINTS, ``profile_seeds`` not 0
+        or in MIN_PROFILE_SEEDS..MAX_PROFILE_SEEDS (each names its argument and the
+        limit).
 
     Examples
     --------
@@ -163,6 +186,10 @@ def check_settings(*, rocks: int, seed: int, bootstrap: int, screen: int) -> Non
         ("bootstrap", bootstrap, 0, MAX_BOOTSTRAP, "each resample is a refit; "
          f"{MIN_BOOTSTRAP_SE} or more give standard errors"),
         ("screen", screen, 0, MAX_SCREEN, "each point is one evaluation"),
+        ("profile_points", profile_points, 0, MAX_PROFILE_POINTS,
+         "0 turns the profile off; each point is a short refit"),
+        ("profile_seeds", profile_seeds, 0, MAX_PROFILE_SEEDS,
+         f"0 leaves the seed spread out; {MIN_PROFILE_SEEDS} or more give its SD"),
     )  # fmt: skip
     for name, value, lo, hi, why in limits:
         if isinstance(value, bool) or not isinstance(value, int | np.integer):
@@ -173,6 +200,12 @@ def check_settings(*, rocks: int, seed: int, bootstrap: int, screen: int) -> Non
                 f"{name} must be between {lo:,} and {hi:,} (got {value}): {why}",
                 source=name,
             )
+    for name, value, least in (("profile_points", profile_points, 2),
+                               ("profile_seeds", profile_seeds, MIN_PROFILE_SEEDS)):
+        if value == 1:
+            raise ArgumentError(
+                f"{name} must be 0 (off) or at least {least} (got 1)", source=name
+            )  # fmt: skip
 
 
 def parameter_bounds(name: str) -> tuple[float, float]:
@@ -454,6 +487,8 @@ class PathFitResult:
     #: freedom.
     t_quantile: float = math.nan
     t_dof: int = 0
+    #: Profile intervals with the seed spread (None: ``profile_points`` 0).
+    profile: PathProfile | None = None
 
     @property
     def stderr_is_lower_bound(self) -> bool:
@@ -570,6 +605,7 @@ class PathFitResult:
                 "(the values the runs cannot tell from the optimum)"
             ),
             "notes": list(self.notes),
+            "profile": None if self.profile is None else self.profile.to_dict(),
         }
 
 
@@ -650,6 +686,9 @@ def fit_paths(
     kinds: Sequence[str] | None = None,
     screen: int = 0,
     step: Step | None = None,
+    profile_points: int = 5,
+    profile_seeds: int = 5,
+    profile_evaluations: int | None = None,
 ) -> PathFitResult:
     """Fit the ``free`` parameters to the observed runouts of ``runs``.
 
@@ -694,6 +733,10 @@ def fit_paths(
         ``step(description, total)`` context manager around each long stage (the
         search, the bootstrap, the slices), yielding ``advance(done, total)``;
         default: none.
+    profile_points, profile_seeds, profile_evaluations
+        The profile intervals (:mod:`fieldkit.fit.path_profile`): grid values across
+        each bound range (0: no profile), other seeds of the objective's seed spread
+        (0: none), evaluations of each point's re-optimisation of the others.
 
     Returns
     -------
@@ -702,7 +745,8 @@ def fit_paths(
     t0 = time.perf_counter()
     say = progress or (lambda _msg: None)
     stage = step or _no_step
-    check_settings(rocks=rocks, seed=seed, bootstrap=bootstrap, screen=screen)
+    check_settings(rocks=rocks, seed=seed, bootstrap=bootstrap, screen=screen,
+                   profile_points=profile_points, profile_seeds=profile_seeds)  # fmt: skip
     names = list(free)
     if not names:
         raise ArgumentError("no free parameters", source="free")
@@ -889,6 +933,20 @@ def fit_paths(
             np.clip(x_best + quantile * stderr, lower, upper),
         ]
     )
+    profile = None
+    if profile_points:
+        with stage(
+            f"profiling the objective across {p} bound ranges (others re-optimised)",
+            p,
+        ) as advance:
+            profile = profile_objective(
+                objective, x_best, lower, upper, points=profile_points,
+                seeds=profile_seeds, evaluations=profile_evaluations, advance=advance,
+            )  # fmt: skip
+        profile.widest = _widest(interval, compatible, profile.interval90)
+        say(
+            f"profile done: {profile.evaluations} evaluations, {profile.wall_s:.1f} s"
+        )
     for j, n in enumerate(names):
         lo, hi = compatible[j]
         if not np.isfinite(interval[j]).all():
@@ -965,4 +1023,23 @@ def fit_paths(
         bootstrap=boot,
         model=model,
         notes=notes,
+        profile=profile,
     )
+
+
+def _widest(boot: np.ndarray, slice_: np.ndarray, profile: np.ndarray) -> list[str]:
+    """Per parameter, which interval is widest: ``bootstrap`` (value ± t SE, before
+    any widening; none without a standard error), ``slice`` or ``profile`` (the first
+    of the widest on a tie).
+
+    Examples
+    --------
+    >>> _widest(np.array([[0, 1.0]]), np.array([[0.2, 0.3]]), np.array([[0, 2.0]]))
+    ['profile']
+    """
+    out = []
+    for b, s, q in zip(boot, slice_, profile, strict=True):
+        widths = {"bootstrap": b[1] - b[0], "slice": s[1] - s[0], "profile": q[1] - q[0]}
+        finite = {k: w for k, w in widths.items() if np.isfinite(w)}
+        out.append(max(finite, key=finite.get))
+    return out
