@@ -200,8 +200,10 @@ def check_settings(
                 f"{name} must be between {lo:,} and {hi:,} (got {value}): {why}",
                 source=name,
             )
-    for name, value, least in (("profile_points", profile_points, 2),
-                               ("profile_seeds", profile_seeds, MIN_PROFILE_SEEDS)):
+    for name, value, least in (
+        ("profile_points", profile_points, 2),
+        ("profile_seeds", profile_seeds, MIN_PROFILE_SEEDS),
+    ):
         if value == 1:
             raise ArgumentError(
                 f"{name} must be 0 (off) or at least {least} (got 1)", source=name
@@ -745,8 +747,10 @@ def fit_paths(
     t0 = time.perf_counter()
     say = progress or (lambda _msg: None)
     stage = step or _no_step
-    check_settings(rocks=rocks, seed=seed, bootstrap=bootstrap, screen=screen,
-                   profile_points=profile_points, profile_seeds=profile_seeds)  # fmt: skip
+    check_settings(
+        rocks=rocks, seed=seed, bootstrap=bootstrap, screen=screen,
+        profile_points=profile_points, profile_seeds=profile_seeds,
+    )  # fmt: skip
     names = list(free)
     if not names:
         raise ArgumentError("no free parameters", source="free")
@@ -944,9 +948,7 @@ def fit_paths(
                 seeds=profile_seeds, evaluations=profile_evaluations, advance=advance,
             )  # fmt: skip
         profile.widest = _widest(interval, compatible, profile.interval90)
-        say(
-            f"profile done: {profile.evaluations} evaluations, {profile.wall_s:.1f} s"
-        )
+        say(f"profile done: {profile.evaluations} evaluations, {profile.wall_s:.1f} s")
     for j, n in enumerate(names):
         lo, hi = compatible[j]
         if not np.isfinite(interval[j]).all():
@@ -1039,7 +1041,9 @@ def _widest(boot: np.ndarray, slice_: np.ndarray, profile: np.ndarray) -> list[s
     """
     out = []
     for b, s, q in zip(boot, slice_, profile, strict=True):
-        widths = {"bootstrap": b[1] - b[0], "slice": s[1] - s[0], "profile": q[1] - q[0]}
+        widths = {
+            "bootstrap": b[1] - b[0], "slice": s[1] - s[0], "profile": q[1] - q[0]
+        }  # fmt: skip
         finite = {k: w for k, w in widths.items() if np.isfinite(w)}
         out.append(max(finite, key=finite.get))
     return out

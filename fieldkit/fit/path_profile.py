@@ -12,10 +12,11 @@ minimised by a short Nelder-Mead (:func:`profile_evaluations`: 6 per other
 parameter, a budget that keeps a 5-parameter profile near half the fit's own cost)
 from the previous profile point's solution (the walk starts at the optimum and goes
 outward, so each start is close). A short search can stop above the true minimum:
-the excess is then overstated and the interval too narrow, never too wide. The grid is ``points`` values evenly across the bounds; on each side
-of the optimum the walk stops at the first incompatible grid value and the end is
-refined by :data:`PROFILE_BISECTIONS` bisections between it and the last compatible
-value (as the slice's ends are).
+the excess is then overstated and the interval too narrow, never too wide. The
+grid is ``points`` values evenly across the bounds; on each side of the optimum
+the walk stops at the first incompatible grid value and the end is refined by
+:data:`PROFILE_BISECTIONS` bisections between it and the last compatible value (as
+the slice's ends are).
 
 **Compatible.** :math:`\\Delta_j(v)` is estimated with two independent errors:
 
@@ -142,7 +143,9 @@ class PathProfile:
         }
 
 
-def seed_values(objective, xs: Sequence[np.ndarray], seeds: Sequence[int]) -> np.ndarray:
+def seed_values(
+    objective, xs: Sequence[np.ndarray], seeds: Sequence[int]
+) -> np.ndarray:
     """``(len(seeds), len(xs))`` objective sums of each ``x`` with each seed.
 
     ``objective`` has a settable ``seed`` and ``units(x)`` (a
@@ -259,8 +262,7 @@ def profile_objective(
         curve = {float(x_best[j]): (0.0, 0.0, 0.0)}
         grid = np.linspace(lower[j], upper[j], points)
         ends = []
-        for side, outward in ((-1, grid[grid < x_best[j]][::-1]),
-                              (1, grid[grid > x_best[j]])):  # fmt: skip
+        for outward in (grid[grid < x_best[j]][::-1], grid[grid > x_best[j]]):
             good, others = float(x_best[j]), x_best[rest]
             end = good
             for v in outward:
@@ -323,4 +325,3 @@ def _minimise(f: Callable[[np.ndarray], float], u0: np.ndarray, budget: int):
     )  # fmt: skip
     # u0 is a vertex of the initial simplex: the result is never worse than it
     return np.clip(res.x, 0.0, 1.0)
-
