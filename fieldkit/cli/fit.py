@@ -34,14 +34,16 @@ FLAGS = {
     "section": "--section",
     "material": "--material",
     "preset": "--preset",
+    "profile_points": "--profile-points",
 }
 
 #: Path-fit settings left unset on the command line take these values.
 PATH_DEFAULTS = {"rocks": 200, "seed": 0, "bootstrap": 20, "screen": 16,
-                 "section": "descent"}  # fmt: skip
+                 "section": "descent", "profile_points": 5}  # fmt: skip
 #: Options of the path fit only: refused by an impact fit, never silently ignored.
 PATH_ONLY = ("json_file", "holdout_releases", "holdout_deposits", "free", "rocks",
-             "seed", "bootstrap", "screen", "bound", "section")  # fmt: skip
+             "seed", "bootstrap", "screen", "bound", "section",
+             "profile_points")  # fmt: skip
 
 
 def impact_report_markdown(
@@ -146,6 +148,11 @@ def _paths(options: dict) -> None:
         bounds=options["bound"],
         material=options["material"],
         preset=options["preset"],
+        profile_points=(
+            PATH_DEFAULTS["profile_points"]
+            if options["profile_points"] is None
+            else options["profile_points"]
+        ),
     )
 
 
@@ -244,6 +251,16 @@ def fit(
     ] = None,
     material: MaterialOpt = None,
     preset: PresetOpt = None,
+    profile_points: Annotated[
+        int | None,
+        typer.Option(
+            "--profile-points",
+            help="Path fit: values across each bound range at which the objective "
+            "is profiled (the other parameters re-optimised; 0: no profile; default "
+            "5); the profile's threshold includes the objective's spread over 5 "
+            "other seeds.",
+        ),
+    ] = None,
     section: Annotated[
         str | None,
         typer.Option(

@@ -139,7 +139,7 @@ def uncertainty_lines(summary: dict) -> list[str]:
     """What ± and the range mean, said where they are printed (before the values)."""
     boot, n_runs = summary["bootstrap_size"], summary["n_runs"]
     if boot < MIN_BOOTSTRAP_SE:
-        return [
+        return ([ONE_PATH] if n_runs == 1 else []) + [
             f"no standard errors or correlations: --bootstrap {boot} is fewer than "
             f"the {MIN_BOOTSTRAP_SE} resamples a standard error needs; the range is "
             "the values the runs cannot tell from the optimum (the objective's slice)"
@@ -151,11 +151,54 @@ def uncertainty_lines(summary: dict) -> list[str]:
         "freedom), widened to the objective's slice where that is wider"
     ]
     if n_runs == 1:
-        lines.insert(
-            0,
-            "one surveyed path: the bootstrap resamples its own observed values, "
-            "which are not independent, so every ± and 90 % range below is a lower "
-            "bound on the uncertainty (more paths give honest ones)",
+        lines.insert(0, ONE_PATH)
+    return lines
+
+
+#: Said with the intervals of a fit to one surveyed path (issue 20).
+ONE_PATH = (
+    "one surveyed path: resampling its points is a lower bound on the uncertainty of "
+    "a site's parameters (another boulder, another path); its observed values are "
+    "not independent, so every ±, 90 % range and profile interval below is a lower "
+    "bound (more paths give honest ones)"
+)
+
+
+def profile_lines(summary: dict) -> list[str]:
+    """The profile intervals beside the bootstrap's, with the seed spread and the
+    profile's cost (none when the fit made no profile)."""
+    prof = summary.get("profile")
+    if not prof:
+        return []
+    sd = prof["optimum_seed_sd"]
+    noise = (
+        f"objective at the optimum {prof['objective_optimum']:.4g}, SD over "
+        f"{prof['seeds']} other seeds {sd:.2g} ({sd / prof['objective_optimum']:.1%} "
+        "of it is Monte Carlo noise)"
+        if sd is not None and prof["objective_optimum"] > 0
+        else "no seed spread (--profile-points with fewer than 2 seeds)"
+    )
+    lines = [
+        f"profile ({prof['points']} values across each bound range, the other "
+        "parameters re-optimised; a value is compatible when its excess over the "
+        "optimum is below 1.645 × √(SE over observations² + SD over "
+        f"{prof['seeds']} seeds²)): {noise}; cost {prof['evaluations']} evaluations, "
+        f"{prof['wall_s']:.1f} s"
+    ]
+    params = {p["name"]: p for p in summary["parameters"]}
+    for q, (slo, shi) in zip(prof["parameters"], summary["slice_compatible"],
+                             strict=True):  # fmt: skip
+        lo, hi = q["interval90"]
+        p = params[q["name"]]
+        boot = (
+            f"90 % interval (bootstrap) {p['interval90'][0]:.4g} to "
+            f"{p['interval90'][1]:.4g}"
+            if p["stderr"] is not None
+            else "no bootstrap interval"
+        )
+        lines.append(
+            f"  {q['name']}: profile {lo:.4g} to {hi:.4g}; {boot}; slice {slo:.4g} "
+            f"to {shi:.4g}; widest: {q['widest']}"
         )
     return lines
 
@@ -291,6 +334,7 @@ def report_markdown(
             f"| {err} | {span} | {p['bounds'][0]:g} to {p['bounds'][1]:g} "
             f"| {pinned_words[p['pinned']]} |"
         )
+    lines += _profile_markdown(summary, lower_bound=n_runs == 1)
     lines += [
         "",
         "## Mean CRPS, starting model → calibrated",
@@ -312,6 +356,59 @@ def report_markdown(
             f"* {_in_words(n, summary['parameters'])}" for n in summary["notes"]
         ]
     return "\n".join(lines) + "\n"
+
+
+def _profile_markdown(summary: dict, *, lower_bound: bool) -> list[str]:
+    """report.md's profile section: each parameter's profile interval beside its 90 %
+    interval and slice, the objective's seed spread, the cost."""
+    prof = summary.get("profile")
+    if not prof:
+        return []
+    sd = prof["optimum_seed_sd"]
+    lines = [
+        "",
+        "## Profile intervals",
+        "",
+        f"Each parameter set to {prof['points']} values across its search bounds "
+        "(ends refined by bisection), the others re-optimised each time; a value is "
+        "compatible with the data when the objective's excess over the optimum is "
+        "below 1.645 × √(SE over the observations² + SD over "
+        f"{prof['seeds']} other seeds²): the threshold includes the run-to-run "
+        "(Monte Carlo) spread of the objective, not only which values were observed.",
+        "",
+    ]
+    if sd is not None:
+        lines += [
+            f"Objective at the optimum: {prof['objective_optimum']:.4g}; its SD over "
+            f"{prof['seeds']} other seeds (new rocks): {sd:.2g}.",
+            "",
+        ]
+    if lower_bound:
+        lines += [
+            "One surveyed path: resampling its points is a lower bound on the "
+            "uncertainty of a site's parameters (another boulder, another path); "
+            "these intervals are lower bounds too.",
+            "",
+        ]
+    lines += [
+        "| parameter | fitted | profile interval | 90 % interval | slice | widest |",
+        "|---|---|---|---|---|---|",
+    ]
+    for p, q, (slo, shi) in zip(summary["parameters"], prof["parameters"],
+                                summary["slice_compatible"], strict=True):  # fmt: skip
+        lo, hi = q["interval90"]
+        blo, bhi = p["interval90"]
+        lines.append(
+            f"| {parameter_words(p['name'])} | {p['value']:.4g} | {lo:.4g} to "
+            f"{hi:.4g} | {blo:.4g} to {bhi:.4g} | {slo:.4g} to {shi:.4g} "
+            f"| {q['widest']} |"
+        )
+    lines += [
+        "",
+        f"Cost of the profile: {prof['evaluations']} evaluations of the objective, "
+        f"{prof['wall_s']:.1f} s (`--profile-points 0` turns it off).",
+    ]
+    return lines
 
 
 def _in_words(text: str, parameters: list[dict]) -> str:
@@ -342,6 +439,7 @@ def fit_paths_command(
     bounds: list[str] | None = None,
     material: list[str] | None = None,
     preset: Path | None = None,
+    profile_points: int = 5,
 ) -> None:
     """Run the path-level fit (see the command's help)."""
     from fieldkit.cli.common import note
@@ -360,7 +458,8 @@ def fit_paths_command(
     )
     from fieldkit.model.model_file import read_model, write_model
 
-    check_settings(rocks=rocks, seed=seed, bootstrap=bootstrap, screen=screen)
+    check_settings(rocks=rocks, seed=seed, bootstrap=bootstrap, screen=screen,
+                   profile_points=profile_points)  # fmt: skip
     box = parse_bounds(bounds)
     on_dem = dem is not None
     if on_dem and (material or preset is not None):
@@ -426,7 +525,7 @@ def fit_paths_command(
         result = fit_paths(
             calibration, base, names, rocks=rocks, seed=seed, bootstrap=bootstrap,
             progress=lambda line: typer.echo(line, err=True), screen=screen,
-            bounds=box, step=step,
+            bounds=box, step=step, profile_points=profile_points,
         )  # fmt: skip
         fitted = dict(zip(result.names, map(float, result.values), strict=True))
         summary = result.to_dict()
@@ -464,6 +563,8 @@ def fit_paths_command(
         typer.echo(line)
     for p in summary["parameters"]:
         typer.echo(f"{p['name']}: {_value(p)}{_flag(p)}")
+    for line in profile_lines(summary):
+        typer.echo(line)
     for line in _kind_lines(result, summary) + _holdout_lines(summary):
         typer.echo(line)
     report_written(written)

@@ -946,6 +946,7 @@ def fit_paths(
             profile = profile_objective(
                 objective, x_best, lower, upper, points=profile_points,
                 seeds=profile_seeds, evaluations=profile_evaluations, advance=advance,
+                inner=compatible,
             )  # fmt: skip
         profile.widest = _widest(interval, compatible, profile.interval90)
         say(f"profile done: {profile.evaluations} evaluations, {profile.wall_s:.1f} s")

@@ -195,6 +195,7 @@ def profile_objective(
     seeds: int,
     evaluations: int | None = None,
     advance: Callable[[int, int], None] | None = None,
+    inner: np.ndarray | None = None,
 ) -> PathProfile:
     """Profile every parameter of ``objective`` about ``x_best`` (module docstring).
 
@@ -216,6 +217,12 @@ def profile_objective(
         :func:`profile_evaluations`).
     advance
         Called with (parameters done, parameters) after each parameter.
+    inner
+        ``(p, 2)`` ranges known compatible (the slice's: a value the data cannot
+        tell from the optimum with the others *held* cannot be told from it with
+        them re-optimised, whose excess is no larger, nor with the seed term, which
+        only raises the threshold); each side's walk starts at its end, so the
+        profile contains it and resolves what lies beyond.
 
     Returns
     -------
@@ -262,8 +269,10 @@ def profile_objective(
         curve = {float(x_best[j]): (0.0, 0.0, 0.0)}
         grid = np.linspace(lower[j], upper[j], points)
         ends = []
-        for outward in (grid[grid < x_best[j]][::-1], grid[grid > x_best[j]]):
-            good, others = float(x_best[j]), x_best[rest]
+        known = (x_best[j], x_best[j]) if inner is None else inner[j]
+        for outward, first in ((grid[grid < known[0]][::-1], known[0]),
+                               (grid[grid > known[1]], known[1])):  # fmt: skip
+            good, others = float(first), x_best[rest]
             end = good
             for v in outward:
                 e, se, sd, o = point(j, float(v), others)
