@@ -85,6 +85,7 @@ def impact_report_markdown(
             f"| {parameter_words(name)} | {s0:.6g} | {v:.6g} | {se:.2g} "
             f"| {'; '.join(flags) or 'none'} |"
         )
+    lines += _profile_markdown(result)
     if result.notes:
         lines += ["", "## Notes", ""] + [f"* {n}" for n in result.notes]
     lines += [
@@ -97,6 +98,50 @@ def impact_report_markdown(
         "![residuals](residuals.png)",
     ]
     return "\n".join(lines) + "\n"
+
+
+def _profile_markdown(result) -> list[str]:
+    """report.md's profile-likelihood section: each parameter's profile interval
+    beside the Jacobian's, the threshold, the cost, the one-path statement."""
+    from fieldkit.cli.fit_paths import parameter_words
+
+    prof = result.profile
+    if not prof:
+        return []
+    lines = [
+        "",
+        "## Profile-likelihood intervals",
+        "",
+        "Each parameter fixed at values around its fit, the others refitted by the "
+        "same weighted least squares; a value is in the 90 % interval while the "
+        "rise of chi2 over its minimum, divided by the reduced chi2, stays below "
+        f"F(0.90; 1, {prof['dof']}) = {prof['threshold']:.4g}. The Jacobian's "
+        f"interval beside it is the fitted value ± {prof['t_quantile']:.4g} standard "
+        "errors (the same t); the two agree where the model is linear in its "
+        f"parameters. {prof['evaluations']} refits, {prof['wall_s']:.2f} s.",
+        "",
+    ]
+    if prof.get("one_path"):
+        lines += [f"**Lower bounds.** {prof['one_path'][0].upper()}"
+                  f"{prof['one_path'][1:]}.", ""]  # fmt: skip
+    lines += [
+        "| parameter | fitted | profile 90 % | Jacobian 90 % | upper / lower "
+        "half-width |",
+        "|---|---|---|---|---|",
+    ]
+
+    def num(x):
+        return "open" if x is None else f"{x:.4g}"
+
+    for q in prof["parameters"]:
+        (lo, hi), (jlo, jhi) = q["interval90"], q["jacobian90"]
+        ends = [num(v) + (" (open)" if o else "") for v, o in
+                zip((lo, hi), q["open"], strict=True)]  # fmt: skip
+        lines.append(
+            f"| {parameter_words(q['name'])} | {q['value']:.6g} | {ends[0]} to "
+            f"{ends[1]} | {num(jlo)} to {num(jhi)} | {num(q['asymmetry'])} |"
+        )
+    return lines
 
 
 def _paths(options: dict) -> None:

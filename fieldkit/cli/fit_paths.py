@@ -159,8 +159,8 @@ def uncertainty_lines(summary: dict) -> list[str]:
 ONE_PATH = (
     "one surveyed path: resampling its points is a lower bound on the uncertainty of "
     "a site's parameters (another boulder, another path); its observed values are "
-    "not independent, so every ±, 90 % range and profile interval below is a lower "
-    "bound (more paths give honest ones)"
+    "not independent, so every standard error, 90 % range and profile interval "
+    "below is a lower bound (more paths give honest ones)"
 )
 
 

@@ -85,6 +85,9 @@ class FitResult:
     residuals: np.ndarray | None = None  # weighted, in data order
     residual_kind: np.ndarray | None = None  # "vfn", "vft", "omega_f" per datum
     residual_row: np.ndarray | None = None  # table row of each datum
+    #: Profile-likelihood intervals (:func:`fieldkit.fit.impact_profile.
+    #: profile_intervals`; None: not made).
+    profile: dict | None = None
 
     def value(self, name: str) -> float:
         """The fitted value of ``name``."""
@@ -215,8 +218,46 @@ class FitResult:
             lines.append(
                 f"  {name:<{width}}  {v:.6g} ± {se:.2g}  (start {s0:.6g}){flag}"
             )
+        lines.extend(self.profile_lines())
         lines.extend(f"note: {n}" for n in self.notes)
         return "\n".join(lines)
+
+    def profile_lines(self) -> list[str]:
+        """The profile-likelihood intervals beside the Jacobian's (none without)."""
+        prof = self.profile
+        if not prof:
+            return []
+        lines = []
+        if prof.get("one_path"):
+            lines.append(prof["one_path"])
+        lines.append(
+            "90 % intervals: profile likelihood (each parameter fixed, the others "
+            f"refitted; Δchi2 / reduced chi2 <= F(1, {prof['dof']}) = "
+            f"{_fmt(prof['threshold'])}) beside the Jacobian's value ± "
+            f"{_fmt(prof['t_quantile'])} SE ({prof['evaluations']} refits, "
+            f"{prof['wall_s']:.2f} s)"
+        )
+        width = max(len(n) for n in self.names)
+        for q, lower, upper in zip(prof["parameters"], self.lower, self.upper,
+                                   strict=True):  # fmt: skip
+            lo, hi = q["interval90"]
+            jlo, jhi = q["jacobian90"]
+            marks = [
+                f"open: the {side} bound is still inside" if math.isfinite(b)
+                else f"open: not closed within {prof['max_half_widths']:g} Jacobian "
+                f"half-widths {'above' if side == 'upper' else 'below'}"
+                for side, o, b in zip(("lower", "upper"), q["open"], (lower, upper),
+                                      strict=True)
+                if o
+            ]  # fmt: skip
+            asym = q["asymmetry"]
+            lines.append(
+                f"  {q['name']:<{width}}  profile {_fmt(lo)} to {_fmt(hi)}; Jacobian "
+                f"{_fmt(jlo)} to {_fmt(jhi)}"
+                + (f"; upper/lower half-width {asym:.2f}" if asym is not None else "")
+                + (f" [{'; '.join(marks)}]" if marks else "")
+            )
+        return lines
 
     def provenance(self, table: str) -> dict:
         """The ``provenance["fit"]`` entry of the calibrated model file."""
@@ -250,4 +291,10 @@ class FitResult:
             "bic": num(self.bic),
             "success": bool(self.success),
             "message": self.message,
+            "profile": self.profile,
         }
+
+
+def _fmt(x: float | None) -> str:
+    """``x`` to 4 significant digits, ``none`` for a missing value."""
+    return "none" if x is None else f"{x:.4g}"

@@ -80,6 +80,7 @@ from fieldkit.fit.impact_model import (
     predict_arrays,
     predict_rows,
 )
+from fieldkit.fit.impact_profile import profile_intervals
 from fieldkit.impact_table import ImpactTable, flight_sides, path_point_kinds
 from fieldkit.model.effects import registry
 from fieldkit.model.materials import MATERIAL_FIELDS
@@ -831,6 +832,26 @@ def fit_result(problem: ImpactProblem, names, start, fit, notes) -> FitResult:
     )
 
 
+#: Said with the intervals of an impact fit to one path's impacts (issue 20).
+ONE_PATH_IMPACTS = (
+    "one path: its impacts are not independent (one rock, one slope, one survey), "
+    "so the standard errors and intervals are a lower bound on the uncertainty of a "
+    "site's parameters (another boulder, another path)"
+)
+
+
+def _profile(problem: ImpactProblem, model: Model, result: FitResult) -> dict:
+    """The profile-likelihood intervals of ``result`` (:mod:`fieldkit.fit.
+    impact_profile`), with the one-path statement when the table has one path."""
+    prof = profile_intervals(
+        problem, model, result.names, result.values, result.stderr, result.chi2,
+        result.ndata - result.nparams,
+    )  # fmt: skip
+    paths = problem.table.frame["path_id"].astype(str).unique()
+    prof["one_path"] = ONE_PATH_IMPACTS if len(paths) == 1 else None
+    return prof
+
+
 def fit_impacts(table: ImpactTable, model: Model) -> tuple[FitResult, Model]:
     """Fit ``model``'s impact laws to ``table``; ``(result, calibrated model)``.
 
@@ -856,5 +877,6 @@ def fit_impacts(table: ImpactTable, model: Model) -> tuple[FitResult, Model]:
         problem = problem.reweighted(model, names, fit.x)
         fit = problem.solve(model, names, start=np.asarray(fit.x, float))
     result = fit_result(problem, names, start, fit, problem.notes + notes + start_notes)
+    result.profile = _profile(problem, model, result)
     calibrated = model.with_parameters(dict(zip(names, map(float, fit.x), strict=True)))
     return result, replace(calibrated, provenance=dict(model.provenance))
