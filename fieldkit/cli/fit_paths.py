@@ -173,8 +173,8 @@ def profile_lines(summary: dict) -> list[str]:
     sd = prof["optimum_seed_sd"]
     noise = (
         f"objective at the optimum {prof['objective_optimum']:.4g}, SD over "
-        f"{prof['seeds']} other seeds {sd:.2g} ({sd / prof['objective_optimum']:.1%} "
-        "of it is Monte Carlo noise)"
+        f"{prof['seeds']} other seeds {sd:.2g} "
+        f"({100 * sd / prof['objective_optimum']:.1f} % of it: Monte Carlo noise)"
         if sd is not None and prof["objective_optimum"] > 0
         else "no seed spread (--profile-points with fewer than 2 seeds)"
     )
