@@ -84,6 +84,7 @@ from fieldkit.fit.path_along import (
     simulated_along,
 )
 from fieldkit.fit.path_runs import PathRun, one_kernel_thread, simulated_runouts
+from fieldkit.fit.plausibility import realised_share_above
 from fieldkit.model.effects import registry
 from fieldkit.model.materials import MATERIAL_FIELDS
 from fieldkit.model.model_file import CORE_DEFAULTS, Model
@@ -127,6 +128,13 @@ MAX_ROCKS = 20_000
 MAX_BOOTSTRAP = 1_000
 MAX_SCREEN = 4_096
 MAX_SEED = 2**32 - 1
+#: A fit constrained to realised e_n <= c (``max_realised_e_n``): the share of a
+#: material's simulated impacts above c it tolerates (a Monte Carlo share of a few
+#: thousand impacts cannot be held at exactly 0 by a search without the exact
+#: reformulation every law lacks), and the penalty per unit share beyond it, in
+#: units of the objective at the start (1 % beyond costs the whole start value).
+REALISED_TOLERANCE = 0.01
+REALISED_PENALTY = 100.0
 
 #: ``step(description, total)``: a context manager yielding ``advance(done, total)``
 #: (:func:`fieldkit.cli.progress.step` on the command line).
@@ -259,7 +267,12 @@ class PathObjective:
         rocks: int,
         seed: int,
         kinds: Sequence[str] | None = None,
+        realised_limit: float | None = None,
     ):
+        #: With a limit, every simulation also counts the impacts whose realised
+        #: e_n exceeds it: :attr:`realised_share` after each evaluation.
+        self.realised_limit = realised_limit
+        self.realised_share = math.nan
         if kinds is not None:
             unknown = sorted(set(kinds) - set(KINDS))
             if unknown:
@@ -341,16 +354,22 @@ class PathObjective:
         values = dict(zip(self.names, map(float, x), strict=True))
         self.evaluations += 1
         out = []
+        counts: dict[str, np.ndarray] = {}
         with one_kernel_thread():
             for (run, i, model), obs in zip(
                 self._models(values), self.observed_along, strict=True
             ):
+                hook = None
+                if self.realised_limit is not None:
+                    hook = _counter(model, counts, self.realised_limit)
                 if self.along:
-                    sims = simulated_along(run, model, obs, self.rocks, self.seed, i)
+                    sims = simulated_along(run, model, obs, self.rocks, self.seed, i,
+                                           on_impacts=hook)  # fmt: skip
                 else:
                     sims = {
                         "runout_m": [
-                            simulated_runouts(run, model, self.rocks, self.seed, i)
+                            simulated_runouts(run, model, self.rocks, self.seed, i,
+                                              on_impacts=hook)  # fmt: skip
                         ]
                     }
                 for k in self.kinds:
@@ -364,6 +383,8 @@ class PathObjective:
                     else:
                         pairs = zip(ens, ys, strict=True)
                         out.append(np.array([crps_ensemble(e, y) for e, y in pairs]))
+        if self.realised_limit is not None:
+            self.realised_share = _worst_share(counts)
         return np.concatenate(out)
 
     def units(self, x: np.ndarray) -> np.ndarray:
@@ -454,6 +475,20 @@ class PathFitResult:
     #: freedom.
     t_quantile: float = math.nan
     t_dof: int = 0
+    #: The realised-e_n constraint (None: none) and the worst material's share of
+    #: simulated impacts above it at the start and at the optimum (the fit's own
+    #: streams; NaN without a constraint).
+    max_realised_e_n: float | None = None
+    realised_share_start: float = math.nan
+    realised_share_optimum: float = math.nan
+
+    def at_bound(self) -> np.ndarray:
+        """Whether each value is within 1/1000 of its bound range of a bound (the
+        rule of the fit's "is at a search bound" notes)."""
+        span = self.upper - self.lower
+        return (np.abs(self.values - self.lower) <= 1e-3 * span) | (
+            np.abs(self.values - self.upper) <= 1e-3 * span
+        )
 
     @property
     def stderr_is_lower_bound(self) -> bool:
@@ -573,6 +608,26 @@ class PathFitResult:
         }
 
 
+def _counter(model: Model, counts: dict[str, np.ndarray], limit: float):
+    """An ``on_impacts`` hook adding, per material of ``model``, [impacts whose
+    realised e_n exceeds ``limit``, impacts with a defined e_n] into ``counts``."""
+    names = list(model.materials)
+
+    def add(columns: dict[str, np.ndarray]) -> None:
+        above, total = realised_share_above([columns], len(names), limit)
+        for name, a, t in zip(names, above, total, strict=True):
+            counts.setdefault(name, np.zeros(2, np.int64))
+            counts[name] += (a, t)
+
+    return add
+
+
+def _worst_share(counts: dict[str, np.ndarray]) -> float:
+    """The largest share over materials with impacts (0 without any)."""
+    shares = [a / t for a, t in counts.values() if t > 0]
+    return max(shares, default=0.0)
+
+
 def _finite(x: float) -> float | None:
     """``x`` as a float, or None where it is not finite (JSON has no NaN)."""
     return float(x) if math.isfinite(x) else None
@@ -650,6 +705,7 @@ def fit_paths(
     kinds: Sequence[str] | None = None,
     screen: int = 0,
     step: Step | None = None,
+    max_realised_e_n: float | None = None,
 ) -> PathFitResult:
     """Fit the ``free`` parameters to the observed runouts of ``runs``.
 
@@ -694,6 +750,17 @@ def fit_paths(
         ``step(description, total)`` context manager around each long stage (the
         search, the bootstrap, the slices), yielding ``advance(done, total)``;
         default: none.
+    max_realised_e_n
+        Constrain the fit to realised ``e_n <= max_realised_e_n`` (None: no
+        constraint). Every evaluation's simulations count, per material, the
+        impacts whose realised ``e_n = -v_fN / v_iN`` (on the slope the kernel
+        used) exceeds it; the worst material's share beyond
+        :data:`REALISED_TOLERANCE` is penalised, ``REALISED_PENALTY x S(start) x
+        excess``, in the search and every bootstrap refit, and slice values beyond
+        the tolerance are not compatible with the data. A penalty rather than a
+        bound: no law has an exact reformulation once its e_n scatters (the start
+        model of boulder A, e_n = 1.0 with e_n_sd 0.04 under eq. 7.1, realises
+        e_n > 1 on 40 % of its impacts), so the share is measured, not assumed.
 
     Returns
     -------
@@ -728,7 +795,16 @@ def fit_paths(
     x0 = clipped
     span = upper - lower
     p = len(names)
-    objective = PathObjective(runs, names, rocks, seed, kinds)
+    if max_realised_e_n is not None and not (
+        math.isfinite(max_realised_e_n) and max_realised_e_n > 0
+    ):
+        raise ArgumentError(
+            f"the realised e_n limit must be a positive number (got "
+            f"{max_realised_e_n!r})",
+            source="max_realised_e_n",
+        )
+    objective = PathObjective(runs, names, rocks, seed, kinds,
+                              realised_limit=max_realised_e_n)  # fmt: skip
     n_runs = len(objective.runs)
     if n_runs < len(runs):
         notes.append(f"{len(runs) - n_runs} runs without any observation left out")
@@ -748,8 +824,14 @@ def fit_paths(
     n_units = sum(s.size for s in objective.strata)
     weights = np.ones(n_units)
 
+    penalty_scale = 0.0  # set from the start value below (a constrained fit)
+
     def f(u):  # progress is the stage's (a bar on a terminal), not a line per 25
-        return float(np.dot(weights, objective.units(to_x(u))))
+        value = float(np.dot(weights, objective.units(to_x(u))))
+        if max_realised_e_n is None:
+            return value
+        excess = max(objective.realised_share - REALISED_TOLERANCE, 0.0)
+        return value + REALISED_PENALTY * penalty_scale * excess
 
     u0 = (x0 - lower) / span
     start_scores = objective.observation_scores(x0)
@@ -763,6 +845,14 @@ def fit_paths(
             + "; each scaled by its CRPS at the start"
         )
     f0 = float(np.sum(objective.units_of(start_scores)))
+    realised_start = objective.realised_share
+    penalty_scale = abs(f0) if f0 != 0 else 1.0
+    if max_realised_e_n is not None:
+        say(
+            f"constrained to realised e_n <= {max_realised_e_n:g}: the worst "
+            f"material's share of simulated impacts above it at most "
+            f"{REALISED_TOLERANCE:.0%} (penalty); {realised_start:.1%} at the start"
+        )
     say(
         f"fit {p} parameter{'s' * (p != 1)} to {n_runs} run{'s' * (n_runs != 1)} "
         f"({rocks} rocks each): "
@@ -798,6 +888,16 @@ def fit_paths(
         "evaluations"
     )
     best_scores = objective.observation_scores(x_best)
+    realised_best = objective.realised_share
+    if max_realised_e_n is not None:
+        notes.append(
+            f"constrained to realised e_n <= {max_realised_e_n:g} (at most "
+            f"{REALISED_TOLERANCE:.0%} of any material's simulated impacts above it, "
+            f"by a penalty): {realised_start:.1%} at the start, {realised_best:.1%} "
+            "at the optimum"
+            + ("" if realised_best <= REALISED_TOLERANCE else
+               " -- beyond the tolerance: no point of the search met it")
+        )  # fmt: skip
     best_units = objective.units_of(best_scores)
     kind_optimum = objective.kind_means_of(best_scores)
     run_crps = objective.per_run_of(best_scores)
@@ -856,6 +956,9 @@ def fit_paths(
         x = x_best.copy()
         x[j] = value
         diff = objective.units(x) - best_units
+        if (max_realised_e_n is not None
+                and objective.realised_share > REALISED_TOLERANCE):
+            return False  # outside the constraint: not a value the fit allows
         return bool(diff.sum() <= Z90 * _stratified_se(diff, objective.strata))
 
     with stage(f"slicing the objective across {p} bound ranges", p) as advance:
@@ -965,4 +1068,7 @@ def fit_paths(
         bootstrap=boot,
         model=model,
         notes=notes,
+        max_realised_e_n=max_realised_e_n,
+        realised_share_start=realised_start,
+        realised_share_optimum=realised_best,
     )
