@@ -34,6 +34,7 @@ FLAGS = {
     "section": "--section",
     "material": "--material",
     "preset": "--preset",
+    "max_realised_e_n": "--max-realised-en",
 }
 
 #: Path-fit settings left unset on the command line take these values.
@@ -146,6 +147,7 @@ def _paths(options: dict) -> None:
         bounds=options["bound"],
         material=options["material"],
         preset=options["preset"],
+        max_realised_e_n=options["max_realised_e_n"],
     )
 
 
@@ -252,6 +254,16 @@ def fit(
             "default) or 'release-deposit' (honest for calibration only).",
         ),
     ] = None,
+    max_realised_e_n: Annotated[
+        float | None,
+        typer.Option(
+            "--max-realised-en",
+            help="Constrain the fit to realised e_n = -vfn/vin <= VALUE: at every "
+            "observed impact (impact fit; a penalty residual per impact) or on at "
+            "most 1 % of each material's simulated impacts (path fit; a penalty). "
+            "Default: no constraint.",
+        ),
+    ] = None,
 ) -> None:
     """Fit restitution and effect parameters to measured impacts (weighted LSQ).
 
@@ -320,7 +332,9 @@ def fit(
         mapping = mapped_table(table, model, material, preset)
         # a weighted least squares of a few parameters: short, shown on a terminal
         with step(f"fitting {model_file.name} to {table_file}", announce=False):
-            result, calibrated = fit_impacts(mapping.table, model)
+            result, calibrated = fit_impacts(
+                mapping.table, model, max_realised_e_n=max_realised_e_n
+            )
         text = result.report()
         if not result.success:
             raise FieldkitError(
@@ -330,6 +344,10 @@ def fit(
             )
         fit_record = result.provenance(str(table_file))
         fit_record["material_map"] = mapping.provenance()
+        plausibility = _impact_plausibility(
+            result, calibrated, mapping.table, max_realised_e_n
+        )
+        fit_record["plausibility"] = plausibility.to_dict()
         provenance = {**calibrated.provenance, "fit": fit_record}
         write_model(replace(calibrated, provenance=provenance), output, outputs=outputs)
         if report is not None:
@@ -353,4 +371,21 @@ def fit(
             )
         written = outputs.commit()
     typer.echo(text)
+    for line in plausibility.lines():
+        typer.echo(line)
     report_written(written)
+
+
+def _impact_plausibility(result, calibrated, table, limit):
+    """The impact fit's plausibility report (the calibrated model simulated on its
+    own stream, the fitted law at the observed impacts, bounds, constraint)."""
+    from fieldkit.fit.plausibility import (
+        PLAUSIBILITY_ROCKS,
+        impact_fit_plausibility,
+    )
+
+    with step(f"simulating {PLAUSIBILITY_ROCKS:,} rocks of the calibrated model "
+              "for its realised restitution"):  # fmt: skip
+        return impact_fit_plausibility(
+            result, calibrated, table, max_realised_e_n=limit
+        )

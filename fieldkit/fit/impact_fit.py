@@ -72,7 +72,7 @@ import numpy as np
 from scipy.optimize import least_squares
 from threadpoolctl import threadpool_limits
 
-from fieldkit.errors import InputFileError
+from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.fit.fit_result import FitResult
 from fieldkit.fit.impact_model import (
     ImpactInputs,
@@ -118,6 +118,12 @@ INPUT_ERRORS = (
     ("vit_mps", "vit_mps", "vit_sd_mps", 1, "vit_vft_corr"),
     ("omega_i_radps", "omega_i_radps", "omega_i_sd_radps", None, None),
 )
+
+#: A fit constrained to realised e_n <= c (``max_realised_e_n``): one residual per
+#: impact, this many times its predicted e_n beyond c (an excess of 0.001 weighs
+#: as one standard error of a datum), added to the weighted residuals; chi2, the
+#: standard errors and AIC/BIC are of the data residuals alone.
+REALISED_PENALTY = 1_000.0
 
 #: Primary columns every fitted row needs finite.
 FINITE_COLUMNS = ("vi_x_mps", "vi_z_mps", "vf_x_mps", "vf_z_mps", "slope_deg")
@@ -426,11 +432,14 @@ class ImpactProblem:
         names: list[str],
         rows: np.ndarray | None = None,
         start: np.ndarray | None = None,
+        max_realised_e_n: float | None = None,
     ):
         """``scipy.optimize.least_squares`` result of ``names`` fitted on ``rows``.
 
         ``rows`` is a boolean mask or index array (all rows when None); the
-        residuals are ``(observed - predicted) / sd`` of the used data.
+        residuals are ``(observed - predicted) / sd`` of the used data, followed,
+        with ``max_realised_e_n``, by one penalty residual per impact
+        (:data:`REALISED_PENALTY` times its predicted ``e_n`` beyond the limit).
         """
         rows = np.ones(len(self.observed), bool) if rows is None else rows
         mask = np.zeros(len(self.observed), bool)
@@ -447,7 +456,8 @@ class ImpactProblem:
             start, _ = self.start(model, names)
         bounds = self.bounds(model, names)
 
-        residuals = _Residuals(self, model, names, sub, observed, sd, keep)
+        residuals = _Residuals(self, model, names, sub, observed, sd, keep,
+                               max_realised_e_n)  # fmt: skip
 
         if not names:
             return _NoFit(residuals(np.zeros(0)))
@@ -472,7 +482,10 @@ class _Residuals:
     writes ``theta`` into copies of three arrays and runs the compiled predictor.
     """
 
-    def __init__(self, problem, model, names, inputs, observed, sd, keep) -> None:
+    def __init__(
+        self, problem, model, names, inputs, observed, sd, keep, limit=None
+    ) -> None:
+        self.limit = limit
         e_n, e_t, effects = problem.unpack(model, [], np.zeros(0))
         self.flags, self.par = registry.kernel_arrays(effects)
         self.e_n, self.e_t = e_n, e_t
@@ -497,7 +510,26 @@ class _Residuals:
             i.vin_mps, i.vit_mps, i.omega_i_radps, i.radius_m, i.gyration_m,
             i.material_index, e_n, e_t, self.flags, par,
         )  # fmt: skip
-        return ((self.observed - pred) / self.sd)[self.keep]
+        out = ((self.observed - pred) / self.sd)[self.keep]
+        if self.limit is None:
+            return out
+        return np.concatenate([out, realised_penalty(pred[:, 0], i.vin_mps,
+                                                     self.limit)])  # fmt: skip
+
+
+def realised_penalty(vfn: np.ndarray, vin: np.ndarray, limit: float) -> np.ndarray:
+    """Penalty residuals of a fit constrained to realised ``e_n <= limit``:
+    :data:`REALISED_PENALTY` ``x max(-vfn/vin - limit, 0)`` per impact (0 where
+    the velocity is not into the ground).
+
+    Examples
+    --------
+    >>> realised_penalty(np.array([1.2, 0.5]), np.array([-1.0, -1.0]), 1.0)
+    array([200.,   0.])
+    """
+    with np.errstate(divide="ignore", invalid="ignore"):
+        e_n = np.where(vin < 0, vfn / -vin, 0.0)
+    return REALISED_PENALTY * np.maximum(np.nan_to_num(e_n) - limit, 0.0)
 
 
 _ARRAY_FIELDS = (
@@ -785,6 +817,31 @@ def too_few_for_errors(problem: ImpactProblem, names: list[str]) -> str | None:
     )
 
 
+def _data_part(problem: ImpactProblem, fit, limit: float):
+    """``(fit with the data residuals and Jacobian rows only, note)`` of a fit
+    constrained to realised e_n <= ``limit``."""
+    n = int(problem.use.sum())
+    penalty = fit.fun[n:]
+    largest = limit + float(penalty.max(initial=0.0)) / REALISED_PENALTY
+    active = int(np.sum(penalty > 0))
+    words = (
+        f"constrained to realised e_n <= {limit:g} at every observed impact (a "
+        f"penalty residual of {REALISED_PENALTY:g} x the excess per impact): "
+        + (
+            f"{active} impact(s) at the limit, the largest realised e_n "
+            f"{largest:.4f}"
+            if active
+            else "no impact reaches it"
+        )
+        + "; chi2, standard errors and AIC/BIC are of the data residuals alone"
+    )
+    if isinstance(fit, _NoFit):
+        return replace(fit, fun=fit.fun[:n]), words
+    data = dict(fit)
+    data.update(fun=fit.fun[:n], jac=fit.jac[:n])
+    return type(fit)(data), words
+
+
 def fit_result(problem: ImpactProblem, names, start, fit, notes) -> FitResult:
     """The :class:`FitResult` of a :meth:`ImpactProblem.solve` on all rows."""
     r = fit.fun
@@ -831,11 +888,19 @@ def fit_result(problem: ImpactProblem, names, start, fit, notes) -> FitResult:
     )
 
 
-def fit_impacts(table: ImpactTable, model: Model) -> tuple[FitResult, Model]:
+def fit_impacts(
+    table: ImpactTable, model: Model, max_realised_e_n: float | None = None
+) -> tuple[FitResult, Model]:
     """Fit ``model``'s impact laws to ``table``; ``(result, calibrated model)``.
 
     The calibrated model is ``model`` with the fitted values in place (its
     ``provenance`` is left to the caller, who knows the table's file name).
+
+    ``max_realised_e_n`` constrains the fit so that the law's realised ``e_n =
+    vfn / -vin`` at every observed impact (the impact velocities the fit uses:
+    regression-calibrated where the table gives their errors) is at most it: a
+    penalty residual per impact (:func:`realised_penalty`), so the largest excess
+    left is of the order of 1/:data:`REALISED_PENALTY` (stated in the notes).
 
     Raises
     ------
@@ -849,12 +914,25 @@ def fit_impacts(table: ImpactTable, model: Model) -> tuple[FitResult, Model]:
     why = too_few(problem, names) or too_few_for_errors(problem, names)
     if why:
         raise InputFileError(why, source=table.source)
+    if max_realised_e_n is not None and not (
+        math.isfinite(max_realised_e_n) and max_realised_e_n > 0
+    ):
+        raise ArgumentError(
+            f"the realised e_n limit must be a positive number (got "
+            f"{max_realised_e_n!r})",
+            source="max_realised_e_n",
+        )
+    limit = max_realised_e_n
     start, start_notes = problem.start(model, names)
-    fit = problem.solve(model, names, start=start)
+    fit = problem.solve(model, names, start=start, max_realised_e_n=limit)
     if problem.errors is not None:
         # the effective variances' derivatives once more, at the fitted values
         problem = problem.reweighted(model, names, fit.x)
-        fit = problem.solve(model, names, start=np.asarray(fit.x, float))
+        fit = problem.solve(model, names, start=np.asarray(fit.x, float),
+                            max_realised_e_n=limit)  # fmt: skip
+    if limit is not None:
+        fit, words = _data_part(problem, fit, limit)
+        notes = [*notes, words]
     result = fit_result(problem, names, start, fit, problem.notes + notes + start_notes)
     calibrated = model.with_parameters(dict(zip(names, map(float, fit.x), strict=True)))
     return result, replace(calibrated, provenance=dict(model.provenance))

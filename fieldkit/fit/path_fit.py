@@ -851,7 +851,8 @@ def fit_paths(
         say(
             f"constrained to realised e_n <= {max_realised_e_n:g}: the worst "
             f"material's share of simulated impacts above it at most "
-            f"{REALISED_TOLERANCE:.0%} (penalty); {realised_start:.1%} at the start"
+            f"{100 * REALISED_TOLERANCE:g} % (penalty); "
+            f"{100 * realised_start:.1f} % at the start"
         )
     say(
         f"fit {p} parameter{'s' * (p != 1)} to {n_runs} run{'s' * (n_runs != 1)} "
@@ -892,9 +893,9 @@ def fit_paths(
     if max_realised_e_n is not None:
         notes.append(
             f"constrained to realised e_n <= {max_realised_e_n:g} (at most "
-            f"{REALISED_TOLERANCE:.0%} of any material's simulated impacts above it, "
-            f"by a penalty): {realised_start:.1%} at the start, {realised_best:.1%} "
-            "at the optimum"
+            f"{100 * REALISED_TOLERANCE:g} % of any material's simulated impacts "
+            f"above it, by a penalty): {100 * realised_start:.1f} % at the start, "
+            f"{100 * realised_best:.1f} % at the optimum"
             + ("" if realised_best <= REALISED_TOLERANCE else
                " -- beyond the tolerance: no point of the search met it")
         )  # fmt: skip

@@ -83,6 +83,9 @@ class RealisedRestitution:
     share_e_t_above_1_se: float
     median_e_t: float
     producers: list[str] = field(default_factory=list)
+    #: With a constrained fit: the limit and the share of impacts above it.
+    limit: float | None = None
+    share_e_n_above_limit: float = math.nan
 
     @property
     def regulator(self) -> bool:
@@ -126,6 +129,11 @@ class RealisedRestitution:
             "median_e_t": _finite(self.median_e_t),
             "regulator": self.regulator,
             "producers": list(self.producers),
+            **(
+                {} if self.limit is None
+                else {"limit": self.limit,
+                      "share_e_n_above_limit": _finite(self.share_e_n_above_limit)}
+            ),  # fmt: skip
         }
 
 
@@ -172,9 +180,15 @@ def realised_share_above(
 
 
 def summarise(
-    material: str, e_n: np.ndarray, e_t: np.ndarray, model: Model
+    material: str,
+    e_n: np.ndarray,
+    e_t: np.ndarray,
+    model: Model,
+    limit: float | None = None,
+    draws: bool = True,
 ) -> RealisedRestitution:
-    """:class:`RealisedRestitution` of one material's realised coefficients."""
+    """:class:`RealisedRestitution` of one material's realised coefficients (and,
+    with ``limit``, the share of ``e_n`` above it)."""
     e_n = e_n[np.isfinite(e_n)]
     e_t = e_t[np.isfinite(e_t)]
 
@@ -186,14 +200,21 @@ def summarise(
 
     pn, sen, men = share(e_n)
     pt, set_, met = share(e_t)
-    why = producers(model, material, e_n=pn > 0, e_t=pt > 0)
+    why = producers(model, material, e_n=pn > 0, e_t=pt > 0, draws=draws)
+    above = (
+        float(np.mean(e_n > limit)) if limit is not None and e_n.size else math.nan
+    )
     return RealisedRestitution(material, int(e_n.size), pn, sen, men, pt, set_, met,
-                               why)  # fmt: skip
+                               why, limit, above)  # fmt: skip
 
 
-def producers(model: Model, material: str, *, e_n: bool, e_t: bool) -> list[str]:
+def producers(
+    model: Model, material: str, *, e_n: bool, e_t: bool, draws: bool = True
+) -> list[str]:
     """What in ``model`` makes ``material``'s realised ``e_n`` (``e_t``) exceed 1,
-    in words, for the coefficients that do (``e_n``, ``e_t`` True).
+    in words, for the coefficients that do (``e_n``, ``e_t`` True); ``draws``:
+    the impacts carry the material's random scatter (simulated, not the law's
+    mean at observed impacts).
 
     Examples
     --------
@@ -212,7 +233,7 @@ def producers(model: Model, material: str, *, e_n: bool, e_t: bool) -> list[str]
     if e_n:
         if mat.e_n > 1.0:
             out.append(f"the material's e_n = {mat.e_n:.4g} > 1")
-        if mat.e_n_sd > 0 and mat.e_n + 2 * mat.e_n_sd > 1.0:
+        if draws and mat.e_n_sd > 0:
             out.append(f"its e_n scatter (e_n_sd {mat.e_n_sd:.3g}) drawing above 1")
         if "velocity_scaled_restitution" in effects and mat.e_n > 1.0:
             k = float(effects["velocity_scaled_restitution"]["k_mps"])
@@ -230,7 +251,7 @@ def producers(model: Model, material: str, *, e_n: bool, e_t: bool) -> list[str]
     if e_t:
         if mat.e_t > 1.0:
             out.append(f"the material's e_t = {mat.e_t:.4g} > 1")
-        if mat.e_t_sd > 0 and mat.e_t + 2 * mat.e_t_sd > 1.0:
+        if draws and mat.e_t_sd > 0:
             out.append(f"its e_t scatter (e_t_sd {mat.e_t_sd:.3g}) drawing above 1")
         if "rotation_friction" in effects:
             out.append("rotation_friction: spin turned into tangential speed")
@@ -242,10 +263,16 @@ def producers(model: Model, material: str, *, e_n: bool, e_t: bool) -> list[str]
 
 
 def simulated_restitution(
-    model: Model, rocks: int = PLAUSIBILITY_ROCKS, seed: int = 0
+    model: Model | Sequence[Model],
+    rocks: int = PLAUSIBILITY_ROCKS,
+    seed: int = 0,
+    limit: float | None = None,
 ) -> list[RealisedRestitution]:
     """Realised ``e_n``, ``e_t`` of ``model``'s simulated impacts, per material
-    (module docstring; materials without impacts are listed with 0 impacts).
+    (module docstring; materials without impacts are listed with 0 impacts; with
+    ``limit``, also the share of ``e_n`` above it). Several models (a path fit's
+    sections, with the same materials) share the rocks, section ``i`` drawn from
+    ``default_rng([seed, PLAUSIBILITY_STREAM, i])``.
 
     Examples
     --------
@@ -258,27 +285,36 @@ def simulated_restitution(
     >>> round(r.median_e_n, 9), r.share_e_n_above_1, r.regulator
     (0.4, 0.0, False)
     """
-    chunks: list[dict[str, np.ndarray]] = []
-    simulate(
-        model,
-        rocks,
-        np.random.default_rng([seed, PLAUSIBILITY_STREAM]),
-        record_impacts=True,
-        on_impact_columns=chunks.append,
-    )
-    names = list(model.materials)
-    parts = [realised_coefficients(c) for c in chunks]
+    sections = [model] if isinstance(model, Model) else list(model)
+    names = list(sections[0].materials)
+    parts = []
+    each = max(math.ceil(rocks / len(sections)), 1)
+    for i, section in enumerate(sections):
+        chunks: list[dict[str, np.ndarray]] = []
+        stream = [seed, PLAUSIBILITY_STREAM] + ([i] if len(sections) > 1 else [])
+        simulate(
+            section,
+            each,
+            np.random.default_rng(stream),
+            record_impacts=True,
+            on_impact_columns=chunks.append,
+        )
+        own = list(section.materials)
+        for c in chunks:
+            mi, e_n, e_t = realised_coefficients(c)
+            index = np.array([names.index(n) for n in own], np.int64)
+            parts.append((index[mi], e_n, e_t))
     mi = np.concatenate([p[0] for p in parts]) if parts else np.zeros(0, np.int64)
     e_n = np.concatenate([p[1] for p in parts]) if parts else np.zeros(0)
     e_t = np.concatenate([p[2] for p in parts]) if parts else np.zeros(0)
     return [
-        summarise(name, e_n[mi == i], e_t[mi == i], model)
+        summarise(name, e_n[mi == i], e_t[mi == i], sections[0], limit)
         for i, name in enumerate(names)
     ]
 
 
 def observed_restitution(
-    table: ImpactTable, model: Model
+    table: ImpactTable, model: Model, limit: float | None = None
 ) -> list[RealisedRestitution]:
     """The fitted law's ``e_n``, ``e_t`` at each observed impact of ``table``
     (its measured impact velocities; release and stop rows, which have no impact,
@@ -294,7 +330,7 @@ def observed_restitution(
         e_t = np.where(np.abs(vit) > 1e-12, pred["vft_mps"] / vit, np.nan)
     labels = table.frame["material"].astype("string").to_numpy(str)
     return [
-        summarise(m, e_n[labels == m], e_t[labels == m], model)
+        summarise(m, e_n[labels == m], e_t[labels == m], model, limit, draws=False)
         for m in model.materials
         if np.any(labels == m)
     ]
@@ -351,7 +387,7 @@ class Plausibility:
             f"plausibility: realised restitution of the calibrated model's simulated "
             f"impacts ({self.rocks:,} rocks, seed {self.seed}, stream "
             f"{PLAUSIBILITY_STREAM}); a material with realised e_n > 1 on more "
-            f"than {REGULATOR_SHARE:.0%} of its impacts is a regulator"
+            f"than {_pct(REGULATOR_SHARE)} of its impacts is a regulator"
         )
         out = [head]
         out += [f"plausibility: {r.words('simulated impacts')}" for r in self.simulated]
@@ -385,3 +421,100 @@ class Plausibility:
             "at_bound": list(self.bounds),
             "constraint": self.constraint,
         }
+
+
+def impact_fit_plausibility(
+    result,
+    calibrated: Model,
+    table: ImpactTable,
+    *,
+    max_realised_e_n: float | None = None,
+    rocks: int = PLAUSIBILITY_ROCKS,
+    seed: int = 0,
+) -> Plausibility:
+    """The :class:`Plausibility` of an impact fit (a
+    :class:`~fieldkit.fit.fit_result.FitResult` and its calibrated model): the
+    calibrated model's simulated impacts, the fitted law at ``table``'s observed
+    impacts, the parameters at a bound and the constraint (its note)."""
+    constraint = None
+    if max_realised_e_n is not None:
+        words = next(
+            (n for n in result.notes if n.startswith("constrained to realised")),
+            f"constrained to realised e_n <= {max_realised_e_n:g}",
+        )
+        constraint = {
+            "max_realised_e_n": float(max_realised_e_n),
+            "applies_to": "the fitted law at every observed impact",
+            "method": "penalty residual per impact",
+            "words": words,
+        }
+    return Plausibility(
+        simulated=simulated_restitution(calibrated, rocks, seed, max_realised_e_n),
+        rocks=rocks,
+        seed=seed,
+        observed=observed_restitution(table, calibrated, max_realised_e_n),
+        bounds=bound_entries(result.names, result.values, result.lower,
+                             result.upper, result.at_bound()),  # fmt: skip
+        constraint=constraint,
+    )
+
+
+def path_fit_plausibility(
+    result,
+    runs: Sequence | None = None,
+    *,
+    rocks: int = PLAUSIBILITY_ROCKS,
+    seed: int = 0,
+) -> Plausibility:
+    """The :class:`Plausibility` of a path fit (a
+    :class:`~fieldkit.fit.path_fit.PathFitResult`): the calibrated model's
+    simulated impacts -- on the sections of ``runs`` (the fitted values set on each
+    run's model, the rocks shared among them), else on the model's own profile --,
+    the parameters at a search bound and the constraint with the shares the fit
+    measured on its own streams."""
+    from fieldkit.fit.path_fit import REALISED_PENALTY, REALISED_TOLERANCE
+
+    constraint = None
+    limit = result.max_realised_e_n
+    fitted = dict(zip(result.names, map(float, result.values), strict=True))
+    models = (
+        [r.model.with_parameters({k: v for k, v in fitted.items()
+                                  if k in r.model.parameters()}) for r in runs]
+        if runs else result.model
+    )  # fmt: skip
+    simulated = simulated_restitution(models, rocks, seed, limit)
+    if limit is not None:
+        above = [
+            f"{r.material} {_pct(r.share_e_n_above_limit)}"
+            for r in simulated
+            if r.impacts and r.share_e_n_above_limit > REALISED_TOLERANCE
+        ]
+        constraint = {
+            "max_realised_e_n": float(limit),
+            "tolerance": REALISED_TOLERANCE,
+            "applies_to": "the worst material's share of the simulated impacts",
+            "method": f"penalty {REALISED_PENALTY:g} x the objective at the start "
+            "x the share beyond the tolerance",
+            "share_start": _finite(result.realised_share_start),
+            "share_optimum": _finite(result.realised_share_optimum),
+            "words": (
+                f"fit constrained to realised e_n <= {limit:g}: the worst "
+                f"material's share of simulated impacts above it "
+                f"{_pct(result.realised_share_start)} at the start, "
+                f"{_pct(result.realised_share_optimum)} at the optimum (tolerance "
+                f"{100 * REALISED_TOLERANCE:g} %, the fit's own rocks)"
+                + (
+                    f"; beyond the tolerance on this report's rocks: "
+                    f"{', '.join(above)}" if above
+                    else "; within it on this report's rocks too"
+                )
+            ),  # fmt: skip
+        }
+    return Plausibility(
+        simulated=simulated,
+        rocks=rocks,
+        seed=seed,
+        bounds=bound_entries(result.names, result.values, result.lower,
+                             result.upper, result.at_bound()),  # fmt: skip
+        constraint=constraint,
+    )
