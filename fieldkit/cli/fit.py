@@ -300,6 +300,9 @@ def fit(
     fitted on the model's own profile: its runout, flight heights, impact spacing
     and speeds at the impacts.
     """
+    from fieldkit.fit.impact_fit import check_realised_limit
+
+    check_realised_limit(max_realised_e_n)
     if releases is not None or deposits is not None or dem is not None:
         _paths(locals())
         return

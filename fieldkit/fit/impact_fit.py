@@ -120,10 +120,14 @@ INPUT_ERRORS = (
 )
 
 #: A fit constrained to realised e_n <= c (``max_realised_e_n``): one residual per
-#: impact, this many times its predicted e_n beyond c (an excess of 0.001 weighs
-#: as one standard error of a datum), added to the weighted residuals; chi2, the
-#: standard errors and AIC/BIC are of the data residuals alone.
-REALISED_PENALTY = 1_000.0
+#: impact, P times its predicted e_n beyond ``c - REALISED_MARGIN``, added to the
+#: weighted residuals and solved for P = each of :data:`REALISED_PENALTIES` in turn
+#: from the last solution (one large P at once leaves the search stuck: chi2 609
+#: against 506 on boulder A); the margin holds the excess the last P leaves
+#: (~1e-6) below c. chi2, the standard errors and AIC/BIC are of the data
+#: residuals alone.
+REALISED_PENALTIES = (1e2, 1e3, 1e4, 1e5)
+REALISED_MARGIN = 1e-4
 
 #: Primary columns every fitted row needs finite.
 FINITE_COLUMNS = ("vi_x_mps", "vi_z_mps", "vf_x_mps", "vf_z_mps", "slope_deg")
@@ -439,7 +443,7 @@ class ImpactProblem:
         ``rows`` is a boolean mask or index array (all rows when None); the
         residuals are ``(observed - predicted) / sd`` of the used data, followed,
         with ``max_realised_e_n``, by one penalty residual per impact
-        (:data:`REALISED_PENALTY` times its predicted ``e_n`` beyond the limit).
+        (:func:`realised_penalty`, :data:`REALISED_PENALTIES` in turn).
         """
         rows = np.ones(len(self.observed), bool) if rows is None else rows
         mask = np.zeros(len(self.observed), bool)
@@ -456,22 +460,34 @@ class ImpactProblem:
             start, _ = self.start(model, names)
         bounds = self.bounds(model, names)
 
-        residuals = _Residuals(self, model, names, sub, observed, sd, keep,
-                               max_realised_e_n)  # fmt: skip
+        limit = None
+        if max_realised_e_n is not None:
+            # the table's own impact velocities (not their regression
+            # calibration): what the plausibility report applies the law to
+            own = impact_inputs(self.table, model)
+            limit = max_realised_e_n, ImpactInputs(
+                *(getattr(own, f)[mask] for f in _ARRAY_FIELDS),
+                material_names=own.material_names,
+            )
+        residuals = _Residuals(self, model, names, sub, observed, sd, keep, limit)
 
         if not names:
             return _NoFit(residuals(np.zeros(0)))
         # The Jacobian is tall and thin (data x a few parameters): threaded BLAS
         # only adds contention (10x slower on a loaded 2-core machine, measured).
         with threadpool_limits(limits=1, user_api="blas"):
-            return least_squares(
-                residuals,
-                start,
-                bounds=(bounds[:, 0], bounds[:, 1]),
-                method="trf",
-                jac="3-point",
-                x_scale="jac",
-            )
+            for penalty in REALISED_PENALTIES if limit is not None else [None]:
+                residuals.penalty = penalty
+                fit = least_squares(
+                    residuals,
+                    start,
+                    bounds=(bounds[:, 0], bounds[:, 1]),
+                    method="trf",
+                    jac="3-point",
+                    x_scale="jac",
+                )
+                start = fit.x
+            return fit
 
 
 class _Residuals:
@@ -486,6 +502,7 @@ class _Residuals:
         self, problem, model, names, inputs, observed, sd, keep, limit=None
     ) -> None:
         self.limit = limit
+        self.penalty = REALISED_PENALTIES[-1]
         e_n, e_t, effects = problem.unpack(model, [], np.zeros(0))
         self.flags, self.par = registry.kernel_arrays(effects)
         self.e_n, self.e_t = e_n, e_t
@@ -513,23 +530,48 @@ class _Residuals:
         out = ((self.observed - pred) / self.sd)[self.keep]
         if self.limit is None:
             return out
-        return np.concatenate([out, realised_penalty(pred[:, 0], i.vin_mps,
-                                                     self.limit)])  # fmt: skip
+        limit, i = self.limit
+        if i is not self.inputs:
+            pred = predict_rows(
+                i.vin_mps, i.vit_mps, i.omega_i_radps, i.radius_m, i.gyration_m,
+                i.material_index, e_n, e_t, self.flags, par,
+            )  # fmt: skip
+        return np.concatenate(
+            [out, realised_penalty(pred[:, 0], i.vin_mps, limit, self.penalty)]
+        )
 
 
-def realised_penalty(vfn: np.ndarray, vin: np.ndarray, limit: float) -> np.ndarray:
+def check_realised_limit(value: float | None) -> None:
+    """Refuse a realised-e_n limit that is not a positive finite number.
+
+    Raises
+    ------
+    ArgumentError
+        Naming ``max_realised_e_n``.
+    """
+    if value is not None and not (math.isfinite(value) and value > 0):
+        raise ArgumentError(
+            f"the realised e_n limit must be a positive number (got {value:g})",
+            source="max_realised_e_n",
+        )
+
+
+def realised_penalty(
+    vfn: np.ndarray, vin: np.ndarray, limit: float, penalty: float
+) -> np.ndarray:
     """Penalty residuals of a fit constrained to realised ``e_n <= limit``:
-    :data:`REALISED_PENALTY` ``x max(-vfn/vin - limit, 0)`` per impact (0 where
-    the velocity is not into the ground).
+    ``penalty x max(-vfn/vin - (limit - REALISED_MARGIN), 0)`` per impact (0
+    where the velocity is not into the ground).
 
     Examples
     --------
-    >>> realised_penalty(np.array([1.2, 0.5]), np.array([-1.0, -1.0]), 1.0)
-    array([200.,   0.])
+    >>> realised_penalty(np.array([1.2, 0.5]), np.array([-1.0, -1.0]), 1.0, 100.0)
+    array([20.01,  0.  ])
     """
     with np.errstate(divide="ignore", invalid="ignore"):
         e_n = np.where(vin < 0, vfn / -vin, 0.0)
-    return REALISED_PENALTY * np.maximum(np.nan_to_num(e_n) - limit, 0.0)
+    excess = np.nan_to_num(e_n) - (limit - REALISED_MARGIN)
+    return penalty * np.maximum(excess, 0.0)
 
 
 _ARRAY_FIELDS = (
@@ -822,14 +864,16 @@ def _data_part(problem: ImpactProblem, fit, limit: float):
     constrained to realised e_n <= ``limit``."""
     n = int(problem.use.sum())
     penalty = fit.fun[n:]
-    largest = limit + float(penalty.max(initial=0.0)) / REALISED_PENALTY
+    margin = limit - REALISED_MARGIN
+    largest = margin + float(penalty.max(initial=0.0)) / REALISED_PENALTIES[-1]
     active = int(np.sum(penalty > 0))
     words = (
         f"constrained to realised e_n <= {limit:g} at every observed impact (a "
-        f"penalty residual of {REALISED_PENALTY:g} x the excess per impact): "
+        f"penalty residual per impact on its e_n beyond {margin:g}, raised to "
+        f"{REALISED_PENALTIES[-1]:g} x the excess): "
         + (
             f"{active} impact(s) at the limit, the largest realised e_n "
-            f"{largest:.4f}"
+            f"{largest:.6f}"
             if active
             else "no impact reaches it"
         )
@@ -897,10 +941,11 @@ def fit_impacts(
     ``provenance`` is left to the caller, who knows the table's file name).
 
     ``max_realised_e_n`` constrains the fit so that the law's realised ``e_n =
-    vfn / -vin`` at every observed impact (the impact velocities the fit uses:
-    regression-calibrated where the table gives their errors) is at most it: a
-    penalty residual per impact (:func:`realised_penalty`), so the largest excess
-    left is of the order of 1/:data:`REALISED_PENALTY` (stated in the notes).
+    vfn / -vin`` at every observed impact (at the table's own impact velocities,
+    as :func:`fieldkit.fit.plausibility.observed_restitution` applies it) is at
+    most it: a penalty residual per impact (:func:`realised_penalty`), raised
+    in steps (:data:`REALISED_PENALTIES`) and aimed :data:`REALISED_MARGIN` below
+    the limit so that none is left above it (the largest value is in the notes).
 
     Raises
     ------
@@ -914,14 +959,7 @@ def fit_impacts(
     why = too_few(problem, names) or too_few_for_errors(problem, names)
     if why:
         raise InputFileError(why, source=table.source)
-    if max_realised_e_n is not None and not (
-        math.isfinite(max_realised_e_n) and max_realised_e_n > 0
-    ):
-        raise ArgumentError(
-            f"the realised e_n limit must be a positive number (got "
-            f"{max_realised_e_n!r})",
-            source="max_realised_e_n",
-        )
+    check_realised_limit(max_realised_e_n)
     limit = max_realised_e_n
     start, start_notes = problem.start(model, names)
     fit = problem.solve(model, names, start=start, max_realised_e_n=limit)

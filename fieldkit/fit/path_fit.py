@@ -77,6 +77,7 @@ from scipy.stats import t as student_t
 
 from fieldkit.errors import ArgumentError
 from fieldkit.fit.holdout import crps_ensemble, crps_ensemble_many
+from fieldkit.fit.impact_fit import check_realised_limit
 from fieldkit.fit.path_along import (
     KINDS,
     AlongObservations,
@@ -795,14 +796,7 @@ def fit_paths(
     x0 = clipped
     span = upper - lower
     p = len(names)
-    if max_realised_e_n is not None and not (
-        math.isfinite(max_realised_e_n) and max_realised_e_n > 0
-    ):
-        raise ArgumentError(
-            f"the realised e_n limit must be a positive number (got "
-            f"{max_realised_e_n!r})",
-            source="max_realised_e_n",
-        )
+    check_realised_limit(max_realised_e_n)
     objective = PathObjective(runs, names, rocks, seed, kinds,
                               realised_limit=max_realised_e_n)  # fmt: skip
     n_runs = len(objective.runs)
