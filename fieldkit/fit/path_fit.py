@@ -85,7 +85,11 @@ from fieldkit.fit.path_along import (
     simulated_along,
 )
 from fieldkit.fit.path_runs import PathRun, one_kernel_thread, simulated_runouts
-from fieldkit.fit.plausibility import realised_share_above
+from fieldkit.fit.plausibility import (
+    REALISED_PENALTY,
+    REALISED_TOLERANCE,
+    realised_share_above,
+)
 from fieldkit.model.effects import registry
 from fieldkit.model.materials import MATERIAL_FIELDS
 from fieldkit.model.model_file import CORE_DEFAULTS, Model
@@ -129,13 +133,6 @@ MAX_ROCKS = 20_000
 MAX_BOOTSTRAP = 1_000
 MAX_SCREEN = 4_096
 MAX_SEED = 2**32 - 1
-#: A fit constrained to realised e_n <= c (``max_realised_e_n``): the share of a
-#: material's simulated impacts above c it tolerates (a Monte Carlo share of a few
-#: thousand impacts cannot be held at exactly 0 by a search without the exact
-#: reformulation every law lacks), and the penalty per unit share beyond it, in
-#: units of the objective at the start (1 % beyond costs the whole start value).
-REALISED_TOLERANCE = 0.01
-REALISED_PENALTY = 100.0
 
 #: ``step(description, total)``: a context manager yielding ``advance(done, total)``
 #: (:func:`fieldkit.cli.progress.step` on the command line).

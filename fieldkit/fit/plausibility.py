@@ -48,6 +48,14 @@ from fieldkit.model.simulate import simulate
 REGULATOR_SHARE = 0.05
 #: Rocks simulated for the report (the impacts are many times more).
 PLAUSIBILITY_ROCKS = 1_000
+#: A path fit constrained to realised e_n <= c (``fit_paths(max_realised_e_n=c)``):
+#: the share of a material's simulated impacts above c it tolerates (a Monte Carlo
+#: share of thousands of impacts cannot be held at exactly 0 by a search without
+#: the exact reformulation no law has once its e_n scatters), and the penalty per
+#: unit share beyond it, in units of the objective at the start (1 % beyond costs
+#: the whole start value).
+REALISED_TOLERANCE = 0.01
+REALISED_PENALTY = 100.0
 #: Stream of the report's simulation: ``default_rng([seed, PLAUSIBILITY_STREAM])``,
 #: apart from a path fit's calibration streams ``[seed, run]`` and its bootstrap's.
 PLAUSIBILITY_STREAM = 6_007
@@ -99,8 +107,8 @@ class RealisedRestitution:
         if self.impacts == 0:
             return f"{self.material}: no {what}"
         en = (
-            f"realised e_n > 1 on {_pct(self.share_e_n_above_1)} ± "
-            f"{_pct(self.share_e_n_above_1_se)} of {self.impacts:,} {what} (median "
+            f"realised e_n > 1 on {_pct(self.share_e_n_above_1)} (SE "
+            f"{_pct(self.share_e_n_above_1_se)}) of {self.impacts:,} {what} (median "
             f"{self.median_e_n:.3f})"
         )
         et = (
@@ -472,8 +480,6 @@ def path_fit_plausibility(
     run's model, the rocks shared among them), else on the model's own profile --,
     the parameters at a search bound and the constraint with the shares the fit
     measured on its own streams."""
-    from fieldkit.fit.path_fit import REALISED_PENALTY, REALISED_TOLERANCE
-
     constraint = None
     limit = result.max_realised_e_n
     fitted = dict(zip(result.names, map(float, result.values), strict=True))
