@@ -362,7 +362,7 @@ def fit(
                 impact_report_markdown(
                     result, table_file=table_file, model_file=model_file,
                     mapping=mapping.notes,
-                ),
+                ) + plausibility.markdown(),
                 outputs,
             )  # fmt: skip
             write_residual_figure(

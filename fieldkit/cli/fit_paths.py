@@ -461,6 +461,7 @@ def fit_paths_command(
                 summary, result, inputs=[str(p) for p in inputs if p != model_file],
                 model_file=model_file, mapping=mapping,
             )  # fmt: skip
+            text += plausibility.markdown()
             write_text(report / "report.md", text, outputs)
         written = outputs.commit()
     for line in uncertainty_lines(summary):

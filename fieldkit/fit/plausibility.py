@@ -412,6 +412,12 @@ class Plausibility:
             out.append(f"plausibility: {self.constraint['words']}")
         return out
 
+    def markdown(self) -> str:
+        """The report.md section ``## Physical plausibility``."""
+        items = [line.removeprefix("plausibility: ") for line in self.lines()]
+        return "\n".join(["", "## Physical plausibility", "", items[0], "",
+                          *[f"* {x}" for x in items[1:]]]) + "\n"  # fmt: skip
+
     def to_dict(self) -> dict:
         """The JSON key ``plausibility``."""
         return {

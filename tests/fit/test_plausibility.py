@@ -201,8 +201,13 @@ def test_boulder_a_impact_fit_reports_observed_and_simulated_and_constrains(
     assert _materials(plaus["simulated"])["colluvium"]["regulator"]
     assert "of 44 observed impacts (the fitted law at their measured impact " \
         "velocities)" in r.stdout
-    r = cli(*common, "-o", tmp_path / "ic.json", "--max-realised-en", "1")
+    r = cli(*common, "-o", tmp_path / "ic.json", "--max-realised-en", "1",
+            "--report", tmp_path / "rep")  # fmt: skip
     assert r.exit_code == 0, r.output
+    report = (tmp_path / "rep" / "report.md").read_text()
+    assert "## Physical plausibility" in report
+    assert "* constrained to realised e_n <= 1 at every observed impact" in report
+    assert f"wrote {tmp_path / 'rep' / 'report.md'}" in r.stdout
     fit = json.loads((tmp_path / "ic.json").read_text())["provenance"]["fit"]
     for m in fit["plausibility"]["observed"]["materials"]:
         assert m["share_e_n_above_1"] == 0.0 and m["share_e_n_above_limit"] == 0.0
