@@ -227,3 +227,25 @@ def test_bad_limit_is_one_line_and_writes_nothing(cli, fails, boulder_a, tmp_pat
                 "--max-realised-en", value)  # fmt: skip
         fails(r, "--max-realised-en")
         assert r.exit_code in (1, 2) and not out.exists()
+
+
+def test_parameter_at_a_search_bound_is_in_the_plausibility_report(
+    cli, boulder_a, tmp_path
+):
+    """Only the colluvium's e_n free, within 0.2-0.9 (below what the flights
+    need): the fit ends on a bound, and the report says which, with the bound."""
+    r = cli("fit", "--paths", boulder_a, "--model", TORNADO / "model_path_start.json",
+            "--preset", TORNADO / "boulder_a_preset.toml",
+            "--free", "materials.colluvium.e_n",
+            "--bound", "materials.colluvium.e_n=0.2,0.9", "--rocks", "30",
+            "--screen", "0", "--bootstrap", "0", "-o", tmp_path / "b.json",
+            "--json", tmp_path / "b.fit.json")  # fmt: skip
+    assert r.exit_code == 0, r.output
+    (entry,) = json.loads((tmp_path / "b.fit.json").read_text())["plausibility"][
+        "at_bound"
+    ]
+    assert entry["name"] == "materials.colluvium.e_n"
+    assert entry["bound"] == "lower" and entry["bound_value"] == 0.2
+    assert entry["value"] == pytest.approx(0.2, abs=1e-3)
+    assert "plausibility: materials.colluvium.e_n = 0.2 is at its lower bound 0.2" \
+        in r.stdout
