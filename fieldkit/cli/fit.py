@@ -35,6 +35,7 @@ FLAGS = {
     "material": "--material",
     "preset": "--preset",
     "profile_points": "--profile-points",
+    "max_realised_e_n": "--max-realised-en",
 }
 
 #: Path-fit settings left unset on the command line take these values.
@@ -198,6 +199,7 @@ def _paths(options: dict) -> None:
             if options["profile_points"] is None
             else options["profile_points"]
         ),
+        max_realised_e_n=options["max_realised_e_n"],
     )
 
 
@@ -314,6 +316,16 @@ def fit(
             "default) or 'release-deposit' (honest for calibration only).",
         ),
     ] = None,
+    max_realised_e_n: Annotated[
+        float | None,
+        typer.Option(
+            "--max-realised-en",
+            help="Constrain the fit to realised e_n = -vfn/vin <= VALUE: at every "
+            "observed impact (impact fit; a penalty residual per impact) or on at "
+            "most 1 % of each material's simulated impacts (path fit; a penalty). "
+            "Default: no constraint.",
+        ),
+    ] = None,
 ) -> None:
     """Fit restitution and effect parameters to measured impacts (weighted LSQ).
 
@@ -350,6 +362,9 @@ def fit(
     fitted on the model's own profile: its runout, flight heights, impact spacing
     and speeds at the impacts.
     """
+    from fieldkit.fit.impact_fit import check_realised_limit
+
+    check_realised_limit(max_realised_e_n)
     if releases is not None or deposits is not None or dem is not None:
         _paths(locals())
         return
@@ -382,7 +397,9 @@ def fit(
         mapping = mapped_table(table, model, material, preset)
         # a weighted least squares of a few parameters: short, shown on a terminal
         with step(f"fitting {model_file.name} to {table_file}", announce=False):
-            result, calibrated = fit_impacts(mapping.table, model)
+            result, calibrated = fit_impacts(
+                mapping.table, model, max_realised_e_n=max_realised_e_n
+            )
         text = result.report()
         if not result.success:
             raise FieldkitError(
@@ -392,6 +409,10 @@ def fit(
             )
         fit_record = result.provenance(str(table_file))
         fit_record["material_map"] = mapping.provenance()
+        plausibility = _impact_plausibility(
+            result, calibrated, mapping.table, max_realised_e_n
+        )
+        fit_record["plausibility"] = plausibility.to_dict()
         provenance = {**calibrated.provenance, "fit": fit_record}
         write_model(replace(calibrated, provenance=provenance), output, outputs=outputs)
         if report is not None:
@@ -403,7 +424,7 @@ def fit(
                 impact_report_markdown(
                     result, table_file=table_file, model_file=model_file,
                     mapping=mapping.notes,
-                ),
+                ) + plausibility.markdown(),
                 outputs,
             )  # fmt: skip
             write_residual_figure(
@@ -415,4 +436,21 @@ def fit(
             )
         written = outputs.commit()
     typer.echo(text)
+    for line in plausibility.lines():
+        typer.echo(line)
     report_written(written)
+
+
+def _impact_plausibility(result, calibrated, table, limit):
+    """The impact fit's plausibility report (the calibrated model simulated on its
+    own stream, the fitted law at the observed impacts, bounds, constraint)."""
+    from fieldkit.fit.plausibility import (
+        PLAUSIBILITY_ROCKS,
+        impact_fit_plausibility,
+    )
+
+    with step(f"simulating {PLAUSIBILITY_ROCKS:,} rocks of the calibrated model "
+              "for its realised restitution"):  # fmt: skip
+        return impact_fit_plausibility(
+            result, calibrated, table, max_realised_e_n=limit
+        )

@@ -440,6 +440,7 @@ def fit_paths_command(
     material: list[str] | None = None,
     preset: Path | None = None,
     profile_points: int = 5,
+    max_realised_e_n: float | None = None,
 ) -> None:
     """Run the path-level fit (see the command's help)."""
     from fieldkit.cli.common import note
@@ -526,11 +527,14 @@ def fit_paths_command(
             calibration, base, names, rocks=rocks, seed=seed, bootstrap=bootstrap,
             progress=lambda line: typer.echo(line, err=True), screen=screen,
             bounds=box, step=step, profile_points=profile_points,
+            max_realised_e_n=max_realised_e_n,
         )  # fmt: skip
         fitted = dict(zip(result.names, map(float, result.values), strict=True))
         summary = result.to_dict()
         summary["section"] = section if on_dem else "the model's own profile"
         summary["material_map"] = material_map
+        plausibility = _path_plausibility(result, calibration, seed, step)
+        summary["plausibility"] = plausibility.to_dict()
         if material_check is not None:
             summary["material_check"] = material_check
         if held is not None:
@@ -557,6 +561,7 @@ def fit_paths_command(
                 summary, result, inputs=[str(p) for p in inputs if p != model_file],
                 model_file=model_file, mapping=mapping,
             )  # fmt: skip
+            text += plausibility.markdown()
             write_text(report / "report.md", text, outputs)
         written = outputs.commit()
     for line in uncertainty_lines(summary):
@@ -567,4 +572,16 @@ def fit_paths_command(
         typer.echo(line)
     for line in _kind_lines(result, summary) + _holdout_lines(summary):
         typer.echo(line)
+    for line in plausibility.lines():
+        typer.echo(line)
     report_written(written)
+
+
+def _path_plausibility(result, runs, seed: int, step):
+    """The path fit's plausibility report: the calibrated model simulated on the
+    calibration runs' sections (its own stream), bounds, the constraint."""
+    from fieldkit.fit.plausibility import PLAUSIBILITY_ROCKS, path_fit_plausibility
+
+    with step(f"simulating {PLAUSIBILITY_ROCKS:,} rocks of the calibrated model "
+              "for its realised restitution"):  # fmt: skip
+        return path_fit_plausibility(result, runs, seed=seed)

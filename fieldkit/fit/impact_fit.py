@@ -72,7 +72,7 @@ import numpy as np
 from scipy.optimize import least_squares
 from threadpoolctl import threadpool_limits
 
-from fieldkit.errors import InputFileError
+from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.fit.fit_result import FitResult
 from fieldkit.fit.impact_model import (
     ImpactInputs,
@@ -119,6 +119,16 @@ INPUT_ERRORS = (
     ("vit_mps", "vit_mps", "vit_sd_mps", 1, "vit_vft_corr"),
     ("omega_i_radps", "omega_i_radps", "omega_i_sd_radps", None, None),
 )
+
+#: A fit constrained to realised e_n <= c (``max_realised_e_n``): one residual per
+#: impact, P times its predicted e_n beyond ``c - REALISED_MARGIN``, added to the
+#: weighted residuals and solved for P = each of :data:`REALISED_PENALTIES` in turn
+#: from the last solution (one large P at once leaves the search stuck: chi2 609
+#: against 506 on boulder A); the margin holds the excess the last P leaves
+#: (~1e-6) below c. chi2, the standard errors and AIC/BIC are of the data
+#: residuals alone.
+REALISED_PENALTIES = (1e2, 1e3, 1e4, 1e5)
+REALISED_MARGIN = 1e-4
 
 #: Primary columns every fitted row needs finite.
 FINITE_COLUMNS = ("vi_x_mps", "vi_z_mps", "vf_x_mps", "vf_z_mps", "slope_deg")
@@ -427,11 +437,14 @@ class ImpactProblem:
         names: list[str],
         rows: np.ndarray | None = None,
         start: np.ndarray | None = None,
+        max_realised_e_n: float | None = None,
     ):
         """``scipy.optimize.least_squares`` result of ``names`` fitted on ``rows``.
 
         ``rows`` is a boolean mask or index array (all rows when None); the
-        residuals are ``(observed - predicted) / sd`` of the used data.
+        residuals are ``(observed - predicted) / sd`` of the used data, followed,
+        with ``max_realised_e_n``, by one penalty residual per impact
+        (:func:`realised_penalty`, :data:`REALISED_PENALTIES` in turn).
         """
         rows = np.ones(len(self.observed), bool) if rows is None else rows
         mask = np.zeros(len(self.observed), bool)
@@ -448,21 +461,34 @@ class ImpactProblem:
             start, _ = self.start(model, names)
         bounds = self.bounds(model, names)
 
-        residuals = _Residuals(self, model, names, sub, observed, sd, keep)
+        limit = None
+        if max_realised_e_n is not None:
+            # the table's own impact velocities (not their regression
+            # calibration): what the plausibility report applies the law to
+            own = impact_inputs(self.table, model)
+            limit = max_realised_e_n, ImpactInputs(
+                *(getattr(own, f)[mask] for f in _ARRAY_FIELDS),
+                material_names=own.material_names,
+            )
+        residuals = _Residuals(self, model, names, sub, observed, sd, keep, limit)
 
         if not names:
             return _NoFit(residuals(np.zeros(0)))
         # The Jacobian is tall and thin (data x a few parameters): threaded BLAS
         # only adds contention (10x slower on a loaded 2-core machine, measured).
         with threadpool_limits(limits=1, user_api="blas"):
-            return least_squares(
-                residuals,
-                start,
-                bounds=(bounds[:, 0], bounds[:, 1]),
-                method="trf",
-                jac="3-point",
-                x_scale="jac",
-            )
+            for penalty in REALISED_PENALTIES if limit is not None else [None]:
+                residuals.penalty = penalty
+                fit = least_squares(
+                    residuals,
+                    start,
+                    bounds=(bounds[:, 0], bounds[:, 1]),
+                    method="trf",
+                    jac="3-point",
+                    x_scale="jac",
+                )
+                start = fit.x
+            return fit
 
 
 class _Residuals:
@@ -473,7 +499,11 @@ class _Residuals:
     writes ``theta`` into copies of three arrays and runs the compiled predictor.
     """
 
-    def __init__(self, problem, model, names, inputs, observed, sd, keep) -> None:
+    def __init__(
+        self, problem, model, names, inputs, observed, sd, keep, limit=None
+    ) -> None:
+        self.limit = limit
+        self.penalty = REALISED_PENALTIES[-1]
         e_n, e_t, effects = problem.unpack(model, [], np.zeros(0))
         self.flags, self.par = registry.kernel_arrays(effects)
         self.e_n, self.e_t = e_n, e_t
@@ -498,7 +528,51 @@ class _Residuals:
             i.vin_mps, i.vit_mps, i.omega_i_radps, i.radius_m, i.gyration_m,
             i.material_index, e_n, e_t, self.flags, par,
         )  # fmt: skip
-        return ((self.observed - pred) / self.sd)[self.keep]
+        out = ((self.observed - pred) / self.sd)[self.keep]
+        if self.limit is None:
+            return out
+        limit, i = self.limit
+        if i is not self.inputs:
+            pred = predict_rows(
+                i.vin_mps, i.vit_mps, i.omega_i_radps, i.radius_m, i.gyration_m,
+                i.material_index, e_n, e_t, self.flags, par,
+            )  # fmt: skip
+        return np.concatenate(
+            [out, realised_penalty(pred[:, 0], i.vin_mps, limit, self.penalty)]
+        )
+
+
+def check_realised_limit(value: float | None) -> None:
+    """Refuse a realised-e_n limit that is not a positive finite number.
+
+    Raises
+    ------
+    ArgumentError
+        Naming ``max_realised_e_n``.
+    """
+    if value is not None and not (math.isfinite(value) and value > 0):
+        raise ArgumentError(
+            f"the realised e_n limit must be a positive number (got {value:g})",
+            source="max_realised_e_n",
+        )
+
+
+def realised_penalty(
+    vfn: np.ndarray, vin: np.ndarray, limit: float, penalty: float
+) -> np.ndarray:
+    """Penalty residuals of a fit constrained to realised ``e_n <= limit``:
+    ``penalty x max(-vfn/vin - (limit - REALISED_MARGIN), 0)`` per impact (0
+    where the velocity is not into the ground).
+
+    Examples
+    --------
+    >>> realised_penalty(np.array([1.2, 0.5]), np.array([-1.0, -1.0]), 1.0, 100.0)
+    array([20.01,  0.  ])
+    """
+    with np.errstate(divide="ignore", invalid="ignore"):
+        e_n = np.where(vin < 0, vfn / -vin, 0.0)
+    excess = np.nan_to_num(e_n) - (limit - REALISED_MARGIN)
+    return penalty * np.maximum(excess, 0.0)
 
 
 _ARRAY_FIELDS = (
@@ -786,6 +860,33 @@ def too_few_for_errors(problem: ImpactProblem, names: list[str]) -> str | None:
     )
 
 
+def _data_part(problem: ImpactProblem, fit, limit: float):
+    """``(fit with the data residuals and Jacobian rows only, note)`` of a fit
+    constrained to realised e_n <= ``limit``."""
+    n = int(problem.use.sum())
+    penalty = fit.fun[n:]
+    margin = limit - REALISED_MARGIN
+    largest = margin + float(penalty.max(initial=0.0)) / REALISED_PENALTIES[-1]
+    active = int(np.sum(penalty > 0))
+    words = (
+        f"constrained to realised e_n <= {limit:g} at every observed impact (a "
+        f"penalty residual per impact on its e_n beyond {margin:g}, raised to "
+        f"{REALISED_PENALTIES[-1]:g} x the excess): "
+        + (
+            f"{active} impact(s) at the limit, the largest realised e_n "
+            f"{largest:.6f}"
+            if active
+            else "no impact reaches it"
+        )
+        + "; chi2, standard errors and AIC/BIC are of the data residuals alone"
+    )
+    if isinstance(fit, _NoFit):
+        return replace(fit, fun=fit.fun[:n]), words
+    data = dict(fit)
+    data.update(fun=fit.fun[:n], jac=fit.jac[:n])
+    return type(fit)(data), words
+
+
 def fit_result(problem: ImpactProblem, names, start, fit, notes) -> FitResult:
     """The :class:`FitResult` of a :meth:`ImpactProblem.solve` on all rows."""
     r = fit.fun
@@ -852,11 +953,20 @@ def _profile(problem: ImpactProblem, model: Model, result: FitResult) -> dict:
     return prof
 
 
-def fit_impacts(table: ImpactTable, model: Model) -> tuple[FitResult, Model]:
+def fit_impacts(
+    table: ImpactTable, model: Model, max_realised_e_n: float | None = None
+) -> tuple[FitResult, Model]:
     """Fit ``model``'s impact laws to ``table``; ``(result, calibrated model)``.
 
     The calibrated model is ``model`` with the fitted values in place (its
     ``provenance`` is left to the caller, who knows the table's file name).
+
+    ``max_realised_e_n`` constrains the fit so that the law's realised ``e_n =
+    vfn / -vin`` at every observed impact (at the table's own impact velocities,
+    as :func:`fieldkit.fit.plausibility.observed_restitution` applies it) is at
+    most it: a penalty residual per impact (:func:`realised_penalty`), raised
+    in steps (:data:`REALISED_PENALTIES`) and aimed :data:`REALISED_MARGIN` below
+    the limit so that none is left above it (the largest value is in the notes).
 
     Raises
     ------
@@ -870,12 +980,18 @@ def fit_impacts(table: ImpactTable, model: Model) -> tuple[FitResult, Model]:
     why = too_few(problem, names) or too_few_for_errors(problem, names)
     if why:
         raise InputFileError(why, source=table.source)
+    check_realised_limit(max_realised_e_n)
+    limit = max_realised_e_n
     start, start_notes = problem.start(model, names)
-    fit = problem.solve(model, names, start=start)
+    fit = problem.solve(model, names, start=start, max_realised_e_n=limit)
     if problem.errors is not None:
         # the effective variances' derivatives once more, at the fitted values
         problem = problem.reweighted(model, names, fit.x)
-        fit = problem.solve(model, names, start=np.asarray(fit.x, float))
+        fit = problem.solve(model, names, start=np.asarray(fit.x, float),
+                            max_realised_e_n=limit)  # fmt: skip
+    if limit is not None:
+        fit, words = _data_part(problem, fit, limit)
+        notes = [*notes, words]
     result = fit_result(problem, names, start, fit, problem.notes + notes + start_notes)
     result.profile = _profile(problem, model, result)
     calibrated = model.with_parameters(dict(zip(names, map(float, fit.x), strict=True)))

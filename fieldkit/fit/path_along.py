@@ -37,7 +37,7 @@ a scar-to-scar flight in the field.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -196,11 +196,13 @@ def simulated_along(
     rocks: int,
     seed: int,
     index: int,
+    on_impacts: Callable[[dict[str, np.ndarray]], None] | None = None,
 ) -> dict[str, list[np.ndarray]]:
     """Simulated ensembles for every observed value of ``run`` (module docstring).
 
     Rocks are drawn from ``default_rng([seed, index])`` (common random numbers, as
-    :func:`fieldkit.fit.path_runs.simulated_runouts`).
+    :func:`fieldkit.fit.path_runs.simulated_runouts`); ``on_impacts``, when given,
+    also receives the simulated impacts' kernel columns.
 
     Returns
     -------
@@ -215,18 +217,23 @@ def simulated_along(
     launches, spacings, heights = [], [], []
 
     def collect(columns: dict[str, np.ndarray]) -> None:
+        if on_impacts is not None:
+            on_impacts(columns)
+        if not need_flights:
+            return
         lx, sp, h = flights(columns)
         launches.append(lx)
         spacings.append(sp)
         heights.append(h)
 
+    record = need_flights or on_impacts is not None
     result = simulate(
         model,
         rocks,
         np.random.default_rng([seed, index]),
         analysis_x_m=release + observed.speed_chainage_m,
-        record_impacts=need_flights,
-        on_impact_columns=collect if need_flights else None,
+        record_impacts=record,
+        on_impact_columns=collect if record else None,
     )
     out: dict[str, list[np.ndarray]] = {}
     runout = np.asarray(result.runout_x_m, float) - release

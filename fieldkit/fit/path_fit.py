@@ -83,6 +83,7 @@ from scipy.stats import t as student_t
 
 from fieldkit.errors import ArgumentError
 from fieldkit.fit.holdout import crps_ensemble, crps_ensemble_many
+from fieldkit.fit.impact_fit import check_realised_limit
 from fieldkit.fit.path_along import (
     KINDS,
     AlongObservations,
@@ -97,6 +98,11 @@ from fieldkit.fit.path_profile import (
     profile_objective,
 )
 from fieldkit.fit.path_runs import PathRun, one_kernel_thread, simulated_runouts
+from fieldkit.fit.plausibility import (
+    REALISED_PENALTY,
+    REALISED_TOLERANCE,
+    realised_share_above,
+)
 from fieldkit.model.effects import registry
 from fieldkit.model.materials import MATERIAL_FIELDS
 from fieldkit.model.model_file import CORE_DEFAULTS, Model
@@ -294,7 +300,12 @@ class PathObjective:
         rocks: int,
         seed: int,
         kinds: Sequence[str] | None = None,
+        realised_limit: float | None = None,
     ):
+        #: With a limit, every simulation also counts the impacts whose realised
+        #: e_n exceeds it: :attr:`realised_share` after each evaluation.
+        self.realised_limit = realised_limit
+        self.realised_share = math.nan
         if kinds is not None:
             unknown = sorted(set(kinds) - set(KINDS))
             if unknown:
@@ -376,16 +387,22 @@ class PathObjective:
         values = dict(zip(self.names, map(float, x), strict=True))
         self.evaluations += 1
         out = []
+        counts: dict[str, np.ndarray] = {}
         with one_kernel_thread():
             for (run, i, model), obs in zip(
                 self._models(values), self.observed_along, strict=True
             ):
+                hook = None
+                if self.realised_limit is not None:
+                    hook = _counter(model, counts, self.realised_limit)
                 if self.along:
-                    sims = simulated_along(run, model, obs, self.rocks, self.seed, i)
+                    sims = simulated_along(run, model, obs, self.rocks, self.seed, i,
+                                           on_impacts=hook)  # fmt: skip
                 else:
                     sims = {
                         "runout_m": [
-                            simulated_runouts(run, model, self.rocks, self.seed, i)
+                            simulated_runouts(run, model, self.rocks, self.seed, i,
+                                              on_impacts=hook)  # fmt: skip
                         ]
                     }
                 for k in self.kinds:
@@ -399,6 +416,8 @@ class PathObjective:
                     else:
                         pairs = zip(ens, ys, strict=True)
                         out.append(np.array([crps_ensemble(e, y) for e, y in pairs]))
+        if self.realised_limit is not None:
+            self.realised_share = _worst_share(counts)
         return np.concatenate(out)
 
     def units(self, x: np.ndarray) -> np.ndarray:
@@ -491,6 +510,20 @@ class PathFitResult:
     t_dof: int = 0
     #: Profile intervals with the seed spread (None: ``profile_points`` 0).
     profile: PathProfile | None = None
+    #: The realised-e_n constraint (None: none) and the worst material's share of
+    #: simulated impacts above it at the start and at the optimum (the fit's own
+    #: streams; NaN without a constraint).
+    max_realised_e_n: float | None = None
+    realised_share_start: float = math.nan
+    realised_share_optimum: float = math.nan
+
+    def at_bound(self) -> np.ndarray:
+        """Whether each value is within 1/1000 of its bound range of a bound (the
+        rule of the fit's "is at a search bound" notes)."""
+        span = self.upper - self.lower
+        return (np.abs(self.values - self.lower) <= 1e-3 * span) | (
+            np.abs(self.values - self.upper) <= 1e-3 * span
+        )
 
     @property
     def stderr_is_lower_bound(self) -> bool:
@@ -611,6 +644,26 @@ class PathFitResult:
         }
 
 
+def _counter(model: Model, counts: dict[str, np.ndarray], limit: float):
+    """An ``on_impacts`` hook adding, per material of ``model``, [impacts whose
+    realised e_n exceeds ``limit``, impacts with a defined e_n] into ``counts``."""
+    names = list(model.materials)
+
+    def add(columns: dict[str, np.ndarray]) -> None:
+        above, total = realised_share_above([columns], len(names), limit)
+        for name, a, t in zip(names, above, total, strict=True):
+            counts.setdefault(name, np.zeros(2, np.int64))
+            counts[name] += (a, t)
+
+    return add
+
+
+def _worst_share(counts: dict[str, np.ndarray]) -> float:
+    """The largest share over materials with impacts (0 without any)."""
+    shares = [a / t for a, t in counts.values() if t > 0]
+    return max(shares, default=0.0)
+
+
 def _finite(x: float) -> float | None:
     """``x`` as a float, or None where it is not finite (JSON has no NaN)."""
     return float(x) if math.isfinite(x) else None
@@ -691,6 +744,7 @@ def fit_paths(
     profile_points: int = 5,
     profile_seeds: int = 5,
     profile_evaluations: int | None = None,
+    max_realised_e_n: float | None = None,
 ) -> PathFitResult:
     """Fit the ``free`` parameters to the observed runouts of ``runs``.
 
@@ -739,6 +793,17 @@ def fit_paths(
         The profile intervals (:mod:`fieldkit.fit.path_profile`): grid values across
         each bound range (0: no profile), other seeds of the objective's seed spread
         (0: none), evaluations of each point's re-optimisation of the others.
+    max_realised_e_n
+        Constrain the fit to realised ``e_n <= max_realised_e_n`` (None: no
+        constraint). Every evaluation's simulations count, per material, the
+        impacts whose realised ``e_n = -v_fN / v_iN`` (on the slope the kernel
+        used) exceeds it; the worst material's share beyond
+        :data:`REALISED_TOLERANCE` is penalised, ``REALISED_PENALTY x S(start) x
+        excess``, in the search and every bootstrap refit, and slice values beyond
+        the tolerance are not compatible with the data. A penalty rather than a
+        bound: no law has an exact reformulation once its e_n scatters (the start
+        model of boulder A, e_n = 1.0 with e_n_sd 0.04 under eq. 7.1, realises
+        e_n > 1 on 40 % of its impacts), so the share is measured, not assumed.
 
     Returns
     -------
@@ -776,7 +841,9 @@ def fit_paths(
     x0 = clipped
     span = upper - lower
     p = len(names)
-    objective = PathObjective(runs, names, rocks, seed, kinds)
+    check_realised_limit(max_realised_e_n)
+    objective = PathObjective(runs, names, rocks, seed, kinds,
+                              realised_limit=max_realised_e_n)  # fmt: skip
     n_runs = len(objective.runs)
     if n_runs < len(runs):
         notes.append(f"{len(runs) - n_runs} runs without any observation left out")
@@ -796,8 +863,14 @@ def fit_paths(
     n_units = sum(s.size for s in objective.strata)
     weights = np.ones(n_units)
 
+    penalty_scale = 0.0  # set from the start value below (a constrained fit)
+
     def f(u):  # progress is the stage's (a bar on a terminal), not a line per 25
-        return float(np.dot(weights, objective.units(to_x(u))))
+        value = float(np.dot(weights, objective.units(to_x(u))))
+        if max_realised_e_n is None:
+            return value
+        excess = max(objective.realised_share - REALISED_TOLERANCE, 0.0)
+        return value + REALISED_PENALTY * penalty_scale * excess
 
     u0 = (x0 - lower) / span
     start_scores = objective.observation_scores(x0)
@@ -811,6 +884,15 @@ def fit_paths(
             + "; each scaled by its CRPS at the start"
         )
     f0 = float(np.sum(objective.units_of(start_scores)))
+    realised_start = objective.realised_share
+    penalty_scale = abs(f0) if f0 != 0 else 1.0
+    if max_realised_e_n is not None:
+        say(
+            f"constrained to realised e_n <= {max_realised_e_n:g}: the worst "
+            f"material's share of simulated impacts above it at most "
+            f"{100 * REALISED_TOLERANCE:g} % (penalty); "
+            f"{100 * realised_start:.1f} % at the start"
+        )
     say(
         f"fit {p} parameter{'s' * (p != 1)} to {n_runs} run{'s' * (n_runs != 1)} "
         f"({rocks} rocks each): "
@@ -846,6 +928,16 @@ def fit_paths(
         "evaluations"
     )
     best_scores = objective.observation_scores(x_best)
+    realised_best = objective.realised_share
+    if max_realised_e_n is not None:
+        notes.append(
+            f"constrained to realised e_n <= {max_realised_e_n:g} (at most "
+            f"{100 * REALISED_TOLERANCE:g} % of any material's simulated impacts "
+            f"above it, by a penalty): {100 * realised_start:.1f} % at the start, "
+            f"{100 * realised_best:.1f} % at the optimum"
+            + ("" if realised_best <= REALISED_TOLERANCE else
+               " -- beyond the tolerance: no point of the search met it")
+        )  # fmt: skip
     best_units = objective.units_of(best_scores)
     kind_optimum = objective.kind_means_of(best_scores)
     run_crps = objective.per_run_of(best_scores)
@@ -904,6 +996,9 @@ def fit_paths(
         x = x_best.copy()
         x[j] = value
         diff = objective.units(x) - best_units
+        if (max_realised_e_n is not None
+                and objective.realised_share > REALISED_TOLERANCE):
+            return False  # outside the constraint: not a value the fit allows
         return bool(diff.sum() <= Z90 * _stratified_se(diff, objective.strata))
 
     with stage(f"slicing the objective across {p} bound ranges", p) as advance:
@@ -950,6 +1045,12 @@ def fit_paths(
             )  # fmt: skip
         profile.widest = _widest(interval, compatible, profile.interval90)
         say(f"profile done: {profile.evaluations} evaluations, {profile.wall_s:.1f} s")
+        if max_realised_e_n is not None:
+            notes.append(
+                "the profile intervals re-optimise the objective without the "
+                f"realised-e_n constraint (<= {max_realised_e_n:g}): they may include "
+                "values the constraint excludes"
+            )
     for j, n in enumerate(names):
         lo, hi = compatible[j]
         if not np.isfinite(interval[j]).all():
@@ -1027,6 +1128,9 @@ def fit_paths(
         model=model,
         notes=notes,
         profile=profile,
+        max_realised_e_n=max_realised_e_n,
+        realised_share_start=realised_start,
+        realised_share_optimum=realised_best,
     )
 
 

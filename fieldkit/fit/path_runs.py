@@ -19,7 +19,7 @@ changes smoothly with them.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 
@@ -64,13 +64,22 @@ class PathRun:
 
 
 def simulated_runouts(
-    run: PathRun, model: Model, rocks: int, seed: int, index: int
+    run: PathRun,
+    model: Model,
+    rocks: int,
+    seed: int,
+    index: int,
+    on_impacts: Callable[[dict[str, np.ndarray]], None] | None = None,
 ) -> np.ndarray:
     """Runouts [m] of ``rocks`` rocks of ``model`` (``run``'s section) with common
     random numbers ``default_rng([seed, index])``: the chainage of the stop less
     that of the release (``model.seeder.x_m``; the profile may start upslope of it,
-    at negative chainage)."""
-    result = simulate(model, rocks, np.random.default_rng([seed, index]))
+    at negative chainage). ``on_impacts``, when given, receives the simulated
+    impacts' kernel columns (``simulate``'s ``on_impact_columns``)."""
+    result = simulate(
+        model, rocks, np.random.default_rng([seed, index]),
+        record_impacts=on_impacts is not None, on_impact_columns=on_impacts,
+    )  # fmt: skip
     return np.asarray(result.runout_x_m, float) - float(model.seeder.x_m)
 
 
