@@ -169,6 +169,7 @@ def test_io_and_physics_depend_on_nothing_above_them():
         "track",
         "impact_table",
         "path_observations",
+        "measured",
     }
 
 

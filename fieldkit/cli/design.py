@@ -20,7 +20,7 @@ import numpy as np
 import typer
 
 from fieldkit.errors import ArgumentError
-from fieldkit.measured import Measured, measured_bounds, measured_problem
+from fieldkit.measured import Measured, measured_problem
 
 #: ``--measured`` keys -> :class:`~fieldkit.measured.Measured` fields.
 MEASURED_KEYS = {
@@ -90,15 +90,6 @@ def parse_measured(text: str) -> Measured:
     return Measured(**values)
 
 
-def measured_help() -> str:
-    """The bounds of ``--measured`` in words, for the options' help."""
-    b = measured_bounds()
-    return (
-        f"speed 0-{b['speed_mps'][0]:g} m/s, ke 0-{b['ke_j'][0]:.0e} J, "
-        f"height 0-{b['height_m'][0]:.0f} m"
-    ).replace("e+", "e")
-
-
 def design_points(
     model, at: Sequence[float] | None, measured: Sequence[Measured]
 ) -> tuple[list[float], list[str], str | None]:
@@ -129,7 +120,7 @@ def design_points(
         names = [""] * len(xs)
         said = (
             "--at not given and the model names no analysis point: design "
-            f"quantities at the measured values' x = "
+            "quantities at the measured values' x = "
             + ", ".join(f"{x:g}" for x in xs) + " m"
             if xs
             else "no analysis point: give --at or an analysis_points block in the "

@@ -279,8 +279,8 @@ def design_quantities(
     ...     "seeder": {"x_m": 0.5, "z_m": 31.0, "vx_mps": 2.0, "vx_sd_mps": 0.5}})
     >>> c = design_quantities({"a": slope, "b": slope}, [20.0],
     ...                       [Measured(20.0, speed_mps=99.0)], rocks=200, seed=1)
-    >>> c.verdicts()[0][:60]
-    'unconservative: measured 99 m/s (speed) at x = 20 m lies abo'
+    >>> c.verdicts()[0][:62]
+    'unconservative: measured 99.0 m/s (speed) at x = 20 m lies abo'
     >>> c.points[0].models["a"] == c.points[0].models["b"]  # the same rocks
     True
     """
@@ -369,7 +369,10 @@ def _verdict(
 ) -> str | None:  # fmt: skip
     """The line for one measured quantity against one model (None: conservative)."""
     words, scale, unit = QUANTITIES[key]
-    what = f"measured {readable(value * scale, 3)} {unit} ({words}) at x = {point.x_m:g} m"
+    what = (
+        f"measured {readable(value * scale, 3)} {unit} ({words}) at x = "
+        f"{point.x_m:g} m"
+    )
     d = at.quantities[key]
     if rank["beyond"] == "above":
         return (
