@@ -126,6 +126,9 @@ def design_points(
             else "no analysis point: give --at or an analysis_points block in the "
             "model file; runout only"
         )
+    from fieldkit.model.simulate import check_run
+
+    check_run(1, (float(model.profile.x_m[0]), float(model.profile.x_m[-1])), xs)
     for m in measured:
         if not any(np.isclose(m.x_m, x) for x in xs):
             raise ArgumentError(
@@ -190,3 +193,28 @@ def design_markdown(consequences, said: str | None) -> list[str]:
         lines += ["", said]
     lines += ["", "```", *consequences.lines(), "```", ""]
     return lines
+
+
+def measured_values(
+    texts: Sequence[str] | None, preset_file=None
+) -> list[Measured]:
+    """The ``--measured`` values, then the preset's ``[[measured]]`` entries."""
+    values = [parse_measured(t) for t in texts or []]
+    if preset_file is not None:
+        from fieldkit.io.preset import read_preset
+
+        values += list(read_preset(preset_file).measured)
+    return values
+
+
+def design_for_fit(
+    start, calibrated, *, at, measured: Sequence[Measured], rocks: int, seed: int
+):
+    """The start and calibrated models' design quantities: (consequences, the
+    line saying where the points came from or None)."""
+    xs, names, said = design_points(start, at, measured)
+    consequences = run_design(
+        {"start": start, "calibrated": calibrated}, xs, names, measured,
+        rocks=rocks, seed=seed,
+    )  # fmt: skip
+    return consequences, said

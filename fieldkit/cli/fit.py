@@ -34,6 +34,10 @@ FLAGS = {
     "section": "--section",
     "material": "--material",
     "preset": "--preset",
+    "analysis_x_m": "--at",
+    "at": "--at",
+    "measured": "--measured",
+    "design_rocks": "--design-rocks",
 }
 
 #: Path-fit settings left unset on the command line take these values.
@@ -45,15 +49,18 @@ PATH_ONLY = ("json_file", "holdout_releases", "holdout_deposits", "free", "rocks
 
 
 def impact_report_markdown(
-    result, *, table_file: Path, model_file: Path, mapping: list[str]
-) -> str:
-    """report.md of an impact fit: the verdict, each parameter in words with its
-    unit, its flags, and the residual figure."""
+    result, *, table_file: Path, model_file: Path, mapping: list[str],
+    design: list[str] = (),
+) -> str:  # fmt: skip
+    """report.md of an impact fit: the design quantities (``design``, first), the
+    verdict, each parameter in words with its unit, its flags, and the residual
+    figure."""
     from fieldkit.cli.fit_paths import parameter_words
 
     lines = [
         "# Impact fit",
         "",
+        *design,
         f"Table: `{table_file}`; base model: `{model_file}`.",
         "",
         *[f"* {m}" for m in mapping],
@@ -146,6 +153,9 @@ def _paths(options: dict) -> None:
         bounds=options["bound"],
         material=options["material"],
         preset=options["preset"],
+        at=options["at"],
+        measured=options["measured"],
+        design_rocks=options["design_rocks"],
     )
 
 
@@ -252,6 +262,33 @@ def fit(
             "default) or 'release-deposit' (honest for calibration only).",
         ),
     ] = None,
+    at: Annotated[
+        list[float] | None,
+        typer.Option(
+            "--at",
+            help="Design quantities at this x (m) (repeatable; default the model "
+            "file's analysis_points, else the measured values' x).",
+        ),
+    ] = None,
+    measured: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--measured",
+            help="A value measured at an analysis point, e.g. "
+            "x=610,speed=18,ke=600e3[,total=690e3][,height=1.5] (J, m/s, m; "
+            "repeatable; the --preset's [[measured]] too): the start and "
+            "calibrated models are set beside it and a line says when one is "
+            "unconservative.",
+        ),
+    ] = None,
+    design_rocks: Annotated[
+        int,
+        typer.Option(
+            "--design-rocks",
+            help="Rocks per model for the design quantities (default 2,000), on "
+            "a random stream the calibration never uses.",
+        ),
+    ] = 2000,
 ) -> None:
     """Fit restitution and effect parameters to measured impacts (weighted LSQ).
 
@@ -287,6 +324,16 @@ def fit(
     With --paths alone, the file is an ImpactTable from reduce and each path is
     fitted on the model's own profile: its runout, flight heights, impact spacing
     and speeds at the impacts.
+
+    Both fits print first what a designer reads: at the analysis points (--at,
+    else the model file's analysis_points) the start and the calibrated model
+    are simulated on one held-out random stream (--design-rocks rocks each) and
+    their passing fraction and p50/p95/p99/max of speed, translational and
+    total energy and bounce height (each with its Monte Carlo SE) are set
+    beside the values measured there (--measured, the preset's [[measured]]);
+    a line says when a model is unconservative (a measured value above its p99,
+    above every rock, or no rock reaching the point). Written under "design" of
+    the JSON and at the top of report.md.
     """
     if releases is not None or deposits is not None or dem is not None:
         _paths(locals())
@@ -305,9 +352,20 @@ def fit(
             + (f" (nor {also})" if also else ""),
             source=given[0],
         )
+    from fieldkit.cli.design import (
+        check_design_rocks,
+        design_for_fit,
+        design_markdown,
+        design_points,
+        measured_values,
+        print_design,
+    )
     from fieldkit.fit.impact_fit import fit_impacts
     from fieldkit.impact_table import ImpactTable
     from fieldkit.model.model_file import read_model, write_model
+
+    check_design_rocks(design_rocks)
+    design_measured = measured_values(measured, preset)
 
     with OutputSet(inputs=[table_file, model_file, preset]) as outputs:
         outputs.confine(report)
@@ -316,6 +374,7 @@ def fit(
             outputs.plan(report / "report.md", argument="--report")
             outputs.plan(report / "residuals.png", argument="--report")
         model = read_model(model_file, outputs=outputs)
+        design_points(model, at, design_measured)  # refused before the fit
         table = ImpactTable.read(table_file)
         mapping = mapped_table(table, model, material, preset)
         # a weighted least squares of a few parameters: short, shown on a terminal
@@ -328,8 +387,15 @@ def fit(
                 "model written",
                 source=str(table_file),
             )
+        # the impact fit has no seed of its own: the design stream's is the path
+        # fit's default, stated in the design table
+        design, said = design_for_fit(
+            model, calibrated, at=at, measured=design_measured, rocks=design_rocks,
+            seed=PATH_DEFAULTS["seed"],
+        )  # fmt: skip
         fit_record = result.provenance(str(table_file))
         fit_record["material_map"] = mapping.provenance()
+        fit_record["design"] = design.to_dict()
         provenance = {**calibrated.provenance, "fit": fit_record}
         write_model(replace(calibrated, provenance=provenance), output, outputs=outputs)
         if report is not None:
@@ -340,7 +406,7 @@ def fit(
                 report / "report.md",
                 impact_report_markdown(
                     result, table_file=table_file, model_file=model_file,
-                    mapping=mapping.notes,
+                    mapping=mapping.notes, design=design_markdown(design, said),
                 ),
                 outputs,
             )  # fmt: skip
@@ -352,5 +418,6 @@ def fit(
                 outputs=outputs,
             )
         written = outputs.commit()
+    print_design(design, said)
     typer.echo(text)
     report_written(written)
