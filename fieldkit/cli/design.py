@@ -181,7 +181,7 @@ def print_design(consequences, said: str | None) -> None:
 
 
 def design_markdown(consequences, said: str | None) -> list[str]:
-    """The report's first section: verdicts as a list, the table verbatim."""
+    """The report's first section: verdicts as a list, then the tables."""
     verdicts = consequences.verdicts()
     lines = ["## Design quantities at the analysis points", ""]
     lines += [f"* **{v}**" for v in verdicts] or [
@@ -191,7 +191,7 @@ def design_markdown(consequences, said: str | None) -> list[str]:
     ]
     if said is not None:
         lines += ["", said]
-    lines += ["", "```", *consequences.lines(), "```", ""]
+    lines += ["", *consequences.markdown(), ""]
     return lines
 
 

@@ -140,15 +140,39 @@ class Consequences:
                         )
         return strong + weak
 
-    def lines(self) -> list[str]:
-        """The table a designer reads: one block per point, a column per model,
-        the measured values beside."""
-        out = [
+    def heading(self) -> str:
+        """What the table holds and how it was simulated, in one line."""
+        return (
             f"design quantities: {self.rocks:,} rocks per model on one held-out "
             f"stream (seed {self.seed}, stream {DESIGN_STREAM}: the same rocks for "
             "every model); ± = Monte Carlo standard error; over the rocks crossing "
             "each point"
-        ]
+        )
+
+    def lines(self) -> list[str]:
+        """The table a designer reads: one block per point, a column per model,
+        the measured values beside."""
+        out = [self.heading()]
+        for rows in self.tables():
+            out += ["", *_table(rows)]
+        return out
+
+    def markdown(self) -> list[str]:
+        """:meth:`lines` as markdown tables (one per point, then the runout)."""
+        out = [self.heading() + "."]
+        for rows in self.tables():
+            out += [""]
+            for i, row in enumerate(rows):
+                cells = [c.strip() or " " for c in row]
+                out.append("| " + " | ".join(cells) + " |")
+                if i == 0:
+                    out.append("|" + "---|" * len(row))
+        return out
+
+    def tables(self) -> list[list[list[str]]]:
+        """The rows of each table (the first row its head): one per point and
+        the runout."""
+        tables: list[list[list[str]]] = []
         heads = list(self.model_names)
         for point in self.points:
             rows: list[list[str]] = []
@@ -187,7 +211,7 @@ class Consequences:
                         + [_rank_cell(point.models[n].ranks[j][key]) for n in heads]
                         + [""]
                     )  # fmt: skip
-            out += ["", *_table(rows)]
+            tables.append(rows)
         rows = [["runout x (m)", *heads, ""]]
         for stat in (*(f"p{q}" for q in DESIGN_PERCENTILES), "max"):
             rows.append(
@@ -195,8 +219,8 @@ class Consequences:
                 + [_stat(self.runout[n], stat, 1.0) for n in heads]
                 + [""]
             )
-        out += ["", *_table(rows)]
-        return out
+        tables.append(rows)
+        return tables
 
     def to_dict(self) -> dict:
         """JSON-ready: settings, the rule, per point and model the distributions
