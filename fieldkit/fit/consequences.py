@@ -212,7 +212,12 @@ class Consequences:
                         + [""]
                     )  # fmt: skip
             tables.append(rows)
-        rows = [["runout x (m)", *heads, ""]]
+        censored = any(any(r.get("lower_bound", {}).values())
+                       for r in self.runout.values())  # fmt: skip
+        head = "runout x (m)" + (
+            "; ≥: a lower bound, rocks left the profile's end" if censored else ""
+        )
+        rows = [[head, *heads, ""]]
         for stat in (*(f"p{q}" for q in DESIGN_PERCENTILES), "max"):
             rows.append(
                 [f"runout {stat}"]
@@ -434,14 +439,14 @@ def _pm(value: float | None, se: float | None, digits: int) -> str:
 
 
 def _stat(d: dict, stat: str, scale: float) -> str:
-    """One statistic of a distribution dict with its SE; ``≥`` for a lower bound."""
+    """One statistic of a distribution dict with its SE; ``≥`` and no SE for a
+    lower bound (a statistic that uses rocks that left the profile)."""
     v = d.get(stat)
     if v is None:
         return "-"
-    text = _pm(v * scale, _se(d, stat, scale), 3)
-    if d.get("lower_bound", {}).get(stat):
-        text = "≥ " + text
-    return text
+    if d.get("lower_bound", {}).get(stat):  # uses rocks that left the profile
+        return "≥ " + _pm(v * scale, None, 3)
+    return _pm(v * scale, _se(d, stat, scale), 3)
 
 
 def _rank_cell(rank: dict) -> str:
