@@ -274,8 +274,13 @@ def test_impact_fit_design_quantities_and_measured_from_both_places(
     out = tmp_path / "cal.json"
     r = cli("fit", boulder_a, "--model", TABLE_7_1, "--preset", PRESET,
             "--measured", "x=610,speed=70", "--design-rocks", "500",
-            "-o", out)  # fmt: skip
+            "-o", out, "--report", tmp_path / "rep")  # fmt: skip
     assert r.exit_code == 0, r.output
+    report = (tmp_path / "rep" / "report.md").read_text()
+    assert report.startswith(
+        "# Impact fit\n\n## Design quantities at the analysis points\n"
+    )
+    assert "| x = 610 m (railway bench) | start | calibrated | measured |" in report
     design = json.loads(out.read_text())["provenance"]["fit"]["design"]
     (point,) = design["points"]
     assert [m["speed_mps"] for m in point["measured"]] == [70.0, 18.0]
