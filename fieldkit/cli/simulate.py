@@ -190,15 +190,9 @@ def simulate(
             outputs.plan(rrd, argument="--rrd")
         model = read_model(model_file, outputs=outputs)
         analysis_x = [float(x) for x in (at or [])]
-        if not at and model.analysis_points:
+        from_model = not at and bool(model.analysis_points)
+        if from_model:
             analysis_x = [p.x_m for p in model.analysis_points]
-            note(
-                "--at not given: analysis points from the model file, "
-                + ", ".join(
-                    f"x = {p.x_m:g} m" + (f" ({p.name})" if p.name else "")
-                    for p in model.analysis_points
-                )
-            )
         if figures is not None:
             from fieldkit.viz.simulation_figure import point_figure_names
 
@@ -210,6 +204,14 @@ def simulate(
             envelope_dx = default_envelope_dx_m(x_range[1] - x_range[0])
         check_run(rocks, x_range, analysis_x, envelope_dx, trajectories)
         _check_measured(points, analysis_x)
+        if from_model:  # said once the inputs are known good (errors are one line)
+            note(
+                "--at not given: analysis points from the model file, "
+                + ", ".join(
+                    f"x = {p.x_m:g} m" + (f" ({p.name})" if p.name else "")
+                    for p in model.analysis_points
+                )
+            )
         if default_dx:
             note(
                 f"--envelope-dx not given: the bounce-height envelope (envelope.png) "
