@@ -102,7 +102,21 @@ class DesignPoint:
 
 @dataclass(frozen=True)
 class Consequences:
-    """What :func:`design_quantities` returns (module docstring)."""
+    """What :func:`design_quantities` returns (module docstring).
+
+    Attributes
+    ----------
+    rocks, seed
+        Rocks per model and the seed of the stream ``[seed, DESIGN_STREAM]``.
+    model_names
+        The models, in column order.
+    points
+        One :class:`DesignPoint` per analysis point.
+    runout
+        Per model: ``n``, ``p50``, ``p95``, ``p99``, ``max`` of the runout x [m]
+        (rocks that stopped on or left the profile), ``se`` and ``lower_bound``
+        (the statistic uses rocks that left the profile's end).
+    """
 
     rocks: int
     seed: int
@@ -120,9 +134,9 @@ class Consequences:
         unconservative lines first."""
         strong: list[str] = []
         weak: list[str] = []
-        for point in self.points:
-            for j, m in enumerate(point.measured):
-                for model in self.model_names:
+        for model in self.model_names:
+            for point in self.points:
+                for j, m in enumerate(point.measured):
                     at = point.models[model]
                     if at.passing == 0:
                         strong.append(
