@@ -276,7 +276,7 @@ def fit(
             "--measured",
             help="A value measured at an analysis point, e.g. "
             "x=610,speed=18,ke=600e3[,total=690e3][,height=1.5] (J, m/s, m; "
-            "repeatable; the --preset's [[measured]] too): the start and "
+            "repeatable; the --preset's measured entries too): the start and "
             "calibrated models are set beside it and a line says when one is "
             "unconservative.",
         ),
@@ -330,7 +330,7 @@ def fit(
     are simulated on one held-out random stream (--design-rocks rocks each) and
     their passing fraction and p50/p95/p99/max of speed, translational and
     total energy and bounce height (each with its Monte Carlo SE) are set
-    beside the values measured there (--measured, the preset's [[measured]]);
+    beside the values measured there (--measured, the preset's measured entries);
     a line says when a model is unconservative (a measured value above its p99,
     above every rock, or no rock reaching the point). Written under "design" of
     the JSON and at the top of report.md.
