@@ -208,13 +208,13 @@ def measured_values(
 
 
 def design_for_fit(
-    start, calibrated, *, at, measured: Sequence[Measured], rocks: int, seed: int
-):
-    """The start and calibrated models' design quantities: (consequences, the
-    line saying where the points came from or None)."""
-    xs, names, said = design_points(start, at, measured)
-    consequences = run_design(
-        {"start": start, "calibrated": calibrated}, xs, names, measured,
-        rocks=rocks, seed=seed,
-    )  # fmt: skip
+    models: Mapping[str, object], *, at, measured: Sequence[Measured], rocks: int,
+    seed: int,
+):  # fmt: skip
+    """The design quantities of the fit's named models (``{"start": ...,
+    "calibrated": ...}``, more when a fit has them), at the first model's points:
+    (consequences, the line saying where the points came from, or None)."""
+    first = next(iter(models.values()))
+    xs, names, said = design_points(first, at, measured)
+    consequences = run_design(models, xs, names, measured, rocks=rocks, seed=seed)
     return consequences, said

@@ -390,8 +390,8 @@ def fit(
         # the impact fit has no seed of its own: the design stream's is the path
         # fit's default, stated in the design table
         design, said = design_for_fit(
-            model, calibrated, at=at, measured=design_measured, rocks=design_rocks,
-            seed=PATH_DEFAULTS["seed"],
+            {"start": model, "calibrated": calibrated}, at=at,
+            measured=design_measured, rocks=design_rocks, seed=PATH_DEFAULTS["seed"],
         )  # fmt: skip
         fit_record = result.provenance(str(table_file))
         fit_record["material_map"] = mapping.provenance()

@@ -465,8 +465,8 @@ def fit_paths_command(
                     report / "holdout.png", validation, outputs=outputs
                 )
         design, said = design_for_fit(
-            base, result.model, at=at, measured=design_measured,
-            rocks=design_rocks, seed=seed,
+            {"start": base, "calibrated": result.model}, at=at,
+            measured=design_measured, rocks=design_rocks, seed=seed,
         )  # fmt: skip
         summary["design"] = design.to_dict()
         provenance = {**base.provenance, "fit_paths": summary}
