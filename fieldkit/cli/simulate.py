@@ -132,8 +132,9 @@ def simulate(
     parabolic flights, impacts (material restitution and the effects the model
     switches on) and sliding until it stops or leaves the profile. Printed:
     the runout distribution, the stopped fraction and, at each analysis point
-    (--at), the fraction of rocks passing and percentiles of speed, energy and
-    bounce height -- each with its Monte Carlo standard error, so you can see
+    (--at, else the model file's analysis_points), the fraction of rocks passing
+    and percentiles of speed, energy and bounce height -- each with its Monte
+    Carlo standard error, so you can see
     whether --rocks was enough -- and the percentile of each --measured value
     (a value above or below every crossing rock has none: "above all N simulated
     rocks", with their maximum).
