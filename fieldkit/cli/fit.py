@@ -9,6 +9,7 @@ from typing import Annotated
 import typer
 
 from fieldkit.cli.common import one_line_errors
+from fieldkit.cli.design import DEFAULT_DESIGN_ROCKS
 from fieldkit.cli.material_options import MaterialOpt, PresetOpt, mapped_table
 from fieldkit.cli.progress import report_written, step
 from fieldkit.errors import ArgumentError, FieldkitError
@@ -285,10 +286,11 @@ def fit(
         int,
         typer.Option(
             "--design-rocks",
-            help="Rocks per model for the design quantities (default 2,000), on "
-            "a random stream the calibration never uses.",
+            help=f"Rocks per model for the design quantities (default "
+            f"{DEFAULT_DESIGN_ROCKS:,}), on a random stream the calibration never "
+            "uses.",
         ),
-    ] = 2000,
+    ] = DEFAULT_DESIGN_ROCKS,
 ) -> None:
     """Fit restitution and effect parameters to measured impacts (weighted LSQ).
 

@@ -347,11 +347,12 @@ def fit_paths_command(
     preset: Path | None = None,
     at: list[float] | None = None,
     measured: list[str] | None = None,
-    design_rocks: int = 2000,
+    design_rocks: int | None = None,
 ) -> None:
     """Run the path-level fit (see the command's help)."""
     from fieldkit.cli.common import note
     from fieldkit.cli.design import (
+        DEFAULT_DESIGN_ROCKS,
         check_design_rocks,
         design_for_fit,
         design_markdown,
@@ -375,6 +376,8 @@ def fit_paths_command(
     from fieldkit.model.model_file import read_model, write_model
 
     check_settings(rocks=rocks, seed=seed, bootstrap=bootstrap, screen=screen)
+    if design_rocks is None:
+        design_rocks = DEFAULT_DESIGN_ROCKS
     check_design_rocks(design_rocks)
     design_measured = measured_values(measured, preset)
     box = parse_bounds(bounds)
