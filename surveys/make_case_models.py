@@ -150,16 +150,20 @@ def model(
     body: dict,
     seeder: dict,
     provenance: dict,
+    analysis_points: list[dict] | None = None,
 ) -> dict:
-    """Assemble one model file (dict) with its provenance."""
+    """Assemble one model file (dict) with its provenance (and its analysis
+    points, where the design quantities are read, when given)."""
     mats, mat_prov = materials(site)
     prov = {"title": title, **provenance, **mat_prov, "effects": EFFECTS_NOTE}
+    points = {"analysis_points": analysis_points} if analysis_points else {}
     return {
         "profile": profile,
         "materials": mats,
         "effects": effects_for(mats),
         "body": body,
         "seeder": seeder,
+        **points,
         "provenance": prov,
     }
 
@@ -201,6 +205,7 @@ def tornado_mountain() -> dict:
             "vx_sd_mps": 0.5,
             "vz_sd_mps": 0.5,
         },
+        analysis_points=[{"x_m": 610.0, "name": "railway bench"}],
         provenance={
             "profile": (
                 "vertices = the 50 mapped points of boulder A in Table 2-4: A "

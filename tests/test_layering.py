@@ -5,8 +5,9 @@ Layers, lowest first (a module may import its own layer's package and any lower 
 0. ``errors`` -- the one error type; ``_version`` -- the version string;
 1. ``physics`` (pure thesis equations: imports nothing of ours but ``errors``) and
    ``outputs`` (safe file writing: all or nothing, never over an input);
-2. the data types ``survey``, ``track``, ``impact_table``, ``path_observations`` (the
-   ImpactTable's derived columns are thesis equations, so it imports ``physics``);
+2. the data types ``survey``, ``track``, ``impact_table``, ``path_observations``,
+   ``measured`` (the ImpactTable's derived columns are thesis equations, so it
+   imports ``physics``);
 3. ``io`` -- field formats in, data types out;
 4. the stages ``reduce``, ``tracking``, ``model``, ``fit``, ``diagnose``, ``export``;
    a stage imports another stage only along :data:`STAGE_EDGES`;
@@ -36,6 +37,7 @@ LAYERS: dict[str, int] = {
     "track": 2,
     "impact_table": 2,
     "path_observations": 2,
+    "measured": 2,
     "io": 3,
     "reduce": 4,
     "tracking": 4,
@@ -167,6 +169,7 @@ def test_io_and_physics_depend_on_nothing_above_them():
         "track",
         "impact_table",
         "path_observations",
+        "measured",
     }
 
 

@@ -9,6 +9,7 @@ from typing import Annotated
 import typer
 
 from fieldkit.cli.common import one_line_errors
+from fieldkit.cli.design import DEFAULT_DESIGN_ROCKS
 from fieldkit.cli.material_options import MaterialOpt, PresetOpt, mapped_table
 from fieldkit.cli.progress import report_written, step
 from fieldkit.errors import ArgumentError, FieldkitError
@@ -36,6 +37,10 @@ FLAGS = {
     "preset": "--preset",
     "profile_points": "--profile-points",
     "max_realised_e_n": "--max-realised-en",
+    "analysis_x_m": "--at",
+    "at": "--at",
+    "measured": "--measured",
+    "design_rocks": "--design-rocks",
 }
 
 #: Path-fit settings left unset on the command line take these values.
@@ -48,15 +53,18 @@ PATH_ONLY = ("json_file", "holdout_releases", "holdout_deposits", "free", "rocks
 
 
 def impact_report_markdown(
-    result, *, table_file: Path, model_file: Path, mapping: list[str]
-) -> str:
-    """report.md of an impact fit: the verdict, each parameter in words with its
-    unit, its flags, and the residual figure."""
+    result, *, table_file: Path, model_file: Path, mapping: list[str],
+    design: list[str] = (),
+) -> str:  # fmt: skip
+    """report.md of an impact fit: the design quantities (``design``, first), the
+    verdict, each parameter in words with its unit, its flags, and the residual
+    figure."""
     from fieldkit.cli.fit_paths import parameter_words
 
     lines = [
         "# Impact fit",
         "",
+        *design,
         f"Table: `{table_file}`; base model: `{model_file}`.",
         "",
         *[f"* {m}" for m in mapping],
@@ -200,6 +208,9 @@ def _paths(options: dict) -> None:
             else options["profile_points"]
         ),
         max_realised_e_n=options["max_realised_e_n"],
+        at=options["at"],
+        measured=options["measured"],
+        design_rocks=options["design_rocks"],
     )
 
 
@@ -326,6 +337,34 @@ def fit(
             "Default: no constraint.",
         ),
     ] = None,
+    at: Annotated[
+        list[float] | None,
+        typer.Option(
+            "--at",
+            help="Design quantities at this x (m) (repeatable; default the model "
+            "file's analysis_points, else the measured values' x).",
+        ),
+    ] = None,
+    measured: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--measured",
+            help="A value measured at an analysis point, e.g. "
+            "x=610,speed=18,ke=600e3[,total=690e3][,height=1.5] (J, m/s, m; "
+            "repeatable; the --preset's measured entries too): the start and "
+            "calibrated models are set beside it and a line says when one is "
+            "unconservative.",
+        ),
+    ] = None,
+    design_rocks: Annotated[
+        int,
+        typer.Option(
+            "--design-rocks",
+            help=f"Rocks per model for the design quantities (default "
+            f"{DEFAULT_DESIGN_ROCKS:,}), on a random stream the calibration never "
+            "uses.",
+        ),
+    ] = DEFAULT_DESIGN_ROCKS,
 ) -> None:
     """Fit restitution and effect parameters to measured impacts (weighted LSQ).
 
@@ -361,6 +400,16 @@ def fit(
     With --paths alone, the file is an ImpactTable from reduce and each path is
     fitted on the model's own profile: its runout, flight heights, impact spacing
     and speeds at the impacts.
+
+    Both fits print first what a designer reads: at the analysis points (--at,
+    else the model file's analysis_points) the start and the calibrated model
+    are simulated on one held-out random stream (--design-rocks rocks each) and
+    their passing fraction and p50/p95/p99/max of speed, translational and
+    total energy and bounce height (each with its Monte Carlo SE) are set
+    beside the values measured there (--measured, the preset's measured entries);
+    a line says when a model is unconservative (a measured value above its p99,
+    above every rock, or no rock reaching the point). Written under "design" of
+    the JSON and at the top of report.md.
     """
     from fieldkit.fit.impact_fit import check_realised_limit
 
@@ -382,9 +431,20 @@ def fit(
             + (f" (nor {also})" if also else ""),
             source=given[0],
         )
+    from fieldkit.cli.design import (
+        check_design_rocks,
+        design_for_fit,
+        design_markdown,
+        design_points,
+        measured_values,
+        print_design,
+    )
     from fieldkit.fit.impact_fit import fit_impacts
     from fieldkit.impact_table import ImpactTable
     from fieldkit.model.model_file import read_model, write_model
+
+    check_design_rocks(design_rocks)
+    design_measured = measured_values(measured, preset)
 
     with OutputSet(inputs=[table_file, model_file, preset]) as outputs:
         outputs.confine(report)
@@ -393,6 +453,7 @@ def fit(
             outputs.plan(report / "report.md", argument="--report")
             outputs.plan(report / "residuals.png", argument="--report")
         model = read_model(model_file, outputs=outputs)
+        design_points(model, at, design_measured)  # refused before the fit
         table = ImpactTable.read(table_file)
         mapping = mapped_table(table, model, material, preset)
         # a weighted least squares of a few parameters: short, shown on a terminal
@@ -407,12 +468,19 @@ def fit(
                 "model written",
                 source=str(table_file),
             )
+        # the impact fit has no seed of its own: the design stream's is the path
+        # fit's default, stated in the design table
+        design, said = design_for_fit(
+            {"start": model, "calibrated": calibrated}, at=at,
+            measured=design_measured, rocks=design_rocks, seed=PATH_DEFAULTS["seed"],
+        )  # fmt: skip
         fit_record = result.provenance(str(table_file))
         fit_record["material_map"] = mapping.provenance()
         plausibility = _impact_plausibility(
             result, calibrated, mapping.table, max_realised_e_n
         )
         fit_record["plausibility"] = plausibility.to_dict()
+        fit_record["design"] = design.to_dict()
         provenance = {**calibrated.provenance, "fit": fit_record}
         write_model(replace(calibrated, provenance=provenance), output, outputs=outputs)
         if report is not None:
@@ -423,7 +491,7 @@ def fit(
                 report / "report.md",
                 impact_report_markdown(
                     result, table_file=table_file, model_file=model_file,
-                    mapping=mapping.notes,
+                    mapping=mapping.notes, design=design_markdown(design, said),
                 ) + plausibility.markdown(),
                 outputs,
             )  # fmt: skip
@@ -435,6 +503,7 @@ def fit(
                 outputs=outputs,
             )
         written = outputs.commit()
+    print_design(design, said)
     typer.echo(text)
     for line in plausibility.lines():
         typer.echo(line)

@@ -242,9 +242,11 @@ def _holdout_lines(summary: dict) -> list[str]:
 
 
 def report_markdown(
-    summary: dict, result, *, inputs: list[str], model_file: Path, mapping: list[str]
-) -> str:
-    """report.md of a path fit: what was fitted, values, CRPS per kind, figures."""
+    summary: dict, result, *, inputs: list[str], model_file: Path, mapping: list[str],
+    design: list[str] = (),
+) -> str:  # fmt: skip
+    """report.md of a path fit: the design quantities (``design``, first), what was
+    fitted, values, CRPS per kind, figures."""
     n_runs = summary["n_runs"]
     objective = (
         "mean CRPS of the observed runouts (m)"
@@ -255,6 +257,7 @@ def report_markdown(
     lines = [
         "# Path fit",
         "",
+        *design,
         f"Observations: {', '.join(f'`{p}`' for p in inputs)}; base model: "
         f"`{model_file}`; sections: "
         f"{SECTION_WORDS.get(summary['section'], summary['section'])}.",
@@ -441,9 +444,21 @@ def fit_paths_command(
     preset: Path | None = None,
     profile_points: int = 5,
     max_realised_e_n: float | None = None,
+    at: list[float] | None = None,
+    measured: list[str] | None = None,
+    design_rocks: int | None = None,
 ) -> None:
     """Run the path-level fit (see the command's help)."""
     from fieldkit.cli.common import note
+    from fieldkit.cli.design import (
+        DEFAULT_DESIGN_ROCKS,
+        check_design_rocks,
+        design_for_fit,
+        design_markdown,
+        design_points,
+        measured_values,
+        print_design,
+    )
     from fieldkit.cli.material_options import mapped_table
     from fieldkit.cli.progress import report_written, step
     from fieldkit.fit.material_map import profile_disagreements
@@ -461,6 +476,10 @@ def fit_paths_command(
 
     check_settings(rocks=rocks, seed=seed, bootstrap=bootstrap, screen=screen,
                    profile_points=profile_points)  # fmt: skip
+    if design_rocks is None:
+        design_rocks = DEFAULT_DESIGN_ROCKS
+    check_design_rocks(design_rocks)
+    design_measured = measured_values(measured, preset)
     box = parse_bounds(bounds)
     on_dem = dem is not None
     if on_dem and (material or preset is not None):
@@ -484,6 +503,7 @@ def fit_paths_command(
             if holdout:
                 outputs.plan(report / "holdout.png", argument="--report")
         base = read_model(model_file, outputs=outputs)
+        design_points(base, at, design_measured)  # refused before the fit
         mapping = []
         material_map: dict[str, str] = {}
         material_check = None
@@ -550,6 +570,11 @@ def fit_paths_command(
                 write_holdout_figure(
                     report / "holdout.png", validation, outputs=outputs
                 )
+        design, said = design_for_fit(
+            {"start": base, "calibrated": result.model}, at=at,
+            measured=design_measured, rocks=design_rocks, seed=seed,
+        )  # fmt: skip
+        summary["design"] = design.to_dict()
         provenance = {**base.provenance, "fit_paths": summary}
         write_model(
             replace(result.model, provenance=provenance), output, outputs=outputs
@@ -560,10 +585,12 @@ def fit_paths_command(
             text = report_markdown(
                 summary, result, inputs=[str(p) for p in inputs if p != model_file],
                 model_file=model_file, mapping=mapping,
+                design=design_markdown(design, said),
             )  # fmt: skip
             text += plausibility.markdown()
             write_text(report / "report.md", text, outputs)
         written = outputs.commit()
+    print_design(design, said)
     for line in uncertainty_lines(summary):
         typer.echo(line)
     for p in summary["parameters"]:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 import secrets
 from pathlib import Path
 from typing import Annotated
@@ -11,6 +10,7 @@ import numpy as np
 import typer
 
 from fieldkit.cli.common import note, one_line_errors, warn
+from fieldkit.cli.design import parse_measured
 from fieldkit.errors import ArgumentError
 from fieldkit.outputs import OutputSet, write_json
 
@@ -26,91 +26,6 @@ FLAGS = {
     "trajectories": "--trajectories",
     "envelope_dx_m": "--envelope-dx",
 }
-
-_MEASURED_KEYS = {"x": "x_m", "speed": "speed_mps", "ke": "ke_j", "height": "height_m"}
-
-#: Standard gravity for the bound on a measured bounce height [m/s^2].
-_G_MPS2 = 9.81
-
-
-def _measured_bounds() -> dict[str, tuple[float, str, str]]:
-    """Largest measured speed, translational KE and bounce height: (limit, units,
-    why), from the command line's physical limits (``PHYSICAL_LIMITS``)."""
-    from fieldkit.cli.common import PHYSICAL_LIMITS
-
-    v_max, _, _ = PHYSICAL_LIMITS["speed_mps"]
-    m_max, _, _ = PHYSICAL_LIMITS["mass_kg"]
-    return {
-        "speed_mps": (v_max, "m/s", PHYSICAL_LIMITS["speed_mps"][2]),
-        "ke_j": (
-            0.5 * m_max * v_max**2, "J",
-            f"1/2 m v^2 of the largest rockfall block ({m_max:g} kg) at "
-            f"{v_max:g} m/s",
-        ),
-        "height_m": (
-            v_max**2 / (2 * _G_MPS2), "m",
-            f"a rock thrown up at {v_max:g} m/s rises v^2/(2g)",
-        ),
-    }  # fmt: skip
-
-
-def parse_measured(text: str):
-    """``x=610,speed=18,ke=600e3[,height=1.5]`` -> a Measured (x required).
-
-    Each key may be given once; a speed, translational KE (J) or bounce height
-    must be from 0 to the bound of :func:`_measured_bounds` (100 m/s, 5e10 J,
-    510 m): a negative or larger value is a typo or a unit slip.
-
-    Examples
-    --------
-    >>> parse_measured("x=610,speed=18,ke=600e3")
-    Measured(x_m=610.0, speed_mps=18.0, ke_j=600000.0, height_m=None)
-    >>> parse_measured("x=50,speed=-5")  # doctest: +ELLIPSIS
-    Traceback (most recent call last):
-    ...
-    fieldkit.errors.ArgumentError: measured: speed=-5 in 'x=50,speed=-5' must be ...
-    """
-    from fieldkit.viz.simulation_figure import Measured
-
-    bounds = _measured_bounds()
-    values: dict[str, float] = {}
-    for part in text.split(","):
-        key, sep, value = part.partition("=")
-        key = key.strip().lower()
-        if not sep or key not in _MEASURED_KEYS:
-            raise ArgumentError(
-                f"{part.strip()!r} in {text!r}: expected key=value with key one of "
-                f"{', '.join(_MEASURED_KEYS)}",
-                source="measured",
-            )
-        name = _MEASURED_KEYS[key]
-        if name in values:
-            raise ArgumentError(
-                f"{key} given twice in {text!r} ({key}={values[name]:g} and "
-                f"{key}={value.strip()}): give each key once",
-                source="measured",
-            )
-        try:
-            number = float(value)
-        except ValueError:
-            number = math.nan
-        if not math.isfinite(number):
-            raise ArgumentError(
-                f"{key}={value!r} is not a finite number", source="measured"
-            )
-        if name in bounds:
-            limit, units, why = bounds[name]
-            if not 0 <= number <= limit:
-                raise ArgumentError(
-                    f"{key}={value.strip()} in {text!r} must be from 0 to "
-                    f"{limit:.4g} {units} ({why})",
-                    source="measured",
-                )
-        values[name] = number
-    if "x_m" not in values:
-        raise ArgumentError(f"{text!r} lacks x=<position m>", source="measured")
-    return Measured(**values)
-
 
 def _fmt(d: dict, key: str, unit: str = "") -> str:
     from fieldkit.model.results import readable
@@ -172,7 +87,8 @@ def simulate(
         list[float] | None,
         typer.Option(
             "--at",
-            help="Analysis point x (m), within the profile; repeatable (up to 100).",
+            help="Analysis point x (m), within the profile; repeatable (up to 100). "
+            "Default: the model file's analysis_points (stated when used).",
         ),
     ] = None,
     trajectories: Annotated[
@@ -193,8 +109,9 @@ def simulate(
         typer.Option(
             "--measured",
             help="A measured value at an --at point, e.g. "
-            "x=610,speed=18,ke=600e3[,height=1.5] (ke translational, J; each key once; "
-            "speed 0-100 m/s, ke 0-5e10 J, height 0-510 m): its "
+            "x=610,speed=18,ke=600e3[,total=690e3][,height=1.5] (ke translational, "
+            "total translational + rotational, J; each key once; speed 0-100 m/s, "
+            "ke 0-5e10 J, total 0-1e11 J, height 0-510 m): its "
             "percentile among the simulated rocks crossing x is printed, written to "
             "summary.json and drawn on the figures; repeatable.",
         ),
@@ -215,8 +132,9 @@ def simulate(
     parabolic flights, impacts (material restitution and the effects the model
     switches on) and sliding until it stops or leaves the profile. Printed:
     the runout distribution, the stopped fraction and, at each analysis point
-    (--at), the fraction of rocks passing and percentiles of speed, energy and
-    bounce height -- each with its Monte Carlo standard error, so you can see
+    (--at, else the model file's analysis_points), the fraction of rocks passing
+    and percentiles of speed, energy and bounce height -- each with its Monte
+    Carlo standard error, so you can see
     whether --rocks was enough -- and the percentile of each --measured value
     (a value above or below every crossing rock has none: "above all N simulated
     rocks", with their maximum).
@@ -258,7 +176,6 @@ def simulate(
         raise ArgumentError(
             f"seed must be from 0 to 2**64 - 1 (got {seed})", source="seed"
         )
-    analysis_x = [float(x) for x in (at or [])]
     points = [parse_measured(text) for text in (measured or [])]
     to_xlsx = impacts is not None and impacts.suffix.lower() == ".xlsx"
     if impacts is not None and not to_xlsx:
@@ -272,18 +189,30 @@ def simulate(
             outputs.plan(summary, argument="--summary")
         if rrd is not None:
             outputs.plan(rrd, argument="--rrd")
+        model = read_model(model_file, outputs=outputs)
+        analysis_x = [float(x) for x in (at or [])]
+        from_model = not at and bool(model.analysis_points)
+        if from_model:
+            analysis_x = [p.x_m for p in model.analysis_points]
         if figures is not None:
             from fieldkit.viz.simulation_figure import point_figure_names
 
             for name in point_figure_names(analysis_x):
                 outputs.plan(figures / name, argument="--figures")
-        model = read_model(model_file, outputs=outputs)
         x_range = (float(model.profile.x_m[0]), float(model.profile.x_m[-1]))
         default_dx = envelope_dx is None and figures is not None
         if default_dx:
             envelope_dx = default_envelope_dx_m(x_range[1] - x_range[0])
         check_run(rocks, x_range, analysis_x, envelope_dx, trajectories)
         _check_measured(points, analysis_x)
+        if from_model:  # said once the inputs are known good (errors are one line)
+            note(
+                "--at not given: analysis points from the model file, "
+                + ", ".join(
+                    f"x = {p.x_m:g} m" + (f" ({p.name})" if p.name else "")
+                    for p in model.analysis_points
+                )
+            )
         if default_dx:
             note(
                 f"--envelope-dx not given: the bounce-height envelope (envelope.png) "
@@ -384,7 +313,7 @@ def _check_measured(points, analysis_x: list[float]) -> None:
     """A measured speed or energy is compared at an analysis point: its x must be
     one of the ``--at`` points (a height alone is drawn on the envelope)."""
     for m in points:
-        compared = m.speed_mps is not None or m.ke_j is not None
+        compared = any(v is not None for v in (m.speed_mps, m.ke_j, m.total_j))
         if compared and not any(np.isclose(m.x_m, x) for x in analysis_x):
             raise ArgumentError(
                 f"x={m.x_m:g} is not an analysis point "
@@ -399,6 +328,7 @@ def _check_measured(points, analysis_x: list[float]) -> None:
 _MEASURED_QUANTITIES = {
     "speed_mps": ("speed_mps", "speed", 1.0, "m/s"),
     "ke_j": ("ke_j", "translational KE", 1e-3, "kJ"),
+    "total_j": ("total_j", "total energy KE+RE", 1e-3, "kJ"),
     "height_m": ("height_m", "bounce height", 1.0, "m"),
 }
 

@@ -14,10 +14,18 @@ path, so the values are not copied into each command line and script::
     talus = "colluvium"
     bench = "colluvium"
 
+    [[measured]]          # a value measured at an analysis point (any number)
+    x_m = 610.0
+    speed_mps = 18.0
+    ke_j = 600e3          # translational, 1/2 m v^2; also total_j, height_m
+    source = "thesis §7.5.4"
+
 ``fieldkit reduce --preset`` reads ``[reduce]``; ``fieldkit fit`` and
 ``fieldkit diagnose --preset`` read ``[materials]``, applied by
 :func:`fieldkit.fit.material_map.map_materials` only to surveyed materials the
 model does not have. Values given on the command line override the preset's.
+``fieldkit fit --preset`` compares its design quantities with each
+``[[measured]]`` entry, beside those of ``--measured``.
 """
 
 from __future__ import annotations
@@ -28,6 +36,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from fieldkit.errors import InputFileError
+from fieldkit.measured import QUANTITIES, Measured, measured_problem
 
 #: ``[reduce]`` keys and their types (SI units in the names).
 REDUCE_KEYS: dict[str, type] = {
@@ -37,7 +46,9 @@ REDUCE_KEYS: dict[str, type] = {
     "gyration_m": float,
     "path_id": str,
 }
-SECTIONS = ("reduce", "materials")
+SECTIONS = ("reduce", "materials", "measured")
+#: ``[[measured]]`` keys: the fields of :class:`fieldkit.measured.Measured`.
+MEASURED_KEYS = ("x_m", *QUANTITIES, "source")
 
 
 @dataclass(frozen=True)
@@ -47,6 +58,7 @@ class SurveyPreset:
     source: str
     reduce: dict[str, float | str] = field(default_factory=dict)
     materials: dict[str, str] = field(default_factory=dict)
+    measured: tuple[Measured, ...] = ()
 
     def body(self) -> dict[str, float]:
         """The body values, as keyword arguments of
@@ -96,7 +108,7 @@ def read_preset(path: str | Path) -> SurveyPreset:
             f"{', '.join(SECTIONS)})",
             source=source,
         )
-    for name in SECTIONS:
+    for name in SECTIONS[:2]:
         if not isinstance(data.get(name, {}), dict):
             raise InputFileError(f"{name} must be a [{name}] table", source=source)
     reduce: dict[str, float | str] = {}
@@ -133,4 +145,47 @@ def read_preset(path: str | Path) -> SurveyPreset:
                 where=f"materials.{key}",
             )
         materials[key] = value.strip()
-    return SurveyPreset(source=source, reduce=reduce, materials=materials)
+    measured = _measured(data.get("measured", []), source)
+    return SurveyPreset(
+        source=source, reduce=reduce, materials=materials, measured=measured
+    )
+
+
+def _measured(entries: object, source: str) -> tuple[Measured, ...]:
+    """The ``[[measured]]`` tables as :class:`~fieldkit.measured.Measured` values
+    (each needs ``x_m`` and at least one measured quantity)."""
+    if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
+        raise InputFileError(
+            "measured must be an array of tables ([[measured]] entries)", source=source
+        )
+    out = []
+    for i, entry in enumerate(entries):
+        where = f"measured[{i}]"
+        for key, value in entry.items():
+            if key not in MEASURED_KEYS:
+                raise InputFileError(
+                    f"unknown key (known: {', '.join(MEASURED_KEYS)})",
+                    source=source,
+                    where=f"{where}.{key}",
+                )
+            if key == "source":
+                if not isinstance(value, str):
+                    raise InputFileError(
+                        f"must be text (got {value!r})", source=source,
+                        where=f"{where}.source",
+                    )  # fmt: skip
+                continue
+            problem = measured_problem(key, value)
+            if problem is not None:
+                raise InputFileError(problem, source=source, where=f"{where}.{key}")
+        if "x_m" not in entry:
+            raise InputFileError("missing", source=source, where=f"{where}.x_m")
+        if not any(k in entry for k in QUANTITIES):
+            raise InputFileError(
+                f"gives no measured value (one or more of {', '.join(QUANTITIES)})",
+                source=source,
+                where=where,
+            )
+        values = {k: float(v) for k, v in entry.items() if k != "source"}
+        out.append(Measured(**values, source=entry.get("source", "").strip()))
+    return tuple(out)

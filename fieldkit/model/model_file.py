@@ -116,6 +116,20 @@ class Trees:
 
 
 @dataclass(frozen=True)
+class AnalysisLocation:
+    """A point of the section where the designer reads the design quantities (a
+    barrier, a road, a building): ``x_m`` along the section [m] and its ``name``
+    (empty when not given)."""
+
+    x_m: float
+    name: str = ""
+
+
+#: Most analysis points a model file may name (as ``fieldkit simulate --at``).
+MAX_ANALYSIS_LOCATIONS = 100
+
+
+@dataclass(frozen=True)
 class Model:
     """A complete forward model (see the module docstring)."""
 
@@ -131,6 +145,8 @@ class Model:
     #: Every file read to build the model: the model file (when read from one),
     #: then its profile CSV or DEM (module docstring, "Files a model reads").
     source_files: tuple[str, ...] = ()
+    #: Where the design quantities are read by default (``"analysis_points"``).
+    analysis_points: tuple[AnalysisLocation, ...] = ()
 
     def parameters(self) -> dict[str, float]:
         """Flat namespaced view of the fittable numbers.
@@ -212,6 +228,7 @@ def model_from_dict(
             "core",
             "trees",
             "provenance",
+            "analysis_points",
         },
         "",
         source,
@@ -275,6 +292,8 @@ def model_from_dict(
             source=source,
             where="trees",
         )
+    analysis_points = _analysis_points(data.get("analysis_points", []), profile,
+                                       source)  # fmt: skip
     provenance = data.get("provenance", {})
     return Model(
         profile=profile,
@@ -287,7 +306,53 @@ def model_from_dict(
         source=source,
         provenance=dict(provenance) if isinstance(provenance, dict) else {},
         source_files=tuple(read),
+        analysis_points=analysis_points,
     )
+
+
+def _analysis_points(
+    data: object, profile: Profile, source: str
+) -> tuple[AnalysisLocation, ...]:
+    """The optional ``"analysis_points"`` block: ``[{"x_m": 610.0, "name":
+    "railway bench"}, ...]``, each x on the profile and given once, the name
+    optional text; one-line errors naming ``analysis_points[i].field``."""
+    if not isinstance(data, list):
+        raise InputFileError(
+            'must be a list of {"x_m": ..., "name": ...} objects',
+            source=source,
+            where="analysis_points",
+        )
+    if len(data) > MAX_ANALYSIS_LOCATIONS:
+        raise InputFileError(
+            f"at most {MAX_ANALYSIS_LOCATIONS} points (got {len(data)})",
+            source=source,
+            where="analysis_points",
+        )
+    x0, x1 = float(profile.x_m[0]), float(profile.x_m[-1])
+    out: list[AnalysisLocation] = []
+    for i, item in enumerate(data):
+        where = f"analysis_points[{i}]"
+        item = _object(item, where, source)
+        _unknown(item, {"x_m", "name"}, where, source)
+        if "x_m" not in item:
+            raise InputFileError("missing", source=source, where=f"{where}.x_m")
+        x = check_number(item["x_m"], x0, x1, source=source, where=f"{where}.x_m",
+                         unit="m")  # fmt: skip
+        name = item.get("name", "")
+        if not isinstance(name, str):
+            raise InputFileError(
+                f"must be text (got {name!r})"[:80], source=source,
+                where=f"{where}.name",
+            )  # fmt: skip
+        twice = [j for j, p in enumerate(out) if p.x_m == x]
+        if twice:
+            raise InputFileError(
+                f"x_m = {x:g} m is given twice (also analysis_points[{twice[0]}])",
+                source=source,
+                where=f"{where}.x_m",
+            )
+        out.append(AnalysisLocation(x_m=x, name=name.strip()))
+    return tuple(out)
 
 
 def _body(data: dict, source: str) -> Body:
@@ -655,6 +720,11 @@ def model_to_dict(model: Model) -> dict:
             "diameter_m": model.trees.diameter_m.tolist(),
             "height_m": model.trees.height_m.tolist(),
         }
+    if model.analysis_points:
+        data["analysis_points"] = [
+            {"x_m": p.x_m, **({"name": p.name} if p.name else {})}
+            for p in model.analysis_points
+        ]
     if model.provenance:
         data["provenance"] = model.provenance
     return data

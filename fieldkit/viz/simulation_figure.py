@@ -19,13 +19,13 @@ from __future__ import annotations
 import os
 import textwrap
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
 
+from fieldkit.measured import Measured  # noqa: F401 (its old home; figures draw it)
 from fieldkit.model.results import SimulationResult
 from fieldkit.model.statistics import PERCENTILES
 from fieldkit.outputs import OutputSet
@@ -36,19 +36,6 @@ _MATERIAL_COLOURS = ("#b89b72", "#8c8c8c", "#7fa36b", "#c9b458", "#9c6f5a", "#6b
 _PERCENTILE_STYLES = {50: "-", 90: "--", 95: "-.", 99: ":"}
 _MEASURED_COLOUR = "red"
 _TRAJECTORY_COLOURS = matplotlib.colormaps["tab10"]
-
-
-@dataclass(frozen=True)
-class Measured:
-    """A measured value at an analysis point, drawn on its distribution (Fig. 7.14).
-
-    Any of speed, kinetic energy and bounce height may be given.
-    """
-
-    x_m: float
-    speed_mps: float | None = None
-    ke_j: float | None = None
-    height_m: float | None = None
 
 
 def _draw_section(ax, profile) -> None:
@@ -252,8 +239,8 @@ def point_histograms_figure(
             "total kinetic energy, translational + rotational (kJ)",
             "kJ",
             1e-3,
-            None,
-            "",
+            None if measured is None else measured.total_j,
+            "measured total energy",
         ),
     )
     for ax, key, (values, label, unit, scale, meas, meas_label) in zip(

@@ -20,7 +20,7 @@ MODEL = Path(__file__).resolve().parents[1] / "model" / "data" / "smoke.json"
 def test_measured_values_parse_and_refuse_bad_keys():
     m = parse_measured("x=610, speed=18,ke=600e3,height=1.5")
     assert (m.x_m, m.speed_mps, m.ke_j, m.height_m) == (610, 18, 600e3, 1.5)
-    with pytest.raises(ArgumentError, match="key one of x, speed, ke, height"):
+    with pytest.raises(ArgumentError, match="key one of x, speed, ke, total, height"):
         parse_measured("x=610,v=18")
     with pytest.raises(ArgumentError, match="lacks x="):
         parse_measured("speed=18")

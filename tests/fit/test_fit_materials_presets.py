@@ -152,7 +152,9 @@ def test_path_fit_report_without_holdout(cli, tmp_path, boulder_a):
     assert "| normal flight height between impacts (m) | 48 |" in text
     assert "| speed at the observed impacts (m/s) | 49 |" in text
     assert "No standard errors: 2 bootstrap resamples are fewer than the 10" in text
-    assert "±" not in r.stdout
+    # no ± on the fitted parameters (the design table's Monte Carlo ± is apart)
+    fitted = [line for line in r.stdout.splitlines() if line.startswith("materials.")]
+    assert fitted and not any("±" in line for line in fitted)
     assert "no standard errors or correlations: --bootstrap 2" in r.stdout
     fit = json.loads(js.read_text())
     assert fit["parameters"][0]["stderr"] is None and fit["correlation"] is None

@@ -116,9 +116,12 @@ def test_path_fit_prints_the_profile_beside_the_bootstrap(cli, tmp_path, boulder
         assert lo <= slo <= p["value"] <= shi <= hi
         assert q["widest"] in ("slice", "profile")  # no standard error: no bootstrap
     out = r.stdout.splitlines()
-    assert out[0].startswith("one surveyed path: resampling its points is a lower "
-                             "bound on the uncertainty of a site's parameters "
-                             "(another boulder, another path)")  # fmt: skip
+    # printed with the fit's own lines, after the consequences (design quantities)
+    # that every fit prints first
+    one_path = ("one surveyed path: resampling its points is a lower bound on the "
+                "uncertainty of a site's parameters (another boulder, another path)")
+    first_parameter = next(i for i, x in enumerate(out) if x.startswith("materials."))
+    assert any(x.startswith(one_path) for x in out[:first_parameter])
     head = next(x for x in out if x.startswith("profile (3 values"))
     sd = prof["optimum_seed_sd"]
     assert f"SD over 5 other seeds {sd:.2g}" in head
