@@ -17,6 +17,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from fieldkit.fit.suspect import SuspectCount
+
 #: |correlation| above which a pair of parameters is flagged as not identifiable.
 CORRELATION_LIMIT = 0.98
 #: A standard error above this times max(|value|, 1e-3) is "huge".
@@ -85,6 +87,8 @@ class FitResult:
     residuals: np.ndarray | None = None  # weighted, in data order
     residual_kind: np.ndarray | None = None  # "vfn", "vft", "omega_f" per datum
     residual_row: np.ndarray | None = None  # table row of each datum
+    #: Suspect impacts and what the fit did with them (fieldkit.fit.suspect).
+    suspect: SuspectCount | None = None
 
     def value(self, name: str) -> float:
         """The fitted value of ``name``."""

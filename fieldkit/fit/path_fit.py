@@ -84,6 +84,7 @@ from fieldkit.fit.path_along import (
     simulated_along,
 )
 from fieldkit.fit.path_runs import PathRun, one_kernel_thread, simulated_runouts
+from fieldkit.fit.suspect import SuspectCount, SuspectPolicy, policy_lines
 from fieldkit.model.effects import registry
 from fieldkit.model.materials import MATERIAL_FIELDS
 from fieldkit.model.model_file import CORE_DEFAULTS, Model
@@ -250,6 +251,9 @@ class PathObjective:
         Rocks per run, and the seed of the common random numbers.
     kinds
         Kinds to score (default: every kind observed on some run).
+    suspect
+        What to do with observed values that rest on a flagged impact or an
+        assumed launch angle (:mod:`fieldkit.fit.suspect`; default: keep them).
     """
 
     def __init__(
@@ -259,6 +263,7 @@ class PathObjective:
         rocks: int,
         seed: int,
         kinds: Sequence[str] | None = None,
+        suspect: SuspectPolicy | None = None,
     ):
         if kinds is not None:
             unknown = sorted(set(kinds) - set(KINDS))
@@ -268,7 +273,8 @@ class PathObjective:
                     source="kinds",
                 )
         self.all_runs = list(runs)
-        observed = [observed_along(r) for r in runs]
+        self.suspect_policy = suspect or SuspectPolicy()
+        observed = [observed_along(r, suspect) for r in runs]
         if kinds is not None:
             observed = [
                 AlongObservations(
@@ -276,6 +282,7 @@ class PathObjective:
                     o.speed_chainage_m if "speed_mps" in kinds else np.zeros(0),
                     o.launch_range_m,
                     o.weights,
+                    {k: c for k, c in o.suspect.items() if k in kinds},
                 )
                 for o in observed
             ]
@@ -313,10 +320,15 @@ class PathObjective:
         self._total = {
             k: float(self._weight[self._kind == k].sum()) for k in self.kinds
         }
+        self.suspect = suspect_counts(self.observed_along)
         if len(self.runs) >= 2:
             self.strata = [np.arange(len(self.runs))]
         else:
             self.strata = [np.flatnonzero(self._kind == k) for k in self.kinds]
+
+    def suspect_words(self) -> list[str]:
+        """What the policy did with the suspect values, one line per group."""
+        return policy_lines(self.suspect_policy, self.suspect, "observed values")
 
     @property
     def along(self) -> bool:
@@ -454,6 +466,9 @@ class PathFitResult:
     #: freedom.
     t_quantile: float = math.nan
     t_dof: int = 0
+    #: Kind -> suspect values and what the fit did with them (fieldkit.fit.suspect).
+    suspect: dict[str, SuspectCount] = field(default_factory=dict)
+    suspect_policy: SuspectPolicy = field(default_factory=SuspectPolicy)
 
     @property
     def stderr_is_lower_bound(self) -> bool:
@@ -573,6 +588,15 @@ class PathFitResult:
         }
 
 
+def suspect_counts(observed: Sequence[AlongObservations]) -> dict[str, SuspectCount]:
+    """Kind -> the suspect counts of every run's observed values, summed."""
+    out: dict[str, SuspectCount] = {}
+    for o in observed:
+        for k, c in o.suspect.items():
+            out.setdefault(k, SuspectCount()).add(c)
+    return out
+
+
 def _finite(x: float) -> float | None:
     """``x`` as a float, or None where it is not finite (JSON has no NaN)."""
     return float(x) if math.isfinite(x) else None
@@ -650,6 +674,7 @@ def fit_paths(
     kinds: Sequence[str] | None = None,
     screen: int = 0,
     step: Step | None = None,
+    suspect: SuspectPolicy | None = None,
 ) -> PathFitResult:
     """Fit the ``free`` parameters to the observed runouts of ``runs``.
 
@@ -694,6 +719,10 @@ def fit_paths(
         ``step(description, total)`` context manager around each long stage (the
         search, the bootstrap, the slices), yielding ``advance(done, total)``;
         default: none.
+    suspect
+        What to do with the flight heights and speeds that rest on a flagged
+        impact or an assumed launch angle (:mod:`fieldkit.fit.suspect`; default:
+        keep them); stated in the notes when it changes anything.
 
     Returns
     -------
@@ -728,7 +757,9 @@ def fit_paths(
     x0 = clipped
     span = upper - lower
     p = len(names)
-    objective = PathObjective(runs, names, rocks, seed, kinds)
+    objective = PathObjective(runs, names, rocks, seed, kinds, suspect)
+    if not objective.suspect_policy.is_default:
+        notes += [f"suspect data: {line}" for line in objective.suspect_words()]
     n_runs = len(objective.runs)
     if n_runs < len(runs):
         notes.append(f"{len(runs) - n_runs} runs without any observation left out")
@@ -965,4 +996,6 @@ def fit_paths(
         bootstrap=boot,
         model=model,
         notes=notes,
+        suspect=objective.suspect,
+        suspect_policy=objective.suspect_policy,
     )
