@@ -11,6 +11,16 @@ import typer
 from fieldkit.cli.common import one_line_errors
 from fieldkit.cli.material_options import MaterialOpt, PresetOpt, mapped_table
 from fieldkit.cli.progress import report_written, step
+from fieldkit.cli.suspect_options import (
+    SUSPECT_FLAGS,
+    AssumedOpt,
+    FlaggedOpt,
+    LeaveOutOpt,
+    suspect_lines,
+    suspect_markdown,
+    suspect_policy,
+    suspect_record,
+)
 from fieldkit.errors import ArgumentError, FieldkitError
 from fieldkit.outputs import OutputSet, write_text
 
@@ -34,6 +44,7 @@ FLAGS = {
     "section": "--section",
     "material": "--material",
     "preset": "--preset",
+    **SUSPECT_FLAGS,
 }
 
 #: Path-fit settings left unset on the command line take these values.
@@ -146,6 +157,8 @@ def _paths(options: dict) -> None:
         bounds=options["bound"],
         material=options["material"],
         preset=options["preset"],
+        suspect=suspect_policy(options["flagged"], options["assumed_theta0"]),
+        leave_out=options["leave_out"],
     )
 
 
@@ -252,6 +265,9 @@ def fit(
             "default) or 'release-deposit' (honest for calibration only).",
         ),
     ] = None,
+    flagged: FlaggedOpt = "keep",
+    assumed_theta0: AssumedOpt = "keep",
+    leave_out: LeaveOutOpt = True,
 ) -> None:
     """Fit restitution and effect parameters to measured impacts (weighted LSQ).
 
@@ -306,8 +322,11 @@ def fit(
             source=given[0],
         )
     from fieldkit.fit.impact_fit import fit_impacts
+    from fieldkit.fit.leave_out import impact_leave_outs
     from fieldkit.impact_table import ImpactTable
     from fieldkit.model.model_file import read_model, write_model
+
+    policy = suspect_policy(flagged, assumed_theta0)
 
     with OutputSet(inputs=[table_file, model_file, preset]) as outputs:
         outputs.confine(report)
@@ -320,7 +339,7 @@ def fit(
         mapping = mapped_table(table, model, material, preset)
         # a weighted least squares of a few parameters: short, shown on a terminal
         with step(f"fitting {model_file.name} to {table_file}", announce=False):
-            result, calibrated = fit_impacts(mapping.table, model)
+            result, calibrated = fit_impacts(mapping.table, model, policy)
         text = result.report()
         if not result.success:
             raise FieldkitError(
@@ -328,8 +347,21 @@ def fit(
                 "model written",
                 source=str(table_file),
             )
+        leave_outs = None
+        if leave_out:
+            leave_outs = impact_leave_outs(
+                mapping.table, model, result, calibrated, policy
+            )
+        counts = {"impacts": result.suspect}
+        suspect = suspect_lines(
+            policy, counts, "impacts", leave_outs,
+            how="weighted least squares from the calibrated values",
+        )  # fmt: skip
         fit_record = result.provenance(str(table_file))
         fit_record["material_map"] = mapping.provenance()
+        fit_record["suspect"] = suspect_record(
+            policy, counts, leave_outs or [], suspect
+        )
         provenance = {**calibrated.provenance, "fit": fit_record}
         write_model(replace(calibrated, provenance=provenance), output, outputs=outputs)
         if report is not None:
@@ -341,7 +373,7 @@ def fit(
                 impact_report_markdown(
                     result, table_file=table_file, model_file=model_file,
                     mapping=mapping.notes,
-                ),
+                ) + suspect_markdown(suspect),
                 outputs,
             )  # fmt: skip
             write_residual_figure(
@@ -353,4 +385,5 @@ def fit(
             )
         written = outputs.commit()
     typer.echo(text)
+    typer.echo("\n".join(suspect))
     report_written(written)

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import typer
 
+from fieldkit.cli.suspect_options import suspect_markdown
 from fieldkit.errors import ArgumentError
 from fieldkit.fit.path_fit import MIN_BOOTSTRAP_SE
 from fieldkit.outputs import OutputSet, write_json, write_text
@@ -342,6 +343,8 @@ def fit_paths_command(
     bounds: list[str] | None = None,
     material: list[str] | None = None,
     preset: Path | None = None,
+    suspect=None,
+    leave_out: bool = True,
 ) -> None:
     """Run the path-level fit (see the command's help)."""
     from fieldkit.cli.common import note
@@ -426,14 +429,16 @@ def fit_paths_command(
         result = fit_paths(
             calibration, base, names, rocks=rocks, seed=seed, bootstrap=bootstrap,
             progress=lambda line: typer.echo(line, err=True), screen=screen,
-            bounds=box, step=step,
+            bounds=box, step=step, suspect=suspect,
         )  # fmt: skip
+        suspect_summary, suspect_text = _suspect(calibration, result, leave_out)
         fitted = dict(zip(result.names, map(float, result.values), strict=True))
         summary = result.to_dict()
         summary["section"] = section if on_dem else "the model's own profile"
         summary["material_map"] = material_map
         if material_check is not None:
             summary["material_check"] = material_check
+        summary["suspect"] = suspect_summary
         if held is not None:
             with step(f"scoring {len(held)} held-out runs ({rocks} rocks each)"):
                 validation = validate(held, calibration, fitted, rocks=rocks, seed=seed)
@@ -458,6 +463,7 @@ def fit_paths_command(
                 summary, result, inputs=[str(p) for p in inputs if p != model_file],
                 model_file=model_file, mapping=mapping,
             )  # fmt: skip
+            text += suspect_markdown(suspect_text)
             write_text(report / "report.md", text, outputs)
         written = outputs.commit()
     for line in uncertainty_lines(summary):
@@ -466,4 +472,25 @@ def fit_paths_command(
         typer.echo(f"{p['name']}: {_value(p)}{_flag(p)}")
     for line in _kind_lines(result, summary) + _holdout_lines(summary):
         typer.echo(line)
+    for line in suspect_text:
+        typer.echo(line)
     report_written(written)
+
+
+def _suspect(runs, result, leave_out: bool) -> tuple[dict, list[str]]:
+    """The path fit's JSON ``suspect`` entry and its lines; the leave-out refits
+    run here unless ``leave_out`` is False (or nothing is suspect)."""
+    from fieldkit.cli.progress import step
+    from fieldkit.cli.suspect_options import suspect_lines, suspect_record
+    from fieldkit.fit.leave_out import path_leave_outs
+
+    leave_outs = None
+    if leave_out and result.suspect:
+        leave_outs = path_leave_outs(runs, result, step=step)
+    how = (
+        "one search each from the calibrated values, same rocks and seed, about "
+        f"{max(150, 60 * len(result.names))} evaluations"
+    )
+    policy, counts = result.suspect_policy, result.suspect
+    lines = suspect_lines(policy, counts, "observed values", leave_outs, how=how)
+    return suspect_record(policy, counts, leave_outs or [], lines), lines

@@ -693,6 +693,9 @@ def impact_problem(
     flags, assumed = impact_markers(marked.frame)
     factor = policy.factors(flags, assumed)
     suspect_count = count(policy, flags[~skip], assumed[~skip])
+    if "point" in table.frame:
+        points = table.frame["point"].astype(str).to_numpy()
+        suspect_count.points = points[~skip & (flags > 0)].tolist()
     excluded = (factor == 0.0) & ~skip
     check_table(table, model, skip | excluded)
     notes = []
@@ -712,7 +715,9 @@ def impact_problem(
     if not policy.is_default:
         notes += [
             f"suspect data: {line}"
-            for line in policy_lines(policy, {"": suspect_count}, "impacts")
+            for line in policy_lines(
+                policy, {"impacts": suspect_count}, "impacts", flights=False
+            )
         ]
     table = table.derive()
     inputs = impact_inputs(table, model)

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from fieldkit.fit.impact_fit import (
+    MIN_IMPACTS_PER_MATERIAL,
     free_parameters,
     impact_problem,
     solve_reweighted,
@@ -71,6 +72,7 @@ class LeaveOut:
     model: Model | None = None
     reason: str | None = None
     held: list[str] = field(default_factory=list)
+    note: str | None = None  # why some parameters are held
     objective_full: float | None = None  # the variant's objective at the full fit
     objective_refit: float | None = None  # ... and at its own optimum
     evaluations: int = 0
@@ -99,6 +101,7 @@ class LeaveOut:
             "refitted": self.values is not None,
             "reason": self.reason,
             "held": list(self.held),
+            "note": self.note,
             "objective_full": self.objective_full,
             "objective_refit": self.objective_refit,
             "evaluations": self.evaluations,
@@ -174,9 +177,22 @@ def impact_leave_outs(
         if leave.reason:
             out.append(leave)
             continue
-        free, _ = free_parameters(model, problem.materials)
+        # a material with fewer impacts left than a fit takes keeps its values:
+        # one impact gives its e_n, e_t exactly, with nothing to tell its scatter
+        used = problem.inputs.material_index[problem.use.any(axis=1)]
+        left = {
+            m: int(np.sum(used == problem.inputs.material_names.index(m)))
+            for m in problem.materials
+        }
+        enough = [m for m, k in left.items() if k >= MIN_IMPACTS_PER_MATERIAL]
+        free, _ = free_parameters(model, enough)
         names = [n for n in result.names if n in free]
         leave.held = [n for n in result.names if n not in free]
+        few = {m: k for m, k in left.items() if k < MIN_IMPACTS_PER_MATERIAL}
+        if few:
+            leave.note = "held at the full fit: " + ", ".join(
+                f"{m} ({k} impact{'s' * (k != 1)} left)" for m, k in few.items()
+            )
         why = too_few(problem, names)
         if why:
             leave.reason = why
@@ -295,9 +311,11 @@ def leave_out_lines(leave_outs: Sequence[LeaveOut]) -> list[str]:
             elif n in lo.held:
                 cell = f"{lo.values[j]:.4g} (held)"
             else:
-                z = lo.shift_se[j]
+                d, z = lo.shift[j], lo.shift_se[j]
+                if abs(d) < 1e-9 * max(1.0, abs(lo.full[j])):  # rounding
+                    d, z = 0.0, (0.0 if math.isfinite(z) else z)
                 se = f", {z:+.1f} SE" if math.isfinite(z) else ""
-                cell = f"{lo.values[j]:.4g} ({lo.shift[j]:+.3g}{se})"
+                cell = f"{lo.values[j]:.4g} ({d:+.3g}{se})"
             row += f"  {cell:>30}"
         lines.append(row)
     for lo in leave_outs:
@@ -306,7 +324,9 @@ def leave_out_lines(leave_outs: Sequence[LeaveOut]) -> list[str]:
         flags = ", ".join(f"{k} {v}" for k, v in lo.dropped_by_flag.items() if v)
         text = f"  {lo.name}: dropped {total}" + (f" ({parts})" if parts else "")
         if flags:
-            text += f"; values on impacts flagged {flags}"
+            text += f"; by flag: {flags}"
+        if lo.note:
+            text += f"; {lo.note}"
         if lo.reason:
             text += f"; not refitted: {lo.reason}"
         elif lo.objective_full is not None:

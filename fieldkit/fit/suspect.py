@@ -189,6 +189,8 @@ class SuspectCount:
     assumed_theta0: int = 0
     excluded: int = 0
     weighted: int = 0
+    #: Names of the flagged impacts (an impact fit's rows), where known.
+    points: list[str] = field(default_factory=list)
 
     def add(self, other: SuspectCount) -> None:
         """Add ``other``'s counts to these."""
@@ -197,6 +199,7 @@ class SuspectCount:
         self.assumed_theta0 += other.assumed_theta0
         self.excluded += other.excluded
         self.weighted += other.weighted
+        self.points += other.points
         for k, v in other.by_flag.items():
             self.by_flag[k] = self.by_flag.get(k, 0) + v
 
@@ -210,6 +213,7 @@ class SuspectCount:
             "excluded": self.excluded,
             "weighted": self.weighted,
             "kept": self.values - self.excluded - self.weighted,
+            "flagged_points": list(self.points),
         }
 
 
@@ -242,37 +246,58 @@ def count(
 
 
 def policy_lines(
-    policy: SuspectPolicy, counts: Mapping[str, SuspectCount], what: str
+    policy: SuspectPolicy,
+    counts: Mapping[str, SuspectCount],
+    what: str,
+    *,
+    flights: bool = True,
 ) -> list[str]:
     """One line per group: how many ``what`` (e.g. "impacts", "observed values")
     are suspect and what the fit did with them (argument names in backticks).
+    ``flights``: the values rest on the flights of flagged impacts (a path fit),
+    not on the impacts themselves (an impact fit).
 
     Examples
     --------
-    >>> c = {"speed_mps": SuspectCount(49, 8, {"energy_gained": 6,
-    ...      "e_t_above_1": 6}, 33)}
+    >>> c = {"flight_height_m": SuspectCount(48, 8, {"energy_gained": 6,
+    ...      "e_t_above_1": 6}, 33), "speed_mps": SuspectCount(49, 8,
+    ...      {"energy_gained": 6, "e_t_above_1": 6}, 34)}
     >>> policy_lines(SuspectPolicy(), c, "observed values")[0]
-    'flagged: 8 observed values (speed_mps 8) rest on impacts flagged energy_gained \
-(6), e_t_above_1 (6): kept (`flagged` keep)'
+    'flagged: 16 observed values (flight_height_m 8, speed_mps 8) rest on the \
+flights of impacts flagged energy_gained or e_t_above_1 (energy_gained 12, \
+e_t_above_1 12): kept (`flagged` keep)'
+    >>> c = {"impacts": SuspectCount(48, 4, {"energy_gained": 3, "e_t_above_1": 3},
+    ...      43, points=["22", "27", "32", "42"])}
+    >>> policy_lines(SuspectPolicy(assumed_theta0=EXCLUDE), c, "impacts",
+    ...              flights=False)[1]
+    'assumed θ0: 43 impacts rest on an assumed launch angle (of the flight \
+arriving or leaving): excluded (`assumed_theta0` exclude)'
     """
     lines = []
+    several = len(counts) > 1
     for group in GROUPS:
-        argument = group
         n = sum(getattr(c, group) for c in counts.values())
         per = ", ".join(
             f"{k} {getattr(c, group)}" for k, c in counts.items() if getattr(c, group)
         )
+        where = f" ({per})" if per and several else ""
         t = policy.treatment(group)
-        where = f" ({per})" if per and list(counts) != [""] else ""
         if group == "flagged":
-            by = {
-                name: sum(c.by_flag.get(name, 0) for c in counts.values())
+            by = ", ".join(
+                f"{name} {sum(c.by_flag.get(name, 0) for c in counts.values())}"
                 for name in SUSPECT_FLAGS
-            }
-            head = f"flagged: {n} {what}{where} rest on impacts flagged " + ", ".join(
-                f"{name} ({m})" for name, m in by.items()
+            )
+            points = [p for c in counts.values() for p in c.points]
+            named = f", points {', '.join(points)}" if points else ""
+            head = (
+                f"flagged: {n} {what}{where} rest on the flights of impacts flagged "
+                f"{' or '.join(SUSPECT_FLAGS)} ({by})"
+                if flights
+                else f"flagged: {n} {what} flagged ({by}{named})"
             )
         else:
             head = f"assumed θ0: {n} {what}{where} rest on an assumed launch angle"
-        lines.append(f"{head}: {t.words} (`{argument}` {t.option})")
+            if not flights:
+                head += " (of the flight arriving or leaving)"
+        lines.append(f"{head}: {t.words} (`{group}` {t.option})")
     return lines
