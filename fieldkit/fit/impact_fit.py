@@ -689,8 +689,7 @@ def impact_problem(
     """
     policy = suspect or SuspectPolicy()
     skip = no_flight_rows(table)
-    marked = table if "qa_flags" in table.frame else table.derive()
-    flags, assumed = impact_markers(marked.frame)
+    flags, assumed = impact_markers(table.derive().frame)  # qa_flags recomputed
     factor = policy.factors(flags, assumed)
     suspect_count = count(policy, flags[~skip], assumed[~skip])
     if "point" in table.frame:
