@@ -365,6 +365,7 @@ def fit(
         provenance = {**calibrated.provenance, "fit": fit_record}
         write_model(replace(calibrated, provenance=provenance), output, outputs=outputs)
         if report is not None:
+            from fieldkit.cli.fit_paths import parameter_words
             from fieldkit.viz.fit_figure import write_residual_figure
 
             derived = mapping.table.derive()
@@ -373,7 +374,7 @@ def fit(
                 impact_report_markdown(
                     result, table_file=table_file, model_file=model_file,
                     mapping=mapping.notes,
-                ) + suspect_markdown(suspect),
+                ) + suspect_markdown(fit_record["suspect"], {}, parameter_words),
                 outputs,
             )  # fmt: skip
             write_residual_figure(

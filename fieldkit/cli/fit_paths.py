@@ -14,7 +14,6 @@ from pathlib import Path
 
 import typer
 
-from fieldkit.cli.suspect_options import suspect_markdown
 from fieldkit.errors import ArgumentError
 from fieldkit.fit.path_fit import MIN_BOOTSTRAP_SE
 from fieldkit.outputs import OutputSet, write_json, write_text
@@ -463,7 +462,9 @@ def fit_paths_command(
                 summary, result, inputs=[str(p) for p in inputs if p != model_file],
                 model_file=model_file, mapping=mapping,
             )  # fmt: skip
-            text += suspect_markdown(suspect_text)
+            from fieldkit.cli.suspect_options import suspect_markdown
+
+            text += suspect_markdown(suspect_summary, KIND_WORDS, parameter_words)
             write_text(report / "report.md", text, outputs)
         written = outputs.commit()
     for line in uncertainty_lines(summary):

@@ -7,7 +7,7 @@ and :mod:`fieldkit.fit.leave_out`.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Annotated
 
 import typer
@@ -101,6 +101,86 @@ def suspect_lines(
     return lines + leave_out_lines(leave_outs)
 
 
-def suspect_markdown(lines: Sequence[str]) -> str:
-    """The report's section on suspect data."""
-    return "\n## Suspect data\n\n```\n" + "\n".join(lines) + "\n```\n"
+#: Suspect flags and groups in words (report.md).
+FLAG_WORDS = {"energy_gained": "kinetic energy gained", "e_t_above_1": "e_T > 1"}
+GROUP_WORDS = {
+    "flagged": ("the flights of impacts flagged", "--flagged"),
+    "assumed_theta0": ("flights on an assumed launch angle θ0", "--assumed-theta0"),
+}
+
+
+def suspect_markdown(
+    record: dict, kind_words: Mapping[str, str], parameter_words: Callable[[str], str]
+) -> str:
+    """The report's section on suspect data (:func:`suspect_record`), in words:
+    kinds by ``kind_words``, parameters by ``parameter_words(name)``."""
+
+    def kinds(counts: dict) -> str:
+        return "; ".join(f"{kind_words.get(k, k)}: {n}" for k, n in counts.items() if n)
+
+    lines = ["", "## Suspect data", ""]
+    counts = record["counts"]
+    if not counts:
+        return "\n".join(lines + [
+            "The observations carry no quality flags or launch angles: nothing to "
+            "weight or leave out.", "",
+        ])  # fmt: skip
+    for group, (words, flag) in GROUP_WORDS.items():
+        per = {k: c[group] for k, c in counts.items()}
+        option = record["policy"][group]
+        done = {"keep": "kept", "exclude": "excluded"}.get(option, f"weighted {option}")
+        extra = ""
+        if group == "flagged":
+            by = {f: sum(c["by_flag"].get(f, 0) for c in counts.values())
+                  for f in FLAG_WORDS}  # fmt: skip
+            extra = " (" + ", ".join(f"{FLAG_WORDS[f]}: {n}" for f, n in by.items())
+            points = [p for c in counts.values() for p in c["flagged_points"]]
+            extra += f"; points {', '.join(points)})" if points else ")"
+        impacts = "impacts" in counts
+        what = "impacts" if impacts else "observed values"
+        per_kind = "" if impacts or not any(per.values()) else f" ({kinds(per)})"
+        lines.append(
+            f"* {sum(per.values())} {what}{per_kind} "
+            f"{'flagged' if impacts and group == 'flagged' else 'rest on ' + words}"
+            f"{extra}: "
+            f"{done} ({flag} {option})."
+        )
+    leave = record["leave_out"]
+    if not leave:
+        return "\n".join(lines + ["", "No leave-out refits (--no-leave-out).", ""])
+    lines += [
+        "",
+        "Leave-out refits: the fit repeated without each group (a search from the "
+        "calibrated values); in brackets the shift from the full fit and, where it "
+        "has one, in its standard errors.",
+        "",
+        "| parameter | full fit | " + " | ".join(v["variant"] for v in leave) + " |",
+        "|---" * (2 + len(leave)) + "|",
+    ]
+    for j, p in enumerate(leave[0]["parameters"]):
+        cells = []
+        for v in leave:
+            q = v["parameters"][j]
+            if not v["refitted"]:
+                cells.append("not refitted")
+            elif q["name"] in v["held"]:
+                cells.append(f"{q['refitted']:.4g} (held)")
+            else:
+                z = q["shift_in_stderr"]
+                se = f", {z + 0.0:+.1f} SE" if z is not None else ""
+                cells.append(f"{q['refitted']:.4g} ({q['shift'] + 0.0:+.3g}{se})")
+        lines.append(
+            f"| {parameter_words(p['name'])} | {p['full']:.4g} | "
+            + " | ".join(cells) + " |"
+        )  # fmt: skip
+    lines.append("")
+    for v in leave:
+        dropped = kinds(v["dropped"]) if "impacts" not in v["dropped"] else ""
+        text = f"* {v['variant']}: dropped {sum(v['dropped'].values())}"
+        text += f" ({dropped})" if dropped else ""
+        if v["note"]:
+            text += f"; {v['note']}"
+        if v["reason"]:
+            text += f"; not refitted: {v['reason']}"
+        lines.append(text + ".")
+    return "\n".join(lines) + "\n"

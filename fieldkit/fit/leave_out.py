@@ -79,10 +79,12 @@ class LeaveOut:
 
     @property
     def shift(self) -> np.ndarray:
-        """Refitted minus full-fit value of each parameter (NaN: not refitted)."""
+        """Refitted minus full-fit value of each parameter (NaN: not refitted; 0
+        where it is rounding, below 1e-9 of the value)."""
         if self.values is None:
             return np.full(len(self.names), np.nan)
-        return self.values - self.full
+        d = self.values - self.full
+        return np.where(np.abs(d) < 1e-9 * np.maximum(1.0, np.abs(self.full)), 0.0, d)
 
     @property
     def shift_se(self) -> np.ndarray:
@@ -311,9 +313,7 @@ def leave_out_lines(leave_outs: Sequence[LeaveOut]) -> list[str]:
             elif n in lo.held:
                 cell = f"{lo.values[j]:.4g} (held)"
             else:
-                d, z = lo.shift[j], lo.shift_se[j]
-                if abs(d) < 1e-9 * max(1.0, abs(lo.full[j])):  # rounding
-                    d, z = 0.0, (0.0 if math.isfinite(z) else z)
+                d, z = lo.shift[j], lo.shift_se[j] + 0.0  # no -0.0
                 se = f", {z:+.1f} SE" if math.isfinite(z) else ""
                 cell = f"{lo.values[j]:.4g} ({d:+.3g}{se})"
             row += f"  {cell:>30}"
@@ -322,7 +322,8 @@ def leave_out_lines(leave_outs: Sequence[LeaveOut]) -> list[str]:
         total = sum(lo.dropped.values())
         parts = ", ".join(f"{k} {v}" for k, v in lo.dropped.items() if v)
         flags = ", ".join(f"{k} {v}" for k, v in lo.dropped_by_flag.items() if v)
-        text = f"  {lo.name}: dropped {total}" + (f" ({parts})" if parts else "")
+        several = len(lo.dropped) > 1
+        text = f"  {lo.name}: dropped {total}" + (f" ({parts})" if several else "")
         if flags:
             text += f"; by flag: {flags}"
         if lo.note:
