@@ -307,9 +307,11 @@ def report_markdown(
         lines += ["", "## Held-out runs", ""]
         lines += [f"* {x}" for x in _holdout_lines(summary)]
         lines += ["", "![held-out runouts](holdout.png)"]
-    if summary["notes"]:
+    # the suspect-data notes are said in words under "Suspect data"
+    notes = [n for n in summary["notes"] if not n.startswith("suspect data:")]
+    if notes:
         lines += ["", "## Notes", ""] + [
-            f"* {_in_words(n, summary['parameters'])}" for n in summary["notes"]
+            f"* {_in_words(n, summary['parameters'])}" for n in notes
         ]
     return "\n".join(lines) + "\n"
 
@@ -430,7 +432,9 @@ def fit_paths_command(
             progress=lambda line: typer.echo(line, err=True), screen=screen,
             bounds=box, step=step, suspect=suspect,
         )  # fmt: skip
-        suspect_summary, suspect_text = _suspect(calibration, result, leave_out)
+        suspect_summary, suspect_text, leave_outs = _suspect(
+            calibration, result, leave_out
+        )
         fitted = dict(zip(result.names, map(float, result.values), strict=True))
         summary = result.to_dict()
         summary["section"] = section if on_dem else "the model's own profile"
@@ -478,9 +482,11 @@ def fit_paths_command(
     report_written(written)
 
 
-def _suspect(runs, result, leave_out: bool) -> tuple[dict, list[str]]:
-    """The path fit's JSON ``suspect`` entry and its lines; the leave-out refits
-    run here unless ``leave_out`` is False (or nothing is suspect)."""
+def _suspect(runs, result, leave_out: bool) -> tuple[dict, list[str], list]:
+    """The path fit's JSON ``suspect`` entry, its lines and the leave-out refits
+    (:class:`~fieldkit.fit.leave_out.LeaveOut`, their models by
+    :func:`~fieldkit.fit.leave_out.leave_out_models`), run here unless
+    ``leave_out`` is False (or nothing is suspect)."""
     from fieldkit.cli.progress import step
     from fieldkit.cli.suspect_options import suspect_lines, suspect_record
     from fieldkit.fit.leave_out import path_leave_outs
@@ -494,4 +500,5 @@ def _suspect(runs, result, leave_out: bool) -> tuple[dict, list[str]]:
     )
     policy, counts = result.suspect_policy, result.suspect
     lines = suspect_lines(policy, counts, "observed values", leave_outs, how=how)
-    return suspect_record(policy, counts, leave_outs or [], lines), lines
+    leave_outs = leave_outs or []
+    return suspect_record(policy, counts, leave_outs, lines), lines, leave_outs

@@ -715,7 +715,11 @@ def impact_problem(
         notes += [
             f"suspect data: {line}"
             for line in policy_lines(
-                policy, {"impacts": suspect_count}, "impacts", flights=False
+                policy,
+                {"impacts": suspect_count},
+                "impacts",
+                flights=False,
+                arguments=False,
             )
         ]
     table = table.derive()

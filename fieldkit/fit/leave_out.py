@@ -139,8 +139,14 @@ def variant_policies(policy: SuspectPolicy) -> list[tuple[str, SuspectPolicy]]:
     return [(g, replace(policy, **{g: EXCLUDE})) for g in GROUPS]
 
 
-def _by_flag(group: str, by_flag: dict[str, int]) -> dict[str, int]:
-    return dict(by_flag) if group == "flagged" else {}
+def _dropped_by_flag(variant: list, full: list) -> dict[str, int]:
+    """Per flag, the values the variant excludes beyond the full fit (both lists
+    of :class:`~fieldkit.fit.suspect.SuspectCount`)."""
+
+    def total(counts: list, flag: str) -> int:
+        return sum(c.excluded_by_flag.get(flag, 0) for c in counts)
+
+    return {f: total(variant, f) - total(full, f) for f in SUSPECT_FLAGS}
 
 
 def impact_leave_outs(
@@ -168,9 +174,10 @@ def impact_leave_outs(
         c = problem.suspect
         already = result.suspect.excluded if result.suspect is not None else 0
         dropped = {"impacts": c.excluded - already}
+        base = [result.suspect] if result.suspect is not None else []
         leave = LeaveOut(
             group, name, list(result.names), full, full_se, dropped,
-            _by_flag(group, c.by_flag),
+            _dropped_by_flag([c], base),
         )  # fmt: skip
         if policy.treatment(group).exclude:
             leave.reason = "already excluded in the fit"
@@ -250,11 +257,10 @@ def path_leave_outs(
             k: c.excluded - (result.suspect[k].excluded if k in result.suspect else 0)
             for k, c in objective.suspect.items()
         }
-        counts = list(objective.suspect.values())
-        by_flag = {f: sum(c.by_flag.get(f, 0) for c in counts) for f in SUSPECT_FLAGS}
-        leave = LeaveOut(
-            group, name, names, full, full_se, dropped, _by_flag(group, by_flag)
+        by_flag = _dropped_by_flag(
+            list(objective.suspect.values()), list(result.suspect.values())
         )
+        leave = LeaveOut(group, name, names, full, full_se, dropped, by_flag)
         if result.suspect_policy.treatment(group).exclude:
             leave.reason = "already excluded in the fit"
         elif sum(dropped.values()) == 0:
@@ -322,7 +328,7 @@ def leave_out_lines(leave_outs: Sequence[LeaveOut]) -> list[str]:
         total = sum(lo.dropped.values())
         parts = ", ".join(f"{k} {v}" for k, v in lo.dropped.items() if v)
         flags = ", ".join(f"{k} {v}" for k, v in lo.dropped_by_flag.items() if v)
-        several = len(lo.dropped) > 1
+        several = len(lo.dropped) > 1 and parts
         text = f"  {lo.name}: dropped {total}" + (f" ({parts})" if several else "")
         if flags:
             text += f"; by flag: {flags}"

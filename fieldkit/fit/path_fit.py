@@ -328,7 +328,9 @@ class PathObjective:
 
     def suspect_words(self) -> list[str]:
         """What the policy did with the suspect values, one line per group."""
-        return policy_lines(self.suspect_policy, self.suspect, "observed values")
+        return policy_lines(
+            self.suspect_policy, self.suspect, "observed values", arguments=False
+        )
 
     @property
     def along(self) -> bool:

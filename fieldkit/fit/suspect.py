@@ -191,6 +191,8 @@ class SuspectCount:
     weighted: int = 0
     #: Names of the flagged impacts (an impact fit's rows), where known.
     points: list[str] = field(default_factory=list)
+    #: Of the excluded values, how many carry each flag.
+    excluded_by_flag: dict[str, int] = field(default_factory=dict)
 
     def add(self, other: SuspectCount) -> None:
         """Add ``other``'s counts to these."""
@@ -202,6 +204,8 @@ class SuspectCount:
         self.points += other.points
         for k, v in other.by_flag.items():
             self.by_flag[k] = self.by_flag.get(k, 0) + v
+        for k, v in other.excluded_by_flag.items():
+            self.excluded_by_flag[k] = self.excluded_by_flag.get(k, 0) + v
 
     def to_dict(self) -> dict:
         """JSON-ready counts."""
@@ -214,6 +218,7 @@ class SuspectCount:
             "weighted": self.weighted,
             "kept": self.values - self.excluded - self.weighted,
             "flagged_points": list(self.points),
+            "excluded_by_flag": dict(self.excluded_by_flag),
         }
 
 
@@ -242,6 +247,10 @@ def count(
         assumed_theta0=int(np.sum(assumed)),
         excluded=int(np.sum(factor == 0.0)),
         weighted=int(np.sum((factor > 0.0) & (factor < 1.0))),
+        excluded_by_flag={
+            name: int(np.sum((flags >> bit & 1).astype(bool) & (factor == 0.0)))
+            for bit, name in enumerate(SUSPECT_FLAGS)
+        },
     )
 
 
@@ -251,11 +260,13 @@ def policy_lines(
     what: str,
     *,
     flights: bool = True,
+    arguments: bool = True,
 ) -> list[str]:
     """One line per group: how many ``what`` (e.g. "impacts", "observed values")
     are suspect and what the fit did with them (argument names in backticks).
     ``flights``: the values rest on the flights of flagged impacts (a path fit),
-    not on the impacts themselves (an impact fit).
+    not on the impacts themselves (an impact fit). ``arguments``: end each line
+    with the argument and its value (for the command line, which names the flag).
 
     Examples
     --------
@@ -299,5 +310,6 @@ arriving or leaving): excluded (`assumed_theta0` exclude)'
             head = f"assumed θ0: {n} {what}{where} rest on an assumed launch angle"
             if not flights:
                 head += " (of the flight arriving or leaving)"
-        lines.append(f"{head}: {t.words} (`{group}` {t.option})")
+        tail = f" (`{group}` {t.option})" if arguments else ""
+        lines.append(f"{head}: {t.words}{tail}")
     return lines

@@ -193,6 +193,39 @@ def test_path_fit_drops_exactly_the_values_named(cli, tmp_path, boulder_a):
     assert not np.isclose(out.values["speed_mps"], 17.875, atol=1e-3).any()
 
 
+def test_weighted_and_excluded_together_on_a_path(cli, tmp_path, boulder_a):
+    """--flagged 0.5 --assumed-theta0 exclude: the 33 heights and 34 speeds on an
+    assumed θ0 are dropped; of the 8 + 8 flagged, the 4 + 4 on tree-fixed flights
+    are weighted; the leave-flagged-out refit drops those 8 more, and the assumed
+    one is not run again (already excluded). Said in the JSON, the console and
+    report.md (in words)."""
+    js, rep = tmp_path / "fit.json", tmp_path / "rep"
+    r = cli("fit", "--paths", boulder_a, "--model", PATH_START, "--preset", PRESET,
+            *SMALL, "--flagged", "0.5", "--assumed-theta0", "exclude",
+            "-o", tmp_path / "cal.json", "--json", js, "--report", rep)  # fmt: skip
+    assert r.exit_code == 0, r.output
+    fit = json.loads(js.read_text())
+    kinds = {k["kind"]: k["observations"] for k in fit["kinds"]}
+    assert kinds["flight_height_m"] == 15 and kinds["speed_mps"] == 15
+    counts = fit["suspect"]["counts"]
+    for kind in ("flight_height_m", "speed_mps"):
+        assert counts[kind]["weighted"] == 4 and counts[kind]["kept"] == 11
+    assert fit["suspect"]["policy"] == {"flagged": "0.5", "assumed_theta0": "exclude"}
+    flagged_out, assumed_out = fit["suspect"]["leave_out"]
+    assert flagged_out["refitted"]
+    assert flagged_out["dropped"] == {"flight_height_m": 4, "speed_mps": 4}
+    assert sum(flagged_out["dropped_by_flag"].values()) > 0
+    assert assumed_out["reason"] == "already excluded in the fit"
+    assert any(n.startswith("suspect data: flagged: 16 observed values")
+               and n.endswith("weighted 0.5") for n in fit["notes"])  # fmt: skip
+    assert "rest on an assumed launch angle: excluded (--assumed-theta0 exclude)" in (
+        r.stdout
+    )
+    report = (rep / "report.md").read_text()
+    assert "weighted 0.5 (--flagged 0.5)" in report
+    assert "flight_height_m" not in report and "```" not in report
+
+
 def test_default_keeps_every_result_identical(cli, tmp_path, boulder_a):
     """The default (keep) fits exactly what a table without any markers fits: the
     CLI's values, objective and kinds equal a library fit on runs whose suspect
