@@ -926,6 +926,12 @@ def fit_impacts(
     names, notes = free_parameters(model, problem.materials)
     why = too_few(problem, names) or too_few_for_errors(problem, names)
     if why:
+        if problem.suspect is not None and problem.suspect.excluded:
+            policy = problem.suspect_policy
+            given = ", ".join(
+                f"`{g}` exclude" for g in GROUPS if policy.treatment(g).exclude
+            )
+            why += f" ({problem.suspect.excluded} suspect impacts left out: {given})"
         raise InputFileError(why, source=table.source)
     start, start_notes = problem.start(model, names)
     problem, fit = solve_reweighted(problem, model, names, start)

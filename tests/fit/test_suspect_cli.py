@@ -136,6 +136,39 @@ def test_bad_suspect_values_one_line_nothing_written(cli, tmp_path, corrupted, f
     assert not out.exists()
 
 
+def test_impact_fit_of_boulder_a_without_assumed_flights_is_too_small(
+    cli, tmp_path, boulder_a
+):
+    """Boulder A's impact fit: 43 of its 48 impacts rest on an assumed θ0 (their
+    arriving or leaving flight); excluding them leaves rock one impact: refused
+    in one line that says why, nothing written. Kept (the default), the
+    leave-out refit holds rock at the full fit and refits the colluvium."""
+    out = tmp_path / "cal.json"
+    table = ("fit", boulder_a, "--model", TORNADO / "model_rocfall_table_7_1.json",
+             "--preset", PRESET)  # fmt: skip
+    r = cli(*table, "--assumed-theta0", "exclude", "-o", out)
+    assert r.exit_code == 1 and "Traceback" not in r.stderr
+    errors = [x for x in r.stderr.splitlines() if x.startswith("error: ")]
+    assert len(errors) == 1 and errors == r.stderr.splitlines()[-1:]  # after notes
+    assert "material rock has 1 impact" in errors[0]
+    assert "(43 suspect impacts left out: --assumed-theta0 exclude)" in errors[0]
+    assert not out.exists()
+    r = cli(*table, "-o", out)
+    assert r.exit_code == 0, r.output
+    assert (
+        "suspect data: flagged: 4 impacts flagged (energy_gained 3, e_t_above_1 3, "
+        "points 22, 27, 32, 42): kept (--flagged keep)"
+    ) in r.stdout
+    assert "assumed θ0 out: dropped 43; held at the full fit: rock (1 impact left)" in (
+        r.stdout
+    )
+    leave = json.loads(out.read_text())["provenance"]["fit"]["suspect"]["leave_out"]
+    assert [v["dropped"] for v in leave] == [{"impacts": 4}, {"impacts": 43}]
+    assert leave[1]["held"] == ["materials.rock.e_n", "materials.rock.e_t"]
+    rock = leave[1]["parameters"][0]
+    assert rock["refitted"] == rock["full"] and rock["shift"] == 0.0
+
+
 def test_path_fit_drops_exactly_the_values_named(cli, tmp_path, boulder_a):
     """Boulder A: 4 impacts flagged (22, 27, 32, 42) -> their 8 flights' heights
     and the speeds those flights give are dropped; 33 flights on an assumed θ0
