@@ -161,8 +161,24 @@ def impact_leave_outs(
     ``calibrated``) without each group of suspect impacts.
 
     A variant needs only more data than parameters (its refit is a comparison,
-    not a calibration with standard errors); parameters of a material with no
-    impact left are held at the full fit's values.
+    not a calibration with standard errors); parameters of a material with fewer
+    than :data:`~fieldkit.fit.impact_fit.MIN_IMPACTS_PER_MATERIAL` impacts left
+    are held at the full fit's values.
+
+    Parameters
+    ----------
+    table, model
+        The table and the base model the fit was given.
+    result, calibrated
+        What :func:`~fieldkit.fit.impact_fit.fit_impacts` returned.
+    policy
+        The fit's suspect-data policy (default: keep everything).
+
+    Returns
+    -------
+    list of LeaveOut
+        ``flagged out`` then ``assumed θ0 out``; one that could not be refitted
+        has ``model`` None and its ``reason``.
     """
     policy = policy or SuspectPolicy()
     full = np.asarray(result.values, float)
@@ -238,7 +254,27 @@ def path_leave_outs(
     ``result.seed`` (common random numbers), each kind scaled by its CRPS at the
     fit's start; ``max_evaluations`` as the fit's main search (default ``max(150,
     60 p)``). Values and kinds as ``result`` scored them (``kinds``: the fit's,
-    default ``result.kinds``)."""
+    default ``result.kinds``).
+
+    Parameters
+    ----------
+    runs
+        The runs the fit was given.
+    result
+        The fit's result (its policy, counts, bounds, start, rocks and seed).
+    kinds
+        The kinds the fit scored, if it was given them.
+    max_evaluations
+        Objective evaluations of each refit's search.
+    step
+        ``step(description, total)`` context manager around each refit.
+
+    Returns
+    -------
+    list of LeaveOut
+        ``flagged out`` then ``assumed θ0 out``, with the variant's objective at
+        the full fit's values and at its own optimum.
+    """
     stage = step or _no_step
     names = list(result.names)
     p = len(names)
