@@ -264,6 +264,7 @@ def observations_from_impact_table(table: ImpactTable) -> PathObservations:
     [5.0, 6.4031242374328485]
     """
     frame = table.frame
+    derived = table.derive().frame  # its qa_flags, whatever the table carried
     source = table.source or "ImpactTable"
     records, along = [], []
     for path_id in table.paths():
@@ -300,7 +301,7 @@ def observations_from_impact_table(table: ImpactTable) -> PathObservations:
                 "z_m": rows["z_m"].to_numpy(float),
             }
         )
-        markers = flight_value_markers(rows)
+        markers = flight_value_markers(derived[derived["path_id"] == path_id])
         for name in ("hmax_normal_m", "vi_mps"):
             values = rows[name].to_numpy(dtype=float, na_value=np.nan)
             if np.isfinite(values).any():

@@ -224,6 +224,15 @@ def test_path_fit_drops_exactly_the_values_named(cli, tmp_path, boulder_a):
     at_43 = full.values["speed_mps"][full.speed_chainage_m == chainage["43"]]
     assert at_43 == pytest.approx([17.875], abs=1e-3)
     assert not np.isclose(out.values["speed_mps"], 17.875, atol=1e-3).any()
+    # a table written without its qa_flags column gives the same markers (the
+    # flags are recomputed from its velocities)
+    bare = tmp_path / "bare.csv"
+    pd.read_csv(boulder_a).drop(columns=["qa_flags"]).to_csv(bare, index=False)
+    along = observations_from_impact_table(ImpactTable.read(bare)).along
+    before = observations_from_impact_table(table).along
+    for column in ("vi_mps_flags", "hmax_normal_m_flags"):
+        assert (along[column] > 0).sum() == 8
+        np.testing.assert_array_equal(along[column], before[column])
 
 
 def test_weighted_and_excluded_together_on_a_path(cli, tmp_path, boulder_a):
