@@ -541,6 +541,118 @@ def quality_flags(frame: pd.DataFrame) -> pd.Series:
     return pd.Series(out, index=frame.index, dtype="string")
 
 
+#: ``qa_flags`` that make an impact suspect (the reduction's physics checks; what a
+#: fit does with them: :mod:`fieldkit.fit.suspect`).
+SUSPECT_FLAGS: tuple[str, ...] = ("energy_gained", "e_t_above_1")
+#: Observed value columns of a surveyed path that rest on flights (path fit).
+FLIGHT_VALUES = ("hmax_normal_m", "vi_mps")
+
+
+def flag_codes(frame: pd.DataFrame) -> np.ndarray:
+    """Per row a bit code of its :data:`SUSPECT_FLAGS` (bit ``k`` = flag ``k``).
+
+    Read from ``qa_flags`` when the table has it (as reduced), else computed
+    (:func:`fieldkit.impact_table.quality_flags`).
+
+    Examples
+    --------
+    >>> flag_codes(pd.DataFrame({"qa_flags": ["e_t_above_1;spin_estimated", None,
+    ...     "energy_gained;e_t_above_1"]})).tolist()
+    [2, 0, 3]
+    """
+    text = frame["qa_flags"] if "qa_flags" in frame else quality_flags(frame)
+    names = [
+        set(str(v).split(";")) if isinstance(v, str) else set()
+        for v in text.astype("string").fillna("").tolist()
+    ]
+    code = np.zeros(len(frame), np.int64)
+    for bit, flag in enumerate(SUSPECT_FLAGS):
+        code |= np.array([flag in n for n in names], bool).astype(np.int64) << bit
+    return code
+
+
+def _assumed(frame: pd.DataFrame) -> np.ndarray:
+    """Per row: the flight leaving it rests on an assumed θ0."""
+    if "theta0_source" not in frame:
+        return np.zeros(len(frame), bool)
+    src = frame["theta0_source"].astype("string").fillna("")
+    return (src.str.strip().str.lower() == "assumed").to_numpy(bool)
+
+
+def _previous_in_path(frame: pd.DataFrame) -> np.ndarray:
+    """Per row: the previous row belongs to the same path (rows in path order)."""
+    if len(frame) == 0:
+        return np.zeros(0, bool)
+    path = frame["path_id"].astype(str).to_numpy()
+    return np.concatenate([[False], path[1:] == path[:-1]])
+
+
+def _shift_down(values: np.ndarray, same: np.ndarray) -> np.ndarray:
+    """``values`` of the previous row where it is in the same path, else 0."""
+    out = np.zeros_like(values)
+    out[1:] = values[:-1]
+    out[~same] = 0
+    return out
+
+
+def impact_markers(frame: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
+    """``(flag code, assumed)`` of each row's impact datum (impact fit).
+
+    The flag code is the row's own (:func:`flag_codes`); assumed when the flight
+    arriving at the impact (the previous row's, same path) or the flight leaving
+    it rests on an assumed θ0.
+
+    Examples
+    --------
+    >>> f = pd.DataFrame({"path_id": "a", "theta0_source": ["assumed", "tree",
+    ...     "tree", "assumed", "tree"], "qa_flags": [None, "energy_gained", None,
+    ...     None, None]})
+    >>> codes, assumed = impact_markers(f)
+    >>> codes.tolist(), assumed.tolist()
+    ([0, 1, 0, 0, 0], [True, True, False, True, True])
+    """
+    leaving = _assumed(frame)
+    arriving = _shift_down(leaving.astype(np.int64), _previous_in_path(frame)) > 0
+    return flag_codes(frame), leaving | arriving
+
+
+def flight_value_markers(frame: pd.DataFrame) -> dict[str, np.ndarray]:
+    """Markers of each point's flight-borne values (path fit), as float columns.
+
+    For each of :data:`FLIGHT_VALUES` ``v``: ``v_flags`` (the flag bit code of
+    the impacts the flight carrying the value joins) and ``v_theta0_assumed`` (1
+    when that flight's θ0 was assumed, else 0). ``hmax_normal_m`` at a point comes
+    from the flight leaving it; ``vi_mps`` from the flight arriving at it.
+
+    Examples
+    --------
+    >>> f = pd.DataFrame({"path_id": "a", "theta0_source": ["assumed", "tree",
+    ...     "assumed", None], "qa_flags": [None, None, "e_t_above_1", None]})
+    >>> m = flight_value_markers(f)
+    >>> m["hmax_normal_m_flags"].tolist(), m["vi_mps_flags"].tolist()
+    ([0.0, 2.0, 2.0, 0.0], [0.0, 0.0, 2.0, 2.0])
+    >>> m["hmax_normal_m_theta0_assumed"].tolist(), m["vi_mps_theta0_assumed"].tolist()
+    ([1.0, 0.0, 1.0, 0.0], [0.0, 1.0, 0.0, 1.0])
+    """
+    same = _previous_in_path(frame)
+    code = flag_codes(frame)
+    n = len(frame)
+    # the flight leaving row j joins impacts j and j + 1 (same path)
+    nxt = np.zeros(n, np.int64)
+    nxt[:-1] = code[1:]
+    has_next = np.concatenate([same[1:], [False]])
+    leaving_flags = code | np.where(has_next, nxt, 0)
+    leaving_flags[~has_next] = 0  # the last point launches no flight
+    leaving_assumed = _assumed(frame).astype(np.int64)
+    leaving_assumed[~has_next] = 0
+    return {
+        "hmax_normal_m_flags": leaving_flags.astype(float),
+        "hmax_normal_m_theta0_assumed": leaving_assumed.astype(float),
+        "vi_mps_flags": _shift_down(leaving_flags, same).astype(float),
+        "vi_mps_theta0_assumed": _shift_down(leaving_assumed, same).astype(float),
+    }
+
+
 def restitution(
     vi_x_mps: np.ndarray,
     vi_z_mps: np.ndarray,

@@ -12,6 +12,16 @@ from fieldkit.cli.common import one_line_errors
 from fieldkit.cli.design import DEFAULT_DESIGN_ROCKS
 from fieldkit.cli.material_options import MaterialOpt, PresetOpt, mapped_table
 from fieldkit.cli.progress import report_written, step
+from fieldkit.cli.suspect_options import (
+    SUSPECT_FLAGS,
+    AssumedOpt,
+    FlaggedOpt,
+    LeaveOutOpt,
+    suspect_lines,
+    suspect_markdown,
+    suspect_policy,
+    suspect_record,
+)
 from fieldkit.errors import ArgumentError, FieldkitError
 from fieldkit.outputs import OutputSet, write_text
 
@@ -41,6 +51,7 @@ FLAGS = {
     "at": "--at",
     "measured": "--measured",
     "design_rocks": "--design-rocks",
+    **SUSPECT_FLAGS,
 }
 
 #: Path-fit settings left unset on the command line take these values.
@@ -211,6 +222,8 @@ def _paths(options: dict) -> None:
         at=options["at"],
         measured=options["measured"],
         design_rocks=options["design_rocks"],
+        suspect=suspect_policy(options["flagged"], options["assumed_theta0"]),
+        leave_out=options["leave_out"],
     )
 
 
@@ -365,6 +378,9 @@ def fit(
             "uses.",
         ),
     ] = DEFAULT_DESIGN_ROCKS,
+    flagged: FlaggedOpt = "keep",
+    assumed_theta0: AssumedOpt = "keep",
+    leave_out: LeaveOutOpt = True,
 ) -> None:
     """Fit restitution and effect parameters to measured impacts (weighted LSQ).
 
@@ -440,11 +456,13 @@ def fit(
         print_design,
     )
     from fieldkit.fit.impact_fit import fit_impacts
+    from fieldkit.fit.leave_out import impact_leave_outs, leave_out_models
     from fieldkit.impact_table import ImpactTable
     from fieldkit.model.model_file import read_model, write_model
 
     check_design_rocks(design_rocks)
     design_measured = measured_values(measured, preset)
+    policy = suspect_policy(flagged, assumed_theta0)
 
     with OutputSet(inputs=[table_file, model_file, preset]) as outputs:
         outputs.confine(report)
@@ -459,7 +477,7 @@ def fit(
         # a weighted least squares of a few parameters: short, shown on a terminal
         with step(f"fitting {model_file.name} to {table_file}", announce=False):
             result, calibrated = fit_impacts(
-                mapping.table, model, max_realised_e_n=max_realised_e_n
+                mapping.table, model, policy, max_realised_e_n=max_realised_e_n
             )
         text = result.report()
         if not result.success:
@@ -468,11 +486,26 @@ def fit(
                 "model written",
                 source=str(table_file),
             )
+        leave_outs = None
+        if leave_out:
+            leave_outs = impact_leave_outs(
+                mapping.table, model, result, calibrated, policy
+            )
+        counts = {"impacts": result.suspect}
+        suspect = suspect_lines(
+            policy, counts, "impacts", leave_outs,
+            how="weighted least squares from the calibrated values"
+            + ("; without the --max-realised-en constraint"
+               if max_realised_e_n is not None else ""),
+        )  # fmt: skip
         # the impact fit has no seed of its own: the design stream's is the path
-        # fit's default, stated in the design table
+        # fit's default, stated in the design table; the leave-out refits' models
+        # are set beside the start and the calibrated model
         design, said = design_for_fit(
-            {"start": model, "calibrated": calibrated}, at=at,
-            measured=design_measured, rocks=design_rocks, seed=PATH_DEFAULTS["seed"],
+            {"start": model, "calibrated": calibrated,
+             **leave_out_models(leave_outs or [])},
+            at=at, measured=design_measured, rocks=design_rocks,
+            seed=PATH_DEFAULTS["seed"],
         )  # fmt: skip
         fit_record = result.provenance(str(table_file))
         fit_record["material_map"] = mapping.provenance()
@@ -481,9 +514,13 @@ def fit(
         )
         fit_record["plausibility"] = plausibility.to_dict()
         fit_record["design"] = design.to_dict()
+        fit_record["suspect"] = suspect_record(
+            policy, counts, leave_outs or [], suspect
+        )
         provenance = {**calibrated.provenance, "fit": fit_record}
         write_model(replace(calibrated, provenance=provenance), output, outputs=outputs)
         if report is not None:
+            from fieldkit.cli.fit_paths import parameter_words
             from fieldkit.viz.fit_figure import write_residual_figure
 
             derived = mapping.table.derive()
@@ -492,7 +529,9 @@ def fit(
                 impact_report_markdown(
                     result, table_file=table_file, model_file=model_file,
                     mapping=mapping.notes, design=design_markdown(design, said),
-                ) + plausibility.markdown(),
+                )
+                + plausibility.markdown()
+                + suspect_markdown(fit_record["suspect"], {}, parameter_words),
                 outputs,
             )  # fmt: skip
             write_residual_figure(
@@ -507,6 +546,7 @@ def fit(
     typer.echo(text)
     for line in plausibility.lines():
         typer.echo(line)
+    typer.echo("\n".join(suspect))
     report_written(written)
 
 

@@ -354,9 +354,11 @@ def report_markdown(
         lines += ["", "## Held-out runs", ""]
         lines += [f"* {x}" for x in _holdout_lines(summary)]
         lines += ["", "![held-out runouts](holdout.png)"]
-    if summary["notes"]:
+    # the suspect-data notes are said in words under "Suspect data"
+    notes = [n for n in summary["notes"] if not n.startswith("suspect data:")]
+    if notes:
         lines += ["", "## Notes", ""] + [
-            f"* {_in_words(n, summary['parameters'])}" for n in summary["notes"]
+            f"* {_in_words(n, summary['parameters'])}" for n in notes
         ]
     return "\n".join(lines) + "\n"
 
@@ -447,6 +449,8 @@ def fit_paths_command(
     at: list[float] | None = None,
     measured: list[str] | None = None,
     design_rocks: int | None = None,
+    suspect=None,
+    leave_out: bool = True,
 ) -> None:
     """Run the path-level fit (see the command's help)."""
     from fieldkit.cli.common import note
@@ -461,6 +465,7 @@ def fit_paths_command(
     )
     from fieldkit.cli.material_options import mapped_table
     from fieldkit.cli.progress import report_written, step
+    from fieldkit.fit.leave_out import leave_out_models
     from fieldkit.fit.material_map import profile_disagreements
     from fieldkit.fit.path_fit import check_settings, fit_paths
     from fieldkit.fit.path_runs import section_runs
@@ -547,8 +552,11 @@ def fit_paths_command(
             calibration, base, names, rocks=rocks, seed=seed, bootstrap=bootstrap,
             progress=lambda line: typer.echo(line, err=True), screen=screen,
             bounds=box, step=step, profile_points=profile_points,
-            max_realised_e_n=max_realised_e_n,
+            max_realised_e_n=max_realised_e_n, suspect=suspect,
         )  # fmt: skip
+        suspect_summary, suspect_text, leave_outs = _suspect(
+            calibration, result, leave_out
+        )
         fitted = dict(zip(result.names, map(float, result.values), strict=True))
         summary = result.to_dict()
         summary["section"] = section if on_dem else "the model's own profile"
@@ -557,6 +565,7 @@ def fit_paths_command(
         summary["plausibility"] = plausibility.to_dict()
         if material_check is not None:
             summary["material_check"] = material_check
+        summary["suspect"] = suspect_summary
         if held is not None:
             with step(f"scoring {len(held)} held-out runs ({rocks} rocks each)"):
                 validation = validate(held, calibration, fitted, rocks=rocks, seed=seed)
@@ -570,9 +579,11 @@ def fit_paths_command(
                 write_holdout_figure(
                     report / "holdout.png", validation, outputs=outputs
                 )
+        # the leave-out refits' models beside the start and the calibrated model
         design, said = design_for_fit(
-            {"start": base, "calibrated": result.model}, at=at,
-            measured=design_measured, rocks=design_rocks, seed=seed,
+            {"start": base, "calibrated": result.model,
+             **leave_out_models(leave_outs)},
+            at=at, measured=design_measured, rocks=design_rocks, seed=seed,
         )  # fmt: skip
         summary["design"] = design.to_dict()
         provenance = {**base.provenance, "fit_paths": summary}
@@ -588,6 +599,9 @@ def fit_paths_command(
                 design=design_markdown(design, said),
             )  # fmt: skip
             text += plausibility.markdown()
+            from fieldkit.cli.suspect_options import suspect_markdown
+
+            text += suspect_markdown(suspect_summary, KIND_WORDS, parameter_words)
             write_text(report / "report.md", text, outputs)
         written = outputs.commit()
     print_design(design, said)
@@ -601,6 +615,8 @@ def fit_paths_command(
         typer.echo(line)
     for line in plausibility.lines():
         typer.echo(line)
+    for line in suspect_text:
+        typer.echo(line)
     report_written(written)
 
 
@@ -612,3 +628,27 @@ def _path_plausibility(result, runs, seed: int, step):
     with step(f"simulating {PLAUSIBILITY_ROCKS:,} rocks of the calibrated model "
               "for its realised restitution"):  # fmt: skip
         return path_fit_plausibility(result, runs, seed=seed)
+
+
+def _suspect(runs, result, leave_out: bool) -> tuple[dict, list[str], list]:
+    """The path fit's JSON ``suspect`` entry, its lines and the leave-out refits
+    (:class:`~fieldkit.fit.leave_out.LeaveOut`, their models by
+    :func:`~fieldkit.fit.leave_out.leave_out_models`), run here unless
+    ``leave_out`` is False (or nothing is suspect)."""
+    from fieldkit.cli.progress import step
+    from fieldkit.cli.suspect_options import suspect_lines, suspect_record
+    from fieldkit.fit.leave_out import path_leave_outs
+
+    leave_outs = None
+    if leave_out and result.suspect:
+        leave_outs = path_leave_outs(runs, result, step=step)
+    how = (
+        "one search each from the calibrated values, same rocks and seed, about "
+        f"{max(150, 60 * len(result.names))} evaluations"
+        + ("; without the realised-e_n constraint"
+           if result.max_realised_e_n is not None else "")
+    )  # fmt: skip
+    policy, counts = result.suspect_policy, result.suspect
+    lines = suspect_lines(policy, counts, "observed values", leave_outs, how=how)
+    leave_outs = leave_outs or []
+    return suspect_record(policy, counts, leave_outs, lines), lines, leave_outs

@@ -17,6 +17,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from fieldkit.fit.suspect import SuspectCount
+
 #: |correlation| above which a pair of parameters is flagged as not identifiable.
 CORRELATION_LIMIT = 0.98
 #: A standard error above this times max(|value|, 1e-3) is "huge".
@@ -88,6 +90,8 @@ class FitResult:
     #: Profile-likelihood intervals (:func:`fieldkit.fit.impact_profile.
     #: profile_intervals`; None: not made).
     profile: dict | None = None
+    #: Suspect impacts and what the fit did with them (fieldkit.fit.suspect).
+    suspect: SuspectCount | None = None
 
     def value(self, name: str) -> float:
         """The fitted value of ``name``."""

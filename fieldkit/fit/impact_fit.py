@@ -81,6 +81,14 @@ from fieldkit.fit.impact_model import (
     predict_rows,
 )
 from fieldkit.fit.impact_profile import profile_intervals
+from fieldkit.fit.suspect import (
+    GROUPS,
+    SuspectCount,
+    SuspectPolicy,
+    count,
+    impact_markers,
+    policy_lines,
+)
 from fieldkit.impact_table import ImpactTable, flight_sides, path_point_kinds
 from fieldkit.model.effects import registry
 from fieldkit.model.materials import MATERIAL_FIELDS
@@ -361,6 +369,13 @@ class ImpactProblem:
     rows: np.ndarray  # the table row (0-based) of each problem row
     notes: list[str] = field(default_factory=list)
     errors: InputErrors | None = None  # inputs measured with error (calibrated)
+    #: Per row the factor its terms count with in the objective (the suspect-data
+    #: policy, :mod:`fieldkit.fit.suspect`: residual / sd times its square root);
+    #: None: all 1.
+    row_weight: np.ndarray | None = None
+    #: The suspect impacts (flagged, on an assumed θ0) and what the policy did.
+    suspect: SuspectCount | None = None
+    suspect_policy: SuspectPolicy = field(default_factory=SuspectPolicy)
 
     def reweighted(
         self,
@@ -456,6 +471,8 @@ class ImpactProblem:
             material_names=inputs.material_names,
         )
         observed, sd = self.observed[mask], self.sd[mask]
+        if self.row_weight is not None:
+            sd = sd / np.sqrt(self.row_weight[mask])[:, None]
         keep = use[mask]
         if start is None:
             start, _ = self.start(model, names)
@@ -728,8 +745,16 @@ def errors_in_variables(
     return inputs, observed, errors, note
 
 
-def impact_problem(table: ImpactTable, model: Model) -> ImpactProblem:
+def impact_problem(
+    table: ImpactTable, model: Model, suspect: SuspectPolicy | None = None
+) -> ImpactProblem:
     """Check ``table`` against ``model`` and gather the arrays of a fit.
+
+    ``suspect`` says what to do with impacts flagged by the reduction or resting
+    on an assumed launch angle (:mod:`fieldkit.fit.suspect`): excluded rows are
+    left out before anything is computed from the table, weighted rows count
+    ``w`` times in the objective (their residuals' SD divided by ``sqrt(w)``);
+    stated in the notes and the weighting. None keeps every impact.
 
     Raises
     ------
@@ -737,8 +762,16 @@ def impact_problem(table: ImpactTable, model: Model) -> ImpactProblem:
         Required columns missing, non-finite values (rows named), materials of the
         table not in the model (named), non-positive uncertainties.
     """
+    policy = suspect or SuspectPolicy()
     skip = no_flight_rows(table)
-    check_table(table, model, skip)
+    flags, assumed = impact_markers(table.derive().frame)  # qa_flags recomputed
+    factor = policy.factors(flags, assumed)
+    suspect_count = count(policy, flags[~skip], assumed[~skip])
+    if "point" in table.frame:
+        points = table.frame["point"].astype(str).to_numpy()
+        suspect_count.points = points[~skip & (flags > 0)].tolist()
+    excluded = (factor == 0.0) & ~skip
+    check_table(table, model, skip | excluded)
     notes = []
     if skip.any():
         kinds = path_point_kinds(table.frame)
@@ -748,9 +781,22 @@ def impact_problem(table: ImpactTable, model: Model) -> ImpactProblem:
             f"{len(kinds)} row{'' if len(kinds) == 1 else 's'} left out: no arriving "
             f"or leaving flight, not an impact ({named}{more})"
         )
+    if skip.any() or excluded.any():
         table = ImpactTable(
-            table.frame.loc[~skip].reset_index(drop=True), source=table.source
+            table.frame.loc[~skip & ~excluded].reset_index(drop=True),
+            source=table.source,
         )
+    if not policy.is_default:
+        notes += [
+            f"suspect data: {line}"
+            for line in policy_lines(
+                policy,
+                {"impacts": suspect_count},
+                "impacts",
+                flights=False,
+                arguments=False,
+            )
+        ]
     table = table.derive()
     inputs = impact_inputs(table, model)
     used = [m for m in inputs.material_names if m in set(table.frame["material"])]
@@ -788,10 +834,24 @@ def impact_problem(table: ImpactTable, model: Model) -> ImpactProblem:
         use=np.isfinite(sd) & np.isfinite(observed),
         weighting=weighting,
         materials=used,
-        rows=np.flatnonzero(~skip),
+        rows=np.flatnonzero(~skip & ~excluded),
         notes=notes,
         errors=errors,
+        row_weight=(factor[~skip & ~excluded] if suspect_count.weighted else None),
+        suspect=suspect_count,
+        suspect_policy=policy,
     )
+    if suspect_count.weighted:
+        problem.weighting += (
+            f"; {suspect_count.weighted} suspect impact(s) weighted (their terms "
+            "count w times: sd / √w; "
+            + ", ".join(
+                f"{GROUPS[g]} {policy.treatment(g).words}"
+                for g in GROUPS
+                if 0.0 < policy.treatment(g).weight < 1.0
+            )
+            + ")"
+        )
     if errors is None:
         return problem
     problem = problem.reweighted(model)
@@ -953,13 +1013,37 @@ def _profile(problem: ImpactProblem, model: Model, result: FitResult) -> dict:
     return prof
 
 
+def solve_reweighted(
+    problem: ImpactProblem,
+    model: Model,
+    names: list[str],
+    start: np.ndarray,
+    max_realised_e_n: float | None = None,
+):
+    """``(problem, least_squares result)`` of ``names`` from ``start`` on every row;
+    with inputs measured with error, solved again with the effective variances'
+    derivatives taken at the first solution (the problem returned is that one)."""
+    fit = problem.solve(model, names, start=start, max_realised_e_n=max_realised_e_n)
+    if problem.errors is not None:
+        # the effective variances' derivatives once more, at the fitted values
+        problem = problem.reweighted(model, names, fit.x)
+        fit = problem.solve(model, names, start=np.asarray(fit.x, float),
+                            max_realised_e_n=max_realised_e_n)  # fmt: skip
+    return problem, fit
+
+
 def fit_impacts(
-    table: ImpactTable, model: Model, max_realised_e_n: float | None = None
+    table: ImpactTable,
+    model: Model,
+    suspect: SuspectPolicy | None = None,
+    max_realised_e_n: float | None = None,
 ) -> tuple[FitResult, Model]:
     """Fit ``model``'s impact laws to ``table``; ``(result, calibrated model)``.
 
     The calibrated model is ``model`` with the fitted values in place (its
     ``provenance`` is left to the caller, who knows the table's file name).
+    ``suspect``: what to do with flagged impacts and impacts on an assumed launch
+    angle (:func:`impact_problem`; default: keep them).
 
     ``max_realised_e_n`` constrains the fit so that the law's realised ``e_n =
     vfn / -vin`` at every observed impact (at the table's own impact velocities,
@@ -975,24 +1059,26 @@ def fit_impacts(
         table not in the model (named), fewer data than parameters, or too few
         for standard errors (:func:`too_few_for_errors`).
     """
-    problem = impact_problem(table, model)
+    problem = impact_problem(table, model, suspect)
     names, notes = free_parameters(model, problem.materials)
     why = too_few(problem, names) or too_few_for_errors(problem, names)
     if why:
+        if problem.suspect is not None and problem.suspect.excluded:
+            policy = problem.suspect_policy
+            given = ", ".join(
+                f"`{g}` exclude" for g in GROUPS if policy.treatment(g).exclude
+            )
+            why += f" ({problem.suspect.excluded} suspect impacts left out: {given})"
         raise InputFileError(why, source=table.source)
     check_realised_limit(max_realised_e_n)
     limit = max_realised_e_n
     start, start_notes = problem.start(model, names)
-    fit = problem.solve(model, names, start=start, max_realised_e_n=limit)
-    if problem.errors is not None:
-        # the effective variances' derivatives once more, at the fitted values
-        problem = problem.reweighted(model, names, fit.x)
-        fit = problem.solve(model, names, start=np.asarray(fit.x, float),
-                            max_realised_e_n=limit)  # fmt: skip
+    problem, fit = solve_reweighted(problem, model, names, start, limit)
     if limit is not None:
         fit, words = _data_part(problem, fit, limit)
         notes = [*notes, words]
     result = fit_result(problem, names, start, fit, problem.notes + notes + start_notes)
     result.profile = _profile(problem, model, result)
+    result.suspect = problem.suspect
     calibrated = model.with_parameters(dict(zip(names, map(float, fit.x), strict=True)))
     return result, replace(calibrated, provenance=dict(model.provenance))

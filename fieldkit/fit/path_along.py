@@ -43,6 +43,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fieldkit.fit.path_runs import PathRun
+from fieldkit.fit.suspect import SuspectCount, SuspectPolicy, count
 from fieldkit.impact_table import ImpactTable
 from fieldkit.model.model_file import Model
 from fieldkit.model.simulate import simulate
@@ -82,6 +83,10 @@ class AlongObservations:
     speed_chainage_m: np.ndarray
     launch_range_m: tuple[float, float] | None
     weights: dict[str, np.ndarray] = field(default_factory=dict)
+    #: Kind -> how many of its values are suspect and what the fit's
+    #: :class:`~fieldkit.fit.suspect.SuspectPolicy` did with them (kinds whose
+    #: values rest on flights: flight heights and speeds).
+    suspect: dict[str, SuspectCount] = field(default_factory=dict)
 
     def weight(self, kind: str) -> np.ndarray:
         """Weights of the observed values of ``kind`` (ones unless given)."""
@@ -89,8 +94,16 @@ class AlongObservations:
         return np.ones(self.values[kind].size) if w is None else w
 
 
-def observed_along(run: PathRun) -> AlongObservations:
+def observed_along(
+    run: PathRun, suspect: SuspectPolicy | None = None
+) -> AlongObservations:
     """The observed values of every kind of ``run`` (module docstring).
+
+    ``suspect`` says what to do with the flight heights and speeds that rest on a
+    flagged impact or an assumed launch angle (the run's ``along_<value>_flags``
+    and ``along_<value>_theta0_assumed`` markers, :mod:`fieldkit.fit.suspect`):
+    excluded values are dropped, weighted ones have their weight multiplied. None
+    (or keeping both groups) leaves every value as observed.
 
     Examples
     --------
@@ -109,8 +122,10 @@ def observed_along(run: PathRun) -> AlongObservations:
     >>> obs.speed_chainage_m.tolist(), obs.launch_range_m, obs.weight("flight_height_m")
     ([10.0, 25.0], (10.0, 25.0), array([15.]))
     """
+    policy = suspect or SuspectPolicy()
     values: dict[str, np.ndarray] = {}
     weights: dict[str, np.ndarray] = {}
+    counts: dict[str, SuspectCount] = {}
     if math.isfinite(run.observed_runout_m):
         values["runout_m"] = np.array([run.observed_runout_m])
     obs = run.observations
@@ -130,17 +145,45 @@ def observed_along(run: PathRun) -> AlongObservations:
         if heights is not None:
             h = np.asarray(heights, float)[order][:-1][launches]
             good = np.isfinite(h)
+            flags, assumed = _markers(obs, "hmax_normal_m", order)
+            flags, assumed = flags[:-1][launches], assumed[:-1][launches]
+            counts["flight_height_m"] = count(policy, flags[good], assumed[good])
+            good &= policy.factors(flags, assumed) > 0
             if good.any():
                 values["flight_height_m"] = h[good]
-                weights["flight_height_m"] = spacing[good]
+                weights["flight_height_m"] = (
+                    spacing[good] * policy.factors(flags, assumed)[good]
+                    if not policy.is_default
+                    else spacing[good]
+                )
     speeds = obs.get("along_vi_mps")
     if speeds is not None:
         v = np.asarray(speeds, float)[order]
         good = np.isfinite(v)
+        flags, assumed = _markers(obs, "vi_mps", order)
+        counts["speed_mps"] = count(policy, flags[good], assumed[good])
+        factor = policy.factors(flags, assumed)
+        good &= factor > 0
         if good.any():
             values["speed_mps"] = v[good]
             speed_at = c[good]
-    return AlongObservations(values, speed_at, stretch, weights)
+            if np.any(factor[good] < 1.0):
+                weights["speed_mps"] = factor[good]
+    return AlongObservations(values, speed_at, stretch, weights, counts)
+
+
+def _markers(
+    obs: Mapping[str, np.ndarray], name: str, order: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(flag code, assumed)`` of the along-path value ``name`` in ``order``
+    (none suspect where the run carries no markers)."""
+    flags = obs.get(f"along_{name}_flags")
+    assumed = obs.get(f"along_{name}_theta0_assumed")
+    if flags is None or assumed is None:
+        return np.zeros(order.size, np.int64), np.zeros(order.size, bool)
+    f = np.nan_to_num(np.asarray(flags, float)[order], nan=0.0).astype(np.int64)
+    a = np.nan_to_num(np.asarray(assumed, float)[order], nan=0.0) > 0
+    return f, a
 
 
 def flights(

@@ -103,6 +103,7 @@ from fieldkit.fit.plausibility import (
     REALISED_TOLERANCE,
     realised_share_above,
 )
+from fieldkit.fit.suspect import SuspectCount, SuspectPolicy, policy_lines
 from fieldkit.model.effects import registry
 from fieldkit.model.materials import MATERIAL_FIELDS
 from fieldkit.model.model_file import CORE_DEFAULTS, Model
@@ -291,6 +292,9 @@ class PathObjective:
         Rocks per run, and the seed of the common random numbers.
     kinds
         Kinds to score (default: every kind observed on some run).
+    suspect
+        What to do with observed values that rest on a flagged impact or an
+        assumed launch angle (:mod:`fieldkit.fit.suspect`; default: keep them).
     """
 
     def __init__(
@@ -301,6 +305,7 @@ class PathObjective:
         seed: int,
         kinds: Sequence[str] | None = None,
         realised_limit: float | None = None,
+        suspect: SuspectPolicy | None = None,
     ):
         #: With a limit, every simulation also counts the impacts whose realised
         #: e_n exceeds it: :attr:`realised_share` after each evaluation.
@@ -314,7 +319,8 @@ class PathObjective:
                     source="kinds",
                 )
         self.all_runs = list(runs)
-        observed = [observed_along(r) for r in runs]
+        self.suspect_policy = suspect or SuspectPolicy()
+        observed = [observed_along(r, suspect) for r in runs]
         if kinds is not None:
             observed = [
                 AlongObservations(
@@ -322,6 +328,7 @@ class PathObjective:
                     o.speed_chainage_m if "speed_mps" in kinds else np.zeros(0),
                     o.launch_range_m,
                     o.weights,
+                    {k: c for k, c in o.suspect.items() if k in kinds},
                 )
                 for o in observed
             ]
@@ -359,10 +366,17 @@ class PathObjective:
         self._total = {
             k: float(self._weight[self._kind == k].sum()) for k in self.kinds
         }
+        self.suspect = suspect_counts(self.observed_along)
         if len(self.runs) >= 2:
             self.strata = [np.arange(len(self.runs))]
         else:
             self.strata = [np.flatnonzero(self._kind == k) for k in self.kinds]
+
+    def suspect_words(self) -> list[str]:
+        """What the policy did with the suspect values, one line per group."""
+        return policy_lines(
+            self.suspect_policy, self.suspect, "observed values", arguments=False
+        )
 
     @property
     def along(self) -> bool:
@@ -524,6 +538,9 @@ class PathFitResult:
         return (np.abs(self.values - self.lower) <= 1e-3 * span) | (
             np.abs(self.values - self.upper) <= 1e-3 * span
         )
+    #: Kind -> suspect values and what the fit did with them (fieldkit.fit.suspect).
+    suspect: dict[str, SuspectCount] = field(default_factory=dict)
+    suspect_policy: SuspectPolicy = field(default_factory=SuspectPolicy)
 
     @property
     def stderr_is_lower_bound(self) -> bool:
@@ -662,6 +679,13 @@ def _worst_share(counts: dict[str, np.ndarray]) -> float:
     """The largest share over materials with impacts (0 without any)."""
     shares = [a / t for a, t in counts.values() if t > 0]
     return max(shares, default=0.0)
+def suspect_counts(observed: Sequence[AlongObservations]) -> dict[str, SuspectCount]:
+    """Kind -> the suspect counts of every run's observed values, summed."""
+    out: dict[str, SuspectCount] = {}
+    for o in observed:
+        for k, c in o.suspect.items():
+            out.setdefault(k, SuspectCount()).add(c)
+    return out
 
 
 def _finite(x: float) -> float | None:
@@ -745,6 +769,7 @@ def fit_paths(
     profile_seeds: int = 5,
     profile_evaluations: int | None = None,
     max_realised_e_n: float | None = None,
+    suspect: SuspectPolicy | None = None,
 ) -> PathFitResult:
     """Fit the ``free`` parameters to the observed runouts of ``runs``.
 
@@ -804,6 +829,10 @@ def fit_paths(
         bound: no law has an exact reformulation once its e_n scatters (the start
         model of boulder A, e_n = 1.0 with e_n_sd 0.04 under eq. 7.1, realises
         e_n > 1 on 40 % of its impacts), so the share is measured, not assumed.
+    suspect
+        What to do with the flight heights and speeds that rest on a flagged
+        impact or an assumed launch angle (:mod:`fieldkit.fit.suspect`; default:
+        keep them); stated in the notes when it changes anything.
 
     Returns
     -------
@@ -843,7 +872,10 @@ def fit_paths(
     p = len(names)
     check_realised_limit(max_realised_e_n)
     objective = PathObjective(runs, names, rocks, seed, kinds,
-                              realised_limit=max_realised_e_n)  # fmt: skip
+                              realised_limit=max_realised_e_n,
+                              suspect=suspect)  # fmt: skip
+    if not objective.suspect_policy.is_default:
+        notes += [f"suspect data: {line}" for line in objective.suspect_words()]
     n_runs = len(objective.runs)
     if n_runs < len(runs):
         notes.append(f"{len(runs) - n_runs} runs without any observation left out")
@@ -1131,6 +1163,8 @@ def fit_paths(
         max_realised_e_n=max_realised_e_n,
         realised_share_start=realised_start,
         realised_share_optimum=realised_best,
+        suspect=objective.suspect,
+        suspect_policy=objective.suspect_policy,
     )
 
 

@@ -36,7 +36,7 @@ import numpy as np
 import pandas as pd
 
 from fieldkit.errors import InputFileError
-from fieldkit.impact_table import ImpactTable
+from fieldkit.impact_table import ImpactTable, flight_value_markers
 from fieldkit.io.csv_table import CsvTable, length_factor, read_csv_table
 from fieldkit.path_observations import PathObservations
 
@@ -240,7 +240,9 @@ def observations_from_impact_table(table: ImpactTable) -> PathObservations:
     Release = the first impact of each path, deposit = its last (x along the
     section, y = 0); mass and radius from the first row where given; every impact
     an along-path observation with ``x_m``, ``z_m`` and, where the table has them,
-    ``hmax_normal_m`` and ``vi_mps``.
+    ``hmax_normal_m`` and ``vi_mps``, each with what it rests on
+    (:func:`fieldkit.impact_table.flight_value_markers`: ``<value>_flags``, the
+    flag bit code of the impacts its flight joins, and ``<value>_theta0_assumed``).
 
     Raises
     ------
@@ -262,6 +264,7 @@ def observations_from_impact_table(table: ImpactTable) -> PathObservations:
     [5.0, 6.4031242374328485]
     """
     frame = table.frame
+    derived = table.derive().frame  # its qa_flags, whatever the table carried
     source = table.source or "ImpactTable"
     records, along = [], []
     for path_id in table.paths():
@@ -298,10 +301,15 @@ def observations_from_impact_table(table: ImpactTable) -> PathObservations:
                 "z_m": rows["z_m"].to_numpy(float),
             }
         )
+        markers = flight_value_markers(derived[derived["path_id"] == path_id])
         for name in ("hmax_normal_m", "vi_mps"):
             values = rows[name].to_numpy(dtype=float, na_value=np.nan)
             if np.isfinite(values).any():
                 points[name] = values
+        for name in ("hmax_normal_m", "vi_mps"):
+            if name in points:  # what the value rests on (fieldkit.fit.suspect)
+                points[f"{name}_flags"] = markers[f"{name}_flags"]
+                points[f"{name}_theta0_assumed"] = markers[f"{name}_theta0_assumed"]
         along.append(points)
     return PathObservations(
         pd.DataFrame.from_records(records),

@@ -226,7 +226,8 @@ def test_path_fit_prints_the_verdict_first(cli, tmp_path, boulder_a):
             "--report", report)  # fmt: skip
     assert r.exit_code == 0, r.output
     design = json.loads(js.read_text())["design"]
-    assert design["models"] == ["start", "calibrated"]
+    # the leave-out refits (suspect data) beside the start and the calibrated model
+    assert design["models"] == ["start", "calibrated", "flagged out", "assumed θ0 out"]
     assert (design["rocks"], design["seed"]) == (1000, 1)
     (point,) = design["points"]
     assert (point["x_m"], point["name"]) == (610.0, "railway bench")
@@ -280,7 +281,9 @@ def test_impact_fit_design_quantities_and_measured_from_both_places(
     assert report.startswith(
         "# Impact fit\n\n## Design quantities at the analysis points\n"
     )
-    assert "| x = 610 m (railway bench) | start | calibrated | measured |" in report
+    # the leave-out refits (suspect data) are set beside the start and calibrated
+    assert ("| x = 610 m (railway bench) | start | calibrated | flagged out | "
+            "assumed θ0 out | measured |") in report  # fmt: skip
     design = json.loads(out.read_text())["provenance"]["fit"]["design"]
     (point,) = design["points"]
     assert [m["speed_mps"] for m in point["measured"]] == [70.0, 18.0]
@@ -311,7 +314,7 @@ def test_no_analysis_point_reports_runout_only(cli, tmp_path, boulder_a):
     )
     design = json.loads(out.read_text())["provenance"]["fit"]["design"]
     assert design["points"] == [] and set(design["runout_x_m"]) == {
-        "start", "calibrated"
+        "start", "calibrated", "flagged out", "assumed θ0 out"
     }
 
 
