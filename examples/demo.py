@@ -190,7 +190,7 @@ def main(out: Path) -> None:
         "-o", calibrated, "--json", fit_json, "--report", out / "fit",
     )  # fmt: skip
     fit = json.loads(fit_json.read_text(encoding="utf-8"))
-    demo.say(f"fit: {fit_line(fit)} -> {relative(calibrated)}")
+    demo.say(f"fit: {fit_line(fit)} -> {relative(calibrated)}{consequence(fit)}")
     demo.index += [
         "One surveyed path: the ± are bootstrap standard errors over its surveyed "
         "points, a lower bound on the uncertainty (the points of one path are not "
@@ -255,6 +255,15 @@ def diagnosis_line(found: dict) -> str:
         f"recommends {', '.join(added)}: held-out error of the rebound velocities "
         f"{before:.2f} -> {after:.2f} m/s ({1 - after / before:.0%} lower){against}"
     )
+
+
+def consequence(fit: dict) -> str:
+    """The fit's first word on the calibrated model at the asset: its first
+    unconservative verdict (``fieldkit fit`` prints them all first), or none."""
+    for verdict in fit.get("design", {}).get("verdicts", []):
+        if verdict.startswith("unconservative") and "calibrated model" in verdict:
+            return "; " + verdict.split(" [measured:")[0]
+    return ""
 
 
 def fit_line(fit: dict) -> str:
