@@ -71,6 +71,10 @@ EXPECTED = {
         # the bench-free fit, and the realised e_n > 1 share
         r"^bench free \(materials\.bench\.friction_deg, materials\.bench\."
         r"roughness_m also fitted; \d+ evaluations\): objective \d",
+        r"^bench grid \(128 settings .*: the fastest median speed at x = 610 m is "
+        r"\d+\.\d m/s \(stopping \d+ % of its rocks by x = 635 m\); settings "
+        r"passing at a median of 14 m/s or more and stopping "
+        r"half the rocks by x = 635 m: \d+",
         r"^  calibrated on the path\s+realised e_n > 1 on \d+\.\d % of [\d,]+ "
         r"simulated colluvium impacts \(median \d\.\d+\)",
         r"^  constrained to realised e_n <= 1\s+realised e_n > 1 on 0\.\d %",
