@@ -198,19 +198,6 @@ def test_simulate_without_at_uses_the_models_points(cli, tmp_path):
     assert "--at not given" not in r.stderr
 
 
-@pytest.fixture(scope="module")
-def boulder_a(tmp_path_factory) -> Path:
-    """Boulder A reduced with the preset (the README's table)."""
-    from typer.testing import CliRunner
-
-    from fieldkit.cli import app
-
-    out = tmp_path_factory.mktemp("boulder") / "boulder_a.csv"
-    r = CliRunner().invoke(app, [str(a) for a in (
-        "reduce", "--impacts", TORNADO / "boulder_a_impacts.gpx",
-        "--trees", TORNADO / "boulder_a_trees.csv", "--preset", PRESET, "-o", out)])
-    assert r.exit_code == 0, r.output
-    return out
 
 
 def test_path_fit_prints_the_verdict_first(cli, tmp_path, boulder_a):

@@ -19,18 +19,6 @@ REDUCE = (
 )  # fmt: skip
 
 
-@pytest.fixture(scope="module")
-def boulder_a(tmp_path_factory) -> Path:
-    """Boulder A reduced with the preset (the README's table)."""
-    from typer.testing import CliRunner
-
-    from fieldkit.cli import app
-
-    out = tmp_path_factory.mktemp("boulder") / "boulder_a.csv"
-    r = CliRunner().invoke(app, [str(a) for a in (*REDUCE, "--preset", PRESET,
-                                                  "-o", out)])  # fmt: skip
-    assert r.exit_code == 0, r.output
-    return out
 
 
 def test_reduce_preset_gives_the_explicit_options_table(cli, tmp_path, boulder_a):

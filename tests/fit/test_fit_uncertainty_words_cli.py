@@ -13,21 +13,6 @@ TABLE_7_1 = TORNADO / "model_rocfall_table_7_1.json"
 E_N, E_T = "materials.colluvium.e_n", "materials.colluvium.e_t"
 
 
-@pytest.fixture(scope="module")
-def boulder_a(tmp_path_factory) -> Path:
-    """Boulder A reduced with its preset (the README's table)."""
-    from typer.testing import CliRunner
-
-    from fieldkit.cli import app
-
-    out = tmp_path_factory.mktemp("boulder") / "b.csv"
-    r = CliRunner().invoke(app, [
-        "reduce", "--impacts", str(TORNADO / "boulder_a_impacts.gpx"),
-        "--trees", str(TORNADO / "boulder_a_trees.csv"),
-        "--preset", str(TORNADO / "boulder_a_preset.toml"), "-o", str(out),
-    ])  # fmt: skip
-    assert r.exit_code == 0, r.output
-    return out
 
 
 def test_zero_width_slice_is_no_evidence_of_pinning(cli, tmp_path, boulder_a):

@@ -6,7 +6,6 @@ import json
 from pathlib import Path
 
 import numpy as np
-import pytest
 
 from fieldkit.fit.path_fit import fit_paths
 from fieldkit.fit.path_profile import profile_objective
@@ -76,20 +75,6 @@ def test_seed_spread_is_zero_without_seed_dependence_and_positive_with():
     )
 
 
-@pytest.fixture(scope="module")
-def boulder_a(tmp_path_factory) -> Path:
-    from typer.testing import CliRunner
-
-    from fieldkit.cli import app
-
-    out = tmp_path_factory.mktemp("boulder") / "b.csv"
-    r = CliRunner().invoke(app, [
-        "reduce", "--impacts", str(TORNADO / "boulder_a_impacts.gpx"),
-        "--trees", str(TORNADO / "boulder_a_trees.csv"),
-        "--preset", str(TORNADO / "boulder_a_preset.toml"), "-o", str(out),
-    ])  # fmt: skip
-    assert r.exit_code == 0, r.output
-    return out
 
 
 def test_path_fit_prints_the_profile_beside_the_bootstrap(cli, tmp_path, boulder_a):

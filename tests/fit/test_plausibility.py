@@ -116,21 +116,6 @@ def test_constrained_path_fit_meets_the_tolerance_the_unconstrained_does_not():
     assert any("constrained to realised e_n <= 1" in n for n in held.notes)
 
 
-@pytest.fixture(scope="module")
-def boulder_a(tmp_path_factory):
-    """Boulder A reduced with its preset (the CLI, as a user would)."""
-    from typer.testing import CliRunner
-
-    from fieldkit.cli import app
-
-    table = tmp_path_factory.mktemp("a") / "a.csv"
-    r = CliRunner().invoke(app, [
-        "reduce", "--impacts", str(TORNADO / "boulder_a_impacts.gpx"),
-        "--trees", str(TORNADO / "boulder_a_trees.csv"),
-        "--preset", str(TORNADO / "boulder_a_preset.toml"), "-o", str(table),
-    ])  # fmt: skip
-    assert r.exit_code == 0, r.output
-    return table
 
 
 PATH_FREE = [
