@@ -16,6 +16,8 @@ from typer.testing import CliRunner
 REPO = Path(__file__).resolve().parents[1]
 
 
+_TORNADO = Path(__file__).resolve().parents[1] / "surveys" / "tornado_mountain"
+
 @pytest.fixture(scope="session")
 def repo() -> Path:
     """The repository root."""
@@ -227,3 +229,21 @@ def synthetic_simulation():
         )
 
     return make
+
+
+@pytest.fixture(scope="session")
+def boulder_a(tmp_path_factory) -> Path:
+    """Boulder A reduced with its preset, as ``fieldkit reduce`` writes it (the
+    README's table); read only."""
+    from typer.testing import CliRunner
+
+    from fieldkit.cli import app
+
+    out = tmp_path_factory.mktemp("boulder") / "boulder_a.csv"
+    r = CliRunner().invoke(app, [
+        "reduce", "--impacts", str(_TORNADO / "boulder_a_impacts.gpx"),
+        "--trees", str(_TORNADO / "boulder_a_trees.csv"),
+        "--preset", str(_TORNADO / "boulder_a_preset.toml"), "-o", str(out),
+    ])  # fmt: skip
+    assert r.exit_code == 0, r.output
+    return out

@@ -1,4 +1,5 @@
-"""Measured values and design quantities on the command line (``simulate``, ``fit``).
+"""Measured values and design quantities on the command line (``simulate``, ``fit``,
+``diagnose -o``).
 
 * :func:`parse_measured` -- ``--measured x=610,speed=18,ke=600e3`` into a
   :class:`fieldkit.measured.Measured` (shared by ``fieldkit simulate`` and
@@ -15,6 +16,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from typing import Annotated
 
 import numpy as np
 import typer
@@ -34,6 +36,36 @@ MEASURED_KEYS = {
 DEFAULT_DESIGN_ROCKS = 2000
 #: Largest ``--design-rocks``: each model is simulated once with them.
 MAX_DESIGN_ROCKS = 1_000_000
+
+#: The options of every command that reports design quantities (``fit``,
+#: ``fit --paths``, ``diagnose -o``).
+AtOpt = Annotated[
+    list[float] | None,
+    typer.Option(
+        "--at",
+        help="Design quantities at this x (m) (repeatable; default the model "
+        "file's analysis_points, else the measured values' x).",
+    ),
+]
+MeasuredOpt = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--measured",
+        help="A value measured at an analysis point, e.g. "
+        "x=610,speed=18,ke=600e3[,total=690e3][,height=1.5] (J, m/s, m; "
+        "repeatable; the --preset's measured entries too): the start and "
+        "calibrated models are set beside it and a line says when one is "
+        "unconservative.",
+    ),
+]
+DesignRocksOpt = Annotated[
+    int,
+    typer.Option(
+        "--design-rocks",
+        help=f"Rocks per model for the design quantities (default "
+        f"{DEFAULT_DESIGN_ROCKS:,}), on a random stream the calibration never uses.",
+    ),
+]
 
 
 def parse_measured(text: str) -> Measured:

@@ -11,6 +11,12 @@ from typing import Annotated
 import typer
 
 from fieldkit.cli.common import note, one_line_errors
+from fieldkit.cli.design import (
+    DEFAULT_DESIGN_ROCKS,
+    AtOpt,
+    DesignRocksOpt,
+    MeasuredOpt,
+)
 from fieldkit.cli.material_options import MaterialOpt, PresetOpt, mapped_table
 from fieldkit.cli.progress import report_written, step
 from fieldkit.errors import ArgumentError
@@ -32,6 +38,9 @@ FLAGS = {
     "null_quantile": "--null-quantile",
     "workers": "--workers",
     "input_files": "TABLE_OR_TRACK",
+    "at": "--at",
+    "measured": "--measured",
+    "design_rocks": "--design-rocks",
 }
 #: Most characters of a CSV's first line read to tell a track from a table.
 MAX_HEADER_CHARS = 1 << 20
@@ -312,6 +321,9 @@ def diagnose(
             "(default: on for a reduced survey, a table with assumed launch angles).",
         ),
     ] = None,
+    at: AtOpt = None,
+    measured: MeasuredOpt = None,
+    design_rocks: DesignRocksOpt = DEFAULT_DESIGN_ROCKS,
 ) -> None:
     """Compare model and measurements; rank the missing effects; add them stepwise.
 
@@ -331,7 +343,10 @@ def diagnose(
     errors of that gain. Its x and z residuals are tested against the time from
     mid-flight and the speed (4 tests; a residual depends on a feature when its
     Holm-adjusted p <= 0.05). The dependence tests only describe the
-    residuals: no recommendation rests on them.
+    residuals: no recommendation rests on them. With -o (a calibration), the
+    base and the written model are first set side by side at the analysis points
+    (--at, else the model file's analysis_points) beside the values measured
+    there (--measured, the preset's), as fit does.
 
     Example (from the repository root):
 
@@ -358,6 +373,16 @@ def diagnose(
     for path in input_files:
         check_readable(path)
     input_file = input_files[0]
+    from fieldkit.cli.design import check_design_rocks, measured_values
+
+    if (at or measured) and output is None:
+        raise ArgumentError(
+            "--at and --measured set the design quantities of the model diagnose "
+            "writes: give -o (and --model)",
+            source="at" if at else "measured",
+        )
+    check_design_rocks(design_rocks)
+    design_measured = measured_values(measured, preset) if output else []
     if output is not None and model is None:
         raise ArgumentError(
             "-o needs --model (the base model supplies profile, body and seeder)",
@@ -427,6 +452,10 @@ def diagnose(
             from fieldkit.model.model_file import read_model
 
             base = read_model(model, outputs=outputs) if model is not None else None
+            if output is not None:
+                from fieldkit.cli.design import design_points
+
+                design_points(base, at, design_measured)  # refused before the work
             from fieldkit.diagnose.sensitivity import is_surveyed
 
             joined = _read_tables(input_files)
@@ -492,8 +521,19 @@ def diagnose(
                     "table was assumed (--sensitivity runs it on any table)"
                 )
         diagnosis.notes.append(f"fold seed {seed}")
+        design = None
+        if output is not None:
+            from fieldkit.cli.design import design_for_fit
+
+            design, said = design_for_fit(
+                {"start": base, "calibrated": diagnosis.arrays["after_model"]},
+                at=at, measured=design_measured, rocks=design_rocks, seed=seed,
+            )  # fmt: skip
         if json_file is not None:
-            write_json(json_file, diagnosis.to_json(), outputs)
+            data = diagnosis.to_json()
+            if design is not None:
+                data["design"] = design.to_dict()
+            write_json(json_file, data, outputs)
         text = None
         if report_dir is not None:
             with step(f"writing the report and its figures to {report_dir}"):
@@ -522,10 +562,15 @@ def diagnose(
                     "added": [s.added for s in diagnosis.steps],
                     "cv_rmse_mps": diagnosis.after.cv_rmse,
                     "params_sd": diagnosis.after.params_sd,
+                    "design": design.to_dict(),
                 },
             }
             write_model(replace(after, provenance=provenance), output, outputs=outputs)
         written = outputs.commit()
+    if design is not None:
+        from fieldkit.cli.design import print_design
+
+        print_design(design, said)
     for line in _summary(diagnosis):
         typer.echo(line)
     report_written(written)

@@ -9,7 +9,12 @@ from typing import Annotated
 import typer
 
 from fieldkit.cli.common import one_line_errors
-from fieldkit.cli.design import DEFAULT_DESIGN_ROCKS
+from fieldkit.cli.design import (
+    DEFAULT_DESIGN_ROCKS,
+    AtOpt,
+    DesignRocksOpt,
+    MeasuredOpt,
+)
 from fieldkit.cli.material_options import MaterialOpt, PresetOpt, mapped_table
 from fieldkit.cli.progress import report_written, step
 from fieldkit.cli.suspect_options import (
@@ -350,34 +355,9 @@ def fit(
             "Default: no constraint.",
         ),
     ] = None,
-    at: Annotated[
-        list[float] | None,
-        typer.Option(
-            "--at",
-            help="Design quantities at this x (m) (repeatable; default the model "
-            "file's analysis_points, else the measured values' x).",
-        ),
-    ] = None,
-    measured: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--measured",
-            help="A value measured at an analysis point, e.g. "
-            "x=610,speed=18,ke=600e3[,total=690e3][,height=1.5] (J, m/s, m; "
-            "repeatable; the --preset's measured entries too): the start and "
-            "calibrated models are set beside it and a line says when one is "
-            "unconservative.",
-        ),
-    ] = None,
-    design_rocks: Annotated[
-        int,
-        typer.Option(
-            "--design-rocks",
-            help=f"Rocks per model for the design quantities (default "
-            f"{DEFAULT_DESIGN_ROCKS:,}), on a random stream the calibration never "
-            "uses.",
-        ),
-    ] = DEFAULT_DESIGN_ROCKS,
+    at: AtOpt = None,
+    measured: MeasuredOpt = None,
+    design_rocks: DesignRocksOpt = DEFAULT_DESIGN_ROCKS,
     flagged: FlaggedOpt = "keep",
     assumed_theta0: AssumedOpt = "keep",
     leave_out: LeaveOutOpt = True,
