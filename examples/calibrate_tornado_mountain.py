@@ -274,7 +274,7 @@ def main() -> None:
     # Free what the question needs: does a bench with its own friction and
     # roughness stop the rock within 30 m and keep its speed at the railway?
     bench_free = {**PATH_FREE, **BENCH_FREE}
-    bench = path_fit(runs, start, bench_free, profile_points=0)
+    bench = path_fit(runs, start, bench_free, profile_points=0, bootstrap=0)
     print(
         f"\nbench free ({', '.join(BENCH_FREE)} also fitted; {bench.n_evaluations} "
         f"evaluations): objective {bench.objective_optimum:.3f} against "
@@ -299,7 +299,7 @@ def main() -> None:
 
     # Physical plausibility: what the fitted laws do at the simulated impacts, and
     # the path fit constrained to realised e_n <= 1.
-    constrained = path_fit(runs, start, PATH_FREE, profile_points=0,
+    constrained = path_fit(runs, start, PATH_FREE, profile_points=0, bootstrap=0,
                            max_realised_e_n=1.0)  # fmt: skip
     print("\nplausibility (the colluvium, simulated on its own stream):")
     for name, model in (
