@@ -21,10 +21,12 @@ one observed deposit ``y`` by
 **Fair (unbiased) ensemble scores** (Ferro 2014). With m members :math:`x_i`, the
 ensemble's own distribution gives
 :math:`\\tfrac12 \\cdot \\frac1{m^2}\\sum_{i,j}\\|x_i - x_j\\|` for the spread term.
-Its diagonal terms are zero, so the mean is taken over m(m - 1) pairs that each have
-expectation :math:`E\\|X - X'\\|` while being divided by m^2: the empirical score
-rewards a small ensemble for under-spread by the factor (m - 1)/m. The fair score
-divides by the number of distinct ordered pairs instead,
+Its diagonal terms are zero, so the sum runs over m(m - 1) pairs that each have
+expectation :math:`E\\|X - X'\\|` but is divided by m^2: the spread term is short by
+the factor (m - 1)/m, and the empirical score of an ensemble of m members drawn from
+F exceeds ES(F, y) on average by :math:`E\\|X - X'\\| / (2m)` -- a small ensemble
+is penalised for its size, not for its forecast. The fair score divides by the
+number of distinct ordered pairs instead,
 
 .. math::
     \\mathrm{ES}_{fair} = \\frac1m \\sum_i \\|x_i - y\\|
@@ -361,8 +363,11 @@ class RunScores:
         Fair CRPS of the lateral offset (:func:`lateral_offset_m`).
     distance_observed_m, distance_mean_m
         Observed distance; ensemble mean distance.
-    lateral_observed_m, lateral_mean_m
-        Observed lateral offset; ensemble mean lateral offset.
+    lateral_observed_m
+        Observed lateral offset (signed).
+    lateral_mean_abs_m
+        The ensemble's mean absolute lateral offset (its lateral spread about the
+        reference line; compare with ``|lateral_observed_m|``).
     distance_in_interval
         Whether the observed distance is in the ensemble's central
         :data:`COVERAGE_LEVEL` interval (1.0/0.0; NaN without members).
@@ -377,7 +382,7 @@ class RunScores:
     distance_observed_m: np.ndarray
     distance_mean_m: np.ndarray
     lateral_observed_m: np.ndarray
-    lateral_mean_m: np.ndarray
+    lateral_mean_abs_m: np.ndarray
     distance_in_interval: np.ndarray
     members: np.ndarray
 
@@ -388,7 +393,8 @@ class RunScores:
         """Means over runs: each score, its SE over runs, the coverage of the
         distance interval, the mean observed and predicted distance and their
         difference (``distance_bias_m``), the mean |lateral offset| observed and
-        predicted."""
+        predicted (``lateral_observed_mean_abs_m``, ``lateral_predicted_mean_abs_m``:
+        the mean over runs of each ensemble's mean |offset|)."""
         out: dict = {"n_runs": int(self.energy_m.size)}
         for name in (*self.SCORES, "energy_m"):
             v = getattr(self, name)
@@ -406,9 +412,7 @@ class RunScores:
         out["lateral_observed_mean_abs_m"] = float(
             np.mean(np.abs(self.lateral_observed_m))
         )
-        out["lateral_predicted_mean_abs_m"] = float(
-            np.nanmean(np.abs(self.lateral_mean_m))
-        )
+        out["lateral_predicted_mean_abs_m"] = float(np.nanmean(self.lateral_mean_abs_m))
         return out
 
 
@@ -469,9 +473,9 @@ def score_runs(
             lo, hi = np.quantile(dist, [lo_q, hi_q])
             fields["distance_in_interval"].append(float(lo <= dist_obs <= hi))
             fields["distance_mean_m"].append(float(np.mean(dist)))
-            fields["lateral_mean_m"].append(float(np.mean(lat)))
+            fields["lateral_mean_abs_m"].append(float(np.mean(np.abs(lat))))
         else:
-            for k in ("distance_in_interval", "distance_mean_m", "lateral_mean_m"):
+            for k in ("distance_in_interval", "distance_mean_m", "lateral_mean_abs_m"):
                 fields[k].append(math.nan)
     return RunScores(**{k: np.asarray(v, float if k != "members" else int)
                         for k, v in fields.items()})  # fmt: skip
