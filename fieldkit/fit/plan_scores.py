@@ -313,6 +313,55 @@ def lateral_offset_m(
     return u[..., 0] * d[..., 1] - u[..., 1] * d[..., 0]
 
 
+def section_to_plan(
+    plan_x_m: np.ndarray, plan_y_m: np.ndarray, chainage_m: np.ndarray
+) -> np.ndarray:
+    """Plan points (x, y) [m] at chainages along a section's plan polyline: how a
+    2-D model's simulated stops on a DEM section become deposits in plan, to be
+    scored beside a 3-D model's.
+
+    The chainage of a vertex is the plan distance along the polyline from its first
+    vertex (as :class:`fieldkit.model.dem_profile.Section` measures it); a chainage
+    before the first vertex (a rock that stopped on the ground kept upslope of the
+    release, at negative chainage) lies on the line back along the first segment's
+    direction, one after the last vertex on the last segment's continuation.
+
+    Parameters
+    ----------
+    plan_x_m, plan_y_m
+        (n,) the polyline's vertices, n >= 2, no two consecutive equal.
+    chainage_m
+        Chainages to place (any shape).
+
+    Returns
+    -------
+    numpy.ndarray
+        (..., 2) the plan points.
+
+    Examples
+    --------
+    >>> section_to_plan(np.array([0.0, 3.0, 3.0]), np.array([0.0, 4.0, 14.0]),
+    ...                 np.array([-5.0, 2.5, 10.0, 16.0])).tolist()
+    [[-3.0, -4.0], [1.5, 2.0], [3.0, 9.0], [3.0, 15.0]]
+    """
+    px = np.asarray(plan_x_m, float)
+    py = np.asarray(plan_y_m, float)
+    seg = np.hypot(np.diff(px), np.diff(py))
+    if px.size < 2 or px.size != py.size or not np.all(seg > 0):
+        raise ArgumentError(
+            "plan_x_m, plan_y_m must be >= 2 vertices of one length, no two "
+            "consecutive equal",
+            source="plan_x_m",
+        )
+    vertex = np.concatenate([[0.0], np.cumsum(seg)])
+    c = np.asarray(chainage_m, float)
+    i = np.clip(np.searchsorted(vertex, c, side="right") - 1, 0, seg.size - 1)
+    t = (c - vertex[i]) / seg[i]
+    x = px[i] + t * (px[i + 1] - px[i])
+    y = py[i] + t * (py[i + 1] - py[i])
+    return np.stack([x, y], axis=-1)
+
+
 def plan_climatology(
     calibration_release_xy: np.ndarray,
     calibration_deposit_xy: np.ndarray,

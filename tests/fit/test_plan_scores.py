@@ -24,6 +24,7 @@ from fieldkit.fit.plan_scores import (
     plan_climatology,
     repeated_kfold,
     score_runs,
+    section_to_plan,
     unique_runs,
 )
 from fieldkit.io.path_observations import read_release_deposit
@@ -322,3 +323,28 @@ def test_climatology_repeated_kfold_over_the_79_distinct_runs(all_runs):
         )
     mean = per_run.mean(axis=0).mean(axis=0)
     np.testing.assert_allclose(mean, [13.875, 10.029], atol=1e-3)
+
+
+def test_section_to_plan_places_the_observed_stop_as_path_runs_measures_it(fixed_split):
+    from fieldkit.fit.path_sections import path_runs
+    from fieldkit.io.dem import read_dem
+    from fieldkit.model.model_file import read_model
+
+    _, hold = fixed_split
+    base = read_model(Path(__file__).parents[2] / "examples/tschamut/model_base.json")
+    runs = path_runs(hold, read_dem(DATA / "terrain.asc"), base, section="descent")
+    deposits = _xyz(hold, "deposit")[:, :2]
+    for run, deposit in zip(runs, deposits, strict=True):
+        px, py = run.observations["section_x_m"], run.observations["section_y_m"]
+        # the section's own vertices come back at their chainages (those >= 0 of the
+        # profile; the ground kept upslope is at negative chainage, on the line back)
+        x = run.model.profile.x_m
+        on = section_to_plan(px, py, x[x >= 0])
+        np.testing.assert_allclose(on, np.column_stack([px, py]), atol=1e-9)
+        back = section_to_plan(px, py, x[0])
+        assert np.hypot(*(back - [px[0], py[0]])) == pytest.approx(-x[0], rel=1e-9)
+        # the observed stop's chainage lies lateral_offset_m from the deposit
+        stop = section_to_plan(px, py, run.observed_runout_m)
+        assert np.hypot(*(stop - deposit)) == pytest.approx(
+            run.lateral_offset_m, abs=1e-6
+        )
