@@ -31,6 +31,7 @@ from fieldkit.io.path_observations import read_release_deposit
 
 DATA = Path(__file__).parents[1] / "data" / "tschamut2014"
 SPLIT = DATA / "calibration_split"
+BASE = Path(__file__).parents[2] / "examples" / "tschamut" / "model_base.json"
 
 
 def test_doctests():
@@ -331,7 +332,7 @@ def test_section_to_plan_places_the_observed_stop_as_path_runs_measures_it(fixed
     from fieldkit.model.model_file import read_model
 
     _, hold = fixed_split
-    base = read_model(Path(__file__).parents[2] / "examples/tschamut/model_base.json")
+    base = read_model(BASE)
     runs = path_runs(hold, read_dem(DATA / "terrain.asc"), base, section="descent")
     deposits = _xyz(hold, "deposit")[:, :2]
     for run, deposit in zip(runs, deposits, strict=True):
@@ -348,3 +349,55 @@ def test_section_to_plan_places_the_observed_stop_as_path_runs_measures_it(fixed
         assert np.hypot(*(stop - deposit)) == pytest.approx(
             run.lateral_offset_m, abs=1e-6
         )
+
+
+@pytest.mark.slow
+def test_the_2d_calibrated_model_loses_to_the_climatology_in_plan(cli, tmp_path):
+    """The issue's measurement: `fieldkit fit` on the calibration runs (the README's
+    command), its held-out deposits in plan over seeds 1-3, against the plan
+    climatology (v033 counted once) -- about twice as bad on both scores."""
+    from fieldkit.fit.path_runs import simulated_runouts
+    from fieldkit.fit.path_sections import path_runs
+    from fieldkit.io.dem import read_dem
+    from fieldkit.model.model_file import read_model
+
+    r = cli(
+        "fit", "--model", BASE,
+        "--paths", SPLIT / "calibration_release_points.csv",
+        "--deposits", SPLIT / "calibration_observed_deposition.csv",
+        "--dem", DATA / "terrain.asc", "--rocks", "40", "--bootstrap", "2",
+        "-o", tmp_path / "cal.json",
+    )  # fmt: skip
+    assert r.exit_code == 0, r.output
+    cal = read_release_deposit(
+        SPLIT / "calibration_release_points.csv",
+        SPLIT / "calibration_observed_deposition.csv",
+    )
+    hold = read_release_deposit(
+        SPLIT / "holdout_release_points.csv", SPLIT / "holdout_observed_deposition.csv"
+    )
+    keep = unique_runs(18, duplicate_runs(_xyz(cal, "release"), _xyz(cal, "deposit")))
+    cal_rel, cal_dep = _xyz(cal, "release")[keep, :2], _xyz(cal, "deposit")[keep, :2]
+    rel, dep = _xyz(hold, "release")[:, :2], _xyz(hold, "deposit")[:, :2]
+    u = mean_direction(cal_rel, cal_dep)
+    clim = score_runs(plan_climatology(cal_rel, cal_dep, rel), rel, dep, u)
+    runs = path_runs(hold, read_dem(DATA / "terrain.asc"),
+                     read_model(tmp_path / "cal.json"), section="descent")  # fmt: skip
+    per_seed = []
+    for seed in (1, 2, 3):
+        ens = [
+            section_to_plan(run.observations["section_x_m"],
+                            run.observations["section_y_m"],
+                            simulated_runouts(run, run.model, 200, seed, i))
+            for i, run in enumerate(runs)
+        ]  # fmt: skip
+        per_seed.append(score_runs(ens, rel, dep, u))
+    for score, model_m, clim_m in (
+        ("energy_fair_m", 20.2, 11.818),
+        ("distance_crps_fair_m", 17.2, 7.671),
+    ):
+        a = np.array([getattr(s, score) for s in per_seed])
+        c = paired_comparison(getattr(clim, score), a, score, "climatology", "2-D")
+        assert c.mean_b == pytest.approx(model_m, abs=1.0)
+        assert c.mean_a == pytest.approx(clim_m, abs=1e-3)
+        assert c.beats(2.0), c.lines()
