@@ -1,0 +1,527 @@
+"""The compiled 3-D core: one rock's flight, impacts and sliding on a DEM (numba).
+
+The ground is the bilinear surface between DEM cell centres
+(:mod:`fieldkit.model.terrain`); the rock is a lumped mass (its centre meets the
+surface), as in 2-D (:mod:`fieldkit.model.kernel`), whose impact laws it shares.
+
+Flight (exact contact): the centre follows ``p(t) = p0 + v0 t - (0, 0, g t^2/2)``
+(no air drag in 3-D yet). Over one bilinear patch (the square between four centres)
+the surface along the path is a quadratic in ``t`` (``x``, ``y`` are linear in
+``t`` and the surface is bilinear), so the height above it ``d(t)`` is a quadratic:
+the contact is its descending root (the root at which ``d`` decreases:
+:func:`fieldkit.model.kernel.descending_root`) lying in the time the path spends
+over the patch. Patches are walked in the order the path's plan projection crosses
+them (a grid traversal), so the first contact found is the first contact: no step
+size and no bisection, the contact is exact to rounding. A path crossing into a
+patch beside nodata or off the grid leaves the DEM there (state ``EXITED``).
+
+Impact in local axes: ``N`` the surface normal at the contact (``slope_roughness``:
+tilted by two independent angles ``N(0, sd)``, in the plane of incidence and across
+it, ``sd`` as in 2-D; the mirror draw, then no tilt, when the tilted surface faces
+away from the rock), ``T`` the direction of the tangential velocity (in the plane of
+incidence; ``vit = |v_t| >= 0``). The 2-D :func:`~fieldkit.model.kernel.restitution`
+and :func:`~fieldkit.model.kernel.passive_normal_speed` give the rebound's normal and
+tangential speeds and spin; the rebound is ``vfn N + vft T``, so the lateral
+direction of the tangential velocity is kept. Spin is a scalar about the axis
+across the direction of travel (the lumped-mass bookkeeping of 2-D: rolling
+``-v/r``); it is carried from impact to impact whatever the change of direction.
+
+Sliding/rolling (eq. 7.3 in 3-D): on the surface under gravity projected on the
+tangent plane and Coulomb friction ``g n_z tan(phi)`` opposite the velocity
+(``tan phi`` drawn per DEM cell entered, as 2-D draws it per segment), stepped
+with the exact constant-acceleration update over steps of at most
+:data:`SLIDE_STEP_CELLS` cells (and half the sampling distance); after each step the
+rock is put back on the surface and its velocity projected on the new tangent plane
+(the normal component is lost, as at a 2-D concave break). When a free (ballistic)
+step would end more than :data:`LAUNCH_GAP_M` above the surface, the surface falls
+away faster than the rock and it flies (the 2-D convex break). A rock slower than
+``stop_speed_mps`` stays if ``|g_t| <= g n_z tan(phi)`` (the 2-D rest test) and
+otherwise restarts down the fall line; friction bringing it to rest within a step
+ends the step there. On an inclined plane the scheme is exact.
+
+Randomness: every draw is ``f(key, impact number, slot)``
+(:mod:`fieldkit.model.random_streams`, the 2-D slots; the tilt across the plane of
+incidence uses :data:`SLOT_ROUGHNESS_LATERAL`), so threads and chunks do not change
+results. Not yet in 3-D: ``mass_loss``, ``tree_impacts``, ``air_drag``
+(:data:`NOT_IN_3D`; :func:`fieldkit.model.simulate3d.simulate3d` refuses them).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+
+import numpy as np
+from numba import njit, prange
+
+from fieldkit.model.effects import slope_roughness
+from fieldkit.model.effects.registry import EFFECTS, LAYOUT
+from fieldkit.model.kernel import descending_root, passive_normal_speed, restitution
+from fieldkit.model.random_streams import (
+    SLOT_E_N,
+    SLOT_E_T,
+    SLOT_FRICTION,
+    SLOT_ROUGHNESS,
+    normal,
+)
+from fieldkit.model.results import EXITED_DOWNSLOPE, MAX_IMPACTS, STOPPED
+from fieldkit.model.terrain import surface_at
+
+G = 9.81
+INF = math.inf
+#: A rock that left the DEM (or reached nodata): the 2-D "exited" code.
+EXITED = EXITED_DOWNSLOPE
+#: Effects the 3-D kernel does not apply yet (a model enabling one is refused).
+NOT_IN_3D = ("mass_loss", "tree_impacts", "air_drag")
+#: Normal draw slot of the roughness tilt across the plane of incidence (uniforms
+#: 6 and 7 of an impact; the 2-D slots use 0-5, 200+ and 2000+).
+SLOT_ROUGHNESS_LATERAL = 3
+#: Longest slide step, in DEM cells travelled.
+SLIDE_STEP_CELLS = 0.1
+#: A free step ending this far above the surface launches a sliding rock [m].
+LAUNCH_GAP_M = 1e-4
+#: Slide steps after which a rock is stopped as capped.
+MAX_SLIDE_STEPS = 1_000_000
+
+_NAMES = [spec.name for spec in EFFECTS]
+F_ROUGH = _NAMES.index("slope_roughness")
+F_ROT = _NAMES.index("rotation_friction")
+P_ROUGH = LAYOUT["slope_roughness.scale"]
+P_ROT_C = LAYOUT["rotation_friction.coupling"]
+#: Material table columns (as the 2-D kernel's).
+M_EN, M_ET, M_PHI, M_EN_SD, M_ET_SD, M_PHI_SD, M_ROUGH, M_ROUGH_SD = range(8)
+
+#: The ground: the terrain grid (:data:`fieldkit.model.terrain.Grid` fields) and the
+#: material index of every cell (int64, the grid's shape).
+Ground = namedtuple("Ground", ("z", "xc0", "yc0", "cell", "mat_index"))
+#: Run settings: slide_vn, stop speed, max impacts, sampling distance, slide step.
+Settings = namedtuple(
+    "Settings", ("slide_vn", "stop_v", "max_impacts", "sample_m", "step_m")
+)
+#: Sampled path buffers (flat, one entry per sample).
+Path = namedtuple("Path", ("x_m", "y_m", "z_m", "speed_mps", "ke_j", "re_j", "height_m"))
+PATH_FIELDS = Path._fields
+#: Columns of a recorded impact row.
+IMPACT_COLUMNS = (
+    "rock",
+    "x_m",
+    "y_m",
+    "z_m",
+    "material_index",
+    "vin_mps",
+    "vit_mps",
+    "vfn_mps",
+    "vft_mps",
+    "omega_i_radps",
+    "omega_f_radps",
+    "normal_x",
+    "normal_y",
+    "normal_z",
+)
+N_IMPACT = len(IMPACT_COLUMNS)
+
+
+@njit(cache=True)
+def _cell_material(gr, x, y):
+    ny, nx = gr.z.shape
+    col = min(max(int(math.floor((x - gr.xc0) / gr.cell + 0.5)), 0), nx - 1)
+    row = min(max(int(math.floor((y - gr.yc0) / gr.cell + 0.5)), 0), ny - 1)
+    return gr.mat_index[row, col], row * nx + col
+
+
+@njit(cache=True)
+def _unit_normal(gx, gy):
+    inv = 1.0 / math.sqrt(gx * gx + gy * gy + 1.0)
+    return -gx * inv, -gy * inv, inv
+
+
+@njit(cache=True)
+def flight_contact(gr, x, y, z, vx, vy, vz):
+    """First contact of the free flight from ``(x, y, z)`` with velocity ``v``.
+
+    Returns ``(t, hit)``: ``hit`` True = contact at ``t``; False = the path's plan
+    projection leaves the surface (grid edge or nodata) at ``t``.
+    """
+    ny, nx = gr.z.shape
+    cell = gr.cell
+    fx = (x - gr.xc0) / cell
+    fy = (y - gr.yc0) / cell
+    if not (0.0 <= fx <= nx - 1.0 and 0.0 <= fy <= ny - 1.0):
+        return 0.0, False
+    # the patch the path is over just after t = 0 (on an edge: the one ahead)
+    i = int(fx)
+    j = int(fy)
+    if vx < 0.0 and fx == i:
+        i -= 1
+    if vy < 0.0 and fy == j:
+        j -= 1
+    i = min(max(i, 0), nx - 2)
+    j = min(max(j, 0), ny - 2)
+    au = vx / cell
+    av = vy / cell
+    t0 = 0.0
+    first = True
+    while True:
+        z00 = gr.z[j, i]
+        z10 = gr.z[j, i + 1]
+        z01 = gr.z[j + 1, i]
+        z11 = gr.z[j + 1, i + 1]
+        if z00 != z00 or z10 != z10 or z01 != z01 or z11 != z11:
+            return t0, False
+        if vx > 0.0:
+            tx = (i + 1 - fx) / au
+        elif vx < 0.0:
+            tx = (i - fx) / au
+        else:
+            tx = INF
+        if vy > 0.0:
+            ty = (j + 1 - fy) / av
+        elif vy < 0.0:
+            ty = (j - fy) / av
+        else:
+            ty = INF
+        t1 = min(tx, ty)
+        # d(t) = z(t) - h(t), h bilinear in u = u0 + au t, v = v0 + av t
+        u0 = fx - i
+        v0 = fy - j
+        a = z10 - z00
+        b = z01 - z00
+        c = z11 - z10 - z01 + z00
+        h0 = z00 + a * u0 + b * v0 + c * u0 * v0
+        h1 = a * au + b * av + c * (u0 * av + v0 * au)
+        h2 = c * au * av
+        qa = -0.5 * G - h2
+        qb = vz - h1
+        qc = z - h0
+        if first and qc <= 0.0 and qb <= 0.0:
+            return 0.0, True  # on (or by rounding below) the surface, moving in
+        first = False
+        tc = descending_root(qa, qb, qc)
+        tol = 1e-12 * (1.0 + t1) if t1 < INF else 0.0
+        if t0 - 1e-12 * (1.0 + t0) <= tc <= t1 + tol:
+            return max(tc, t0), True
+        if t1 == INF:
+            return INF, False  # cannot happen with gravity; guards the loop
+        t0 = t1
+        if tx <= ty:
+            i += 1 if vx > 0.0 else -1
+            if i < 0 or i > nx - 2:
+                return t0, False
+        else:
+            j += 1 if vy > 0.0 else -1
+            if j < 0 or j > ny - 2:
+                return t0, False
+
+
+@njit(cache=True)
+def _emit(path, k, on, x, y, z, speed, m, re, hgt):
+    if on:
+        path.x_m[k] = x
+        path.y_m[k] = y
+        path.z_m[k] = z
+        path.speed_mps[k] = speed
+        path.ke_j[k] = 0.5 * m * speed * speed
+        path.re_j[k] = re
+        path.height_m[k] = hgt
+    return k + 1
+
+
+@njit(cache=True)
+def _friction_tan(mat, mi, key, n, entry):
+    phi = mat[mi, M_PHI]
+    if mat[mi, M_PHI_SD] > 0.0:
+        slot = SLOT_FRICTION + entry % 500_000
+        phi = max(0.0, phi + mat[mi, M_PHI_SD] * normal(key, n, slot))
+    return math.tan(math.radians(min(phi, 89.9)))
+
+
+@njit(cache=True)
+def _sample_flight(gr, path, k, on, x, y, z, vx, vy, vz, t1, sample_m, m, re):
+    """Samples of the flight over ``[0, t1)``: at most ``sample_m`` travelled apart."""
+    q = math.sqrt(2.0 * G * sample_m)
+    t = 0.0
+    while t < t1:
+        cz = vz - G * t
+        sp = math.sqrt(vx * vx + vy * vy + cz * cz)
+        px = x + vx * t
+        py = y + vy * t
+        pz = z + vz * t - 0.5 * G * t * t
+        k = _emit(path, k, on, px, py, pz, sp, m, re, pz - surface_at(gr, px, py)[0])
+        t += sample_m / (sp + q)  # travels at most sample_m (module docstring)
+    return k
+
+
+@njit(cache=True)
+def impact(gr, mat, flags, par, key, n, x, y, vx, vy, vz, w, r, kg):
+    """One impact at ``(x, y)`` on the surface; returns the rebound and its axes.
+
+    Returns ``(vfx, vfy, vfz, w_f, vin, vit, vfn, vft, nx, ny, nz, mi)``: rebound
+    velocity and spin, the local-axes speeds, the normal used (tilted by roughness)
+    and the material index.
+    """
+    h, gx, gy = surface_at(gr, x, y)
+    nx, ny, nz = _unit_normal(gx, gy)
+    mi, _ = _cell_material(gr, x, y)
+    e_n = mat[mi, M_EN]
+    if mat[mi, M_EN_SD] > 0.0:
+        e_n = max(0.0, e_n + mat[mi, M_EN_SD] * normal(key, n, SLOT_E_N))
+    e_t = mat[mi, M_ET]
+    if mat[mi, M_ET_SD] > 0.0:
+        e_t = max(0.0, e_t + mat[mi, M_ET_SD] * normal(key, n, SLOT_E_T))
+    vin = vx * nx + vy * ny + vz * nz
+    tx = vx - vin * nx
+    ty = vy - vin * ny
+    tz = vz - vin * nz
+    vit = math.sqrt(tx * tx + ty * ty + tz * tz)
+    if vit > 0.0:
+        tx, ty, tz = tx / vit, ty / vit, tz / vit
+    else:  # normal incidence: T down the fall line (or along x on level ground)
+        tx, ty, tz = nx * nz, ny * nz, nz * nz - 1.0
+        tn = math.sqrt(tx * tx + ty * ty + tz * tz)
+        if tn > 1e-12:
+            tx, ty, tz = tx / tn, ty / tn, tz / tn
+        else:
+            tx, ty, tz = 1.0, 0.0, 0.0
+    if flags[F_ROUGH] == 1:
+        sd = slope_roughness.dip_sd_rad(
+            mat[mi, M_ROUGH], mat[mi, M_ROUGH_SD], r, par[P_ROUGH]
+        )
+        if sd > 0.0:
+            d1 = sd * normal(key, n, SLOT_ROUGHNESS)
+            d2 = sd * normal(key, n, SLOT_ROUGHNESS_LATERAL)
+            # L = N x T: across the plane of incidence
+            lx = ny * tz - nz * ty
+            ly = nz * tx - nx * tz
+            lz = nx * ty - ny * tx
+            for trial in range(3):
+                sgn = 1.0 if trial == 0 else (-1.0 if trial == 1 else 0.0)
+                a1 = math.tan(sgn * d1)
+                a2 = math.tan(sgn * d2)
+                mx = nx + a1 * tx + a2 * lx
+                my = ny + a1 * ty + a2 * ly
+                mz = nz + a1 * tz + a2 * lz
+                mn = math.sqrt(mx * mx + my * my + mz * mz)
+                mx, my, mz = mx / mn, my / mn, mz / mn
+                if vx * mx + vy * my + vz * mz < 0.0 or trial == 2:
+                    nx, ny, nz = mx, my, mz
+                    break
+            vin = vx * nx + vy * ny + vz * nz
+            tx = vx - vin * nx
+            ty = vy - vin * ny
+            tz = vz - vin * nz
+            vit = math.sqrt(tx * tx + ty * ty + tz * tz)
+            if vit > 0.0:
+                tx, ty, tz = tx / vit, ty / vit, tz / vit
+    vfn, vft, w_f = restitution(vin, vit, e_n, mat[mi, M_EN], e_t, w, r, kg, flags, par)
+    k_spin = kg if flags[F_ROT] == 1 and par[P_ROT_C] > 0.0 else 0.0
+    vfn = passive_normal_speed(vin, vit, w, vfn, vft, w_f, k_spin)
+    vfx = vft * tx + vfn * nx
+    vfy = vft * ty + vfn * ny
+    vfz = vft * tz + vfn * nz
+    return vfx, vfy, vfz, w_f, vin, vit, vfn, vft, nx, ny, nz, mi
+
+
+@njit(cache=True)
+def run_rock(
+    key, x, y, z, vx, vy, vz, w, m, r, kg, gr, mat, flags, par, st,
+    path, path_start, path_on, rec, rec_start, rec_on, rock,
+):  # fmt: skip
+    """Follow one rock; returns ``(impacts, state, x, y, z, samples)``.
+
+    ``gr`` is a :data:`Ground`, ``mat`` the material table (columns ``M_*``),
+    ``flags`` / ``par`` the effects (registry layout), ``st`` the :data:`Settings`.
+    Path samples are written from ``path_start`` when ``path_on`` (else only
+    counted), impact rows into ``rec[rec_start + i]`` when ``rec_on``.
+    """
+    max_imp = st.max_impacts
+    kr = kg * kg
+    n = 0
+    k = path_start
+    state = -1
+    h, gx, gy = surface_at(gr, x, y)
+    if h != h:
+        k = _emit(path, k, path_on, x, y, z, 0.0, m, 0.0, math.nan)
+        return 0, EXITED, x, y, z, k - path_start
+    nx, ny, nz = _unit_normal(gx, gy)
+    flying = z > h or vx * nx + vy * ny + vz * nz > 0.0
+    if not flying:
+        z = h
+        vn = vx * nx + vy * ny + vz * nz
+        vx, vy, vz = vx - vn * nx, vy - vn * ny, vz - vn * nz
+    k = _emit(
+        path, k, path_on, x, y, z, math.sqrt(vx * vx + vy * vy + vz * vz), m,
+        0.5 * m * kr * w * w, z - h,
+    )  # fmt: skip
+    while state < 0:
+        if flying:
+            tc, hit = flight_contact(gr, x, y, z, vx, vy, vz)
+            k = _sample_flight(
+                gr, path, k, path_on, x, y, z, vx, vy, vz, tc, st.sample_m, m,
+                0.5 * m * kr * w * w,
+            )  # fmt: skip
+            x = x + vx * tc
+            y = y + vy * tc
+            z = z + vz * tc - 0.5 * G * tc * tc
+            vz = vz - G * tc
+            if not hit:
+                state = EXITED
+                break
+            h = surface_at(gr, x, y)[0]
+            if h == h:
+                z = h  # exactly on the surface
+            if n >= max_imp:
+                state = MAX_IMPACTS
+                break
+            n += 1
+            sp = math.sqrt(vx * vx + vy * vy + vz * vz)
+            k = _emit(path, k, path_on, x, y, z, sp, m, 0.5 * m * kr * w * w, 0.0)
+            w_i = w
+            vfx, vfy, vfz, w, vin, vit, vfn, vft, nnx, nny, nnz, mi = impact(
+                gr, mat, flags, par, key, n, x, y, vx, vy, vz, w, r, kg
+            )
+            if rec_on:
+                row = rec_start + n - 1
+                rec[row, 0] = rock
+                rec[row, 1] = x
+                rec[row, 2] = y
+                rec[row, 3] = z
+                rec[row, 4] = mi
+                rec[row, 5] = vin
+                rec[row, 6] = vit
+                rec[row, 7] = vfn
+                rec[row, 8] = vft
+                rec[row, 9] = w_i
+                rec[row, 10] = w
+                rec[row, 11] = nnx
+                rec[row, 12] = nny
+                rec[row, 13] = nnz
+            h, gx, gy = surface_at(gr, x, y)
+            nx, ny, nz = _unit_normal(gx, gy)
+            vn_real = vfx * nx + vfy * ny + vfz * nz
+            if vfn < st.slide_vn or vn_real <= 0.0:
+                flying = False
+                vx = vfx - vn_real * nx
+                vy = vfy - vn_real * ny
+                vz = vfz - vn_real * nz
+            else:
+                vx, vy, vz = vfx, vfy, vfz
+        else:
+            state, x, y, z, vx, vy, vz, w, k = _slide(
+                gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st,
+                path, k, path_on,
+            )  # fmt: skip
+            if state < 0:
+                flying = True
+    sp = math.sqrt(vx * vx + vy * vy + vz * vz) if state != STOPPED else 0.0
+    hh = surface_at(gr, x, y)[0]
+    k = _emit(path, k, path_on, x, y, z, sp, m, 0.5 * m * kr * w * w, z - hh)
+    return n, state, x, y, z, k - path_start
+
+
+@njit(cache=True)
+def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
+    """Slide/roll on the surface until the rock stops, leaves the DEM or launches.
+
+    Returns ``(state, x, y, z, vx, vy, vz, w, samples)``; ``state`` -1 = launched
+    (flying from the returned point, above the surface).
+    """
+    mi, cell_id = _cell_material(gr, x, y)
+    entry = 0
+    tanphi = _friction_tan(mat, mi, key, n, entry)
+    walked = 0.0
+    half = 0.5 * st.sample_m
+    for _ in range(MAX_SLIDE_STEPS):
+        h, gx, gy = surface_at(gr, x, y)
+        nx, ny, nz = _unit_normal(gx, gy)
+        # gravity on the tangent plane: (0, 0, -g) + g nz n
+        gtx = G * nz * nx
+        gty = G * nz * ny
+        gtz = -G + G * nz * nz
+        gt = math.sqrt(gtx * gtx + gty * gty + gtz * gtz)
+        fric = G * nz * tanphi
+        sp = math.sqrt(vx * vx + vy * vy + vz * vz)
+        if sp < st.stop_v or sp == 0.0:
+            if gt <= fric:
+                return STOPPED, x, y, z, 0.0, 0.0, 0.0, 0.0, k
+            vx = vy = vz = 0.0
+            sp = 0.0
+            s = 1.0 - fric / gt
+            ax, ay, az = gtx * s, gty * s, gtz * s
+        else:
+            ax = gtx - fric * vx / sp
+            ay = gty - fric * vy / sp
+            az = gtz - fric * vz / sp
+        acc = math.sqrt(ax * ax + ay * ay + az * az)
+        dt = st.step_m / (sp + math.sqrt(2.0 * st.step_m * acc) + 1e-300)
+        av = ax * vx + ay * vy + az * vz
+        rest = False
+        if sp > 0.0 and av < 0.0:
+            ts = -sp * sp / av  # the speed along the travel reaches 0
+            if ts <= dt:
+                dt = ts
+                rest = True
+        # a free step: does the surface fall away faster than the rock?
+        bx = x + vx * dt
+        by = y + vy * dt
+        bz = z + vz * dt - 0.5 * G * dt * dt
+        hb = surface_at(gr, bx, by)[0]
+        if hb != hb:
+            return EXITED, x, y, z, vx, vy, vz, w, k
+        if bz > hb + LAUNCH_GAP_M:
+            k = _emit(path, k, on, x, y, z, sp, m, 0.5 * m * kr * w * w, 0.0)
+            return -1, bx, by, bz, vx, vy, vz - G * dt, w, k
+        x1 = x + vx * dt + 0.5 * ax * dt * dt
+        y1 = y + vy * dt + 0.5 * ay * dt * dt
+        h1, gx1, gy1 = surface_at(gr, x1, y1)
+        if h1 != h1:
+            return EXITED, x, y, z, vx, vy, vz, w, k
+        walked += math.sqrt((x1 - x) ** 2 + (y1 - y) ** 2 + (h1 - z) ** 2)
+        if rest:
+            vx = vy = vz = 0.0
+        else:
+            vx += ax * dt
+            vy += ay * dt
+            vz += az * dt
+            n1x, n1y, n1z = _unit_normal(gx1, gy1)
+            vn = vx * n1x + vy * n1y + vz * n1z
+            vx -= vn * n1x
+            vy -= vn * n1y
+            vz -= vn * n1z
+        x, y, z = x1, y1, h1
+        sp = math.sqrt(vx * vx + vy * vy + vz * vz)
+        w = -sp / r
+        if walked >= half:
+            k = _emit(path, k, on, x, y, z, sp, m, 0.5 * m * kr * w * w, 0.0)
+            walked = 0.0
+        mi1, cell1 = _cell_material(gr, x, y)
+        if cell1 != cell_id:
+            cell_id = cell1
+            entry += 1
+            tanphi = _friction_tan(mat, mi1, key, n, entry)
+    return MAX_IMPACTS, x, y, z, vx, vy, vz, w, k
+
+
+@njit(cache=True, parallel=True)
+def run_rocks(
+    keys, x, y, z, vx, vy, vz, w, m, r, kg, gr, mat, flags, par, st,
+    path, path_offsets, path_on, rec, rec_offsets, rec_on, first_rock,
+    impacts, states, deposit, samples,
+):  # fmt: skip
+    """:func:`run_rock` over all rocks in parallel; outputs written in place."""
+    for i in prange(keys.size):
+        n, s, xf, yf, zf, ns = run_rock(
+            keys[i], x[i], y[i], z[i], vx[i], vy[i], vz[i], w[i], m[i], r[i], kg[i],
+            gr, mat, flags, par, st, path, path_offsets[i], path_on,
+            rec, rec_offsets[i], rec_on, first_rock + i,
+        )  # fmt: skip
+        impacts[i] = n
+        states[i] = s
+        deposit[i, 0] = xf
+        deposit[i, 1] = yf
+        deposit[i, 2] = zf
+        samples[i] = ns
+
+
+def empty_path() -> Path:
+    """Path buffers of no samples (for a counting run)."""
+    return Path(*(np.zeros(0) for _ in PATH_FIELDS))
