@@ -99,7 +99,9 @@ Settings = namedtuple(
     "Settings", ("slide_vn", "stop_v", "max_impacts", "sample_m", "step_m")
 )
 #: Sampled path buffers (flat, one entry per sample).
-Path = namedtuple("Path", ("x_m", "y_m", "z_m", "speed_mps", "ke_j", "re_j", "height_m"))
+Path = namedtuple(
+    "Path", ("x_m", "y_m", "z_m", "speed_mps", "ke_j", "re_j", "height_m")
+)
 PATH_FIELDS = Path._fields
 #: Columns of a recorded impact row.
 IMPACT_COLUMNS = (

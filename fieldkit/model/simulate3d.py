@@ -20,8 +20,8 @@ import numpy as np
 from fieldkit.errors import ArgumentError
 from fieldkit.model import kernel3d
 from fieldkit.model.effects import registry
-from fieldkit.model.model_file import CORE_DEFAULTS
 from fieldkit.model.model3d import Model3D
+from fieldkit.model.model_file import CORE_DEFAULTS
 
 #: Rocks per kernel call.
 CHUNK_ROCKS = 20_000
@@ -247,7 +247,9 @@ def simulate3d(
         starts = [d[k][sel] for k in ("keys", "x", "y", "z", "vx", "vy", "vz", "w")]
         body = [d[k][sel] for k in ("m", "r", "kg")]
 
-        def run(path, poff, pon, rec, roff, ron, sel=sel, starts=starts, body=body):
+        def run(
+            path, poff, pon, rec, roff, ron, a=a, sel=sel, starts=starts, body=body
+        ):
             kernel3d.run_rocks(
                 *starts, *body, ground, mat, flags, par, settings,
                 path, poff, pon, rec, roff, ron, a,
@@ -259,7 +261,9 @@ def simulate3d(
         run(kernel3d.empty_path(), zeros, False, no_rec, zeros, False)
         counts = samples[sel].copy()
         poff = np.cumsum(counts) - counts
-        path = kernel3d.Path(*(np.empty(int(counts.sum())) for _ in kernel3d.PATH_FIELDS))
+        path = kernel3d.Path(
+            *(np.empty(int(counts.sum())) for _ in kernel3d.PATH_FIELDS)
+        )
         if record_impacts:
             nimp = impacts[sel]
             roff = np.cumsum(nimp) - nimp
