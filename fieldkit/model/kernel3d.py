@@ -30,14 +30,20 @@ Sliding/rolling (eq. 7.3 in 3-D): on the surface under gravity projected on the
 tangent plane and Coulomb friction ``g n_z tan(phi)`` opposite the velocity
 (``tan phi`` drawn per DEM cell entered, as 2-D draws it per segment), stepped
 with the exact constant-acceleration update over steps of at most
-:data:`SLIDE_STEP_CELLS` cells (and half the sampling distance); after each step the
-rock is put back on the surface and its velocity projected on the new tangent plane
-(the normal component is lost, as at a 2-D concave break). When a free (ballistic)
-step would end more than :data:`LAUNCH_GAP_M` above the surface, the surface falls
-away faster than the rock and it flies (the 2-D convex break). A rock slower than
-``stop_speed_mps`` stays if ``|g_t| <= g n_z tan(phi)`` (the 2-D rest test) and
-otherwise restarts down the fall line; friction bringing it to rest within a step
-ends the step there. On an inclined plane the scheme is exact.
+:data:`SLIDE_STEP_CELLS` cells (and half the sampling distance), each ended at the
+next patch edge it reaches (the surface's slope jumps there, as at a 2-D vertex;
+the step ends :data:`EDGE_NUDGE` cell past it). After each step the rock is put
+back on the surface and its velocity projected on the new tangent plane (the normal
+component is lost, as at a 2-D concave break). The rock flies (the 2-D convex
+break) at an edge where its velocity points away from the new tangent plane fast
+enough to rise more than :data:`LAUNCH_GAP_M` off it, or when a free (ballistic)
+step inside a patch would end more than :data:`LAUNCH_GAP_M` above the surface. A
+rock slower than ``stop_speed_mps`` stays if ``|g_t| <= g n_z tan(phi)`` (the 2-D
+rest test) and otherwise restarts down the fall line -- unless that step from rest
+ends where the ground rises along it (the fall lines meet within one step: a notch,
+where it stays, as in 2-D); friction bringing it to rest within a step ends the step
+there. On an inclined plane the scheme is exact; on a profile extruded along y it
+follows the 2-D kernel's exact slide (tests/model/test_kernel3d.py).
 
 Randomness: every draw is ``f(key, impact number, slot)``
 (:mod:`fieldkit.model.random_streams`, the 2-D slots; the tilt across the plane of
@@ -56,7 +62,12 @@ from numba import njit, prange
 
 from fieldkit.model.effects import slope_roughness
 from fieldkit.model.effects.registry import EFFECTS, LAYOUT
-from fieldkit.model.kernel import descending_root, passive_normal_speed, restitution
+from fieldkit.model.kernel import (
+    descending_root,
+    passive_normal_speed,
+    restitution,
+    time_to_x,
+)
 from fieldkit.model.random_streams import (
     SLOT_E_N,
     SLOT_E_T,
@@ -80,6 +91,8 @@ SLOT_ROUGHNESS_LATERAL = 3
 SLIDE_STEP_CELLS = 0.1
 #: A free step ending this far above the surface launches a sliding rock [m].
 LAUNCH_GAP_M = 1e-4
+#: A slide step ending on a patch edge ends this fraction of a cell past it.
+EDGE_NUDGE = 1e-9
 #: Slide steps after which a rock is stopped as capped.
 MAX_SLIDE_STEPS = 1_000_000
 
@@ -442,6 +455,7 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
         gt = math.sqrt(gtx * gtx + gty * gty + gtz * gtz)
         fric = G * nz * tanphi
         sp = math.sqrt(vx * vx + vy * vy + vz * vz)
+        restart = False
         if sp < st.stop_v or sp == 0.0:
             if gt <= fric:
                 return STOPPED, x, y, z, 0.0, 0.0, 0.0, 0.0, k
@@ -449,6 +463,7 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
             sp = 0.0
             s = 1.0 - fric / gt
             ax, ay, az = gtx * s, gty * s, gtz * s
+            restart = True
         else:
             ax = gtx - fric * vx / sp
             ay = gty - fric * vy / sp
@@ -462,6 +477,22 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
             if ts <= dt:
                 dt = ts
                 rest = True
+        # end the step at the next patch edge (where the surface's slope jumps), as
+        # 2-D ends a slide step at the next vertex
+        edge = 0
+        edge_at = 0.0
+        fx = (x - gr.xc0) / gr.cell
+        ix = math.floor(fx)
+        for e in (ix if fx > ix else ix - 1, ix + 1):
+            tb = time_to_x(x, vx, ax, gr.xc0 + e * gr.cell)
+            if tb < dt:
+                dt, edge, edge_at, rest = tb, 1, e - fx, False
+        fy = (y - gr.yc0) / gr.cell
+        iy = math.floor(fy)
+        for e in (iy if fy > iy else iy - 1, iy + 1):
+            tb = time_to_x(y, vy, ay, gr.yc0 + e * gr.cell)
+            if tb < dt:
+                dt, edge, edge_at, rest = tb, 2, e - fy, False
         # a free step: does the surface fall away faster than the rock?
         bx = x + vx * dt
         by = y + vy * dt
@@ -474,9 +505,17 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
             return -1, bx, by, bz, vx, vy, vz - G * dt, w, k
         x1 = x + vx * dt + 0.5 * ax * dt * dt
         y1 = y + vy * dt + 0.5 * ay * dt * dt
+        if edge == 1:  # just past the edge, in the patch ahead
+            x1 = x + (edge_at + math.copysign(EDGE_NUDGE, edge_at)) * gr.cell
+        elif edge == 2:
+            y1 = y + (edge_at + math.copysign(EDGE_NUDGE, edge_at)) * gr.cell
         h1, gx1, gy1 = surface_at(gr, x1, y1)
         if h1 != h1:
             return EXITED, x, y, z, vx, vy, vz, w, k
+        if restart and (x1 - x) * gx1 + (y1 - y) * gy1 > 0.0:
+            # a step from rest ends where the ground rises along it: the fall lines
+            # meet within one step (a notch), where the rock stays
+            return STOPPED, x, y, z, 0.0, 0.0, 0.0, 0.0, k
         walked += math.sqrt((x1 - x) ** 2 + (y1 - y) ** 2 + (h1 - z) ** 2)
         if rest:
             vx = vy = vz = 0.0
@@ -486,6 +525,11 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
             vz += az * dt
             n1x, n1y, n1z = _unit_normal(gx1, gy1)
             vn = vx * n1x + vy * n1y + vz * n1z
+            if edge != 0 and vn > 0.0 and vn * vn > 2.0 * G * n1z * LAUNCH_GAP_M:
+                # a convex edge: the rock leaves the surface (the 2-D convex break)
+                # when its free flight would rise above LAUNCH_GAP_M off the plane
+                k = _emit(path, k, on, x, y, z, sp, m, 0.5 * m * kr * w * w, 0.0)
+                return -1, x1, y1, h1, vx, vy, vz, w, k
             vx -= vn * n1x
             vy -= vn * n1y
             vz -= vn * n1z

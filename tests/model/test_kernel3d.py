@@ -1,0 +1,326 @@
+"""The 3-D kernel against independent references: closed forms on planes, the
+symmetry of a V-valley, the 2-D kernel on the same profile, and reproducibility."""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+import pytest
+
+from fieldkit.errors import ArgumentError
+from fieldkit.model import model_from_dict, simulate
+from fieldkit.model.kernel3d import SLIDE_STEP_CELLS
+from fieldkit.model.materials import Material
+from fieldkit.model.model3d import Model3D, Seeder3D
+from fieldkit.model.model_file import Body
+from fieldkit.model.results import EXITED_DOWNSLOPE, STOPPED
+from fieldkit.model.simulate3d import simulate3d
+from fieldkit.model.terrain import Terrain
+
+G = 9.81
+BODY = Body(mass_kg=100.0, radius_m=0.2, gyration_m=0.126)
+
+
+def grid_of(fn, nx, ny, cell=1.0, x0=0.0, y0=0.0):
+    """A terrain whose cell centres take ``fn(x, y)``."""
+    xc = x0 + (np.arange(nx) + 0.5) * cell
+    yc = y0 + (np.arange(ny) + 0.5) * cell
+    xx, yy = np.meshgrid(xc, yc)
+    return Terrain(x0, y0, cell, fn(xx, yy))
+
+
+def model_on(terrain, releases, *, seeder=None, effects=None, core=None, **material):
+    mat = {"e_n": 0.3, "e_t": 0.8, "friction_deg": 20.0} | material
+    release = np.array([[x, y, terrain.height(x, y)] for x, y in releases], dtype=float)
+    return Model3D(
+        terrain=terrain,
+        materials={"m": Material("m", **mat)},
+        material_index=np.zeros(terrain.shape, np.int64),
+        effects=effects or {},
+        body=BODY,
+        releases=release,
+        release_weights=np.ones(len(releases)),
+        seeder=seeder or Seeder3D(),
+        core=core or {},
+    )
+
+
+def plane(beta_deg, azimuth_deg, z0=300.0):
+    """A plane dipping ``beta`` towards the azimuth (from +x towards +y)."""
+    tb = math.tan(math.radians(beta_deg))
+    ca, sa = math.cos(math.radians(azimuth_deg)), math.sin(math.radians(azimuth_deg))
+    return lambda x, y: z0 - tb * (x * ca + y * sa)
+
+
+def test_terrain_is_bilinear_between_centres_and_off_outside():
+    t = Terrain(10.0, 20.0, 2.0, np.array([[0.0, 2.0], [4.0, 10.0]]))
+    # centres at x 11, 13 and y 21, 23; a point a quarter in from (11, 21)
+    u, v = 0.25, 0.5
+    expected = 0 * (1 - u) * (1 - v) + 2 * u * (1 - v) + 4 * (1 - u) * v + 10 * u * v
+    assert t.height(11.5, 22.0) == pytest.approx(expected, rel=1e-14)
+    assert math.isnan(t.height(10.9, 22.0))  # west of the first centre
+    nx, ny, nz = t.normal(11.5, 22.0)
+    gx = ((2 - 0) * (1 - v) + (10 - 4) * v) / 2.0
+    gy = ((4 - 0) * (1 - u) + (10 - 2) * u) / 2.0
+    norm = math.sqrt(gx * gx + gy * gy + 1)
+    assert (nx, ny, nz) == pytest.approx((-gx / norm, -gy / norm, 1 / norm), rel=1e-14)
+    with_hole = Terrain(0.0, 0.0, 1.0, np.array([[0.0, np.nan], [0.0, 0.0]]))
+    assert math.isnan(with_hole.height(1.0, 1.0))
+
+
+@pytest.mark.parametrize("azimuth_deg", [0.0, 30.0, 135.0])
+def test_a_rock_slides_down_an_inclined_plane_as_eq_7_3_says(azimuth_deg):
+    beta, phi = 30.0, 20.0
+    t = grid_of(plane(beta, azimuth_deg), 160, 160)
+    ca, sa = math.cos(math.radians(azimuth_deg)), math.sin(math.radians(azimuth_deg))
+    x0, y0 = 80.0 - 40.0 * ca, 80.0 - 40.0 * sa
+    model = model_on(t, [(x0, y0)], friction_deg=phi)
+    res = simulate3d(model, 1, np.random.default_rng(0), sample_m=0.5)
+    assert res.impacts == 0
+    assert res.state[0] == EXITED_DOWNSLOPE  # slides off the DEM
+    p = res.rock_path(0)
+    along = (p["x_m"] - x0) * ca + (p["y_m"] - y0) * sa  # plan distance down-dip
+    across = -(p["x_m"] - x0) * sa + (p["y_m"] - y0) * ca
+    b = math.radians(beta)
+    a = G * (math.sin(b) - math.tan(math.radians(phi)) * math.cos(b))
+    s = along / math.cos(b)  # distance travelled along the slope
+    # the fall line, and v^2 = 2 a s at every sample (a closed form in s; with
+    # s = a t^2 / 2 it is the position at t)
+    np.testing.assert_allclose(across, 0.0, atol=1e-8)  # edge nudges 1e-9 cell
+    np.testing.assert_allclose(p["speed_mps"] ** 2, 2 * a * s, rtol=1e-8, atol=1e-8)
+    np.testing.assert_allclose(
+        p["z_m"], t.heights(p["x_m"], p["y_m"]), rtol=0, atol=1e-9
+    )
+    # passing the line 30 m down-dip (plan): speed there from the samples around it
+    line = 30.0
+    k = np.searchsorted(along, line)
+    f = (line - along[k - 1]) / (along[k] - along[k - 1])
+    v2 = (1 - f) * p["speed_mps"][k - 1] ** 2 + f * p["speed_mps"][k] ** 2
+    assert v2 == pytest.approx(2 * a * line / math.cos(b), rel=1e-8)
+    # sampled at least every sample_m travelled
+    step = np.sqrt(
+        np.diff(p["x_m"]) ** 2 + np.diff(p["y_m"]) ** 2 + np.diff(p["z_m"]) ** 2
+    )
+    assert step.max() <= 0.5 + 1e-9
+
+
+def test_a_rock_on_a_plane_steeper_friction_does_not_move():
+    t = grid_of(plane(25.0, 60.0), 40, 40)
+    model = model_on(t, [(20.0, 20.0)], friction_deg=30.0)
+    res = simulate3d(model, 3, np.random.default_rng(1))
+    assert (res.state == STOPPED).all()
+    assert res.impacts == 0
+    np.testing.assert_array_equal(res.deposit_xyz[:, :2], [[20.0, 20.0]] * 3)
+
+
+def test_a_thrown_rock_lands_where_the_parabola_meets_the_plane():
+    beta, az = 35.0, 20.0
+    t = grid_of(plane(beta, az), 120, 120)
+    x0, y0, hgt = 20.0, 30.0, 3.0
+    vx, vy, vz = 4.0, -1.5, 2.0
+    seeder = Seeder3D(height_m=hgt, vx_mps=vx, vy_mps=vy, vz_mps=vz)
+    model = model_on(t, [(x0, y0)], seeder=seeder)
+    res = simulate3d(model, 1, np.random.default_rng(0), record_impacts=True)
+    rows = res.impact_rows
+    # closed form: z0 + vz t - g t^2/2 = plane(x0 + vx t, y0 + vy t)
+    tb = math.tan(math.radians(beta))
+    ca, sa = math.cos(math.radians(az)), math.sin(math.radians(az))
+    z0 = t.height(x0, y0) + hgt
+    slope_rate = -tb * (vx * ca + vy * sa)  # dz_plane/dt along the plan path
+    qa, qb, qc = -G / 2, vz - slope_rate, z0 - t.height(x0, y0)
+    tl = (-qb - math.sqrt(qb * qb - 4 * qa * qc)) / (2 * qa)
+    first = (x0 + vx * tl, y0 + vy * tl, z0 + vz * tl - G * tl * tl / 2)
+    got = (rows["x_m"][0], rows["y_m"][0], rows["z_m"][0])
+    assert got == pytest.approx(first, abs=1e-9)  # exact contact (1 mm bound: 1e-3)
+    # impact speeds in the plane's axes
+    n = np.array([tb * ca, tb * sa, 1.0]) / math.sqrt(1 + tb * tb)
+    v_in = np.array([vx, vy, vz - G * tl])
+    assert rows["vin_mps"][0] == pytest.approx(v_in @ n, rel=1e-9)
+    vt = v_in - (v_in @ n) * n
+    assert rows["vit_mps"][0] == pytest.approx(np.linalg.norm(vt), rel=1e-9)
+    assert rows["vfn_mps"][0] == pytest.approx(-0.3 * (v_in @ n), rel=1e-9)
+    assert rows["vft_mps"][0] == pytest.approx(0.8 * np.linalg.norm(vt), rel=1e-9)
+
+
+def v_valley(nx=60, ny=41, cell=1.0, flank_deg=30.0, axis_deg=0.0):
+    """A V-valley along x, axis on the centre row ny // 2, falling ``axis_deg``."""
+    yc = (ny // 2 + 0.5) * cell
+    tf = math.tan(math.radians(flank_deg))
+    ta = math.tan(math.radians(axis_deg))
+    return grid_of(lambda x, y: 100.0 + tf * np.abs(y - yc) - ta * x, nx, ny, cell), yc
+
+
+def test_a_rock_released_on_a_flank_ends_on_the_valley_axis():
+    t, yc = v_valley()
+    model = model_on(t, [(30.0, yc + 8.0)], friction_deg=15.0)
+    res = simulate3d(model, 1, np.random.default_rng(0))
+    assert res.state[0] == STOPPED
+    assert abs(res.deposit_xyz[0, 1] - yc) < 0.5  # within half a cell of the axis
+    assert res.deposit_xyz[0, 0] == pytest.approx(30.0, abs=1e-9)  # no x motion
+
+
+def test_v_valley_rocks_released_on_the_axis_spread_symmetrically_and_lose_energy():
+    t, yc = v_valley(nx=200, ny=61, flank_deg=35.0, axis_deg=20.0)
+    seeder = Seeder3D(
+        height_m=2.0, vx_mps=3.0, vy_sd_mps=2.0, vz_sd_mps=1.0, height_sd_m=0.5
+    )
+    model = model_on(
+        t,
+        [(10.0, yc)],
+        seeder=seeder,
+        e_n=0.45,
+        e_n_sd=0.15,
+        e_t=0.85,  # no SD: a drawn e_t > 1 gains energy in 2-D too (legal)
+        friction_deg=30.0,  # < the flanks (35), > the axis (20): rests in the axis
+        roughness_m=0.1,
+        roughness_deg_sd=5.0,
+        effects={"slope_roughness": {"scale": 1.0}},
+    )
+    res = simulate3d(model, 600, np.random.default_rng(7), record_impacts=True)
+    # every rock comes to rest in the valley's axis (the notch), most exactly, all
+    # within one slide step (where a step from rest meets rising ground)
+    stopped = res.state == STOPPED
+    assert stopped.mean() > 0.9
+    off = np.abs(res.deposit_xyz[stopped, 1] - yc)
+    assert np.median(off) < 1e-6
+    assert off.max() <= SLIDE_STEP_CELLS * t.cell_m
+    # on the way the bounces spread to both flanks alike
+    rows = res.impact_rows
+    lateral = rows["y_m"] - yc
+    se = lateral.std(ddof=1) / math.sqrt(lateral.size)  # impacts of a rock: +-
+    assert lateral.std() > 0.5  # the test has spread to see
+    assert abs(lateral.mean()) < 3 * se
+    per_rock = np.bincount(rows["rock"], weights=lateral, minlength=600)
+    se_rock = per_rock.std(ddof=1) / math.sqrt(per_rock.size)  # rocks independent
+    assert abs(per_rock.mean()) < 3 * se_rock
+    before = rows["vin_mps"] ** 2 + rows["vit_mps"] ** 2
+    after = rows["vfn_mps"] ** 2 + rows["vft_mps"] ** 2
+    assert rows["vin_mps"].size > 1000
+    assert (after <= before * (1 + 1e-12)).all()  # passive impacts
+    assert (rows["vin_mps"] < 0).all()  # every impact moves into its (tilted) surface
+
+
+def test_a_plane_dipping_along_x_reproduces_the_2d_runout_distribution():
+    # a 35 deg slope of 60 m onto a level floor, both at the DEM's centres
+    cell = 1.0
+    nx = 150
+    xc = (np.arange(nx) + 0.5) * cell
+    slope = math.tan(math.radians(35.0))
+    zx = np.where(xc < 60.5, (60.5 - xc) * slope, 0.0)  # the break at a centre
+    t = Terrain(0.0, 0.0, cell, np.tile(zx, (5, 1)))
+    material = {
+        "e_n": 0.35,
+        "e_n_sd": 0.1,
+        "e_t": 0.8,
+        "e_t_sd": 0.1,
+        "friction_deg": 32.0,
+    }
+    x0, hgt, vx0 = 2.5, 1.5, 2.0
+    rocks = 3000
+    m3 = model_on(
+        t,
+        [(x0, 2.5)],
+        seeder=Seeder3D(height_m=hgt, vx_mps=vx0, vx_sd_mps=0.5),
+        **material,
+    )
+    r3 = simulate3d(m3, rocks, np.random.default_rng(11))
+    ground0 = float(np.interp(x0, xc, zx))
+    m2 = model_from_dict(
+        {
+            # the same surface by its three vertices (collinear intermediate
+            # vertices make the 2-D kernel launch on rounding-level dip changes)
+            "profile": {"x_m": [0.5, 60.5, 149.5], "z_m": [60 * slope, 0.0, 0.0],
+                        "material": "m"},
+            "materials": {"m": material},
+            "body": {"mass_kg": 100.0, "radius_m": 0.2, "gyration_m": 0.126},
+            "seeder": {"x_m": x0, "z_m": ground0 + hgt, "vx_mps": vx0,
+                       "vx_sd_mps": 0.5},
+        }
+    )  # fmt: skip
+    r2 = simulate(m2, rocks, np.random.default_rng(12))
+    assert (r3.state == STOPPED).all() and (r2.state == STOPPED).all()
+    np.testing.assert_allclose(r3.deposit_xyz[:, 1], 2.5, atol=1e-9)  # stays in plane
+    x3, x2 = r3.deposit_xyz[:, 0], r2.runout_x_m
+    for q in (0.1, 0.5, 0.9):
+        # MC error of a quantile: sqrt(q (1-q) / n) / density, density from the
+        # pooled sample's spacing around the quantile
+        pooled = np.concatenate([x3, x2])
+        lo, hi = np.quantile(pooled, [q - 0.05, q + 0.05])
+        density = 0.1 / (hi - lo)
+        se = math.sqrt(q * (1 - q) / rocks) / density
+        diff = np.quantile(x3, q) - np.quantile(x2, q)
+        assert abs(diff) < 3 * math.sqrt(2) * se, (q, diff, se)
+    se_mean = math.sqrt(x3.var() / rocks + x2.var() / rocks)
+    assert abs(x3.mean() - x2.mean()) < 3 * se_mean
+
+
+@pytest.mark.parametrize("vx0", [1.0, 3.0])
+def test_one_rock_on_a_plane_dipping_along_x_follows_the_2d_kernel_exactly(vx0):
+    # no random draws: the same rock in both kernels, impact by impact
+    slope = math.tan(math.radians(35.0))
+    xc = np.arange(150) + 0.5
+    zx = np.where(xc < 60.5, (60.5 - xc) * slope, 0.0)
+    t = Terrain(0.0, 0.0, 1.0, np.tile(zx, (5, 1)))
+    material = {"e_n": 0.35, "e_t": 0.8, "friction_deg": 32.0}
+    m3 = model_on(t, [(2.5, 2.5)], seeder=Seeder3D(height_m=1.5, vx_mps=vx0),
+                  **material)  # fmt: skip
+    r3 = simulate3d(m3, 1, np.random.default_rng(0), record_impacts=True)
+    m2 = model_from_dict(
+        {
+            "profile": {"x_m": [0.5, 60.5, 149.5], "z_m": [60 * slope, 0.0, 0.0],
+                        "material": "m"},
+            "materials": {"m": material},
+            "body": {"mass_kg": 100.0, "radius_m": 0.2, "gyration_m": 0.126},
+            "seeder": {"x_m": 2.5, "z_m": 58 * slope + 1.5, "vx_mps": vx0},
+        }
+    )  # fmt: skip
+    r2 = simulate(m2, 1, np.random.default_rng(0), record_impacts=True)
+    frame = r2.impact_table.frame
+    assert r3.impacts == r2.impacts >= 2
+    np.testing.assert_allclose(r3.impact_rows["x_m"], frame["x_m"], rtol=1e-12)
+    np.testing.assert_allclose(r3.impact_rows["z_m"], frame["z_m"], rtol=1e-12)
+    assert r3.state[0] == r2.state[0] == STOPPED
+    # the slide (stepped in 3-D, exact in 2-D) ends at the same place
+    assert r3.deposit_xyz[0, 0] == pytest.approx(r2.runout_x_m[0], abs=1e-8)
+
+
+def test_same_seed_same_result_whatever_threads_and_chunks():
+    t, yc = v_valley(nx=80, ny=31, flank_deg=30.0, axis_deg=25.0)
+    seeder = Seeder3D(height_m=1.0, vx_mps=2.0, vy_sd_mps=1.0, vz_sd_mps=0.5)
+    model = model_on(
+        t,
+        [(5.0, yc), (5.0, yc + 4.0)],
+        seeder=seeder,
+        e_n_sd=0.1,
+        friction_deg_sd=3.0,
+        roughness_m=0.1,
+        effects={"slope_roughness": {"scale": 1.0}},
+    )
+    threads = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = simulate3d(model, 200, np.random.default_rng(3), record_impacts=True)
+        numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
+        two = simulate3d(
+            model, 200, np.random.default_rng(3), record_impacts=True, chunk_rocks=37
+        )
+    finally:
+        numba.set_num_threads(threads)
+    np.testing.assert_array_equal(one.deposit_xyz, two.deposit_xyz)
+    np.testing.assert_array_equal(one.state, two.state)
+    np.testing.assert_array_equal(one.path_offsets, two.path_offsets)
+    for name in one.path:
+        np.testing.assert_array_equal(one.path[name], two.path[name])
+    for name in one.impact_rows:
+        np.testing.assert_array_equal(one.impact_rows[name], two.impact_rows[name])
+    assert one.impacts > 200
+
+
+@pytest.mark.parametrize("effect", ["mass_loss", "tree_impacts", "air_drag"])
+def test_an_effect_not_yet_in_3d_is_refused(effect):
+    t = grid_of(plane(30.0, 0.0), 10, 10)
+    model = model_on(t, [(5.0, 5.0)], effects={effect: {}})
+    with pytest.raises(ArgumentError, match=f"{effect} are not yet in the 3-D"):
+        simulate3d(model, 1, np.random.default_rng(0))
