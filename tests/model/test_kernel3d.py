@@ -318,6 +318,35 @@ def test_same_seed_same_result_whatever_threads_and_chunks():
     assert one.impacts > 200
 
 
+def test_the_impact_effects_act_in_3d_and_impacts_stay_passive():
+    t, yc = v_valley(nx=120, ny=41, flank_deg=30.0, axis_deg=30.0)
+    effects = {
+        "angle_dependent_restitution": {"b": 0.8},
+        "velocity_scaled_restitution": {"k_mps": 12.0},
+        "rotation_friction": {"friction": 0.6, "coupling": 0.7},
+        "slope_roughness": {"scale": 1.0},
+        "affine_rebound": {"b_n_mps": 0.3, "b_t_mps": -0.2},
+    }
+    seeder = Seeder3D(height_m=2.0, vx_mps=4.0, vy_sd_mps=1.0)
+    common = {"seeder": seeder, "e_n": 0.4, "e_n_sd": 0.1, "roughness_m": 0.05}
+    on = model_on(t, [(5.0, yc)], effects=effects, **common)
+    off = model_on(t, [(5.0, yc)], **common)
+    r_on = simulate3d(on, 200, np.random.default_rng(5), record_impacts=True)
+    r_off = simulate3d(off, 200, np.random.default_rng(5), record_impacts=True)
+    rows = r_on.impact_rows
+    assert not np.allclose(r_on.deposit_xyz, r_off.deposit_xyz)
+    # with rotation coupling the spin is carried energy: v^2 + k^2 w^2 never grows
+    k2 = BODY.gyration_m**2
+    before = (
+        rows["vin_mps"] ** 2 + rows["vit_mps"] ** 2 + k2 * rows["omega_i_radps"] ** 2
+    )
+    after = (
+        rows["vfn_mps"] ** 2 + rows["vft_mps"] ** 2 + k2 * rows["omega_f_radps"] ** 2
+    )
+    assert rows["vin_mps"].size > 200
+    assert (after <= before * (1 + 1e-12) + 1e-12).all()
+
+
 @pytest.mark.parametrize("effect", ["mass_loss", "tree_impacts", "air_drag"])
 def test_an_effect_not_yet_in_3d_is_refused(effect):
     t = grid_of(plane(30.0, 0.0), 10, 10)
