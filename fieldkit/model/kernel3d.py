@@ -42,8 +42,13 @@ rock slower than ``stop_speed_mps`` stays if ``|g_t| <= g n_z tan(phi)`` (the 2-
 rest test) and otherwise restarts down the fall line -- unless that step from rest
 ends where the ground rises along it (the fall lines meet within one step: a notch,
 where it stays, as in 2-D); friction bringing it to rest within a step ends the step
-there. On an inclined plane the scheme is exact; on a profile extruded along y it
-follows the 2-D kernel's exact slide (tests/model/test_kernel3d.py).
+there. A rock that crosses into a groove (a patch edge with the ground rising on
+both sides) with too little speed across it to climb the far flank by one slide step
+follows the groove's line (gravity along it, friction from gravity across it: the
+2-D law on that line) until the groove opens -- without this it would zigzag across
+the edge in ever shorter steps. On an inclined plane and along a groove the scheme
+is exact; on a profile extruded along y it follows the 2-D kernel's exact slide
+(tests/model/test_kernel3d.py).
 
 Randomness: every draw is ``f(key, impact number, slot)``
 (:mod:`fieldkit.model.random_streams`, the 2-D slots; the tilt across the plane of
@@ -434,6 +439,26 @@ def run_rock(
 
 
 @njit(cache=True)
+def _is_groove(gr, x, y, groove):
+    """Whether the patch edge through ``(x, y)`` (``groove`` 1: ``y`` const, 2:
+    ``x`` const) is a groove: the ground rises away from it on both sides."""
+    e = EDGE_NUDGE * gr.cell
+    if groove == 1:
+        return surface_at(gr, x, y - e)[2] < 0.0 < surface_at(gr, x, y + e)[2]
+    return surface_at(gr, x - e, y)[1] < 0.0 < surface_at(gr, x + e, y)[1]
+
+
+@njit(cache=True)
+def _line_direction(gx, gy, groove):
+    """Unit direction of a groove line (towards +x or +y) from the surface slope."""
+    sl = gx if groove == 1 else gy
+    inv = 1.0 / math.sqrt(1.0 + sl * sl)
+    if groove == 1:
+        return inv, 0.0, sl * inv
+    return 0.0, inv, sl * inv
+
+
+@njit(cache=True)
 def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
     """Slide/roll on the surface until the rock stops, leaves the DEM or launches.
 
@@ -445,15 +470,36 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
     tanphi = _friction_tan(mat, mi, key, n, entry)
     walked = 0.0
     half = 0.5 * st.sample_m
+    groove = 0  # 1: in a groove along a patch edge y = const, 2: along x = const
+    fy = (y - gr.yc0) / gr.cell
+    fx = (x - gr.xc0) / gr.cell
+    if fy == math.floor(fy) and _is_groove(gr, x, y, 1):
+        groove = 1
+    elif fx == math.floor(fx) and _is_groove(gr, x, y, 2):
+        groove = 2
+    if groove != 0:  # starting in a groove: the velocity along its line
+        h, gx, gy = surface_at(gr, x, y)
+        dx, dy, dz = _line_direction(gx, gy, groove)
+        u = vx * dx + vy * dy + vz * dz
+        vx, vy, vz = u * dx, u * dy, u * dz
     for _ in range(MAX_SLIDE_STEPS):
         h, gx, gy = surface_at(gr, x, y)
-        nx, ny, nz = _unit_normal(gx, gy)
-        # gravity on the tangent plane: (0, 0, -g) + g nz n
-        gtx = G * nz * nx
-        gty = G * nz * ny
-        gtz = -G + G * nz * nz
+        if groove == 0:
+            nx, ny, nz = _unit_normal(gx, gy)
+            # gravity on the tangent plane: (0, 0, -g) + g nz n
+            gtx = G * nz * nx
+            gty = G * nz * ny
+            gtz = -G + G * nz * nz
+            fric = G * nz * tanphi
+        else:
+            # on the groove's line, direction d: gravity along it, (g . d) d, and
+            # friction from gravity across it, g cos(dip of the line)
+            dx, dy, dz = _line_direction(gx, gy, groove)
+            gtx = -G * dz * dx
+            gty = -G * dz * dy
+            gtz = -G * dz * dz
+            fric = G * math.sqrt(1.0 - dz * dz) * tanphi
         gt = math.sqrt(gtx * gtx + gty * gty + gtz * gtz)
-        fric = G * nz * tanphi
         sp = math.sqrt(vx * vx + vy * vy + vz * vz)
         restart = False
         if sp < st.stop_v or sp == 0.0:
@@ -523,17 +569,42 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
             vx += ax * dt
             vy += ay * dt
             vz += az * dt
-            n1x, n1y, n1z = _unit_normal(gx1, gy1)
+            if groove == 0:
+                n1x, n1y, n1z = _unit_normal(gx1, gy1)
+            else:  # the normal of the line's vertical plane
+                dx, dy, dz = _line_direction(gx1, gy1, groove)
+                hor = math.sqrt(1.0 - dz * dz)
+                n1x, n1y, n1z = -dz * dx / hor, -dz * dy / hor, hor
             vn = vx * n1x + vy * n1y + vz * n1z
             if edge != 0 and vn > 0.0 and vn * vn > 2.0 * G * n1z * LAUNCH_GAP_M:
                 # a convex edge: the rock leaves the surface (the 2-D convex break)
                 # when its free flight would rise above LAUNCH_GAP_M off the plane
                 k = _emit(path, k, on, x, y, z, sp, m, 0.5 * m * kr * w * w, 0.0)
                 return -1, x1, y1, h1, vx, vy, vz, w, k
-            vx -= vn * n1x
-            vy -= vn * n1y
-            vz -= vn * n1z
+            if groove == 0:
+                vx -= vn * n1x
+                vy -= vn * n1y
+                vz -= vn * n1z
+                if edge != 0 and _is_groove(gr, x1, y1, 3 - edge):
+                    # crossed into a groove: an excursion up the far flank shorter
+                    # than a slide step is below the step's resolution (and would
+                    # zigzag across the edge for ever): follow the groove
+                    across = vy if edge == 2 else vx
+                    a_across = G * n1z * abs(n1y if edge == 2 else n1x)
+                    if across * across < 2.0 * a_across * st.step_m:
+                        groove = 3 - edge
+                        if edge == 2:
+                            y1 = y + edge_at * gr.cell  # on the edge
+                        else:
+                            x1 = x + edge_at * gr.cell
+                        h1, gx1, gy1 = surface_at(gr, x1, y1)
+            if groove != 0:
+                dx, dy, dz = _line_direction(gx1, gy1, groove)
+                u = vx * dx + vy * dy + vz * dz
+                vx, vy, vz = u * dx, u * dy, u * dz
         x, y, z = x1, y1, h1
+        if groove != 0 and not _is_groove(gr, x, y, groove):
+            groove = 0  # the groove opens: back on the surface
         sp = math.sqrt(vx * vx + vy * vy + vz * vz)
         w = -sp / r
         if walked >= half:

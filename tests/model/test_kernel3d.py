@@ -161,6 +161,21 @@ def test_a_rock_released_on_a_flank_ends_on_the_valley_axis():
     assert res.deposit_xyz[0, 0] == pytest.approx(30.0, abs=1e-9)  # no x motion
 
 
+def test_a_rock_slides_down_a_v_valley_axis_as_eq_7_3_says_along_it():
+    axis, phi = 30.0, 20.0
+    t, yc = v_valley(nx=120, ny=21, flank_deg=40.0, axis_deg=axis)
+    model = model_on(t, [(10.0, yc)], friction_deg=phi)
+    res = simulate3d(model, 1, np.random.default_rng(0), sample_m=1.0)
+    assert res.impacts == 0 and res.state[0] == EXITED_DOWNSLOPE
+    p = res.rock_path(0)
+    np.testing.assert_allclose(p["y_m"], yc, atol=1e-12)  # in the axis all along
+    b = math.radians(axis)
+    a = G * (math.sin(b) - math.tan(math.radians(phi)) * math.cos(b))
+    s = (p["x_m"] - 10.0) / math.cos(b)
+    assert s[-1] > 100.0
+    np.testing.assert_allclose(p["speed_mps"] ** 2, 2 * a * s, rtol=1e-8, atol=1e-8)
+
+
 def test_v_valley_rocks_released_on_the_axis_spread_symmetrically_and_lose_energy():
     t, yc = v_valley(nx=200, ny=61, flank_deg=35.0, axis_deg=20.0)
     seeder = Seeder3D(
