@@ -27,6 +27,9 @@ from fieldkit.model.model_file import CORE_DEFAULTS
 CHUNK_ROCKS = 20_000
 #: Largest run accepted.
 MAX_ROCKS = 10_000_000
+#: Memory the sampled paths may take (7 float64 per sample).
+PATH_MEMORY_LIMIT_BYTES = 4 * 2**30
+_BYTES_PER_SAMPLE = 7 * 8
 
 
 @dataclass
@@ -163,6 +166,37 @@ def draw_rocks3d(model: Model3D, rocks: int, rng: np.random.Generator) -> dict:
     }
 
 
+def _tiny_model() -> Model3D:
+    """A one-patch model exercising every kernel signature (the warm-up)."""
+    from fieldkit.model.materials import Material
+    from fieldkit.model.model_file import Body
+    from fieldkit.model.terrain import Terrain
+
+    terrain = Terrain(0.0, 0.0, 1.0, np.array([[1.0, 0.0], [1.0, 0.0]]))
+    return Model3D(
+        terrain=terrain,
+        materials={"m": Material("m", 0.3, 0.8, 30.0)},
+        material_index=np.zeros((2, 2), np.int64),
+        effects={},
+        body=Body(100.0, 0.2, 0.126),
+        releases=np.array([[0.6, 1.0, 0.9]]),
+        release_weights=np.ones(1),
+    )
+
+
+def warm_kernel3d() -> float:
+    """Compile the 3-D kernel (or load it from numba's cache); returns the seconds.
+
+    Examples
+    --------
+    >>> warm_kernel3d() >= 0.0
+    True
+    """
+    tic = time.perf_counter()
+    simulate3d(_tiny_model(), 1, np.random.default_rng(0), record_impacts=True)
+    return time.perf_counter() - tic
+
+
 def simulate3d(
     model: Model3D,
     rocks: int,
@@ -260,6 +294,15 @@ def simulate3d(
         tic = time.perf_counter()
         run(kernel3d.empty_path(), zeros, False, no_rec, zeros, False)
         counts = samples[sel].copy()
+        total = int(counts.sum()) + sum(p.x_m.size for p in path_parts)
+        if total * _BYTES_PER_SAMPLE > PATH_MEMORY_LIMIT_BYTES:
+            raise ArgumentError(
+                f"the sampled paths of the first {b:,} rocks already hold {total:,} "
+                f"samples ({total * _BYTES_PER_SAMPLE / 2**30:.1f} GiB, limit "
+                f"{PATH_MEMORY_LIMIT_BYTES / 2**30:.0f} GiB): run fewer rocks or a "
+                f"larger sample_m (now {sample_m:g} m)",
+                source="rocks",
+            )
         poff = np.cumsum(counts) - counts
         path = kernel3d.Path(
             *(np.empty(int(counts.sum())) for _ in kernel3d.PATH_FIELDS)

@@ -368,3 +368,18 @@ def test_an_effect_not_yet_in_3d_is_refused(effect):
     model = model_on(t, [(5.0, 5.0)], effects={effect: {}})
     with pytest.raises(ArgumentError, match=f"{effect} are not yet in the 3-D"):
         simulate3d(model, 1, np.random.default_rng(0))
+
+
+def test_bad_runs_are_refused_in_one_line_naming_the_argument(monkeypatch):
+    import fieldkit.model.simulate3d as sim3
+
+    t = grid_of(plane(30.0, 0.0), 20, 10)
+    model = model_on(t, [(5.0, 5.0)])
+    bad_index = Model3D(**{**model.__dict__, "material_index": np.zeros((3, 3))})
+    with pytest.raises(ArgumentError, match="material_index has shape"):
+        simulate3d(bad_index, 1, np.random.default_rng(0))
+    with pytest.raises(ArgumentError, match="sample_m must be"):
+        simulate3d(model, 1, np.random.default_rng(0), sample_m=0.0)
+    monkeypatch.setattr(sim3, "PATH_MEMORY_LIMIT_BYTES", 56 * 100)
+    with pytest.raises(ArgumentError, match="run fewer rocks or a larger sample_m"):
+        simulate3d(model, 5, np.random.default_rng(0), sample_m=0.1)
