@@ -8,7 +8,9 @@ core settings mean what they mean in 2-D (:mod:`fieldkit.model.model_file`);
 Releases are points ``(x, y, z)`` with ``z`` the ground there, each with a weight
 (a count of rocks or a relative weight); every rock picks a release point with
 probability proportional to its weight, then its start is drawn by
-:class:`Seeder3D`: ``height_m`` above the ground (with its SD, reflected to stay
+:class:`Seeder3D`: ``height_m`` above the DEM's surface at the point's (x, y) (the
+surface's height, so a release's z rounded in a file cannot start it inside the
+ground) (with its SD, reflected to stay
 above), velocity ``(vx, vy, vz)`` and spin with their SDs, mass with its SD (at least
 1 % of the body's mass), as the 2-D seeder does.
 """

@@ -95,8 +95,8 @@ def check_model3d(model: Model3D) -> None:
     ArgumentError
         An effect not yet in 3-D (:data:`fieldkit.model.kernel3d.NOT_IN_3D`) is on;
         ``material_index`` is not the DEM's shape or indexes past ``materials``;
-        ``releases`` is not (n, 3) finite or its weights are not >= 0 with a
-        positive sum.
+        ``releases`` is not (n, 3) finite, has a point off the DEM's surface, or
+        its weights are not >= 0 with a positive sum.
     """
     off = [name for name in kernel3d.NOT_IN_3D if name in model.effects]
     if off:
@@ -125,6 +125,15 @@ def check_model3d(model: Model3D) -> None:
         )
     if not np.isfinite(rel).all():
         raise ArgumentError("releases hold a non-finite coordinate", source="releases")
+    ground = model.terrain.heights(rel[:, 0], rel[:, 1])
+    off = np.flatnonzero(~np.isfinite(ground))
+    if off.size:
+        i = int(off[0])
+        raise ArgumentError(
+            f"release point {i + 1} (x {rel[i, 0]:g}, y {rel[i, 1]:g}) is off the "
+            "DEM's surface (outside its cell centres or beside nodata)",
+            source="releases",
+        )
     wts = np.asarray(model.release_weights, float)
     if wts.shape != (rel.shape[0],) or not (wts >= 0).all() or not wts.sum() > 0:
         raise ArgumentError(
@@ -148,8 +157,7 @@ def draw_rocks3d(model: Model3D, rocks: int, rng: np.random.Generator) -> dict:
     keys = rng.integers(0, 2**63, size=rocks, dtype=np.uint64)
     x = rel[index, 0].copy()
     y = rel[index, 1].copy()
-    ground = model.terrain.heights(x, y)
-    ground = np.where(np.isfinite(ground), ground, rel[index, 2])
+    ground = model.terrain.heights(x, y)  # the surface itself, not the given z
     return {
         "index": index,
         "keys": keys,

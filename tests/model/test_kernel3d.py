@@ -380,6 +380,9 @@ def test_bad_runs_are_refused_in_one_line_naming_the_argument(monkeypatch):
         simulate3d(bad_index, 1, np.random.default_rng(0))
     with pytest.raises(ArgumentError, match="sample_m must be"):
         simulate3d(model, 1, np.random.default_rng(0), sample_m=0.0)
+    outside = Model3D(**{**model.__dict__, "releases": np.array([[0.2, 5.0, 0.0]])})
+    with pytest.raises(ArgumentError, match="release point 1 .* is off the DEM"):
+        simulate3d(outside, 1, np.random.default_rng(0))
     monkeypatch.setattr(sim3, "PATH_MEMORY_LIMIT_BYTES", 56 * 100)
     with pytest.raises(ArgumentError, match="run fewer rocks or a larger sample_m"):
         simulate3d(model, 5, np.random.default_rng(0), sample_m=0.1)
