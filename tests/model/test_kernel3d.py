@@ -207,6 +207,13 @@ def test_v_valley_rocks_released_on_the_axis_spread_symmetrically_and_lose_energ
     se = lateral.std(ddof=1) / math.sqrt(lateral.size)  # impacts of a rock: +-
     assert lateral.std() > 0.5  # the test has spread to see
     assert abs(lateral.mean()) < 3 * se
+    # paths: a sample at least every sample_m (half a cell here) travelled
+    p = res.path
+    gap = np.hypot(np.hypot(np.diff(p["x_m"]), np.diff(p["y_m"])), np.diff(p["z_m"]))
+    inside = np.ones(gap.size, bool)
+    inside[res.path_offsets[1:-1] - 1] = False  # from one rock's end to the next
+    assert res.sample_m == 0.5
+    assert gap[inside].max() <= 0.5 * (1 + 1e-9)
     per_rock = np.bincount(rows["rock"], weights=lateral, minlength=600)
     se_rock = per_rock.std(ddof=1) / math.sqrt(per_rock.size)  # rocks independent
     assert abs(per_rock.mean()) < 3 * se_rock
