@@ -213,6 +213,7 @@ def simulate3d(
     sample_m: float | None = None,
     record_impacts: bool = False,
     chunk_rocks: int = CHUNK_ROCKS,
+    keep_paths: bool = True,
 ) -> Result3D:
     """Simulate ``rocks`` rocks of ``model`` with the random numbers of ``rng``.
 
@@ -231,6 +232,11 @@ def simulate3d(
         Keep every impact's row (:data:`fieldkit.model.kernel3d.IMPACT_COLUMNS`).
     chunk_rocks
         Rocks per kernel call (results do not depend on it).
+    keep_paths
+        False: no path samples (``path`` arrays empty, ``path_offsets`` zeros) and,
+        without ``record_impacts``, one kernel pass instead of two -- for fits and
+        benchmarks that need only deposits. Deposits, states and impacts are the
+        same either way.
 
     Returns
     -------
@@ -301,7 +307,10 @@ def simulate3d(
         zeros = np.zeros(b - a, np.int64)
         tic = time.perf_counter()
         run(kernel3d.empty_path(), zeros, False, no_rec, zeros, False)
-        counts = samples[sel].copy()
+        if not (keep_paths or record_impacts):
+            wall += time.perf_counter() - tic
+            continue
+        counts = samples[sel].copy() if keep_paths else zeros
         total = int(counts.sum()) + sum(p.x_m.size for p in path_parts)
         if total * _BYTES_PER_SAMPLE > PATH_MEMORY_LIMIT_BYTES:
             raise ArgumentError(
@@ -321,15 +330,16 @@ def simulate3d(
             rec = np.empty((int(nimp.sum()), kernel3d.N_IMPACT))
         else:
             roff, rec = zeros, no_rec
-        run(path, poff, True, rec, roff, record_impacts)
+        run(path, poff, keep_paths, rec, roff, record_impacts)
         wall += time.perf_counter() - tic
         path_parts.append(path)
         if record_impacts:
             rec_parts.append(rec)
     offsets = np.zeros(rocks + 1, np.int64)
-    np.cumsum(samples, out=offsets[1:])
+    if keep_paths:
+        np.cumsum(samples, out=offsets[1:])
     path_arrays = {
-        name: np.concatenate([getattr(p, name) for p in path_parts])
+        name: np.concatenate([getattr(p, name) for p in path_parts] + [np.zeros(0)])
         for name in kernel3d.PATH_FIELDS
     }
     rows = None

@@ -330,6 +330,9 @@ def test_same_seed_same_result_whatever_threads_and_chunks():
         )
     finally:
         numba.set_num_threads(threads)
+    bare = simulate3d(model, 200, np.random.default_rng(3), keep_paths=False)
+    np.testing.assert_array_equal(bare.deposit_xyz, one.deposit_xyz)
+    assert bare.path["x_m"].size == 0 and not bare.path_offsets.any()
     np.testing.assert_array_equal(one.deposit_xyz, two.deposit_xyz)
     np.testing.assert_array_equal(one.state, two.state)
     np.testing.assert_array_equal(one.path_offsets, two.path_offsets)
