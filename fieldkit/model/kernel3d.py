@@ -53,7 +53,8 @@ is exact; on a profile extruded along y it follows the 2-D kernel's exact slide
 Randomness: every draw is ``f(key, impact number, slot)``
 (:mod:`fieldkit.model.random_streams`, the 2-D slots; the tilt across the plane of
 incidence uses :data:`SLOT_ROUGHNESS_LATERAL`), so threads and chunks do not change
-results. Not yet in 3-D: ``mass_loss``, ``tree_impacts``, ``air_drag``
+results. ``mass_loss`` uses the plan distance from the release point (2-D: the
+horizontal distance). Not yet in 3-D: ``tree_impacts``, ``air_drag``
 (:data:`NOT_IN_3D`; :func:`fieldkit.model.simulate3d.simulate3d` refuses them).
 """
 
@@ -65,7 +66,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit, prange
 
-from fieldkit.model.effects import slope_roughness
+from fieldkit.model.effects import mass_loss, slope_roughness
 from fieldkit.model.effects.registry import EFFECTS, LAYOUT
 from fieldkit.model.kernel import (
     descending_root,
@@ -88,7 +89,7 @@ INF = math.inf
 #: A rock that left the DEM (or reached nodata): the 2-D "exited" code.
 EXITED = EXITED_DOWNSLOPE
 #: Effects the 3-D kernel does not apply yet (a model enabling one is refused).
-NOT_IN_3D = ("mass_loss", "tree_impacts", "air_drag")
+NOT_IN_3D = ("tree_impacts", "air_drag")
 #: Normal draw slot of the roughness tilt across the plane of incidence (uniforms
 #: 6 and 7 of an impact; the 2-D slots use 0-5, 200+ and 2000+).
 SLOT_ROUGHNESS_LATERAL = 3
@@ -104,6 +105,9 @@ MAX_SLIDE_STEPS = 1_000_000
 _NAMES = [spec.name for spec in EFFECTS]
 F_ROUGH = _NAMES.index("slope_roughness")
 F_ROT = _NAMES.index("rotation_friction")
+F_MASS = _NAMES.index("mass_loss")
+P_MASS_RATE = LAYOUT["mass_loss.rate_per_m"]
+P_MASS_EXP = LAYOUT["mass_loss.impact_exponent"]
 P_ROUGH = LAYOUT["slope_roughness.scale"]
 P_ROT_C = LAYOUT["rotation_friction.coupling"]
 #: Material table columns (as the 2-D kernel's).
@@ -355,6 +359,8 @@ def run_rock(
     """
     max_imp = st.max_impacts
     kr = kg * kg
+    m0, r0, k0, x_rel, y_rel = m, r, kg, x, y
+    losing = flags[F_MASS] == 1
     n = 0
     k = path_start
     state = -1
@@ -395,6 +401,14 @@ def run_rock(
             n += 1
             sp = math.sqrt(vx * vx + vy * vy + vz * vz)
             k = _emit(path, k, path_on, x, y, z, sp, m, 0.5 * m * kr * w * w, 0.0)
+            if losing:  # eqs. 6.15-6.16 with the plan distance from the release
+                ratio = mass_loss.volume_ratio(
+                    math.hypot(x - x_rel, y - y_rel), n, par[P_MASS_RATE],
+                    par[P_MASS_EXP],
+                )  # fmt: skip
+                cube = ratio ** (1.0 / 3.0)
+                m, r, kg = m0 * ratio, r0 * cube, k0 * cube
+                kr = kg * kg
             w_i = w
             vfx, vfy, vfz, w, vin, vit, vfn, vft, nnx, nny, nnz, mi = impact(
                 gr, mat, flags, par, key, n, x, y, vx, vy, vz, w, r, kg

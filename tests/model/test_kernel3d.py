@@ -372,7 +372,25 @@ def test_the_impact_effects_act_in_3d_and_impacts_stay_passive():
     assert (after <= before * (1 + 1e-12) + 1e-12).all()
 
 
-@pytest.mark.parametrize("effect", ["mass_loss", "tree_impacts", "air_drag"])
+def test_mass_loss_follows_eqs_6_15_16_with_the_plan_distance():
+    t = grid_of(plane(35.0, 45.0), 80, 80)
+    seeder = Seeder3D(height_m=3.0, vx_mps=3.0, vy_mps=3.0)
+    effects = {"mass_loss": {"rate_per_m": 0.02, "impact_exponent": 0.5}}
+    model = model_on(t, [(10.0, 10.0)], seeder=seeder, e_n=0.5, effects=effects)
+    res = simulate3d(model, 1, np.random.default_rng(0), record_impacts=True)
+    rows = res.impact_rows
+    assert rows["x_m"].size >= 3
+    p = res.rock_path(0)
+    # the sample just after impact i (its rebound) carries the reduced mass
+    moving = p["speed_mps"] > 0
+    mass = 2 * p["ke_j"][moving] / p["speed_mps"][moving] ** 2
+    for i in range(rows["x_m"].size):
+        dist = math.hypot(rows["x_m"][i] - 10.0, rows["y_m"][i] - 10.0)
+        ratio = (i + 1.0) ** -0.5 / (1 + 0.02 * dist) if i else 1 / (1 + 0.02 * dist)
+        assert np.isclose(mass, BODY.mass_kg * ratio, rtol=1e-9).any(), i
+
+
+@pytest.mark.parametrize("effect", ["tree_impacts", "air_drag"])
 def test_an_effect_not_yet_in_3d_is_refused(effect):
     t = grid_of(plane(30.0, 0.0), 10, 10)
     model = model_on(t, [(5.0, 5.0)], effects={effect: {}})
