@@ -219,13 +219,15 @@ def flight_contact(gr, x, y, z, vx, vy, vz):
         qc = z - h0
         if first and qc <= 0.0 and qb <= 0.0:
             return 0.0, True  # on (or by rounding below) the surface, moving in
+        if not first and (qa * t0 + qb) * t0 + qc < 0.0:
+            return t0, True  # below the surface on entering (a root lost to rounding)
         first = False
         tc = descending_root(qa, qb, qc)
         tol = 1e-12 * (1.0 + t1) if t1 < INF else 0.0
         if t0 - 1e-12 * (1.0 + t0) <= tc <= t1 + tol:
             return max(tc, t0), True
         if t1 == INF:
-            return INF, False  # cannot happen with gravity; guards the loop
+            return t0, False  # cannot happen with gravity; guards the loops
         t0 = t1
         if tx <= ty:
             i += 1 if vx > 0.0 else -1
