@@ -398,6 +398,36 @@ def test_an_effect_not_yet_in_3d_is_refused(effect):
         simulate3d(model, 1, np.random.default_rng(0))
 
 
+def test_on_rough_ground_no_path_goes_below_the_surface():
+    rng = np.random.default_rng(4)
+    xc = np.arange(60) + 0.5
+    z = 60.0 - 0.8 * xc[None, :] + rng.normal(0.0, 0.4, (30, 60))
+    z[20:23, 40:43] = np.nan  # a nodata hole
+    t = Terrain(0.0, 0.0, 1.0, z)
+    seeder = Seeder3D(height_m=1.0, vx_mps=3.0, vx_sd_mps=1.0, vy_sd_mps=2.0)
+    model = model_on(
+        t,
+        [(3.0, 15.0), (5.0, 21.5)],
+        seeder=seeder,
+        e_n=0.5,
+        e_n_sd=0.15,
+        roughness_m=0.2,
+        effects={"slope_roughness": {"scale": 1.0}},
+    )
+    res = simulate3d(model, 300, np.random.default_rng(9), record_impacts=True)
+    h = res.path["height_m"]
+    assert res.impacts > 1000
+    assert np.nanmin(h) > -1e-9  # never inside the ground
+    assert np.isfinite(res.deposit_xyz).all()
+    stopped = res.state == STOPPED
+    ground = t.heights(res.deposit_xyz[stopped, 0], res.deposit_xyz[stopped, 1])
+    np.testing.assert_allclose(res.deposit_xyz[stopped, 2], ground, atol=1e-9)
+    assert set(np.unique(res.state)) <= {STOPPED, EXITED_DOWNSLOPE}
+    d = res.deposit_xyz[res.state == EXITED_DOWNSLOPE]
+    at_hole = (d[:, 0] > 38) & (d[:, 0] < 44) & (d[:, 1] > 19) & (d[:, 1] < 24)
+    assert at_hole.any()  # some rocks end at the nodata hole, as "exited"
+
+
 def test_bad_runs_are_refused_in_one_line_naming_the_argument(monkeypatch):
     import fieldkit.model.simulate3d as sim3
 
