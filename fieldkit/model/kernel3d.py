@@ -42,12 +42,14 @@ rock slower than ``stop_speed_mps`` stays if ``|g_t| <= g n_z tan(phi)`` (the 2-
 rest test) and otherwise restarts down the fall line -- unless that step from rest
 ends where the ground rises along it (the fall lines meet within one step: a notch,
 where it stays, as in 2-D); friction bringing it to rest within a step ends the step
-there. A rock that crosses into a groove (a patch edge with the ground rising on
-both sides) with too little speed across it to climb the far flank by one slide step
-follows the groove's line (gravity along it, friction from gravity across it: the
-2-D law on that line) until the groove opens -- without this it would zigzag across
-the edge in ever shorter steps. On an inclined plane and along a groove the scheme
-is exact; on a profile extruded along y it follows the 2-D kernel's exact slide
+there. On a patch edge or a centre the slope is that of the patch the velocity
+points into (the mean of the patches there along an axis it has no component on). A
+rock that crosses into a groove (a patch edge with the ground rising on both sides)
+with too little speed across it to climb the far flank by one slide step follows the
+groove's line (gravity along it, friction from gravity across it: the 2-D law on
+that line) until the groove opens -- without this it would zigzag across the edge in
+ever shorter steps. On an inclined plane and along a groove the scheme is exact; on
+a profile extruded along y it follows the 2-D kernel's exact slide
 (tests/model/test_kernel3d.py).
 
 Randomness: every draw is ``f(key, impact number, slot)``
@@ -465,6 +467,40 @@ def _is_groove(gr, x, y, groove):
 
 
 @njit(cache=True)
+def _edge_gradient(gr, x, y, vx, vy, gx, gy):
+    """The gradient a sliding rock at ``(x, y)`` feels. On a patch edge or a centre
+    (where the slope jumps) it is that of the patch the velocity points into, and
+    the mean over the patches meeting there along the axis the velocity has no
+    component on (a rock at rest on a cell centre does not take the north-east
+    patch's fall line; one running along a crest stays on it)."""
+    fx = (x - gr.xc0) / gr.cell
+    fy = (y - gr.yc0) / gr.cell
+    on_x = fx == math.floor(fx)
+    on_y = fy == math.floor(fy)
+    if not (on_x or on_y):
+        return gx, gy
+    e = EDGE_NUDGE * gr.cell
+    sx = 0.0
+    sy = 0.0
+    count = 0
+    for corner in range(4):  # (repeated offsets keep equal weights)
+        dx = 0.0
+        if on_x:
+            dx = math.copysign(e, vx) if vx != 0.0 else (e if corner & 1 else -e)
+        dy = 0.0
+        if on_y:
+            dy = math.copysign(e, vy) if vy != 0.0 else (e if corner & 2 else -e)
+        h, ax, ay = surface_at(gr, x + dx, y + dy)
+        if h == h:
+            sx += ax
+            sy += ay
+            count += 1
+    if count == 0:
+        return gx, gy
+    return sx / count, sy / count
+
+
+@njit(cache=True)
 def _line_direction(gx, gy, groove):
     """Unit direction of a groove line (towards +x or +y) from the surface slope."""
     sl = gx if groove == 1 else gy
@@ -500,6 +536,8 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
         vx, vy, vz = u * dx, u * dy, u * dz
     for _ in range(MAX_SLIDE_STEPS):
         h, gx, gy = surface_at(gr, x, y)
+        if groove == 0:
+            gx, gy = _edge_gradient(gr, x, y, vx, vy, gx, gy)
         if groove == 0:
             nx, ny, nz = _unit_normal(gx, gy)
             # gravity on the tangent plane: (0, 0, -g) + g nz n
@@ -586,6 +624,7 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
             vy += ay * dt
             vz += az * dt
             if groove == 0:
+                gx1, gy1 = _edge_gradient(gr, x1, y1, vx, vy, gx1, gy1)
                 n1x, n1y, n1z = _unit_normal(gx1, gy1)
             else:  # the normal of the line's vertical plane
                 dx, dy, dz = _line_direction(gx1, gy1, groove)

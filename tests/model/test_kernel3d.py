@@ -428,6 +428,19 @@ def test_on_rough_ground_no_path_goes_below_the_surface():
     assert at_hole.any()  # some rocks end at the nodata hole, as "exited"
 
 
+def test_a_rock_at_rest_on_a_ridge_centre_starts_down_the_crest_not_one_side():
+    # a crest along y (the centre column x = 10.5), falling towards -y
+    t = grid_of(lambda x, y: 50.0 + 0.6 * y - 0.3 * np.abs(x - 10.5), 21, 40)
+    model = model_on(t, [(10.5, 30.5)], friction_deg=10.0)  # a cell centre
+    res = simulate3d(model, 1, np.random.default_rng(0), sample_m=0.2)
+    p = res.rock_path(0)
+    assert p["y_m"][1] < 30.5  # it moved, down the crest (the patches' mean slope)
+    assert p["x_m"][1] == 10.5  # not down the north-east patch's fall line
+    # and, balanced on the crest, it runs down it to the DEM's edge
+    assert res.state[0] == EXITED_DOWNSLOPE
+    np.testing.assert_array_equal(p["x_m"], 10.5)
+
+
 def test_bad_runs_are_refused_in_one_line_naming_the_argument(monkeypatch):
     import fieldkit.model.simulate3d as sim3
 
