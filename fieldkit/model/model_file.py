@@ -217,6 +217,10 @@ def model_from_dict(
     DEM) are looked up: the model file's folder (None: the working directory).
     """
     data = _object(data, "model", source)
+    if "terrain" in data:  # one model-file format: a DEM instead of a profile
+        from fieldkit.model.model3d import model3d_from_dict
+
+        return model3d_from_dict(data, source=source, base_dir=base_dir)
     _unknown(
         data,
         {
@@ -256,33 +260,8 @@ def model_from_dict(
             )
     body = _body(_object(data["body"], "body", source), source)
     seeder = _seeder(_object(data["seeder"], "seeder", source), profile, source)
-    effects_data = _object(data.get("effects", {}), "effects", source)
-    effects: dict[str, dict[str, float]] = {}
-    for name, values in effects_data.items():
-        if name not in registry.BY_NAME:
-            raise InputFileError(
-                f"unknown effect (known: {', '.join(registry.BY_NAME)})",
-                source=source,
-                where=f"effects.{name}",
-            )
-        values = _object(values, f"effects.{name}", source)
-        try:
-            effects[name] = registry.validate(name, values, source=source)
-        except FieldkitError as exc:
-            raise InputFileError(exc.message, source=source, where=exc.where) from None
-    core_data = _object(data.get("core", {}), "core", source)
-    _unknown(core_data, set(CORE_DEFAULTS), "core", source)
-    core = {}
-    for key, (default, lower, upper, unit) in CORE_DEFAULTS.items():
-        core[key] = check_number(
-            core_data.get(key, default),
-            lower,
-            upper,
-            source=source,
-            where=f"core.{key}",
-            unit=unit,
-            whole=key in WHOLE_NUMBER_CORE,
-        )
+    effects = read_effects(data, source)
+    core = read_core(data, source)
     trees = None
     if "trees" in data:
         trees = _trees(_object(data["trees"], "trees", source), profile, source)
@@ -308,6 +287,45 @@ def model_from_dict(
         source_files=tuple(read),
         analysis_points=analysis_points,
     )
+
+
+def read_effects(data: dict, source: str) -> dict[str, dict[str, float]]:
+    """The model file's ``"effects"`` block, each effect validated by its registry
+    entry (one-line errors naming ``effects.<name>``); 2-D and 3-D models alike."""
+    effects_data = _object(data.get("effects", {}), "effects", source)
+    effects: dict[str, dict[str, float]] = {}
+    for name, values in effects_data.items():
+        if name not in registry.BY_NAME:
+            raise InputFileError(
+                f"unknown effect (known: {', '.join(registry.BY_NAME)})",
+                source=source,
+                where=f"effects.{name}",
+            )
+        values = _object(values, f"effects.{name}", source)
+        try:
+            effects[name] = registry.validate(name, values, source=source)
+        except FieldkitError as exc:
+            raise InputFileError(exc.message, source=source, where=exc.where) from None
+    return effects
+
+
+def read_core(data: dict, source: str) -> dict[str, float]:
+    """The model file's ``"core"`` block, every setting bounded and defaulted
+    (:data:`CORE_DEFAULTS`); 2-D and 3-D models alike."""
+    core_data = _object(data.get("core", {}), "core", source)
+    _unknown(core_data, set(CORE_DEFAULTS), "core", source)
+    core = {}
+    for key, (default, lower, upper, unit) in CORE_DEFAULTS.items():
+        core[key] = check_number(
+            core_data.get(key, default),
+            lower,
+            upper,
+            source=source,
+            where=f"core.{key}",
+            unit=unit,
+            whole=key in WHOLE_NUMBER_CORE,
+        )
+    return core
 
 
 def _analysis_points(
