@@ -79,7 +79,7 @@ def simulate_terrain(
     from fieldkit.model.results3d import (
         RASTERS,
         deposits_frame,
-        run_simulation3d,
+        simulator3d,
         summary3d,
         write_geotiff,
     )
@@ -120,8 +120,9 @@ def simulate_terrain(
         seed = secrets.randbits(32)
         note(f"`seed` not given: used {seed}; pass --seed {seed} to reproduce")
     rng = np.random.default_rng(seed)
+    run = simulator3d()
     with step(f"simulating {rocks:,} rocks on the DEM"):
-        result = run_simulation3d(model, rocks, rng)
+        result = run(model, rocks, rng)
     result.seed = seed
     stats = summary3d(result, model, analysis)
     if summary is not None:

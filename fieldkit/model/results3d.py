@@ -60,24 +60,14 @@ RASTERS = {
 PIECE_CELLS = 0.25
 
 
-def run_simulation3d(model, rocks: int, rng: np.random.Generator, *, sample_m=None):
-    """Run the 3-D kernel: the one place the outputs call it.
-
-    Parameters
-    ----------
-    model
-        A :class:`~fieldkit.model.model3d.Model3D`.
-    rocks
-        Number of rocks.
-    rng
-        The random generator (seeded by the caller).
-    sample_m
-        Path sampling distance [m] (None: the kernel's default, half a cell).
+def simulator3d():
+    """The 3-D kernel's entry point: the one place the outputs reach it.
 
     Returns
     -------
-    Result3D
-        The contract of :func:`fieldkit.model.simulate3d.simulate3d`.
+    callable
+        :func:`fieldkit.model.simulate3d.simulate3d` -- ``(model, rocks, rng, *,
+        sample_m=None, record_impacts=False) -> Result3D``.
 
     Raises
     ------
@@ -91,7 +81,7 @@ def run_simulation3d(model, rocks: int, rng: np.random.Generator, *, sample_m=No
             "this build has no 3-D simulator (fieldkit.model.simulate3d); the model "
             "file describes a DEM"
         ) from None
-    return simulate3d(model, rocks, rng, sample_m=sample_m)
+    return simulate3d
 
 
 def state_names(state: np.ndarray) -> list[str]:
@@ -185,11 +175,11 @@ def write_geotiff(path, values: np.ndarray, terrain: Terrain) -> None:
     the DEM's transform and CRS (none when the DEM has none); NaN = nodata."""
     import rasterio
     from rasterio.crs import CRS
-    from rasterio.transform import from_origin
+    from rasterio.transform import Affine
 
     ny, nx = terrain.shape
     top = terrain.y0_m + ny * terrain.cell_m
-    transform = from_origin(terrain.x0_m, top, terrain.cell_m, terrain.cell_m)
+    transform = Affine(terrain.cell_m, 0.0, terrain.x0_m, 0.0, -terrain.cell_m, top)
     crs = CRS.from_user_input(terrain.crs) if terrain.crs else None
     data = np.flipud(np.asarray(values))
     integer = np.issubdtype(data.dtype, np.integer)
