@@ -50,17 +50,16 @@ from fieldkit.errors import InputFileError
 from fieldkit.io.dem import read_dem
 from fieldkit.io.releases import cells_inside, read_releases
 from fieldkit.model.materials import Material, check_number
-from fieldkit.model.model_file import (
-    MAX_ANALYSIS_LOCATIONS,
+from fieldkit.model.model_blocks import (
     SEEDER_BOUNDS,
     TREE_BOUNDS,
     Body,
-    _body,
-    _object,
-    _unknown,
+    read_body,
     read_core,
     read_effects,
 )
+from fieldkit.model.model_blocks import object_field as _object
+from fieldkit.model.model_blocks import refuse_unknown as _unknown
 from fieldkit.model.terrain import Terrain, terrain_from_dem
 
 #: Top-level fields of a 3-D model file.
@@ -76,6 +75,8 @@ SEEDER3D_FIELDS = {
     "vx_sd_mps": "mps", "vy_sd_mps": "mps", "vz_sd_mps": "mps",
     "omega_sd_radps": "radps",
 }  # fmt: skip
+#: Most analysis lines a model file may name (as analysis points in 2-D).
+MAX_ANALYSIS_LINES = 100
 #: Most points an analysis line may have.
 MAX_LINE_VERTICES = 10_000
 
@@ -207,7 +208,7 @@ def model3d_from_dict(
         block["materials"], terrain, list(materials), base, source, read
     )
     releases, weights = _releases(block["releases"], terrain, base, source, read)
-    body = _body(_object(data["body"], "body", source), source)
+    body = read_body(_object(data["body"], "body", source), source)
     seeder = _seeder3d(_object(data.get("seeder", {}), "seeder", source), source)
     effects = read_effects(data, source)
     core = read_core(data, source)
@@ -499,9 +500,9 @@ def analysis_lines_from(
             source=source,
             where=where,
         )
-    if len(data) > MAX_ANALYSIS_LOCATIONS:
+    if len(data) > MAX_ANALYSIS_LINES:
         raise InputFileError(
-            f"at most {MAX_ANALYSIS_LOCATIONS} lines (got {len(data)})",
+            f"at most {MAX_ANALYSIS_LINES} lines (got {len(data)})",
             source=source,
             where=where,
         )
