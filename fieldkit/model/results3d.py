@@ -58,6 +58,8 @@ RASTERS = {
 }
 #: Longest straight piece a path is cut into for the rasters, in cells.
 PIECE_CELLS = 0.25
+#: Points of cut paths the rasters handle at a time (blocks of whole rocks).
+CHUNK_POINTS = 2_000_000
 
 
 def simulator3d():
@@ -124,45 +126,59 @@ def _segments(result) -> tuple[np.ndarray, np.ndarray]:
 def rasters(result, terrain: Terrain) -> dict[str, np.ndarray]:
     """The four rasters of the module docstring, each ``terrain.shape``, row 0 south.
 
-    Cells no rock entered hold 0 (counts) or NaN (maxima).
+    Cells no rock entered hold 0 (counts) or NaN (maxima). The paths are cut into
+    pieces in blocks of whole rocks (at most about :data:`CHUNK_POINTS` points at a
+    time), so memory stays bounded whatever the number of rocks.
     """
     ny, nx = terrain.shape
+    cells = ny * nx
     f = _path_fields(result)
     start, rock = _segments(result)
-    a, b = start, start + 1
-    length = np.hypot(f["x_m"][b] - f["x_m"][a], f["y_m"][b] - f["y_m"][a])
+    length = np.hypot(f["x_m"][start + 1] - f["x_m"][start],
+                      f["y_m"][start + 1] - f["y_m"][start])  # fmt: skip
     pieces = np.maximum(np.ceil(length / (PIECE_CELLS * terrain.cell_m)), 1)
     pieces = pieces.astype(np.int64)
-    # points at t = 0, 1/k, ..., 1 of every piece (the end point repeated is harmless)
-    seg = np.repeat(np.arange(a.size), pieces + 1)
-    first = np.repeat(np.cumsum(pieces + 1) - (pieces + 1), pieces + 1)
-    t = (np.arange(seg.size) - first) / np.repeat(pieces, pieces + 1)
     offsets = np.asarray(result.path_offsets, np.int64)
-    lone = np.flatnonzero(np.diff(offsets) == 1)  # a rock of one sample
-    idx_a = np.concatenate([a[seg], offsets[lone]])
-    idx_b = np.concatenate([b[seg], offsets[lone]])
-    t = np.concatenate([t, np.zeros(lone.size)])
-    rocks_of = np.concatenate([rock[seg], lone])
+    lone = np.flatnonzero(np.diff(offsets) == 1)  # rocks of one sample
+    n_rocks = offsets.size - 1
+    per_rock = np.bincount(rock, pieces + 1, minlength=n_rocks) + np.bincount(
+        lone, minlength=n_rocks
+    )
+    block = np.cumsum(per_rock) // CHUNK_POINTS
+    edges = np.concatenate([[0], np.flatnonzero(np.diff(block)) + 1, [n_rocks]])
+    passing = np.zeros(cells, np.int64)
+    maxima = {key: np.full(cells, -np.inf) for key in ("ke_j", "height_m")}
+    for r0, r1 in zip(edges[:-1], edges[1:], strict=True):
+        s0, s1 = np.searchsorted(rock, [r0, r1])
+        l0, l1 = np.searchsorted(lone, [r0, r1])
+        a, k = start[s0:s1], pieces[s0:s1]
+        # points at t = 0, 1/k, ..., 1 along every piece (shared ends repeated)
+        seg = np.repeat(np.arange(a.size), k + 1)
+        first = np.repeat(np.cumsum(k + 1) - (k + 1), k + 1)
+        t = (np.arange(seg.size) - first) / np.repeat(k, k + 1)
+        ia = np.concatenate([a[seg], offsets[lone[l0:l1]]])
+        ib = np.concatenate([a[seg] + 1, offsets[lone[l0:l1]]])
+        t = np.concatenate([t, np.zeros(l1 - l0)])
+        owner = np.concatenate([rock[s0:s1][seg], lone[l0:l1]])
 
-    def lerp(key: str) -> np.ndarray:
-        return f[key][idx_a] + t * (f[key][idx_b] - f[key][idx_a])
+        def lerp(key: str, ia=ia, ib=ib, t=t) -> np.ndarray:
+            return f[key][ia] + t * (f[key][ib] - f[key][ia])
 
-    row, col, inside = terrain.cell_index(lerp("x_m"), lerp("y_m"))
-    cell = row[inside] * nx + col[inside]
-    out: dict[str, np.ndarray] = {}
-    pairs = np.unique(rocks_of[inside] * (ny * nx) + cell)
-    out["passing_count"] = np.bincount(
-        pairs % (ny * nx), minlength=ny * nx
-    ).reshape(ny, nx).astype(np.int64)  # fmt: skip
+        row, col, inside = terrain.cell_index(lerp("x_m"), lerp("y_m"))
+        cell = row[inside] * nx + col[inside]
+        pairs = np.unique(owner[inside] * cells + cell)
+        passing += np.bincount(pairs % cells, minlength=cells)
+        for key, grid in maxima.items():
+            np.maximum.at(grid, cell, lerp(key)[inside])
+    out: dict[str, np.ndarray] = {"passing_count": passing.reshape(ny, nx)}
     for name, key in (("max_ke_j", "ke_j"), ("max_height_m", "height_m")):
-        grid = np.full(ny * nx, -np.inf)
-        np.maximum.at(grid, cell, lerp(key)[inside])
+        grid = maxima[key]
         grid[~np.isfinite(grid)] = np.nan
         out[name] = grid.reshape(ny, nx)
     xyz = np.asarray(result.deposit_xyz, float)
     stopped = np.asarray(result.state) == STOPPED
     row, col, inside = terrain.cell_index(xyz[stopped, 0], xyz[stopped, 1])
-    count = np.bincount(row[inside] * nx + col[inside], minlength=ny * nx)
+    count = np.bincount(row[inside] * nx + col[inside], minlength=cells)
     rocks = max(int(result.rocks), 1)
     out["deposit_density_per_m2"] = (
         count.reshape(ny, nx) / (rocks * terrain.cell_m**2)

@@ -84,7 +84,7 @@ def write_terrain_map(
                           alpha=0.75)  # fmt: skip
         fig.colorbar(image, ax=ax, shrink=0.7,
                      label="simulated deposits per rock per m²")  # fmt: skip
-    ax.plot(deposits[:, 0], deposits[:, 1], ",", color="tab:orange",
+    ax.plot(deposits[:, 0], deposits[:, 1], ".", ms=2, color="tab:orange",
             label="simulated stop")  # fmt: skip
     ax.plot(releases[:, 0], releases[:, 1], "^", color="tab:green", ms=4,
             label="release")  # fmt: skip
