@@ -248,7 +248,7 @@ def simulate(
             outputs.plan(summary, argument="--summary")
         if rrd is not None:
             outputs.plan(rrd, argument="--rrd")
-        model = read_model(model_file, outputs=outputs)
+        model = read_model(model_file, outputs=outputs, terrain=True)
         given = {"impacts": impacts, "at": at, "measured": measured,
                  "envelope_dx": envelope_dx, "deposits": deposits,
                  "rasters": rasters, "line": line, "observed": observed}  # fmt: skip

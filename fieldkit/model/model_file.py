@@ -539,7 +539,10 @@ def _trees(data: dict, profile: Profile, source: str) -> Trees:
 
 
 def read_model(
-    path: str | os.PathLike[str], *, outputs: OutputSet | None = None
+    path: str | os.PathLike[str],
+    *,
+    outputs: OutputSet | None = None,
+    terrain: bool = False,
 ) -> Model:
     """Read and validate a JSON model file (one-line errors naming the file): a
     :class:`Model` for a ``profile``, a :class:`fieldkit.model.model3d.Model3D`
@@ -553,13 +556,17 @@ def read_model(
         The calling command's outputs: every file the model reads
         (:attr:`Model.source_files`) is added to its inputs, so no output replaces
         them (:meth:`fieldkit.outputs.OutputSet.add_inputs`).
+    terrain
+        Whether the caller runs a 3-D model (a ``terrain`` block): without it such a
+        file is refused in one line (every reader of a profile model is safe).
 
     Raises
     ------
     InputFileError
         The file cannot be read, is not UTF-8 or not JSON, is nested deeper than
         :data:`MAX_JSON_DEPTH`, gives a key twice in one object
-        (:func:`fieldkit.io.csv_table.parse_json`), or has a bad field (named).
+        (:func:`fieldkit.io.csv_table.parse_json`), or has a bad field (named); a
+        terrain (3-D) model when ``terrain`` is False.
     OutputFileError
         A planned output of ``outputs`` is a file the model reads.
     """
@@ -586,6 +593,12 @@ def read_model(
     # that the check of their field refuses them by name; a key given twice is
     # refused naming its path (Python's reader would keep the last silently)
     data = parse_json(text, str(path))
+    if not terrain and isinstance(data, dict) and "terrain" in data:
+        raise InputFileError(
+            "a 3-D model (a terrain block, a DEM) where a profile model is needed",
+            source=path,
+            where="terrain",
+        )
     model = model_from_dict(data, source=str(path), base_dir=path.parent)
     model = replace(model, source_files=(str(path), *model.source_files))
     if outputs is not None:

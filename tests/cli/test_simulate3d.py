@@ -421,3 +421,19 @@ def test_rasters_independent_of_chunking(cli, site, kernel, tmp_path, monkeypatc
     for name in results3d.RASTERS:
         np.testing.assert_array_equal(grids[0][name], grids[1][name])
     assert grids[0]["passing_count"].sum() > 12
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ("export", "{model}", "--to", "json", "-o", "{out}/m.json"),
+        ("synth", "{model}", "-o", "{out}/t.csv"),
+    ],
+)
+def test_profile_commands_refuse_a_terrain_model(cli, fails, repo, tmp_path, args):
+    """Commands that read a profile model say so in one line for a 3-D model."""
+    model = repo / "examples/tschamut/model_3d.json"
+    argv = [a.format(model=model, out=tmp_path / "out") for a in args]
+    fails(cli(*argv), "model_3d.json", "terrain",
+          "a 3-D model (a terrain block, a DEM) where a profile model is needed")
+    assert not (tmp_path / "out").exists()
