@@ -177,7 +177,15 @@ def print_summary3d(s: dict, model) -> None:
     echo = typer.echo
     echo(
         f"{s['rocks']} rocks, {s['impacts']} impacts in {s['wall_s']:.2f} s of "
-        f"simulation (seed {s['seed']}); {len(model.releases)} release points"
+        f"simulation (seed {s['seed']})"
+    )
+    sd, weights = model.seeder, int(model.release_weights.sum())
+    echo(
+        f"released from {len(model.releases)} points (weights {weights} in all)"
+        f" at v = ({sd.vx_mps:g}, {sd.vy_mps:g}, {sd.vz_mps:g}) m/s, SD "
+        f"({sd.vx_sd_mps:g}, {sd.vy_sd_mps:g}, {sd.vz_sd_mps:g}) m/s, spin "
+        f"{sd.omega_radps:g} ± {sd.omega_sd_radps:g} rad/s (the model's seeder; all 0 "
+        "when it has none)"
     )
     final = s["final_state"]
     echo(

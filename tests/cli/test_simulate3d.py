@@ -361,7 +361,7 @@ def test_material_polygons_and_rest(site):
             {"material": "rock", "polygon": [[1000, 2050], [1080, 2050],
                                              [1080, 2100], [1000, 2100]]},
         ]})  # fmt: skip
-    model = read_model(site / "poly.json")
+    model = read_model(site / "poly.json", terrain=True)
     assert model.material_index.shape == (NY, NX)
     assert (model.material_index[:10] == 0).all()  # south of y = 2050: grass
     assert (model.material_index[10:] == 1).all()
@@ -372,7 +372,7 @@ def test_tschamut_example_model(repo):
     """examples/tschamut/model_3d.json: the DEM, one material, the 80 releases."""
     from fieldkit.model.model_file import read_model
 
-    model = read_model(repo / "examples/tschamut/model_3d.json")
+    model = read_model(repo / "examples/tschamut/model_3d.json", terrain=True)
     assert model.terrain.shape == (46, 43)
     assert (model.terrain.x0_m, model.terrain.y0_m, model.terrain.cell_m) == (
         -35.0, 85.0, 5.0)  # fmt: skip
@@ -437,3 +437,58 @@ def test_profile_commands_refuse_a_terrain_model(cli, fails, repo, tmp_path, arg
     fails(cli(*argv), "model_3d.json", "terrain",
           "a 3-D model (a terrain block, a DEM) where a profile model is needed")
     assert not (tmp_path / "out").exists()
+
+
+def _grid_file(path: Path, values: np.ndarray) -> Path:
+    """An ESRI grid on the test DEM's grid; ``values`` row 0 south."""
+    rows = "\n".join(" ".join(f"{v:g}" for v in row) for row in values[::-1])
+    path.write_text(f"ncols {NX}\nnrows {NY}\nxllcorner {X0}\nyllcorner {Y0}\n"
+                    f"cellsize {CELL}\nNODATA_value -9999\n{rows}\n")  # fmt: skip
+    return path
+
+
+def test_material_and_release_rasters(cli, site, kernel):
+    """A material raster (cell value = index into "materials") and a raster of
+    release cells with counts: releases at the cell centres on the ground, the
+    counts their weights; the run states them."""
+    codes = np.zeros((NY, NX))
+    codes[12:, :] = 1
+    _grid_file(site / "materials.asc", codes)
+    counts = np.zeros((NY, NX))
+    counts[15, 3], counts[17, 10] = 2, 5
+    _grid_file(site / "release_cells.asc", counts)
+    write_model(site / "rasters.json", {
+        "materials.rock": {"e_n": 0.3, "e_t": 0.9, "friction_deg": 40},
+        "terrain.materials": "materials.asc",
+        "terrain.releases": "release_cells.asc"})  # fmt: skip
+    result = cli("simulate", site / "rasters.json", "--rocks", "7", "--seed", "1")
+    assert result.exit_code == 0, result.stderr
+    assert "released from 2 points (weights 7 in all) at v = (0, 0, 0) m/s" in (
+        result.stdout
+    )
+    (model, _rocks), = kernel.calls
+    assert (model.material_index[:12] == 0).all()
+    assert (model.material_index[12:] == 1).all()
+    x = X0 + CELL * np.array([3.5, 10.5])
+    y = Y0 + CELL * np.array([15.5, 17.5])
+    np.testing.assert_allclose(model.releases, np.column_stack([x, y, plane_z(x, y)]))
+    assert model.release_weights.tolist() == [2, 5]
+
+
+def test_material_raster_bad_code_named(cli, fails, site, kernel):
+    codes = np.zeros((NY, NX))
+    codes[4, 7] = 3
+    _grid_file(site / "materials.asc", codes)
+    write_model(site / "model3d.json", {"terrain.materials": "materials.asc"})
+    fails(cli("simulate", site / "model3d.json", "--rocks", "2"),
+          "terrain.materials", "x = 1037.5, y = 2022.5", "holds 3",
+          "0 to 0 (grass)")  # fmt: skip
+
+
+def test_observed_file_errors_one_line(cli, fails, site, kernel, tmp_path):
+    (tmp_path / "obs.csv").write_text("x_m,y_m\n1020,2035\n1030,abc\n")
+    out = tmp_path / "out"
+    fails(cli("simulate", site / "model3d.json", "--rocks", "2", "--observed",
+              tmp_path / "obs.csv", "--figures", out),
+          "obs.csv", "row 3", "y_m")  # fmt: skip
+    assert not out.exists() and not kernel.calls
