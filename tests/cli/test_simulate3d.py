@@ -276,6 +276,12 @@ def test_all_outputs_written_once_each(cli, site, kernel, tmp_path):
     assert model.releases[1].tolist() == pytest.approx([1032.5, 2090.5, 45.25])
     s = json.loads((out / "summary.json").read_text())
     assert s["deposits"]["distance_m"]["p50"] == pytest.approx(50.0)
+    from rerun.chunk import RrdReader
+
+    summary = RrdReader(out / "sim.rrd").store().summary()
+    entities = {line.split(" ", 1)[0] for line in summary.splitlines()}
+    assert {"/terrain/dem", "/terrain/deposits", "/terrain/observed"} <= entities
+    assert {f"/terrain/trajectories/{i}" for i in range(6)} <= entities
 
 
 def test_model_file_lines_used_and_stated(cli, site, kernel, tmp_path):
