@@ -41,7 +41,7 @@ def refuse_options(given: dict[str, object], which: dict[str, str], why: str) ->
 
 def parse_line(text: str) -> np.ndarray:
     """``--line x1,y1,x2,y2[,...]`` -> ``(n, 2)`` vertices [m]; one-line errors."""
-    from fieldkit.model.model3d import line_vertices
+    from fieldkit.model.terrain_file import line_vertices
 
     try:
         values = [float(v) for v in text.replace(";", ",").split(",")]
@@ -75,7 +75,6 @@ def simulate_terrain(
     """Run a 3-D model and write what was asked (:mod:`fieldkit.model.results3d`)."""
     from fieldkit.cli.progress import report_written, step
     from fieldkit.io.releases import read_releases
-    from fieldkit.model.model3d import AnalysisLine
     from fieldkit.model.results3d import (
         RASTERS,
         deposits_frame,
@@ -84,6 +83,7 @@ def simulate_terrain(
         write_geotiff,
     )
     from fieldkit.model.results3d import rasters as make_rasters
+    from fieldkit.model.terrain_file import AnalysisLine
 
     if not 1 <= rocks <= MAX_ROCKS:
         raise ArgumentError(

@@ -1,14 +1,16 @@
 """Blocks shared by the 2-D and the 3-D model file: body, effects, core settings.
 
-:mod:`fieldkit.model.model_file` (a ``profile``) and :mod:`fieldkit.model.model3d`
-(a ``terrain``) read these blocks the same way; their bounds and defaults are
-documented in :mod:`fieldkit.model.model_file`.
+:mod:`fieldkit.model.model_file` (a ``profile``) and
+:mod:`fieldkit.model.terrain_file` (a ``terrain``) read these blocks the same way;
+their bounds and defaults are documented in :mod:`fieldkit.model.model_file`.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+
+import numpy as np
 
 from fieldkit.errors import ArgumentError, FieldkitError, InputFileError
 from fieldkit.model.effects import registry
@@ -43,6 +45,15 @@ class Body:
     mass_kg: float
     radius_m: float
     gyration_m: float
+
+
+@dataclass(frozen=True)
+class Trees:
+    """Trees along the profile: position [m], trunk diameter [m], height [m]."""
+
+    x_m: np.ndarray
+    diameter_m: np.ndarray
+    height_m: np.ndarray
 
 
 def object_field(data: object, where: str, source: str) -> dict:

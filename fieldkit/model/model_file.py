@@ -76,6 +76,7 @@ from fieldkit.model.model_blocks import (  # noqa: F401 (the model file's names)
     TREE_BOUNDS,
     WHOLE_NUMBER_CORE,
     Body,
+    Trees,
     read_body,
     read_core,
     read_effects,
@@ -89,15 +90,6 @@ from fieldkit.outputs import OutputSet, json_text, write_file
 
 #: JSON nesting deeper than this is refused (a model file is 4 levels deep).
 MAX_JSON_DEPTH = 64
-
-
-@dataclass(frozen=True)
-class Trees:
-    """Trees along the profile: position [m], trunk diameter [m], height [m]."""
-
-    x_m: np.ndarray
-    diameter_m: np.ndarray
-    height_m: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -184,14 +176,14 @@ def model_from_dict(
 
     A file with a ``terrain`` block (a DEM) instead of a ``profile`` is a 3-D
     model: a :class:`fieldkit.model.model3d.Model3D` is returned
-    (:func:`fieldkit.model.model3d.model3d_from_dict`).
+    (:func:`fieldkit.model.terrain_file.model3d_from_dict`).
 
     ``base_dir`` is where relative file names in the model file (a profile CSV or
     DEM) are looked up: the model file's folder (None: the working directory).
     """
     data = _object(data, "model", source)
     if "terrain" in data:  # one model-file format: a DEM instead of a profile
-        from fieldkit.model.model3d import model3d_from_dict
+        from fieldkit.model.terrain_file import model3d_from_dict
 
         return model3d_from_dict(data, source=source, base_dir=base_dir)
     _unknown(

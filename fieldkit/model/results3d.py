@@ -123,6 +123,24 @@ def _segments(result) -> tuple[np.ndarray, np.ndarray]:
     return start, rock_of_sample[start]
 
 
+def cells_of(terrain: Terrain, x_m, y_m) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(row, col, inside)`` of the cells holding the points (row 0 south); a
+    point off the grid has ``inside`` False (its row, col are then meaningless).
+
+    Examples
+    --------
+    >>> t = Terrain(100.0, 200.0, 5.0, np.zeros((2, 3)))
+    >>> [a.tolist() for a in cells_of(t, np.array([101.0, 114.9, 99.0]),
+    ...                               np.array([209.0, 200.0, 201.0]))]
+    [[1, 0, 0], [0, 2, -1], [True, True, False]]
+    """
+    col = np.floor((np.asarray(x_m, float) - terrain.x0_m) / terrain.cell_m)
+    row = np.floor((np.asarray(y_m, float) - terrain.y0_m) / terrain.cell_m)
+    ny, nx = terrain.shape
+    inside = (col >= 0) & (col < nx) & (row >= 0) & (row < ny)
+    return row.astype(np.int64), col.astype(np.int64), inside
+
+
 def rasters(result, terrain: Terrain) -> dict[str, np.ndarray]:
     """The four rasters of the module docstring, each ``terrain.shape``, row 0 south.
 
@@ -164,7 +182,7 @@ def rasters(result, terrain: Terrain) -> dict[str, np.ndarray]:
         def lerp(key: str, ia=ia, ib=ib, t=t) -> np.ndarray:
             return f[key][ia] + t * (f[key][ib] - f[key][ia])
 
-        row, col, inside = terrain.cell_index(lerp("x_m"), lerp("y_m"))
+        row, col, inside = cells_of(terrain, lerp("x_m"), lerp("y_m"))
         cell = row[inside] * nx + col[inside]
         pairs = np.unique(owner[inside] * cells + cell)
         passing += np.bincount(pairs % cells, minlength=cells)
@@ -177,7 +195,7 @@ def rasters(result, terrain: Terrain) -> dict[str, np.ndarray]:
         out[name] = grid.reshape(ny, nx)
     xyz = np.asarray(result.deposit_xyz, float)
     stopped = np.asarray(result.state) == STOPPED
-    row, col, inside = terrain.cell_index(xyz[stopped, 0], xyz[stopped, 1])
+    row, col, inside = cells_of(terrain, xyz[stopped, 0], xyz[stopped, 1])
     count = np.bincount(row[inside] * nx + col[inside], minlength=cells)
     rocks = max(int(result.rocks), 1)
     out["deposit_density_per_m2"] = (
@@ -281,7 +299,7 @@ def line_summary(result, xy_m: np.ndarray, name: str) -> dict:
 def summary3d(result, model, lines: list) -> dict:
     """summary.json of a 3-D run: rocks, impacts, wall_s, seed, final states, the
     stopped fraction, release-to-deposit distance in plan, and the analysis lines
-    (``lines``: :class:`~fieldkit.model.model3d.AnalysisLine`)."""
+    (``lines``: :class:`~fieldkit.model.terrain_file.AnalysisLine`)."""
     state = np.asarray(result.state)
     names = state_names(state)
     final = {k: names.count(k) for k in ("stopped", "left_dem", "capped")}

@@ -1,39 +1,57 @@
-"""The ground of a 3-D model: a DEM as a regular grid, row 0 south.
+"""The ground of a 3-D model: a DEM on a regular grid, bilinear between cell centres.
 
-:class:`Terrain` is the contract between the 3-D model file
-(:mod:`fieldkit.model.model3d`), the 3-D kernel and the 3-D outputs
-(:mod:`fieldkit.model.results3d`): ``x0_m, y0_m`` is the lower-left corner of the
-lower-left cell, cells are square (``cell_m``), ``z[row, col]`` is the elevation of
-the cell centre ``(x0_m + (col + 0.5) cell_m, y0_m + (row + 0.5) cell_m)``, row 0
-the southern row (y increases with the row index), NaN = nodata. The surface is the
-bilinear interpolation between cell centres.
+:class:`Terrain` holds the grid as the 3-D kernel reads it: ``z[row, col]`` with row 0
+the SOUTHERN row (``y`` grows with the row index; an ESRI ASCII grid, whose first row
+is the northern one, is flipped when read), ``x0_m, y0_m`` the lower-left corner of
+the lower-left cell and ``cell_m`` the cell size. The value of a cell belongs to its
+centre ``(x0_m + (col + 1/2) cell_m, y0_m + (row + 1/2) cell_m)``; the surface is the
+bilinear interpolation between the four centres around a point, so it is defined
+from the first to the last centre (half a cell inside the grid's outer edge). NaN is
+nodata: a point whose four centres include one is off the surface.
+
+:func:`surface_at` (compiled) gives the height and its gradient at a point,
+:func:`height` and :func:`normal` the height and the upward unit normal
+``(-dz/dx, -dz/dy, 1) / |...|``.
 """
 
 from __future__ import annotations
 
+import math
+from collections import namedtuple
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
-from fieldkit.errors import InputFileError
-from fieldkit.io.dem import DemGrid
+from fieldkit.errors import ArgumentError
+
+#: The grid as the compiled code takes it: ``z`` (ny, nx) float64, row 0 south;
+#: ``xc0``, ``yc0`` the centre of cell (0, 0); ``cell`` the cell size [m].
+Grid = namedtuple("Grid", ("z", "xc0", "yc0", "cell"))
 
 
 @dataclass(frozen=True)
 class Terrain:
-    """A DEM surface (module docstring).
+    """A DEM (see the module docstring).
 
-    Attributes
+    Parameters
     ----------
     x0_m, y0_m
-        Lower-left corner of the lower-left cell [m], in the DEM's CRS.
+        Lower-left corner of the lower-left cell [m].
     cell_m
-        Cell size [m] (square cells).
+        Cell size [m], > 0.
     z
-        ``(ny, nx)`` float64 elevations [m] of the cell centres, row 0 south; NaN =
-        nodata.
+        Elevations [m], float64 (ny, nx), row 0 = south; NaN = nodata; at least 2 x 2.
     crs
-        The DEM's coordinate reference system (WKT or ``EPSG:...``), or None.
+        Coordinate reference system (WKT) or None.
+
+    Examples
+    --------
+    >>> t = Terrain(0.0, 0.0, 1.0, np.array([[0.0, 1.0], [2.0, 3.0]]))
+    >>> t.height(1.0, 1.0)  # the mean of the four centres
+    1.5
+    >>> [round(c, 4) for c in t.normal(1.0, 1.0)]
+    [-0.4082, -0.8165, 0.4082]
     """
 
     x0_m: float
@@ -42,78 +60,110 @@ class Terrain:
     z: np.ndarray
     crs: str | None = None
 
+    def __post_init__(self) -> None:
+        z = np.ascontiguousarray(self.z, dtype=np.float64)
+        if z.ndim != 2 or z.shape[0] < 2 or z.shape[1] < 2:
+            raise ArgumentError(
+                f"z must be a 2-D grid of at least 2 x 2 cells (got shape {z.shape})",
+                source="z",
+            )
+        if not (math.isfinite(self.cell_m) and self.cell_m > 0):
+            raise ArgumentError(
+                f"cell_m must be a finite size > 0 m (got {self.cell_m})",
+                source="cell_m",
+            )
+        if not (math.isfinite(self.x0_m) and math.isfinite(self.y0_m)):
+            raise ArgumentError("x0_m and y0_m must be finite", source="x0_m")
+        if np.isinf(z).any():
+            raise ArgumentError("z holds an infinite elevation", source="z")
+        object.__setattr__(self, "z", z)
+
     @property
     def shape(self) -> tuple[int, int]:
-        """``(ny, nx)``."""
-        return self.z.shape  # type: ignore[return-value]
+        """``(ny, nx)``: rows (south to north) and columns (west to east)."""
+        return self.z.shape
 
-    def centres(self) -> tuple[np.ndarray, np.ndarray]:
-        """``(x_m, y_m)``: the column and row centres [m], both increasing."""
-        ny, nx = self.shape
-        return (
-            self.x0_m + self.cell_m * (np.arange(nx) + 0.5),
-            self.y0_m + self.cell_m * (np.arange(ny) + 0.5),
+    def grid(self) -> Grid:
+        """The grid as the compiled code takes it (:data:`Grid`)."""
+        half = 0.5 * self.cell_m
+        return Grid(
+            self.z, float(self.x0_m + half), float(self.y0_m + half), float(self.cell_m)
         )
 
-    def cell_index(self, x_m: np.ndarray, y_m: np.ndarray) -> tuple[np.ndarray, ...]:
-        """``(row, col, inside)`` of the cells holding the points (row 0 south).
-
-        Examples
-        --------
-        >>> t = Terrain(100.0, 200.0, 5.0, np.zeros((2, 3)))
-        >>> [a.tolist() for a in t.cell_index(np.array([101.0, 114.9, 99.0]),
-        ...                                   np.array([209.0, 200.0, 201.0]))]
-        [[1, 0, 0], [0, 2, -1], [True, True, False]]
-        """
+    def cell_index(self, x_m, y_m) -> tuple[np.ndarray, np.ndarray]:
+        """``(row, col)`` of the cell holding each point (clipped to the grid)."""
+        ny, nx = self.shape
         col = np.floor((np.asarray(x_m, float) - self.x0_m) / self.cell_m)
         row = np.floor((np.asarray(y_m, float) - self.y0_m) / self.cell_m)
-        ny, nx = self.shape
-        inside = (col >= 0) & (col < nx) & (row >= 0) & (row < ny)
-        return row.astype(np.int64), col.astype(np.int64), inside
+        return (
+            np.clip(row, 0, ny - 1).astype(np.int64),
+            np.clip(col, 0, nx - 1).astype(np.int64),
+        )
 
-    def ground_m(self, x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
-        """Bilinear elevation [m] between cell centres; NaN outside the rectangle
-        of cell centres or where a nodata cell is used."""
-        xc, yc = self.centres()
+    def height(self, x_m: float, y_m: float) -> float:
+        """Surface height at ``(x_m, y_m)``; NaN off the surface."""
+        return float(height(self.grid(), float(x_m), float(y_m)))
+
+    def heights(self, x_m, y_m) -> np.ndarray:
+        """Surface heights at arrays of points; NaN off the surface."""
         x = np.asarray(x_m, float)
         y = np.asarray(y_m, float)
-        fx = (x - xc[0]) / self.cell_m
-        fy = (y - yc[0]) / self.cell_m
-        ny, nx = self.shape
-        ok = (fx >= 0) & (fx <= nx - 1) & (fy >= 0) & (fy <= ny - 1)
-        i = np.clip(np.floor(fx), 0, max(nx - 2, 0)).astype(np.int64)
-        j = np.clip(np.floor(fy), 0, max(ny - 2, 0)).astype(np.int64)
-        u = np.where(ok, fx - i, 0.0)
-        v = np.where(ok, fy - j, 0.0)
-        z = self.z
-        out = (
-            z[j, i] * (1 - u) * (1 - v)
-            + z[j, i + 1] * u * (1 - v)
-            + z[j + 1, i] * (1 - u) * v
-            + z[j + 1, i + 1] * u * v
-        )
-        return np.where(ok, out, np.nan)
+        bx, by = np.broadcast_arrays(x, y)
+        out = np.empty(bx.size)
+        _heights(self.grid(), np.ascontiguousarray(bx).reshape(-1),
+                 np.ascontiguousarray(by).reshape(-1), out)  # fmt: skip
+        return out.reshape(bx.shape)
+
+    def normal(self, x_m: float, y_m: float) -> tuple[float, float, float]:
+        """Upward unit normal at ``(x_m, y_m)``; NaNs off the surface."""
+        nx, ny, nz = normal(self.grid(), float(x_m), float(y_m))
+        return float(nx), float(ny), float(nz)
 
 
-def terrain_from_dem(grid: DemGrid) -> Terrain:
-    """The :class:`Terrain` of a DEM read by :func:`fieldkit.io.dem.read_dem`.
+@njit(cache=True)
+def surface_at(g, x, y):
+    """``(h, dh/dx, dh/dy)`` of the bilinear surface at ``(x, y)``.
 
-    Raises
-    ------
-    InputFileError
-        The cells are not square (naming the DEM).
+    ``h`` is NaN off the surface (outside the centres or beside nodata). On a
+    patch edge the patch to the south-west of it is used (lower index), except at
+    the last centre row/column.
     """
-    dx, dy = grid.dx_m, grid.dy_m
-    if not np.isclose(dx, dy, rtol=1e-9, atol=0.0):
-        raise InputFileError(
-            f"cells are {dx:g} x {dy:g} m; the 3-D model needs square cells "
-            "(resample it: gdalwarp -tr)",
-            source=grid.source,
-        )
-    return Terrain(
-        x0_m=float(grid.x_m[0] - dx / 2),
-        y0_m=float(grid.y_m[-1] - dy / 2),
-        cell_m=float(dx),
-        z=np.ascontiguousarray(np.flipud(grid.values), dtype=np.float64),
-        crs=grid.crs,
-    )
+    ny, nx = g.z.shape
+    fx = (x - g.xc0) / g.cell
+    fy = (y - g.yc0) / g.cell
+    if not (0.0 <= fx <= nx - 1.0 and 0.0 <= fy <= ny - 1.0):
+        return math.nan, 0.0, 0.0
+    i = min(int(fx), nx - 2)
+    j = min(int(fy), ny - 2)
+    u = fx - i
+    v = fy - j
+    z00 = g.z[j, i]
+    z10 = g.z[j, i + 1]
+    z01 = g.z[j + 1, i]
+    z11 = g.z[j + 1, i + 1]
+    h = z00 * (1 - u) * (1 - v) + z10 * u * (1 - v) + z01 * (1 - u) * v + z11 * u * v
+    dhdx = ((z10 - z00) * (1.0 - v) + (z11 - z01) * v) / g.cell
+    dhdy = ((z01 - z00) * (1.0 - u) + (z11 - z10) * u) / g.cell
+    return h, dhdx, dhdy
+
+
+@njit(cache=True)
+def height(g, x, y):
+    """Surface height at ``(x, y)``; NaN off the surface."""
+    return surface_at(g, x, y)[0]
+
+
+@njit(cache=True)
+def normal(g, x, y):
+    """Upward unit normal ``(nx, ny, nz)`` at ``(x, y)``; NaNs off the surface."""
+    h, gx, gy = surface_at(g, x, y)
+    if h != h:
+        return math.nan, math.nan, math.nan
+    inv = 1.0 / math.sqrt(gx * gx + gy * gy + 1.0)
+    return -gx * inv, -gy * inv, inv
+
+
+@njit(cache=True)
+def _heights(g, x, y, out):
+    for k in range(out.size):
+        out[k] = surface_at(g, x[k], y[k])[0]

@@ -10,6 +10,7 @@ import numpy as np
 import rerun as rr
 
 from fieldkit.model.terrain import Terrain
+from fieldkit.model.terrain_file import cell_centres
 from fieldkit.outputs import OutputSet, write_file
 from fieldkit.viz.rerun_log import open_recording
 
@@ -28,7 +29,7 @@ def terrain_mesh(terrain: Terrain) -> tuple[np.ndarray, np.ndarray]:
     ((6, 3), (4, 3), [3.0, 1.0, 0.0])
     """
     ny, nx = terrain.shape
-    xc, yc = terrain.centres()
+    xc, yc = cell_centres(terrain)
     gx, gy = np.meshgrid(xc, yc)
     vertices = np.column_stack([gx.ravel(), gy.ravel(), terrain.z.ravel()])
     j, i = np.meshgrid(np.arange(ny - 1), np.arange(nx - 1), indexing="ij")
@@ -74,7 +75,7 @@ def write_terrain_recording(
             rec.log("terrain/deposits", rr.Points3D(deposits, radii=0.4,
                     colors=[(230, 120, 30)]), static=True)  # fmt: skip
             if observed is not None and len(observed):
-                z = terrain.ground_m(observed[:, 0], observed[:, 1])
+                z = terrain.heights(observed[:, 0], observed[:, 1])
                 rec.log("terrain/observed", rr.Points3D(
                     np.column_stack([observed, np.nan_to_num(z)]), radii=0.5,
                     colors=[(40, 90, 220)]), static=True)  # fmt: skip
