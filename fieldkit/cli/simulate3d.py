@@ -75,6 +75,7 @@ def simulate_terrain(
     """Run a 3-D model and write what was asked (:mod:`fieldkit.model.results3d`)."""
     from fieldkit.cli.progress import report_written, step
     from fieldkit.io.releases import read_releases
+    from fieldkit.model.results import STOPPED
     from fieldkit.model.results3d import (
         RASTERS,
         deposits_frame,
@@ -124,6 +125,8 @@ def simulate_terrain(
     with step(f"simulating {rocks:,} rocks on the DEM"):
         result = run(model, rocks, rng)
     result.seed = seed
+    for text in getattr(result, "notes", None) or []:
+        note(text)  # what the simulator assumed (a default that changes a result)
     stats = summary3d(result, model, analysis)
     if summary is not None:
         write_json(summary, stats, outputs)
@@ -148,7 +151,9 @@ def simulate_terrain(
             model.terrain,
             grids["deposit_density_per_m2"],
             releases=model.releases,
-            deposits=np.asarray(result.deposit_xyz, float),
+            deposits=np.asarray(result.deposit_xyz, float)[
+                np.asarray(result.state) == STOPPED
+            ],
             observed=observed_xy,
             lines=[(ln.label(i), ln.xy_m) for i, ln in enumerate(analysis)],
             outputs=outputs,

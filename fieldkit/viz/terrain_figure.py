@@ -59,7 +59,7 @@ def write_terrain_map(
     releases
         ``(n, 2+)`` release points [m].
     deposits
-        ``(rocks, 2+)`` simulated stopping points [m] (drawn small).
+        ``(n, 2+)`` where simulated rocks stopped [m] (drawn small).
     observed
         ``(m, 2)`` observed deposits [m], or None.
     lines
