@@ -180,14 +180,16 @@ def rasters(result, terrain: Terrain) -> dict[str, np.ndarray]:
         owner = np.concatenate([rock[s0:s1][seg], lone[l0:l1]])
 
         def lerp(key: str, ia=ia, ib=ib, t=t) -> np.ndarray:
-            return f[key][ia] + t * (f[key][ib] - f[key][ia])
+            va, vb = f[key][ia], f[key][ib]
+            out = np.where(t == 1, vb, va + t * (vb - va))
+            return np.where(t == 0, va, out)  # a NaN neighbour spoils no sample
 
         row, col, inside = cells_of(terrain, lerp("x_m"), lerp("y_m"))
         cell = row[inside] * nx + col[inside]
         pairs = np.unique(owner[inside] * cells + cell)
         passing += np.bincount(pairs % cells, minlength=cells)
         for key, grid in maxima.items():
-            np.maximum.at(grid, cell, lerp(key)[inside])
+            np.fmax.at(grid, cell, lerp(key)[inside])  # NaN samples ignored
     out: dict[str, np.ndarray] = {"passing_count": passing.reshape(ny, nx)}
     for name, key in (("max_ke_j", "ke_j"), ("max_height_m", "height_m")):
         grid = maxima[key]

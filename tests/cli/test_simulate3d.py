@@ -135,12 +135,16 @@ def kernel(monkeypatch):
     class Fake:
         paths: list[np.ndarray] | None = None
         releases: list[int] | None = None
+        nan_height_at: int | None = None  # a path sample whose height is NaN
         calls: list = []
 
         def __call__(self, model, rocks, rng, *, sample_m=None):
             self.calls.append((model, rocks))
             if self.paths is not None:
-                return fake_result(self.paths, self.releases or [0] * len(self.paths))
+                result = fake_result(self.paths, self.releases or [0] * len(self.paths))
+                if self.nan_height_at is not None:
+                    result.path["height_m"][self.nan_height_at] = np.nan
+                return result
             starts = model.releases
             which = [i % len(starts) for i in range(rocks)]
             paths = [straight(x, y, y - 50) for x, y, _z in starts[which]]
@@ -498,3 +502,20 @@ def test_observed_file_errors_one_line(cli, fails, site, kernel, tmp_path):
               tmp_path / "obs.csv", "--figures", out),
           "obs.csv", "row 3", "y_m")  # fmt: skip
     assert not out.exists() and not kernel.calls
+
+
+def test_nan_sample_does_not_blank_a_cell(cli, site, kernel, tmp_path):
+    """A sample without a height (NaN, e.g. a rock's last sample off the surface)
+    leaves the cell's max height that of the other samples there."""
+    import rasterio
+
+    kernel.paths = [np.array([[1012.0, 2047.0], [1013.0, 2047.0]])]
+    kernel.nan_height_at = 1
+    out = tmp_path / "r"
+    result = cli("simulate", site / "model3d.json", "--rocks", "1", "--seed", "1",
+                 "--rasters", out)  # fmt: skip
+    assert result.exit_code == 0, result.stderr
+    assert "RuntimeWarning" not in result.stderr
+    with rasterio.open(out / "max_height_m.tif") as src:
+        height = src.read(1)[::-1]
+    assert height[9, 2] == pytest.approx(1.0)
