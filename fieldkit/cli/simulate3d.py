@@ -84,13 +84,23 @@ def simulate_terrain(
         write_geotiff,
     )
     from fieldkit.model.results3d import rasters as make_rasters
-    from fieldkit.model.terrain_file import AnalysisLine
+    from fieldkit.model.simulate import MAX_TRAJECTORIES
+    from fieldkit.model.terrain_file import AnalysisLine, check_line_on_dem
 
     if not 1 <= rocks <= MAX_ROCKS:
         raise ArgumentError(
             f"must be from 1 to {MAX_ROCKS:,} (got {rocks})", source="--rocks"
         )
-    analysis = [AnalysisLine(parse_line(t)) for t in (lines or [])]
+    if not 0 <= trajectories <= MAX_TRAJECTORIES:
+        raise ArgumentError(
+            f"must be from 0 to {MAX_TRAJECTORIES:,} (got {trajectories})",
+            source="--trajectories",
+        )
+    analysis = []
+    for text in lines or []:
+        xy = parse_line(text)
+        check_line_on_dem(xy, model.terrain, source="--line", where=text)
+        analysis.append(AnalysisLine(xy))
     from_model = not analysis and bool(model.analysis_lines)
     if from_model:
         analysis = list(model.analysis_lines)

@@ -208,6 +208,9 @@ def model3d_from_dict(
     lines = tuple(
         analysis_lines_from(data.get("analysis_lines", []), source, "analysis_lines")
     )
+    for i, line in enumerate(lines):
+        check_line_on_dem(line.xy_m, terrain, source=source,
+                          where=f"analysis_lines[{i}].xy_m")  # fmt: skip
     provenance = data.get("provenance", {})
     return Model3D(
         terrain=terrain,
@@ -506,6 +509,43 @@ def analysis_lines_from(
         out.append(AnalysisLine(line_vertices(item["xy_m"], source, f"{at}.xy_m"),
                                 name.strip()))  # fmt: skip
     return out
+
+
+def check_line_on_dem(
+    xy_m: np.ndarray, terrain: Terrain, *, source: str, where: str
+) -> None:
+    """Refuse a polyline that never enters the DEM's rectangle (no rock can cross
+    it there: a line in another coordinate system, or a typing error). A line
+    partly outside is accepted.
+
+    Raises
+    ------
+    InputFileError
+        Every segment misses the rectangle (naming ``source`` and ``where``).
+    """
+    ny, nx = terrain.shape
+    x0, y0 = terrain.x0_m, terrain.y0_m
+    x1, y1 = x0 + nx * terrain.cell_m, y0 + ny * terrain.cell_m
+    for (ax, ay), (bx, by) in zip(xy_m[:-1], xy_m[1:], strict=True):
+        # Liang-Barsky: does the segment meet the rectangle?
+        lo, hi = 0.0, 1.0
+        for p, q in ((-(bx - ax), ax - x0), (bx - ax, x1 - ax),
+                     (-(by - ay), ay - y0), (by - ay, y1 - ay)):  # fmt: skip
+            if p == 0:
+                if q < 0:
+                    lo, hi = 1.0, 0.0
+            elif p < 0:
+                lo = max(lo, q / p)
+            else:
+                hi = min(hi, q / p)
+        if lo <= hi:
+            return
+    raise InputFileError(
+        f"the line never enters the DEM (x {x0:g} to {x1:g} m, y {y0:g} to "
+        f"{y1:g} m): check its coordinates are in the DEM's system",
+        source=source,
+        where=where,
+    )
 
 
 def line_vertices(value: object, source: str, where: str) -> np.ndarray:

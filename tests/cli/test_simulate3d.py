@@ -321,6 +321,8 @@ def test_model_file_lines_used_and_stated(cli, site, kernel, tmp_path):
         ({"analysis_lines": [{"xy_m": [[1000, 2050]]}]}, (),
          ("analysis_lines[0].xy_m", "at least 2")),
         ({"seeder": {"vy_mps": 500}}, (), ("seeder.vy_mps", "100")),
+        ({"analysis_lines": [{"xy_m": [[0, 0], [10, 50]]}]}, (),
+         ("analysis_lines[0].xy_m", "never enters the DEM (x 1000 to 1080 m")),
     ],
 )  # fmt: skip
 def test_bad_terrain_block_one_line(cli, fails, site, kernel, changes, drop, words):
@@ -519,3 +521,17 @@ def test_nan_sample_does_not_blank_a_cell(cli, site, kernel, tmp_path):
     with rasterio.open(out / "max_height_m.tif") as src:
         height = src.read(1)[::-1]
     assert height[9, 2] == pytest.approx(1.0)
+
+
+def test_line_off_the_dem_and_trajectories_bound(cli, fails, site, kernel):
+    """A --line that never enters the DEM is refused (a line partly outside, or
+    crossing the whole DEM without a vertex in it, is not)."""
+    fails(cli("simulate", site / "model3d.json", "--line", "0,0,10,50"),
+          "--line", "0,0,10,50", "never enters the DEM")  # fmt: skip
+    fails(cli("simulate", site / "model3d.json", "--trajectories", "5000"),
+          "--trajectories", "from 0 to 1,000")  # fmt: skip
+    assert not kernel.calls
+    result = cli("simulate", site / "model3d.json", "--rocks", "2", "--seed", "1",
+                 "--line", "900,2050.5,1200,2050.5")  # fmt: skip
+    assert result.exit_code == 0, result.stderr
+    assert "line 1: passing 1.000" in result.stdout
