@@ -61,7 +61,11 @@ def _runout_values(r: dict, censored: dict) -> str:
 @one_line_errors(flags=FLAGS)
 def simulate(
     model_file: Annotated[
-        Path, typer.Argument(metavar="MODEL.json", help="The model file (§5).")
+        Path,
+        typer.Argument(
+            metavar="MODEL.json",
+            help="The model file: a profile (§5) or a terrain block (a DEM, 3-D).",
+        ),
     ],
     rocks: Annotated[
         int, typer.Option("--rocks", help="Number of rocks (1 to 10,000,000).")
@@ -95,7 +99,8 @@ def simulate(
         int,
         typer.Option(
             "--trajectories",
-            help="Keep the paths of the first K rocks (0 to 1,000).",
+            help="Keep the paths of the first K rocks (0 to 1,000); 3-D: the "
+            "paths --rrd draws (at most 200).",
         ),
     ] = 20,
     figures: Annotated[

@@ -200,9 +200,7 @@ def rasters(result, terrain: Terrain) -> dict[str, np.ndarray]:
     row, col, inside = cells_of(terrain, xyz[stopped, 0], xyz[stopped, 1])
     count = np.bincount(row[inside] * nx + col[inside], minlength=cells)
     rocks = max(int(result.rocks), 1)
-    out["deposit_density_per_m2"] = (
-        count.reshape(ny, nx) / (rocks * terrain.cell_m**2)
-    )
+    out["deposit_density_per_m2"] = count.reshape(ny, nx) / (rocks * terrain.cell_m**2)
     return out
 
 
@@ -324,6 +322,7 @@ def summary3d(result, model, lines: list) -> dict:
             "distance_m": distribution(np.where(stopped, distance, math.nan)),
             "over": "stopped rocks; distance in plan from the release point",
         },
-        "lines": [line_summary(result, ln.xy_m, ln.label(i))
-                  for i, ln in enumerate(lines)],  # fmt: skip
+        "lines": [
+            line_summary(result, ln.xy_m, ln.label(i)) for i, ln in enumerate(lines)
+        ],  # fmt: skip
     }

@@ -282,7 +282,7 @@ def _material_index(
     if isinstance(value, str):
         if not value.lower().endswith((".tif", ".tiff", ".asc")):
             raise InputFileError(
-                f"{value!r} is neither a material of \"materials\" "
+                f'{value!r} is neither a material of "materials" '
                 f"({', '.join(names)}) nor a raster (.tif, .asc)",
                 source=source,
                 where=where,
@@ -300,7 +300,7 @@ def _material_index(
             raise InputFileError(
                 f"{path.name}: the cell at x = {xc[col]:g}, y = {yc[row]:g} m holds "
                 f"{codes[row, col]:g}; a cell holds the index of a material of "
-                f"\"materials\", 0 to {len(names) - 1} ({', '.join(names)})",
+                f'"materials", 0 to {len(names) - 1} ({", ".join(names)})',
                 source=source,
                 where=where,
             )
@@ -480,9 +480,7 @@ def _trees3d(data: dict, source: str) -> Trees3D:
     return Trees3D(**arrays)
 
 
-def analysis_lines_from(
-    data: object, source: str, where: str
-) -> list[AnalysisLine]:
+def analysis_lines_from(data: object, source: str, where: str) -> list[AnalysisLine]:
     """The ``analysis_lines`` block: ``[{"name": ..., "xy_m": [[x, y], ...]}]``."""
     if not isinstance(data, list):
         raise InputFileError(

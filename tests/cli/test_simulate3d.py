@@ -275,7 +275,7 @@ def test_all_outputs_written_once_each(cli, site, kernel, tmp_path):
     assert deposits["rock"].tolist() == list(range(6))
     assert deposits["state"].eq("stopped").all()
     assert deposits["y_m"].iloc[0] == pytest.approx(2080.5 - 50)
-    (model, rocks), = kernel.calls
+    ((model, rocks),) = kernel.calls
     assert rocks == 6 and model.release_weights.tolist() == [1, 2]
     assert model.releases[1].tolist() == pytest.approx([1032.5, 2090.5, 45.25])
     s = json.loads((out / "summary.json").read_text())
@@ -446,8 +446,12 @@ def test_profile_commands_refuse_a_terrain_model(cli, fails, repo, tmp_path, arg
     """Commands that read a profile model say so in one line for a 3-D model."""
     model = repo / "examples/tschamut/model_3d.json"
     argv = [a.format(model=model, out=tmp_path / "out") for a in args]
-    fails(cli(*argv), "model_3d.json", "terrain",
-          "a 3-D model (a terrain block, a DEM) where a profile model is needed")
+    fails(
+        cli(*argv),
+        "model_3d.json",
+        "terrain",
+        "a 3-D model (a terrain block, a DEM) where a profile model is needed",
+    )
     assert not (tmp_path / "out").exists()
 
 
@@ -478,7 +482,7 @@ def test_material_and_release_rasters(cli, site, kernel):
     assert "released from 2 points (weights 7 in all) at v = (0, 0, 0) m/s" in (
         result.stdout
     )
-    (model, _rocks), = kernel.calls
+    ((model, _rocks),) = kernel.calls
     assert (model.material_index[:12] == 0).all()
     assert (model.material_index[12:] == 1).all()
     x = X0 + CELL * np.array([3.5, 10.5])
