@@ -61,7 +61,11 @@ def _runout_values(r: dict, censored: dict) -> str:
 @one_line_errors(flags=FLAGS)
 def simulate(
     model_file: Annotated[
-        Path, typer.Argument(metavar="MODEL.json", help="The model file (§5).")
+        Path,
+        typer.Argument(
+            metavar="MODEL.json",
+            help="The model file: a profile (§5) or a terrain block (a DEM, 3-D).",
+        ),
     ],
     rocks: Annotated[
         int, typer.Option("--rocks", help="Number of rocks (1 to 10,000,000).")
@@ -95,7 +99,8 @@ def simulate(
         int,
         typer.Option(
             "--trajectories",
-            help="Keep the paths of the first K rocks (0 to 1,000).",
+            help="Keep the paths of the first K rocks (0 to 1,000); 3-D: the "
+            "paths --rrd draws (at most 200).",
         ),
     ] = 20,
     figures: Annotated[
@@ -125,6 +130,40 @@ def simulate(
             "10^k m (stated when used).",
         ),
     ] = None,
+    deposits: Annotated[
+        Path | None,
+        typer.Option(
+            "--deposits",
+            help="3-D: write every rock's final position (rock, release, x_m, y_m, "
+            "z_m, state) as CSV.",
+        ),
+    ] = None,
+    rasters: Annotated[
+        Path | None,
+        typer.Option(
+            "--rasters",
+            help="3-D: write GeoTIFFs on the DEM's grid and CRS into DIR: "
+            "passing_count, max_ke_j, max_height_m, deposit_density_per_m2.",
+        ),
+    ] = None,
+    line: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--line",
+            help="3-D: an analysis line (a barrier) x1,y1,x2,y2[,...] in the DEM's "
+            "coordinates (m): passing fraction and speed, KE, bounce height "
+            "percentiles of the rocks crossing it; repeatable. Default: the model "
+            "file's analysis_lines (stated when used).",
+        ),
+    ] = None,
+    observed: Annotated[
+        Path | None,
+        typer.Option(
+            "--observed",
+            help="3-D: observed deposits (CSV with x_m, y_m) drawn on map.png and "
+            "in the recording.",
+        ),
+    ] = None,
 ) -> None:
     """Simulate rock falls down a slope profile and say what a designer reads.
 
@@ -151,19 +190,44 @@ def simulate(
     simulator once ("compiling the simulator, first run only"); compile and
     simulation times are reported apart (compile_s, wall_s in summary.json).
 
+    A model file with a terrain block (a DEM, 3-D) runs the 3-D simulator on
+    the DEM from its release points. Printed: final states, the release-to-deposit
+    distance and, at each analysis line (--line, else the model file's
+    analysis_lines), the passing fraction and p50/p95/p99 of speed, kinetic energy
+    and bounce height with their Monte Carlo SEs; --deposits, --rasters (GeoTIFF in
+    the DEM's CRS), --figures (map.png) and --rrd write the rest. --impacts, --at,
+    --measured and --envelope-dx are for profile models; --deposits, --rasters,
+    --line and --observed for terrain models.
+
     Example (from the repository root; thesis §7.5.4, Tornado Mountain with
     the RocFall inputs of Table 7-1):
 
         fieldkit simulate surveys/tornado_mountain/model_rocfall_table_7_1.json \\
           --rocks 2000 --seed 1 --at 610 --measured x=610,speed=18,ke=600e3 \\
           --summary out/summary.json --figures out/sim
+
+    Example, 3-D (Tschamut 2014: the DEM, the 80 runs' release points, a line
+    across the slope below them):
+
+        fieldkit simulate examples/tschamut/model_3d.json --rocks 800 --seed 1 \\
+          --line 0,180,120,180 \\
+          --observed tests/data/tschamut2014/observed_deposition.csv \\
+          --summary out3d/summary.json --deposits out3d/deposits.csv \\
+          --rasters out3d/rasters --figures out3d/figures --rrd out3d/sim.rrd
     """
     import fieldkit.model.kernel as kernel
     from fieldkit.cli.progress import report_written, step
+    from fieldkit.cli.simulate3d import (
+        PROFILE_ONLY,
+        TERRAIN_ONLY,
+        refuse_options,
+        simulate_terrain,
+    )
     from fieldkit.io.impact_stream import (
         ImpactStreamWriter,
         stream_format,
     )
+    from fieldkit.model.model3d import Model3D
     from fieldkit.model.model_file import read_model
     from fieldkit.model.simulate import (
         check_run,
@@ -189,7 +253,21 @@ def simulate(
             outputs.plan(summary, argument="--summary")
         if rrd is not None:
             outputs.plan(rrd, argument="--rrd")
-        model = read_model(model_file, outputs=outputs)
+        model = read_model(model_file, outputs=outputs, terrain=True)
+        given = {"impacts": impacts, "at": at, "measured": measured,
+                 "envelope_dx": envelope_dx, "deposits": deposits,
+                 "rasters": rasters, "line": line, "observed": observed}  # fmt: skip
+        if isinstance(model, Model3D):
+            refuse_options(given, PROFILE_ONLY, "is for a profile model; "
+                           f"{model_file.name} describes a DEM (terrain)")  # fmt: skip
+            simulate_terrain(
+                model, outputs, rocks=rocks, seed=seed, summary=summary,
+                deposits=deposits, rasters=rasters, lines=line, observed=observed,
+                figures=figures, rrd=rrd, trajectories=trajectories,
+            )  # fmt: skip
+            return
+        refuse_options(given, TERRAIN_ONLY, "is for a terrain (3-D) model; "
+                       f"{model_file.name} describes a profile")  # fmt: skip
         analysis_x = [float(x) for x in (at or [])]
         from_model = not at and bool(model.analysis_points)
         if from_model:

@@ -10,7 +10,9 @@ the DEM's coordinate system:
   end -- a repeated closing vertex is dropped); the cells whose centre lies inside
   it are release cells (even-odd rule, :func:`cells_inside`). Rows with the cell
   empty, or a file without the column, are release points: the cell holding each
-  point is a release cell.
+  point is a release cell;
+* ``count`` (optional; also ``rocks``): how many rocks start at a release point, a
+  whole number >= 1 (empty or no column: 1).
 
 Rows are file line numbers (the header is row 1), so every message names the row
 a user can find in a spreadsheet.
@@ -29,6 +31,9 @@ from fieldkit.io.csv_table import length_factor, read_csv_table
 X_ALIASES = ("x", "easting")
 Y_ALIASES = ("y", "northing")
 POLYGON_ALIASES = ("polygon", "polygon_id")
+COUNT_ALIASES = ("count", "rocks")
+#: Most rocks one release point may start (a count beyond is a typing error).
+MAX_POINT_COUNT = 10_000_000
 
 
 @dataclass(frozen=True)
@@ -58,12 +63,15 @@ class Releases:
         The release polygons, in file order.
     source
         The file.
+    point_counts
+        ``(n,)`` rocks started at each point (the ``count`` column; 1 without it).
     """
 
     points_m: np.ndarray
     point_rows: tuple[int, ...]
     polygons: tuple[ReleasePolygon, ...]
     source: str
+    point_counts: np.ndarray | None = None
 
     def summary(self) -> str:
         """``"80 points"``, ``"1 polygon (5 vertices)"``, or both."""
@@ -100,6 +108,7 @@ def read_releases(path: str | PathLike[str]) -> Releases:
         "a release file needs plan coordinates in columns x, y (e.g. x_m, y_m)",
     )
     polygon = table.find(POLYGON_ALIASES, "polygon")
+    count = table.find(COUNT_ALIASES, "count")
     for column in found.values():
         if column.unit is None:
             header = column.header.strip()
@@ -110,7 +119,7 @@ def read_releases(path: str | PathLike[str]) -> Releases:
                 where="row 1",
             )
     factors = {k: length_factor(table, c, None) for k, c in found.items()}
-    points, point_rows = [], []
+    points, point_rows, counts = [], [], []
     vertices: dict[str, list[tuple[float, float, int]]] = {}
     for number, row in table.rows:
         x = table.number(number, row, found["x"]) * factors["x"]
@@ -121,6 +130,7 @@ def read_releases(path: str | PathLike[str]) -> Releases:
         else:
             points.append((x, y))
             point_rows.append(number)
+            counts.append(_count(table, number, row, count))
     polygons = []
     for name, vs in vertices.items():
         rows = tuple(v[2] for v in vs)
@@ -140,7 +150,23 @@ def read_releases(path: str | PathLike[str]) -> Releases:
         tuple(point_rows),
         tuple(polygons),
         table.source,
+        np.array(counts, np.int64),
     )
+
+
+def _count(table, number: int, row: tuple[str, ...], column) -> int:
+    """The ``count`` of a release point: a whole number in [1, 10 million]."""
+    if column is None or table.cell(row, column) == "":
+        return 1
+    value = table.number(number, row, column)
+    if value != int(value) or not 1 <= value <= MAX_POINT_COUNT:
+        raise InputFileError(
+            f"column '{column.header.strip()}': a count is a whole number from 1 to "
+            f"{MAX_POINT_COUNT:,} (got {value:g})",
+            source=table.source,
+            where=f"row {number}",
+        )
+    return int(value)
 
 
 def cells_inside(

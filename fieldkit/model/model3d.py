@@ -1,8 +1,9 @@
 """A 3-D forward model: a DEM with materials, the rock, its releases and the effects.
 
 :class:`Model3D` is what :func:`fieldkit.model.simulate3d.simulate3d` runs; the model
-file's ``terrain`` block (read elsewhere) builds one. Materials, body, effects and
-core settings mean what they mean in 2-D (:mod:`fieldkit.model.model_file`);
+file's ``terrain`` block (:mod:`fieldkit.model.terrain_file`) builds one. Materials,
+body, effects and core settings mean what they mean in 2-D
+(:mod:`fieldkit.model.model_file`);
 ``material_index`` gives every DEM cell an index into ``list(materials)``.
 
 Releases are points ``(x, y, z)`` with ``z`` the ground there, each with a weight
@@ -21,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fieldkit.model.model_file import Body, Trees
+from fieldkit.model.model_blocks import Body, Trees
 from fieldkit.model.terrain import Terrain
 
 
@@ -70,6 +71,13 @@ class Model3D:
         Tree positions and sizes (not yet used in 3-D: refused when active).
     crs
         The DEM's coordinate reference system (WKT) or None.
+    analysis_lines
+        Barrier polylines of the model file
+        (:class:`fieldkit.model.terrain_file.AnalysisLine`).
+    source_files
+        Every file read to build the model: the model file, the DEM, rasters, CSVs
+        (:func:`fieldkit.model.model_file.read_model` adds them to a command's
+        inputs).
     """
 
     terrain: Terrain
@@ -85,3 +93,5 @@ class Model3D:
     crs: str | None = None
     provenance: dict = field(default_factory=dict)
     source: str = ""
+    analysis_lines: tuple = ()
+    source_files: tuple[str, ...] = ()

@@ -58,7 +58,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fieldkit.errors import ArgumentError, FieldkitError, InputFileError
+from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.io.csv_table import parse_json
 from fieldkit.io.dem import read_dem
 from fieldkit.io.profile_csv import read_profile_csv
@@ -67,52 +67,29 @@ from fieldkit.model.dem_profile import (
     section_from_vertices,
     steepest_descent_line,
 )
-from fieldkit.model.effects import registry
 from fieldkit.model.materials import Material, check_number
+from fieldkit.model.model_blocks import (  # noqa: F401 (the model file's names)
+    BODY_BOUNDS,
+    CORE_DEFAULTS,
+    G_MPS2,
+    SEEDER_BOUNDS,
+    TREE_BOUNDS,
+    WHOLE_NUMBER_CORE,
+    Body,
+    Trees,
+    read_body,
+    read_core,
+    read_effects,
+)
+from fieldkit.model.model_blocks import object_field as _object
+from fieldkit.model.model_blocks import read_body as _body
+from fieldkit.model.model_blocks import refuse_unknown as _unknown
 from fieldkit.model.profile import Profile
 from fieldkit.model.seeder import Seeder
 from fieldkit.outputs import OutputSet, json_text, write_file
 
-#: Core settings -> (default, lower, upper, unit).
-CORE_DEFAULTS: dict[str, tuple[float, float, float, str]] = {
-    "slide_vn_mps": (0.5, 0.0, 10.0, "m/s"),
-    "stop_speed_mps": (0.05, 0.0, 10.0, "m/s"),
-    "max_impacts": (500.0, 1.0, 1e6, "-"),
-    "drag_dt_s": (0.25, 1e-4, 5.0, "s"),
-}
-#: Core settings that count something: whole numbers only (500, not 500.5).
-WHOLE_NUMBER_CORE = frozenset({"max_impacts"})
-G_MPS2 = 9.81
-#: Body fields -> (lower, upper) [SI]; the lower bound is exclusive (module docstring).
-BODY_BOUNDS: dict[str, tuple[float, float]] = {
-    "mass_kg": (0.0, 1e9),
-    "radius_m": (0.0, 50.0),
-    "gyration_m": (0.0, 50.0),
-}
-#: Largest |speed| [m/s], |spin| [rad/s] and height above the ground [m] of a start.
-SEEDER_BOUNDS: dict[str, float] = {"mps": 100.0, "radps": 500.0, "m": 1000.0}
-#: Largest tree trunk diameter and height [m].
-TREE_BOUNDS: dict[str, float] = {"diameter_m": 5.0, "height_m": 150.0}
 #: JSON nesting deeper than this is refused (a model file is 4 levels deep).
 MAX_JSON_DEPTH = 64
-
-
-@dataclass(frozen=True)
-class Body:
-    """The rock: mass [kg], contact radius [m], radius of gyration [m]."""
-
-    mass_kg: float
-    radius_m: float
-    gyration_m: float
-
-
-@dataclass(frozen=True)
-class Trees:
-    """Trees along the profile: position [m], trunk diameter [m], height [m]."""
-
-    x_m: np.ndarray
-    diameter_m: np.ndarray
-    height_m: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -192,31 +169,23 @@ class Model:
         )
 
 
-def _object(data: object, where: str, source: str) -> dict:
-    if not isinstance(data, dict):
-        raise InputFileError("must be an object", source=source, where=where)
-    return data
-
-
-def _unknown(data: dict, known: set[str], where: str, source: str) -> None:
-    for key in data:
-        if key not in known:
-            raise InputFileError(
-                f"unknown field (known: {', '.join(sorted(known))})",
-                source=source,
-                where=f"{where}.{key}" if where else key,
-            )
-
-
 def model_from_dict(
     data: dict, *, source: str = "", base_dir: str | os.PathLike[str] | None = None
 ) -> Model:
     """Validate a parsed model file; one-line errors naming ``source`` and the field.
 
+    A file with a ``terrain`` block (a DEM) instead of a ``profile`` is a 3-D
+    model: a :class:`fieldkit.model.model3d.Model3D` is returned
+    (:func:`fieldkit.model.terrain_file.model3d_from_dict`).
+
     ``base_dir`` is where relative file names in the model file (a profile CSV or
     DEM) are looked up: the model file's folder (None: the working directory).
     """
     data = _object(data, "model", source)
+    if "terrain" in data:  # one model-file format: a DEM instead of a profile
+        from fieldkit.model.terrain_file import model3d_from_dict
+
+        return model3d_from_dict(data, source=source, base_dir=base_dir)
     _unknown(
         data,
         {
@@ -256,33 +225,8 @@ def model_from_dict(
             )
     body = _body(_object(data["body"], "body", source), source)
     seeder = _seeder(_object(data["seeder"], "seeder", source), profile, source)
-    effects_data = _object(data.get("effects", {}), "effects", source)
-    effects: dict[str, dict[str, float]] = {}
-    for name, values in effects_data.items():
-        if name not in registry.BY_NAME:
-            raise InputFileError(
-                f"unknown effect (known: {', '.join(registry.BY_NAME)})",
-                source=source,
-                where=f"effects.{name}",
-            )
-        values = _object(values, f"effects.{name}", source)
-        try:
-            effects[name] = registry.validate(name, values, source=source)
-        except FieldkitError as exc:
-            raise InputFileError(exc.message, source=source, where=exc.where) from None
-    core_data = _object(data.get("core", {}), "core", source)
-    _unknown(core_data, set(CORE_DEFAULTS), "core", source)
-    core = {}
-    for key, (default, lower, upper, unit) in CORE_DEFAULTS.items():
-        core[key] = check_number(
-            core_data.get(key, default),
-            lower,
-            upper,
-            source=source,
-            where=f"core.{key}",
-            unit=unit,
-            whole=key in WHOLE_NUMBER_CORE,
-        )
+    effects = read_effects(data, source)
+    core = read_core(data, source)
     trees = None
     if "trees" in data:
         trees = _trees(_object(data["trees"], "trees", source), profile, source)
@@ -353,41 +297,6 @@ def _analysis_points(
             )
         out.append(AnalysisLocation(x_m=x, name=name.strip()))
     return tuple(out)
-
-
-def _body(data: dict, source: str) -> Body:
-    """The body, bounded (:data:`BODY_BOUNDS`) and checked as
-    :class:`fieldkit.physics.bodies.Body` checks a body (k <= r)."""
-    from fieldkit.physics.bodies import Body as PhysicalBody
-
-    _unknown(data, set(BODY_BOUNDS), "body", source)
-    values = {}
-    for key in ("mass_kg", "radius_m"):
-        if key not in data:
-            raise InputFileError("missing", source=source, where=f"body.{key}")
-    # Solid sphere k = sqrt(2/5) r when not given (physics.bodies, Table 4-1).
-    given = {"gyration_m": None, **data}
-    for key, (lower, upper) in BODY_BOUNDS.items():
-        value = given[key]
-        if value is None and key == "gyration_m":
-            value = math.sqrt(0.4) * values["radius_m"]
-        values[key] = check_number(
-            value, lower, upper, source=source, where=f"body.{key}",
-            unit="kg" if key == "mass_kg" else "m",
-        )  # fmt: skip
-        if values[key] <= lower:
-            raise InputFileError(
-                f"must be > {lower:g} (got {values[key]:g})",
-                source=source,
-                where=f"body.{key}",
-            )
-    try:
-        PhysicalBody(**values)
-    except ArgumentError as exc:
-        raise InputFileError(
-            exc.message, source=source, where=f"body.{exc.source}"
-        ) from None
-    return Body(**values)
 
 
 #: Arguments of the section readers -> the profile field that gives them.
@@ -622,9 +531,14 @@ def _trees(data: dict, profile: Profile, source: str) -> Trees:
 
 
 def read_model(
-    path: str | os.PathLike[str], *, outputs: OutputSet | None = None
+    path: str | os.PathLike[str],
+    *,
+    outputs: OutputSet | None = None,
+    terrain: bool = False,
 ) -> Model:
-    """Read and validate a JSON model file (one-line errors naming the file).
+    """Read and validate a JSON model file (one-line errors naming the file): a
+    :class:`Model` for a ``profile``, a :class:`fieldkit.model.model3d.Model3D`
+    for a ``terrain`` block.
 
     Parameters
     ----------
@@ -634,13 +548,17 @@ def read_model(
         The calling command's outputs: every file the model reads
         (:attr:`Model.source_files`) is added to its inputs, so no output replaces
         them (:meth:`fieldkit.outputs.OutputSet.add_inputs`).
+    terrain
+        Whether the caller runs a 3-D model (a ``terrain`` block): without it such a
+        file is refused in one line (every reader of a profile model is safe).
 
     Raises
     ------
     InputFileError
         The file cannot be read, is not UTF-8 or not JSON, is nested deeper than
         :data:`MAX_JSON_DEPTH`, gives a key twice in one object
-        (:func:`fieldkit.io.csv_table.parse_json`), or has a bad field (named).
+        (:func:`fieldkit.io.csv_table.parse_json`), or has a bad field (named); a
+        terrain (3-D) model when ``terrain`` is False.
     OutputFileError
         A planned output of ``outputs`` is a file the model reads.
     """
@@ -667,6 +585,12 @@ def read_model(
     # that the check of their field refuses them by name; a key given twice is
     # refused naming its path (Python's reader would keep the last silently)
     data = parse_json(text, str(path))
+    if not terrain and isinstance(data, dict) and "terrain" in data:
+        raise InputFileError(
+            "a 3-D model (a terrain block, a DEM) where a profile model is needed",
+            source=path,
+            where="terrain",
+        )
     model = model_from_dict(data, source=str(path), base_dir=path.parent)
     model = replace(model, source_files=(str(path), *model.source_files))
     if outputs is not None:

@@ -1,0 +1,147 @@
+"""Blocks shared by the 2-D and the 3-D model file: body, effects, core settings.
+
+:mod:`fieldkit.model.model_file` (a ``profile``) and
+:mod:`fieldkit.model.terrain_file` (a ``terrain``) read these blocks the same way;
+their bounds and defaults are documented in :mod:`fieldkit.model.model_file`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from fieldkit.errors import ArgumentError, FieldkitError, InputFileError
+from fieldkit.model.effects import registry
+from fieldkit.model.materials import check_number
+
+#: Core settings -> (default, lower, upper, unit).
+CORE_DEFAULTS: dict[str, tuple[float, float, float, str]] = {
+    "slide_vn_mps": (0.5, 0.0, 10.0, "m/s"),
+    "stop_speed_mps": (0.05, 0.0, 10.0, "m/s"),
+    "max_impacts": (500.0, 1.0, 1e6, "-"),
+    "drag_dt_s": (0.25, 1e-4, 5.0, "s"),
+}
+#: Core settings that count something: whole numbers only (500, not 500.5).
+WHOLE_NUMBER_CORE = frozenset({"max_impacts"})
+G_MPS2 = 9.81
+#: Body fields -> (lower, upper) [SI]; the lower bound is exclusive (module docstring).
+BODY_BOUNDS: dict[str, tuple[float, float]] = {
+    "mass_kg": (0.0, 1e9),
+    "radius_m": (0.0, 50.0),
+    "gyration_m": (0.0, 50.0),
+}
+#: Largest |speed| [m/s], |spin| [rad/s] and height above the ground [m] of a start.
+SEEDER_BOUNDS: dict[str, float] = {"mps": 100.0, "radps": 500.0, "m": 1000.0}
+#: Largest tree trunk diameter and height [m].
+TREE_BOUNDS: dict[str, float] = {"diameter_m": 5.0, "height_m": 150.0}
+
+
+@dataclass(frozen=True)
+class Body:
+    """The rock: mass [kg], contact radius [m], radius of gyration [m]."""
+
+    mass_kg: float
+    radius_m: float
+    gyration_m: float
+
+
+@dataclass(frozen=True)
+class Trees:
+    """Trees along the profile: position [m], trunk diameter [m], height [m]."""
+
+    x_m: np.ndarray
+    diameter_m: np.ndarray
+    height_m: np.ndarray
+
+
+def object_field(data: object, where: str, source: str) -> dict:
+    """``data`` as an object (a JSON ``{...}``); a one-line error naming ``where``."""
+    if not isinstance(data, dict):
+        raise InputFileError("must be an object", source=source, where=where)
+    return data
+
+
+def refuse_unknown(data: dict, known: set[str], where: str, source: str) -> None:
+    for key in data:
+        if key not in known:
+            raise InputFileError(
+                f"unknown field (known: {', '.join(sorted(known))})",
+                source=source,
+                where=f"{where}.{key}" if where else key,
+            )
+
+
+def read_effects(data: dict, source: str) -> dict[str, dict[str, float]]:
+    """The model file's ``"effects"`` block, each effect validated by its registry
+    entry (one-line errors naming ``effects.<name>``); 2-D and 3-D models alike."""
+    effects_data = object_field(data.get("effects", {}), "effects", source)
+    effects: dict[str, dict[str, float]] = {}
+    for name, values in effects_data.items():
+        if name not in registry.BY_NAME:
+            raise InputFileError(
+                f"unknown effect (known: {', '.join(registry.BY_NAME)})",
+                source=source,
+                where=f"effects.{name}",
+            )
+        values = object_field(values, f"effects.{name}", source)
+        try:
+            effects[name] = registry.validate(name, values, source=source)
+        except FieldkitError as exc:
+            raise InputFileError(exc.message, source=source, where=exc.where) from None
+    return effects
+
+
+def read_core(data: dict, source: str) -> dict[str, float]:
+    """The model file's ``"core"`` block, every setting bounded and defaulted
+    (:data:`CORE_DEFAULTS`); 2-D and 3-D models alike."""
+    core_data = object_field(data.get("core", {}), "core", source)
+    refuse_unknown(core_data, set(CORE_DEFAULTS), "core", source)
+    core = {}
+    for key, (default, lower, upper, unit) in CORE_DEFAULTS.items():
+        core[key] = check_number(
+            core_data.get(key, default),
+            lower,
+            upper,
+            source=source,
+            where=f"core.{key}",
+            unit=unit,
+            whole=key in WHOLE_NUMBER_CORE,
+        )
+    return core
+
+
+def read_body(data: dict, source: str) -> Body:
+    """The body, bounded (:data:`BODY_BOUNDS`) and checked as
+    :class:`fieldkit.physics.bodies.Body` checks a body (k <= r)."""
+    from fieldkit.physics.bodies import Body as PhysicalBody
+
+    refuse_unknown(data, set(BODY_BOUNDS), "body", source)
+    values = {}
+    for key in ("mass_kg", "radius_m"):
+        if key not in data:
+            raise InputFileError("missing", source=source, where=f"body.{key}")
+    # Solid sphere k = sqrt(2/5) r when not given (physics.bodies, Table 4-1).
+    given = {"gyration_m": None, **data}
+    for key, (lower, upper) in BODY_BOUNDS.items():
+        value = given[key]
+        if value is None and key == "gyration_m":
+            value = math.sqrt(0.4) * values["radius_m"]
+        values[key] = check_number(
+            value, lower, upper, source=source, where=f"body.{key}",
+            unit="kg" if key == "mass_kg" else "m",
+        )  # fmt: skip
+        if values[key] <= lower:
+            raise InputFileError(
+                f"must be > {lower:g} (got {values[key]:g})",
+                source=source,
+                where=f"body.{key}",
+            )
+    try:
+        PhysicalBody(**values)
+    except ArgumentError as exc:
+        raise InputFileError(
+            exc.message, source=source, where=f"body.{exc.source}"
+        ) from None
+    return Body(**values)
