@@ -175,8 +175,15 @@ def platrock_python() -> Path | None:
         [sys.executable, "-m", "venv", str(PLATROCK_VENV)],
         [*pip, "setuptools", "wheel", "numpy<2.1"],
         # its numpy support (gdal_array) needs numpy at build time: no build isolation
-        [*pip, "--no-build-isolation", f"gdal[numpy]=={gdal_version}"],
+        # (and not a wheel cached by an earlier build without numpy: no cache)
+        [
+            *pip,
+            "--no-build-isolation",
+            "--no-cache-dir",
+            f"gdal[numpy]=={gdal_version}",
+        ],
         [*pip, f"platrock=={PLATROCK_VERSION}"],
+        [str(python), "-c", "from osgeo import gdal_array; import platrock.ThreeD"],
     ]
     for step in steps:
         done = subprocess.run(step, capture_output=True, text=True)
@@ -343,13 +350,15 @@ def run_fieldkit(site: dict) -> dict | None:
 
 
 def state_names() -> dict[int, str]:
-    try:
-        from fieldkit.model.kernel import STATE_NAMES
-    except ImportError:
-        return {}
-    if isinstance(STATE_NAMES, dict):
-        return {int(k): str(v) for k, v in STATE_NAMES.items()}
-    return {i: str(v) for i, v in enumerate(STATE_NAMES)}
+    """Short names of the 2-D state codes, which the 3-D result uses."""
+    from fieldkit.model import results
+
+    return {
+        results.STOPPED: "stopped",
+        results.EXITED_DOWNSLOPE: "left the DEM",
+        results.EXITED_UPSLOPE: "left the DEM",
+        results.MAX_IMPACTS: "capped",
+    }
 
 
 # --------------------------------------------------------------------------- main
@@ -412,9 +421,12 @@ def main() -> None:
     print(runout_line("observed (80 runs, 3 blocks)", observed_runouts_m()))
     if fieldkit is not None:
         names = state_names()
-        states = ", ".join(
-            f"{names.get(s, s)} {n}" for s, n in sorted(fieldkit["states"].items())
-        )
+        counts: dict[str, int] = {}
+        for code, n in sorted(fieldkit["states"].items()):
+            counts[names.get(code, str(code))] = (
+                counts.get(names.get(code, str(code)), 0) + n
+            )
+        states = ", ".join(f"{name} {n}" for name, n in counts.items())
         print(runout_line("fieldkit simulate3d", fieldkit["runout_m"], f" ({states})"))
     if platrock is not None:
         deposit = np.asarray(platrock["deposit_xyz_m"])[:, :2]
