@@ -130,11 +130,17 @@ def load() -> str:
     )
 
 
-def runout_line(name: str, distance_m: np.ndarray, extra: str = "") -> str:
-    median, p95 = np.percentile(distance_m, [50, 95])
-    return (
-        f"  {name:28s} {len(distance_m):5d} rocks: median {median:6.1f} m, "
-        f"p95 {p95:6.1f} m{extra}"
+def runout_line(name: str, distance_m: np.ndarray, stopped: np.ndarray) -> str:
+    """Median and p95 of the stopped rocks' runouts, and how many did not stop."""
+    kept = np.asarray(distance_m)[np.asarray(stopped, bool)]
+    figures = (
+        "median {:6.1f} m, p95 {:6.1f} m".format(*np.percentile(kept, [50, 95]))
+        if len(kept)
+        else "none stopped"
+    )
+    others = len(stopped) - len(kept)
+    return f"  {name:26s} {len(kept):5d} stopped: {figures}" + (
+        f"; {others} did not stop on the DEM (left it or capped)" if others else ""
     )
 
 
@@ -328,6 +334,8 @@ def run_fieldkit(site: dict) -> dict | None:
         return None
     import numba
 
+    from fieldkit.model.results import STOPPED
+
     simulate3d(model, 20, np.random.default_rng(0))  # warm-up (compile / load cache)
     out: dict = {"threads": {}}
     for threads in THREADS:
@@ -341,24 +349,9 @@ def run_fieldkit(site: dict) -> dict | None:
     result = simulate3d(model, RUNOUT_ROCKS, np.random.default_rng(SEED))
     start = np.asarray(model.releases)[np.asarray(result.release_index)][:, :2]
     deposit = np.asarray(result.deposit_xyz)[:, :2]
-    out["runout_m"] = np.hypot(*(deposit - start).T)
-    states = np.asarray(result.state)
-    out["states"] = {
-        int(s): int(np.count_nonzero(states == s)) for s in np.unique(states)
-    }
+    distance = np.hypot(*(deposit - start).T)
+    out["runout_m"] = (distance, np.asarray(result.state) == STOPPED)
     return out
-
-
-def state_names() -> dict[int, str]:
-    """Short names of the 2-D state codes, which the 3-D result uses."""
-    from fieldkit.model import results
-
-    return {
-        results.STOPPED: "stopped",
-        results.EXITED_DOWNSLOPE: "left the DEM",
-        results.EXITED_UPSLOPE: "left the DEM",
-        results.MAX_IMPACTS: "capped",
-    }
 
 
 # --------------------------------------------------------------------------- main
@@ -418,24 +411,15 @@ def main() -> None:
     print(load())
 
     print("\nrunout, release to final position in plan:")
-    print(runout_line("observed (80 runs, 3 blocks)", observed_runouts_m()))
+    observed = observed_runouts_m()
+    print(runout_line("observed (80 runs)", observed, np.ones(len(observed), bool)))
     if fieldkit is not None:
-        names = state_names()
-        counts: dict[str, int] = {}
-        for code, n in sorted(fieldkit["states"].items()):
-            counts[names.get(code, str(code))] = (
-                counts.get(names.get(code, str(code)), 0) + n
-            )
-        states = ", ".join(f"{name} {n}" for name, n in counts.items())
-        print(runout_line("fieldkit simulate3d", fieldkit["runout_m"], f" ({states})"))
+        print(runout_line("fieldkit simulate3d", *fieldkit["runout_m"]))
     if platrock is not None:
         deposit = np.asarray(platrock["deposit_xyz_m"])[:, :2]
         distance = np.hypot(*(deposit - site["xyz_m"][:2]).T)
-        left = (
-            f" (left the DEM {platrock['out']}: for those, the distance where the "
-            "centre fell below the DEM's lowest point)"
-        )
-        print(runout_line("PlatRock ThreeD", distance, left))
+        stopped = ~np.asarray(platrock["left_dem"], bool)
+        print(runout_line("PlatRock ThreeD", distance, stopped))
 
 
 if __name__ == "__main__":

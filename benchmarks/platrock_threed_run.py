@@ -26,7 +26,7 @@ change; no network needed).
 The JSON printed on the last line of stdout: ``wall_s`` (``Simulation.run`` only, not
 the terrain build), ``build_s``, ``rocks``, ``impacts`` (rock-soil contacts, PlatRock's
 ``Outputs.SOIL`` rows), ``steps`` (time steps), ``deposit_xyz_m`` (world coordinates of
-the last position), ``out`` (rocks that left), ``platrock_version``.
+the last position), ``left_dem`` (per rock: it left the DEM), ``platrock_version``.
 """
 
 from __future__ import annotations
@@ -143,12 +143,12 @@ def main(setup_path: str) -> None:
         raise SystemExit(f"PlatRock ThreeD run ended with status {sim.status!r}")
 
     impacts = 0
-    out = 0
+    left = []
     deposits = []
     for contacts in sim.output.contacts:
         types = contacts[:, 0].astype(int)
         impacts += int(np.count_nonzero(types == Outputs.SOIL))
-        out += int(types[-1] == Outputs.OUT)
+        left.append(bool(types[-1] == Outputs.OUT))
         x, y, z = (float(v) for v in contacts[-1, 1:4])
         deposits.append([x + x0, y + y0, z])
     print(
@@ -158,7 +158,7 @@ def main(setup_path: str) -> None:
                 "rocks": len(sim.output.contacts),
                 "impacts": impacts,
                 "steps": steps[0],
-                "out": out,
+                "left_dem": left,
                 "wall_s": wall,
                 "build_s": build,
                 "deposit_xyz_m": deposits,
