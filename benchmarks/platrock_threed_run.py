@@ -25,8 +25,10 @@ change; no network needed).
 
 The JSON printed on the last line of stdout: ``wall_s`` (``Simulation.run`` only, not
 the terrain build), ``build_s``, ``rocks``, ``impacts`` (rock-soil contacts, PlatRock's
-``Outputs.SOIL`` rows), ``steps`` (time steps), ``deposit_xyz_m`` (world coordinates of
-the last position), ``left_dem`` (per rock: it left the DEM), ``platrock_version``.
+``Outputs.SOIL`` rows: one per time step in contact), ``bounces`` (those contacts not
+preceded by a contact at the step before), ``steps`` (time steps), ``deposit_xyz_m``
+(world coordinates of the last position), ``left_dem`` (per rock: it left the DEM),
+``platrock_version``.
 """
 
 from __future__ import annotations
@@ -64,7 +66,8 @@ def main(setup_path: str) -> None:
     volume = 4.0 / 3.0 * np.pi * radius**3
     density = float(setup["mass_kg"]) / volume
 
-    steps = [0]
+    steps = []  # time steps per rock
+    soil_steps = []  # (rock, time step) of every rock-soil contact
 
     class Run(Simulations.Simulation):
         """PlatRock's ThreeD simulation with an exact start (position, velocity)."""
@@ -81,9 +84,19 @@ def main(setup_path: str) -> None:
                 angVel=[0, 0, 0], ori=[0, 0, 0],
             )  # fmt: skip
 
-        def rock_propagation_tasks(self):
-            steps[0] += 1
-            super().rock_propagation_tasks()
+        def after_rock_propagation_tasks(self, *args, **kwargs):
+            steps.append(self.iter)
+            super().after_rock_propagation_tasks(*args, **kwargs)
+
+    add_contact = Outputs.Output.add_contact
+
+    def add_contact_noting_step(output, rock, normal, type_):
+        """PlatRock's add_contact, noting the time step of a rock-soil contact."""
+        if type_ == Outputs.SOIL:
+            soil_steps.append((sim.current_rock_number, sim.iter))
+        add_contact(output, rock, normal, type_)
+
+    Outputs.Output.add_contact = add_contact_noting_step  # per contact, not per step
 
     start = time.perf_counter()
     terrain = Objects.Terrain(DEM_asc=setup["dem"])
@@ -142,6 +155,11 @@ def main(setup_path: str) -> None:
     if sim.status != "finished":
         raise SystemExit(f"PlatRock ThreeD run ended with status {sim.status!r}")
 
+    # a bounce: a contact whose rock was not in contact at the step before (rolling
+    # is a train of contacts at successive steps)
+    noted = np.array(soil_steps, dtype=np.int64).reshape(-1, 2)
+    continued = (np.diff(noted[:, 0]) == 0) & (np.diff(noted[:, 1]) == 1)
+    bounces = int(len(noted) - np.count_nonzero(continued))
     impacts = 0
     left = []
     deposits = []
@@ -157,7 +175,8 @@ def main(setup_path: str) -> None:
                 "platrock_version": platrock.version,
                 "rocks": len(sim.output.contacts),
                 "impacts": impacts,
-                "steps": steps[0],
+                "bounces": bounces,
+                "steps": int(sum(steps)),
                 "left_dem": left,
                 "wall_s": wall,
                 "build_s": build,
