@@ -123,6 +123,11 @@ def shifted_dem(path: Path) -> None:
     path.write_text("\n".join(out) + "\n", encoding="utf8")
 
 
+def shown(path: Path) -> str:
+    """``path`` relative to the repository when it is inside it."""
+    return str(path.relative_to(ROOT)) if path.is_relative_to(ROOT) else str(path)
+
+
 def load() -> str:
     one, five, _ = os.getloadavg()
     return (
@@ -163,7 +168,7 @@ def platrock_python() -> Path | None:
         [gdal, "--version"], capture_output=True, text=True, check=True
     ).stdout.strip()
     print(
-        f"PlatRock: creating its venv {PLATROCK_VENV.relative_to(ROOT)} (first run "
+        f"PlatRock: creating its venv {shown(PLATROCK_VENV)} (first run "
         f"only, a few minutes): platrock=={PLATROCK_VERSION}, GDAL {gdal_version} "
         "bindings built with numpy",
         flush=True,
@@ -359,7 +364,7 @@ def main() -> None:
     site = release()
     print(load())
     print(
-        f"site: Tschamut 2014 terrain proxy ({DEM.relative_to(ROOT)}); release of run "
+        f"site: Tschamut 2014 terrain proxy ({shown(DEM)}); release of run "
         f"{site['run']} at x {site['xyz_m'][0]:.2f}, y {site['xyz_m'][1]:.2f} m, "
         f"v ({', '.join(f'{v:.2f}' for v in site['v_mps'])}) m/s; block "
         f"{site['block']}: {site['mass_kg']:g} kg, radius {site['radius_m']:g} m"
