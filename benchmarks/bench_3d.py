@@ -135,17 +135,18 @@ def load() -> str:
     )
 
 
-def runout_line(name: str, distance_m: np.ndarray, stopped: np.ndarray) -> str:
-    """Median and p95 of the stopped rocks' runouts, and how many did not stop."""
+def runout_line(
+    name: str, distance_m: np.ndarray, stopped: np.ndarray, others: str = ""
+) -> str:
+    """Median and p95 of the stopped rocks' runouts; ``others``: the rest, said."""
     kept = np.asarray(distance_m)[np.asarray(stopped, bool)]
     figures = (
         "median {:6.1f} m, p95 {:6.1f} m".format(*np.percentile(kept, [50, 95]))
         if len(kept)
         else "none stopped"
     )
-    others = len(stopped) - len(kept)
     return f"  {name:26s} {len(kept):5d} stopped: {figures}" + (
-        f"; {others} did not stop on the DEM (left it or capped)" if others else ""
+        f"; {others}" if others else ""
     )
 
 
@@ -271,6 +272,8 @@ def find_model3d():
 def seeder_value(model3d_cls, site: dict):
     """The release velocity as the seeder type ``Model3D.seeder`` declares."""
     values = {
+        # the rock's centre above the ground (the release file's z is the centre)
+        "height_m": max(site["xyz_m"][2] - site["ground_z_m"], site["radius_m"]),
         "vx_mps": site["v_mps"][0], "vy_mps": site["v_mps"][1],
         "vz_mps": site["v_mps"][2], "omega_radps": 0.0,
         "vx_sd_mps": 0.0, "vy_sd_mps": 0.0, "vz_sd_mps": 0.0, "mass_sd_kg": 0.0,
@@ -339,7 +342,12 @@ def run_fieldkit(site: dict) -> dict | None:
         return None
     import numba
 
-    from fieldkit.model.results import STOPPED
+    from fieldkit.model.results import (
+        EXITED_DOWNSLOPE,
+        EXITED_UPSLOPE,
+        MAX_IMPACTS,
+        STOPPED,
+    )
 
     simulate3d(model, 20, np.random.default_rng(0))  # warm-up (compile / load cache)
     out: dict = {"threads": {}}
@@ -359,7 +367,14 @@ def run_fieldkit(site: dict) -> dict | None:
     start = np.asarray(model.releases)[np.asarray(result.release_index)][:, :2]
     deposit = np.asarray(result.deposit_xyz)[:, :2]
     distance = np.hypot(*(deposit - start).T)
-    out["runout_m"] = (distance, np.asarray(result.state) == STOPPED)
+    state = np.asarray(result.state)
+    left = np.count_nonzero((state == EXITED_DOWNSLOPE) | (state == EXITED_UPSLOPE))
+    capped = np.count_nonzero(state == MAX_IMPACTS)
+    out["runout"] = (
+        distance,
+        state == STOPPED,
+        f"left the DEM {left}, capped {capped}",
+    )
     return out
 
 
@@ -427,12 +442,13 @@ def main() -> None:
     observed = observed_runouts_m()
     print(runout_line("observed (80 runs)", observed, np.ones(len(observed), bool)))
     if fieldkit is not None:
-        print(runout_line("fieldkit simulate3d", *fieldkit["runout_m"]))
+        print(runout_line("fieldkit simulate3d", *fieldkit["runout"]))
     if platrock is not None:
         deposit = np.asarray(platrock["deposit_xyz_m"])[:, :2]
         distance = np.hypot(*(deposit - site["xyz_m"][:2]).T)
         stopped = ~np.asarray(platrock["left_dem"], bool)
-        print(runout_line("PlatRock ThreeD", distance, stopped))
+        left = f"left the DEM {np.count_nonzero(~stopped)}"
+        print(runout_line("PlatRock ThreeD", distance, stopped, left))
 
 
 if __name__ == "__main__":
