@@ -7,9 +7,12 @@ every rock there with that velocity.
 
 fieldkit: ``fieldkit.model.simulate3d.simulate3d`` (the contract of issue 21) on the
 Tschamut starting model (``examples/tschamut/model_base.json``: one material, e_n 1.0,
-e_t 0.62, friction 19.29 deg, roughness SD 8 deg), timed by its own ``wall_s`` after a
-warm-up compile, on 1 and 2 numba threads. If the 3-D simulator is not built yet, that
-is said and PlatRock's figures are still printed.
+e_t 0.62, friction 19.29 deg, roughness SD 8 deg, slope_roughness on) over the whole
+DEM, the release as its one release point (z = the ground), the seeder's height the
+release's centre above the ground (the radius) and its velocity the release's, with no
+spreads; timed by its own ``wall_s`` after a warm-up compile, on 1 and 2 numba
+threads. If the 3-D simulator is not built yet, that is said and PlatRock's figures
+are still printed.
 
 PlatRock 0.4.6 (the open-source peer; GPL, never a dependency of fieldkit) runs in its
 own venv, ``.bench/platrock-venv`` at the repository root, created on the first run
@@ -27,16 +30,20 @@ s. PlatRock has no sliding friction (rolling is a train of small Classical bounc
 one per time step in contact), so friction_deg has no counterpart. PlatRock puts the
 grid's values at ``xllcorner + i * cellsize`` (the cell corners); it is handed a copy of
 the grid with its corner moved by half a cell so that both codes' surfaces pass through
-the same points (the cell centres, as ESRI ASCII defines them).
+the same points (the cell centres, as ESRI ASCII defines them): fieldkit's surface is
+bilinear between them, PlatRock's two planar triangles per grid square.
 
 What is compared: impacts/s and rocks/s (fieldkit on 1 and 2 threads, PlatRock on one
 core: it is single-threaded Python with Cython helpers), the ratio fieldkit / PlatRock
 in impacts/s, and the runout (release to final position, in plan) of 1,000 rocks from
-each, median and 95th percentile, beside the 80 observed runs. An "impact" is not the
-same event in both: fieldkit counts bounces (sliding/rolling is integrated between
-them), PlatRock counts every time step with a rock-soil contact (its rolling is made of
-such contacts), so its impact count is larger for the same path; rocks/s compares like
-with like. Printed, not asserted (target of issue 21: fieldkit >= 100x PlatRock in
+each, median and 95th percentile of the rocks that stopped on the DEM (those that left
+it, or hit fieldkit's impact cap, are counted, not measured), beside the 80 observed
+runs. An "impact" is not quite the same event in both: fieldkit counts impacts
+(sliding and rolling are integrated between them), PlatRock every time step with a
+rock-soil contact (its rolling is a train of such contacts); the bench prints how many
+of PlatRock's contacts are bounces (no contact the step before) and the ratio on
+those too. rocks/s depends on how far each code's rocks go, so it is printed beside
+the runouts. Printed, not asserted (target of issue 21: fieldkit >= 100x PlatRock in
 impacts/s).
 """
 
