@@ -24,11 +24,12 @@ there is no forest here, so that constructor is replaced by a stub (the only oth
 change; no network needed).
 
 The JSON printed on the last line of stdout: ``wall_s`` (``Simulation.run`` only, not
-the terrain build), ``build_s``, ``rocks``, ``impacts`` (rock-soil contacts, PlatRock's
-``Outputs.SOIL`` rows: one per time step in contact), ``bounces`` (those contacts not
-preceded by a contact at the step before), ``steps`` (time steps), ``deposit_xyz_m``
-(world coordinates of the last position), ``left_dem`` (per rock: it left the DEM),
-``platrock_version``.
+the terrain build; it includes PlatRock's per-run set-up, the soil parameters put on
+the faces: 0.02 s for the 3,780 faces of Tschamut), ``build_s``, ``rocks``,
+``impacts`` (rock-soil contacts, PlatRock's ``Outputs.SOIL`` rows: one per time step
+in contact), ``bounces`` (those contacts not preceded by a contact at the step
+before), ``steps`` (time steps), ``deposit_xyz_m`` (world coordinates of the last
+position), ``left_dem`` (per rock: it left the DEM), ``platrock_version``.
 """
 
 from __future__ import annotations
