@@ -35,7 +35,10 @@ test-rstone: $(STAMP)
 ## Speed and memory figures (printed, not asserted); bench_diagnose_power runs its
 ## short setting here (a few tables per condition, ~3 min on 2 cores), and
 ## bench_campaign_power its short grid of virtual campaigns (1 and 3 paths of 20
-## and 50 scars, a few campaigns per cell).
+## and 50 scars, a few campaigns per cell). bench_3d runs PlatRock's ThreeD engine
+## beside fieldkit's 3-D simulator: its first run creates PlatRock's own venv in
+## .bench/platrock-venv (a few minutes; needs libgdal-dev for gdal-config; skipped
+## with the reason when pip cannot reach the index or GDAL is missing).
 bench: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python benchmarks/run_all.py
 
@@ -55,4 +58,4 @@ lint: $(STAMP)
 	$(BIN)/ruff check fieldkit tests benchmarks examples
 
 clean:
-	rm -rf $(VENV) out .pytest_cache
+	rm -rf $(VENV) .bench out .pytest_cache
