@@ -298,10 +298,9 @@ def seeder_value(model3d_cls, site: dict):
 
 def fieldkit_model(site: dict):
     """The Tschamut starting model on the DEM, built to the issue-21 contract."""
-    from fieldkit.model.terrain import Terrain
-
     from fieldkit.io.dem import read_dem
     from fieldkit.model.model_file import model_from_dict
+    from fieldkit.model.terrain import Terrain
 
     base = json.loads(BASE_MODEL.read_text(encoding="utf8"))
     base["body"] = {"mass_kg": site["mass_kg"], "radius_m": site["radius_m"]}
