@@ -409,11 +409,9 @@ def _env_put(env, env0, envdx, xq, h, edge):
 
 
 @njit(cache=True)
-def _sweep_flight(x0, z0, vx, vz, ax, az, t1, prof, m, kg, w, probe, trace, ntr):
+def _sweep_flight(x0, z0, vx, vz, ax, az, t1, px, pz, sl, m, kg, w, ana_x, ana, env0,
+                  envdx, env, trace, ntr):  # fmt: skip
     """Analysis-point crossings, envelope and trace of one flight piece ``[0, t1]``."""
-    px, pz, sl = prof.x_m, prof.z_m, prof.slope
-    ana_x, ana = probe.x_m, probe.values
-    env0, envdx, env = probe.env_x0_m, probe.env_dx_m, probe.env
     x1 = x0 + vx * t1 + 0.5 * ax * t1 * t1
     lo, hi = min(x0, x1), max(x0, x1)
     for a in range(ana_x.size):
@@ -480,10 +478,9 @@ def _sweep_flight(x0, z0, vx, vz, ax, az, t1, prof, m, kg, w, probe, trace, ntr)
 
 
 @njit(cache=True)
-def _sweep_slide(xa, xb, sp, ad, cpsi, m, r, kg, prof, probe, trace, ntr):
+def _sweep_slide(xa, xb, sp, ad, cpsi, m, r, kg, px, pz, sl, ana_x, ana, env0, envdx,
+                 env, trace, ntr):  # fmt: skip
     """Analysis crossings, envelope (height 0) and trace of a slide from xa to xb."""
-    ana_x, ana = probe.x_m, probe.values
-    env0, envdx, env = probe.env_x0_m, probe.env_dx_m, probe.env
     lo, hi = min(xa, xb), max(xa, xb)
     for a in range(ana_x.size):
         xq = ana_x[a]
@@ -507,7 +504,7 @@ def _sweep_slide(xa, xb, sp, ad, cpsi, m, r, kg, prof, probe, trace, ntr):
                 env[b] = 0.0
     if trace.shape[0] > ntr:
         trace[ntr, 0] = xa
-        trace[ntr, 1] = ground_z(prof.x_m, prof.z_m, prof.slope, xa)
+        trace[ntr, 1] = ground_z(px, pz, sl, xa)
         ntr += 1
     return ntr
 
@@ -614,10 +611,9 @@ def passive_normal_speed(vin, vit, w_i, vfn, vft, w_f, kg):
 
 
 @njit(cache=True)
-def _flight_tree(key, n, x, z, vx, vz, ax, az, tc, prof, trees, p_hit):
+def _flight_tree(key, n, x, z, vx, vz, ax, az, tc, px, pz, sl, tx, th, p_hit):
     """The first tree the flight piece ``[0, tc)`` passes below its top and strikes
     (one draw per tree passed): ``(index, time)``, index -1 for none."""
-    tx, th = trees.x_m, trees.height_m
     x_end = x + vx * tc + 0.5 * ax * tc * tc
     lo, hi = min(x, x_end), max(x, x_end)
     i0 = np.searchsorted(tx, lo, side="right")
@@ -628,7 +624,7 @@ def _flight_tree(key, n, x, z, vx, vz, ax, az, tc, prof, trees, p_hit):
         tt = time_to_x(x, vx, ax, tx[ii])
         if tt < tc:
             zt = z + vz * tt + 0.5 * az * tt * tt
-            above = zt - ground_z(prof.x_m, prof.z_m, prof.slope, tx[ii])
+            above = zt - ground_z(px, pz, sl, tx[ii])
             if 0.0 < above < th[ii] and uniform(key, n, SLOT_TREE + ii) < p_hit:
                 return ii, tt
         ii += 1 if vx > 0.0 else -1
@@ -636,7 +632,8 @@ def _flight_tree(key, n, x, z, vx, vz, ax, az, tc, prof, trees, p_hit):
 
 
 @njit(cache=True)
-def fly(key, n, x, z, vx, vz, w, m, r, kg, t, j, tree_hit, model, probe, trace, ntr):
+def fly(key, n, x, z, vx, vz, w, m, r, kg, t, j, tree_hit, px, pz, sl, tx, td, th,
+        flags, par, drag_dt, ana_x, ana, env0, envdx, env, trace, ntr):  # fmt: skip
     """The flight stage: from ``(x, z)`` with ``(vx, vz)`` over segment ``j`` until
     the centre meets the profile or leaves it.
 
@@ -646,29 +643,28 @@ def fly(key, n, x, z, vx, vz, w, m, r, kg, t, j, tree_hit, model, probe, trace, 
     exit_x)``: ``state`` -1 on a contact with segment ``j`` (``z`` then exactly on
     its line), else ``EXITED_*`` with ``exit_x`` the profile end left.
     """
-    prof = model.profile
-    px, pz, sl = prof.x_m, prof.z_m, prof.slope
-    flags, par = model.effects.flags, model.effects.par
-    tx, td = model.trees.x_m, model.trees.diameter_m
     drag = flags[F_DRAG] == 1 and par[P_DRAG_CD] > 0.0
     trees = flags[F_TREE] == 1 and tx.size > 0 and par[P_TREE_P] > 0.0
     nseg = px.size - 1
+    state = -1
+    exit_x = x
     while True:
         if drag:
             k = air_drag.drag_factor(par[P_DRAG_CD], par[P_DRAG_RHO], r, m)
-            tmax = air_drag.substep_s(vx, vz, k, model.core.drag_dt_s)
+            tmax = air_drag.substep_s(vx, vz, k, drag_dt)
             ax, az = air_drag.substep_acceleration(vx, vz, k, G, tmax)
         else:
             ax, az, tmax = 0.0, -G, INF
         jc, tc = piece_contact(px, pz, sl, j, x, z, vx, vz, ax, az, tmax)
         if trees and vx != 0.0:
             struck, tt = _flight_tree(
-                key, n, x, z, vx, vz, ax, az, tc, prof, model.trees, par[P_TREE_P]
+                key, n, x, z, vx, vz, ax, az, tc, px, pz, sl, tx, th, par[P_TREE_P]
             )
             if struck >= 0:
                 ntr = _sweep_flight(
-                    x, z, vx, vz, ax, az, tt, prof, m, kg, w, probe, trace, ntr
-                )
+                    x, z, vx, vz, ax, az, tt, px, pz, sl, m, kg, w, ana_x, ana, env0,
+                    envdx, env, trace, ntr,
+                )  # fmt: skip
                 z = z + vz * tt + 0.5 * az * tt * tt
                 x = tx[struck]
                 vx = vx + ax * tt
@@ -684,41 +680,48 @@ def fly(key, n, x, z, vx, vz, w, m, r, kg, t, j, tree_hit, model, probe, trace, 
                 tree_hit = 1.0
                 j = segment_at(px, x)
                 continue
-        ntr = _sweep_flight(x, z, vx, vz, ax, az, tc, prof, m, kg, w, probe, trace, ntr)
+        ntr = _sweep_flight(
+            x, z, vx, vz, ax, az, tc, px, pz, sl, m, kg, w, ana_x, ana, env0, envdx,
+            env, trace, ntr,
+        )  # fmt: skip
         x = x + vx * tc + 0.5 * ax * tc * tc
         z = z + vz * tc + 0.5 * az * tc * tc
         vx = vx + ax * tc
         vz = vz + az * tc
         t += tc
         if jc >= 0:
-            z = pz[jc] + sl[jc] * (x - px[jc])  # exactly on the line
-            return x, z, vx, vz, t, jc, tree_hit, ntr, -1, x
+            j = jc
+            z = pz[j] + sl[j] * (x - px[j])  # exactly on the line
+            break
         if jc == -2:
-            return x, z, vx, vz, t, j, tree_hit, ntr, EXITED_DOWNSLOPE, px[nseg]
+            state = EXITED_DOWNSLOPE
+            exit_x = px[nseg]
+            break
         if jc == -3:
-            return x, z, vx, vz, t, j, tree_hit, ntr, EXITED_UPSLOPE, px[0]
+            state = EXITED_UPSLOPE
+            exit_x = px[0]
+            break
         j = segment_at(px, x)
+    return x, z, vx, vz, t, j, tree_hit, ntr, state, exit_x
 
 
 @njit(cache=True)
-def impact(key, n, x, z, vx, vz, w, t, j, m, r, kg, rock, tree_hit, model, record):
+def impact(key, n, x, z, vx, vz, w, t, j, m, r, kg, x0, m0, r0, k0, tree_hit, cpsi,
+           spsi, psid, smat, mat, flags, par, slide_vn, rec, rec_start,
+           rec_on):  # fmt: skip
     """The impact stage: impact number ``n`` of the rock at ``(x, z)`` on segment
     ``j`` with incoming ``(vx, vz)`` and spin ``w``.
 
     Draws ``e_n, e_t`` of the segment's material, applies ``mass_loss`` (from the
-    rock's start ``rock``) and ``slope_roughness`` (a random tilt of the dip), the
-    rebound laws (:func:`restitution`, :func:`passive_normal_speed`) and writes the
-    impact row. Returns ``(vx, vz, w, m, r, kg, flying, u, tanphi)``: the rebound
-    velocity when the rock flies on; when it starts sliding (rebound normal speed
-    below ``slide_vn_mps`` or into the segment) ``flying`` False, the incoming
-    ``(vx, vz)``, ``u`` the velocity along the segment and ``tanphi`` the friction of
-    its first segment entry.
+    rock's release ``x0`` and start mass, radius, gyration ``m0, r0, k0``) and
+    ``slope_roughness`` (a random tilt of the dip), the rebound laws
+    (:func:`restitution`, :func:`passive_normal_speed`) and writes the impact row.
+    Returns ``(vx, vz, w, m, r, kg, flying, u)``: the rebound velocity when the
+    rock flies on; when it starts sliding (rebound normal speed below
+    ``slide_vn_mps`` or into the segment) ``flying`` False, the incoming ``(vx,
+    vz)`` and ``u`` the velocity along the segment.
     """
-    prof = model.profile
-    mat = model.materials
-    flags, par = model.effects.flags, model.effects.par
-    cpsi, spsi, psid = prof.cos_psi, prof.sin_psi, prof.psi_deg
-    mi = prof.material[j]
+    mi = smat[j]
     e_n = mat[mi, M_EN]
     if mat[mi, M_EN_SD] > 0.0:
         e_n = max(0.0, e_n + mat[mi, M_EN_SD] * normal(key, n, SLOT_E_N))
@@ -726,11 +729,9 @@ def impact(key, n, x, z, vx, vz, w, t, j, m, r, kg, rock, tree_hit, model, recor
     if mat[mi, M_ET_SD] > 0.0:
         e_t = max(0.0, e_t + mat[mi, M_ET_SD] * normal(key, n, SLOT_E_T))
     if flags[F_MASS] == 1:
-        ratio = mass_loss.volume_ratio(
-            x - rock.x_m, n, par[P_MASS_RATE], par[P_MASS_EXP]
-        )
+        ratio = mass_loss.volume_ratio(x - x0, n, par[P_MASS_RATE], par[P_MASS_EXP])
         cube = ratio ** (1.0 / 3.0)
-        m, r, kg = rock.mass_kg * ratio, rock.radius_m * cube, rock.gyration_m * cube
+        m, r, kg = m0 * ratio, r0 * cube, k0 * cube
     c = cpsi[j]
     s = spsi[j]
     psi = psid[j]
@@ -764,9 +765,8 @@ def impact(key, n, x, z, vx, vz, w, t, j, m, r, kg, rock, tree_hit, model, recor
     vfn = passive_normal_speed(vin, vit, w_i, vfn, vft, w, k_spin)
     vfx = vft * c + vfn * s
     vfz = -vft * s + vfn * c
-    if record.on:
-        row = record.start + n - 1
-        rec = record.rows
+    if rec_on:
+        row = rec_start + n - 1
         rec[row, R_T] = t
         rec[row, R_X] = x
         rec[row, R_Z] = z
@@ -783,35 +783,33 @@ def impact(key, n, x, z, vx, vz, w, t, j, m, r, kg, rock, tree_hit, model, recor
         rec[row, R_MATERIAL] = mi
         rec[row, R_TREE] = tree_hit
     vn_real = vfx * spsi[j] + vfz * cpsi[j]
-    if vfn < model.core.slide_vn_mps or vn_real <= 0.0:
+    if vfn < slide_vn or vn_real <= 0.0:
         u = vfx * cpsi[j] - vfz * spsi[j]
-        tanphi = _friction_tan(mat, mi, key, n, 0)
-        return vx, vz, w, m, r, kg, False, u, tanphi
-    return vfx, vfz, w, m, r, kg, True, 0.0, 0.0
+        return vx, vz, w, m, r, kg, False, u
+    return vfx, vfz, w, m, r, kg, True, 0.0
 
 
 @njit(cache=True)
-def slide(key, n, x, z, vx, vz, w, u, t, j, tanphi, m, r, kg, tree_hit, model, probe,
-          trace, ntr):  # fmt: skip
+def slide(key, n, x, u, t, j, m, r, kg, px, pz, sl, cpsi, spsi, psid, smat, mat, tx,
+          td, flags, par, stop_v, ana_x, ana, env0, envdx, env, trace,
+          ntr):  # fmt: skip
     """The slide stage (eq. 7.3): sliding / rolling from ``x`` on segment ``j`` with
-    velocity ``u`` along it and friction ``tanphi``, segment by segment (a new
-    friction draw at each entry), until the rock stops, leaves the profile, launches
-    at a convex break or takes :data:`MAX_SLIDE_STEPS` steps; trees on the way are
-    struck with their probability.
+    velocity ``u`` along it after impact ``n``, segment by segment (a friction draw
+    at each entry), until the rock stops, leaves the profile, launches at a convex
+    break or takes :data:`MAX_SLIDE_STEPS` steps; trees on the way are struck with
+    their probability.
 
-    Returns ``(x, z, vx, vz, w, t, j, tree_hit, ntr, state)``: ``state`` -1 for a
-    launch (``vx, vz, w`` the take-off velocity and spin), else the final state.
+    Returns ``(x, t, j, ntr, state, tree_hit, z, vx, vz, w)``: ``state`` -1 for a
+    launch, then ``z, vx, vz, w`` the take-off height, velocity and spin (zeros
+    otherwise); ``tree_hit`` 1.0 when a tree was struck.
     """
-    prof = model.profile
-    px, pz, sl = prof.x_m, prof.z_m, prof.slope
-    cpsi, spsi, psid = prof.cos_psi, prof.sin_psi, prof.psi_deg
-    flags, par = model.effects.flags, model.effects.par
-    tx, td = model.trees.x_m, model.trees.diameter_m
     trees = flags[F_TREE] == 1 and tx.size > 0 and par[P_TREE_P] > 0.0
-    stop_v = model.core.stop_speed_mps
     nseg = px.size - 1
     state = -1
     entry = 0
+    tanphi = _friction_tan(mat, smat[j], key, n, entry)
+    tree_hit = 0.0
+    z = vx = vz = w = 0.0
     for _ in range(MAX_SLIDE_STEPS):
         c = cpsi[j]
         s = spsi[j]
@@ -839,8 +837,9 @@ def slide(key, n, x, z, vx, vz, w, u, t, j, tanphi, m, r, kg, tree_hit, model, p
                 vt2 = sp * sp + 2.0 * ad * d
                 vt = math.sqrt(vt2) if vt2 > 0.0 else 0.0
                 ntr = _sweep_slide(
-                    x, tx[ii], sp, ad, c, m, r, kg, prof, probe, trace, ntr
-                )
+                    x, tx[ii], sp, ad, c, m, r, kg, px, pz, sl, ana_x, ana, env0,
+                    envdx, env, trace, ntr,
+                )  # fmt: skip
                 t += (vt - sp) / ad if ad != 0.0 else d / sp
                 x = tx[ii]
                 vt = tree_impacts.speed_after_strike(
@@ -852,14 +851,20 @@ def slide(key, n, x, z, vx, vz, w, u, t, j, tanphi, m, r, kg, tree_hit, model, p
         if v2 <= 0.0:
             dist = sp * sp / (-2.0 * ad)
             x_new = x + dirn * dist * c
-            ntr = _sweep_slide(x, x_new, sp, ad, c, m, r, kg, prof, probe, trace, ntr)
+            ntr = _sweep_slide(
+                x, x_new, sp, ad, c, m, r, kg, px, pz, sl, ana_x, ana, env0, envdx,
+                env, trace, ntr,
+            )  # fmt: skip
             t += sp / (-ad)
             x = x_new
             u = 0.0
             continue
         ve = math.sqrt(v2)
         x_new = px[j + 1] if dirn > 0.0 else px[j]
-        ntr = _sweep_slide(x, x_new, sp, ad, c, m, r, kg, prof, probe, trace, ntr)
+        ntr = _sweep_slide(
+            x, x_new, sp, ad, c, m, r, kg, px, pz, sl, ana_x, ana, env0, envdx, env,
+            trace, ntr,
+        )  # fmt: skip
         t += (ve - sp) / ad if ad != 0.0 else length / sp
         x = x_new
         jn = j + (1 if dirn > 0.0 else -1)
@@ -883,7 +888,7 @@ def slide(key, n, x, z, vx, vz, w, u, t, j, tanphi, m, r, kg, tree_hit, model, p
             u = 0.0
         j = jn
         entry += 1
-        tanphi = _friction_tan(model.materials, prof.material[j], key, n, entry)
+        tanphi = _friction_tan(mat, smat[j], key, n, entry)
     else:
         state = MAX_IMPACTS
     if state >= 0:
@@ -894,7 +899,69 @@ def slide(key, n, x, z, vx, vz, w, u, t, j, tanphi, m, r, kg, tree_hit, model, p
     else:
         # the spin of the launch: rolling at the speed of the last segment entry
         w = -u / r if u != 0.0 else w
-    return x, z, vx, vz, w, t, j, tree_hit, ntr, state
+    return x, t, j, ntr, state, tree_hit, z, vx, vz, w
+
+
+@njit(cache=True)
+def _drive(key, x, z, vx, vz, w, m, r, kg, px, pz, sl, cpsi, spsi, psid, smat, mat, tx,
+           td, th, flags, par, slide_vn, stop_v, max_imp, drag_dt, ana_x, ana, env0,
+           envdx, env, rec, rec_start, rec_on, trace):  # fmt: skip
+    """The stage loop of :func:`run_rock` on the bundles' fields (called by name
+    from :func:`run_rock` and :func:`run_rocks` only: numba counts references to
+    every array taken out of a tuple, so the per-rock loop takes them out of the
+    bundles once per run, not once per rock or per stage)."""
+    x0, m0, r0, k0 = x, m, r, kg
+    max_imp = int(max_imp)
+    n = 0
+    t = 0.0
+    ntr = 0
+    tree_hit = 0.0
+    state = -1
+    runout = x
+    j = segment_at(px, x)
+    flying = True
+    u = 0.0
+    while state < 0:
+        if flying:
+            x, z, vx, vz, t, j, tree_hit, ntr, state, exit_x = fly(
+                key, n, x, z, vx, vz, w, m, r, kg, t, j, tree_hit, px, pz, sl, tx, td,
+                th, flags, par, drag_dt, ana_x, ana, env0, envdx, env, trace, ntr,
+            )  # fmt: skip
+            if state >= 0:
+                runout = exit_x
+                break
+            if n >= max_imp:
+                state = MAX_IMPACTS
+                runout = x
+                break
+            n += 1
+            vx, vz, w, m, r, kg, flying, u = impact(
+                key, n, x, z, vx, vz, w, t, j, m, r, kg, x0, m0, r0, k0, tree_hit, cpsi,
+                spsi, psid, smat, mat, flags, par, slide_vn, rec, rec_start, rec_on,
+            )  # fmt: skip
+            tree_hit = 0.0
+            if trace.shape[0] > ntr:
+                trace[ntr, 0] = x
+                trace[ntr, 1] = z
+                ntr += 1
+        else:
+            x, t, j, ntr, state, hit, z_l, vx_l, vz_l, w_l = slide(
+                key, n, x, u, t, j, m, r, kg, px, pz, sl, cpsi, spsi, psid, smat,
+                mat, tx, td, flags, par, stop_v, ana_x, ana, env0, envdx, env,
+                trace, ntr,
+            )  # fmt: skip
+            if hit == 1.0:
+                tree_hit = 1.0
+            if state >= 0:
+                runout = x
+            else:
+                z, vx, vz, w = z_l, vx_l, vz_l, w_l
+                flying = True
+    if state != STOPPED and trace.shape[0] > ntr:
+        trace[ntr, 0] = x if state == MAX_IMPACTS else runout
+        trace[ntr, 1] = z
+        ntr += 1
+    return n, state, runout, ntr
 
 
 @njit(cache=True)
@@ -906,112 +973,51 @@ def run_rock(rock, model, probe, record, trace):
     place: ``probe`` (:class:`Probe`), ``record`` (:class:`Record`, impact rows when
     ``record.on``) and ``trace`` (x, z points; zero rows for none).
     """
-    key = rock.key
-    x, z = rock.x_m, rock.z_m
-    vx, vz, w = rock.vx_mps, rock.vz_mps, rock.omega_radps
-    m, r, kg = rock.mass_kg, rock.radius_m, rock.gyration_m
-    max_imp = int(model.core.max_impacts)
-    n = 0
-    t = 0.0
-    ntr = 0
-    tree_hit = 0.0
-    state = -1
-    runout = x
-    j = segment_at(model.profile.x_m, x)
-    flying = True
-    u = 0.0
-    tanphi = 0.0
-    while state < 0:
-        if flying:
-            x, z, vx, vz, t, j, tree_hit, ntr, state, exit_x = fly(
-                key, n, x, z, vx, vz, w, m, r, kg, t, j, tree_hit, model, probe,
-                trace, ntr,
-            )  # fmt: skip
-            if state >= 0:
-                runout = exit_x
-                break
-            if n >= max_imp:
-                state = MAX_IMPACTS
-                runout = x
-                break
-            n += 1
-            vx, vz, w, m, r, kg, flying, u, tanphi = impact(
-                key, n, x, z, vx, vz, w, t, j, m, r, kg, rock, tree_hit, model, record
-            )
-            tree_hit = 0.0
-            if trace.shape[0] > ntr:
-                trace[ntr, 0] = x
-                trace[ntr, 1] = z
-                ntr += 1
-        else:
-            x, z, vx, vz, w, t, j, tree_hit, ntr, state = slide(
-                key, n, x, z, vx, vz, w, u, t, j, tanphi, m, r, kg, tree_hit, model,
-                probe, trace, ntr,
-            )  # fmt: skip
-            if state >= 0:
-                runout = x
-            else:
-                flying = True
-    if state != STOPPED and trace.shape[0] > ntr:
-        trace[ntr, 0] = x if state == MAX_IMPACTS else runout
-        trace[ntr, 1] = z
-        ntr += 1
-    return n, state, runout, ntr
+    prof, trees, effects, core = model.profile, model.trees, model.effects, model.core
+    return _drive(
+        rock.key, rock.x_m, rock.z_m, rock.vx_mps, rock.vz_mps, rock.omega_radps,
+        rock.mass_kg, rock.radius_m, rock.gyration_m, prof.x_m, prof.z_m, prof.slope,
+        prof.cos_psi, prof.sin_psi, prof.psi_deg, prof.material, model.materials,
+        trees.x_m, trees.diameter_m, trees.height_m, effects.flags, effects.par,
+        core.slide_vn_mps, core.stop_speed_mps, core.max_impacts, core.drag_dt_s,
+        probe.x_m, probe.values, probe.env_x0_m, probe.env_dx_m, probe.env,
+        record.rows, record.start, record.on, trace,
+    )  # fmt: skip
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
 def run_rocks(rocks, model, probes, records, out):
     """:func:`run_rock` over all ``rocks`` (:class:`Rocks`) in parallel; outputs
     written in place (``probes`` :class:`Probes`, ``records`` :class:`Records`,
-    ``out`` :class:`Outcomes`).
+    ``out`` :class:`Outcomes`)."""
+    prof, trees, effects, core = model.profile, model.trees, model.effects, model.core
+    _run_rocks(
+        rocks.key, rocks.x_m, rocks.z_m, rocks.vx_mps, rocks.vz_mps,
+        rocks.omega_radps, rocks.mass_kg, rocks.radius_m, rocks.gyration_m,
+        prof.x_m, prof.z_m, prof.slope, prof.cos_psi, prof.sin_psi, prof.psi_deg,
+        prof.material, model.materials, trees.x_m, trees.diameter_m, trees.height_m,
+        effects.flags, effects.par, core.slide_vn_mps, core.stop_speed_mps,
+        core.max_impacts, core.drag_dt_s, probes.x_m, probes.values,
+        probes.env_x0_m, probes.env_dx_m, probes.env, records.rows, records.offsets,
+        records.on, out.impacts, out.state, out.runout_x_m,
+    )  # fmt: skip
 
-    numba's ``prange`` cannot hand a tuple holding arrays to its worker function,
-    so the bundles' arrays are taken out here and the bundles rebuilt (at no cost)
-    inside the loop.
-    """
-    profile, trees, core = model.profile, model.trees, model.core
-    effects = model.effects
-    px, pz, sl = profile.x_m, profile.z_m, profile.slope
-    cpsi, spsi, psid, smat = (
-        profile.cos_psi, profile.sin_psi, profile.psi_deg, profile.material
-    )  # fmt: skip
-    materials = model.materials
-    tx, td, th = trees.x_m, trees.diameter_m, trees.height_m
-    flags, par = effects.flags, effects.par
-    slide_vn, stop_v, max_imp, drag_dt = (
-        core.slide_vn_mps, core.stop_speed_mps, core.max_impacts, core.drag_dt_s
-    )  # fmt: skip
-    key, x, z, vx, vz = rocks.key, rocks.x_m, rocks.z_m, rocks.vx_mps, rocks.vz_mps
-    w, m, r, kg = rocks.omega_radps, rocks.mass_kg, rocks.radius_m, rocks.gyration_m
-    ana_x, ana, env0, envdx, env = (
-        probes.x_m, probes.values, probes.env_x0_m, probes.env_dx_m, probes.env
-    )  # fmt: skip
-    rows, offsets, rec_on = records.rows, records.offsets, records.on
-    impacts, states, runout = out.impacts, out.state, out.runout_x_m
+
+@njit(cache=True, parallel=True)
+def _run_rocks(key, x, z, vx, vz, w, m, r, kg, px, pz, sl, cpsi, spsi, psid, smat,
+               mat, tx, td, th, flags, par, slide_vn, stop_v, max_imp, drag_dt, ana_x,
+               ana, env0, envdx, env, rows, offsets, rec_on, impacts, states,
+               runout):  # fmt: skip
+    """The ``prange`` loop of :func:`run_rocks` on the bundles' fields (numba's
+    ``prange`` cannot hand a tuple holding arrays to its worker function)."""
     no_trace = np.zeros((0, 2))
     for i in prange(key.size):
-        bundle = KernelModel(
-            profile=Profile(
-                x_m=px, z_m=pz, slope=sl, cos_psi=cpsi, sin_psi=spsi, psi_deg=psid,
-                material=smat,
-            ),
-            materials=materials,
-            trees=Trees(x_m=tx, diameter_m=td, height_m=th),
-            effects=Effects(flags=flags, par=par),
-            core=Core(
-                slide_vn_mps=slide_vn, stop_speed_mps=stop_v, max_impacts=max_imp,
-                drag_dt_s=drag_dt,
-            ),
+        n, st, ro, _ = _drive(
+            key[i], x[i], z[i], vx[i], vz[i], w[i], m[i], r[i], kg[i], px, pz, sl,
+            cpsi, spsi, psid, smat, mat, tx, td, th, flags, par, slide_vn, stop_v,
+            max_imp, drag_dt, ana_x, ana[i], env0, envdx, env[i], rows, offsets[i],
+            rec_on, no_trace,
         )  # fmt: skip
-        rock = Rock(
-            key=key[i], x_m=x[i], z_m=z[i], vx_mps=vx[i], vz_mps=vz[i],
-            omega_radps=w[i], mass_kg=m[i], radius_m=r[i], gyration_m=kg[i],
-        )  # fmt: skip
-        probe = Probe(
-            x_m=ana_x, values=ana[i], env_x0_m=env0, env_dx_m=envdx, env=env[i]
-        )
-        record = Record(rows=rows, start=offsets[i], on=rec_on)
-        n, st, ro, _ = run_rock(rock, bundle, probe, record, no_trace)
         impacts[i] = n
         states[i] = st
         runout[i] = ro

@@ -40,19 +40,19 @@ class OneRock:
         return self.impacts[:, kernel.RECORD_COLUMNS.index(name)]
 
 
-#: The kernel's stage functions the reference interprets with its driver
-#: (:func:`kernel.run_rock`); the helpers they call (contact, sweeps, laws) run
-#: compiled, as before the split.
-INTERPRETED = ("fly", "impact", "slide")
+#: The kernel's functions the reference interprets: the driver and its stages
+#: (the helpers they call -- contact, sweeps, laws -- run compiled).
+INTERPRETED = ("run_rock", "_drive", "fly", "impact", "slide")
 
 
 def _interpreted_run_rock() -> Callable:
     """:func:`kernel.run_rock`'s Python source, calling the Python source of the
-    stages :data:`INTERPRETED`."""
-    py = kernel.run_rock.py_func
-    names = dict(py.__globals__)
-    names.update({name: getattr(kernel, name).py_func for name in INTERPRETED})
-    return types.FunctionType(py.__code__, names, py.__name__, py.__defaults__)
+    other functions :data:`INTERPRETED`."""
+    names = dict(vars(kernel))
+    for name in INTERPRETED:
+        py = getattr(kernel, name).py_func
+        names[name] = types.FunctionType(py.__code__, names, name, py.__defaults__)
+    return names["run_rock"]
 
 
 def simulate_one_rock(
