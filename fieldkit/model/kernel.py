@@ -631,7 +631,7 @@ def _flight_tree(key, n, x, z, vx, vz, ax, az, tc, px, pz, sl, tx, th, p_hit):
     return -1, tt
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def fly(key, n, x, z, vx, vz, w, m, r, kg, t, j, tree_hit, px, pz, sl, tx, td, th,
         flags, par, drag_dt, ana_x, ana, env0, envdx, env, trace, ntr):  # fmt: skip
     """The flight stage: from ``(x, z)`` with ``(vx, vz)`` over segment ``j`` until
@@ -705,7 +705,7 @@ def fly(key, n, x, z, vx, vz, w, m, r, kg, t, j, tree_hit, px, pz, sl, tx, td, t
     return x, z, vx, vz, t, j, tree_hit, ntr, state, exit_x
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def impact(key, n, x, z, vx, vz, w, t, j, m, r, kg, x0, m0, r0, k0, tree_hit, cpsi,
            spsi, psid, smat, mat, flags, par, slide_vn, rec, rec_start,
            rec_on):  # fmt: skip
@@ -789,7 +789,7 @@ def impact(key, n, x, z, vx, vz, w, t, j, m, r, kg, x0, m0, r0, k0, tree_hit, cp
     return vfx, vfz, w, m, r, kg, True, 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def slide(key, n, x, u, t, j, m, r, kg, px, pz, sl, cpsi, spsi, psid, smat, mat, tx,
           td, flags, par, stop_v, ana_x, ana, env0, envdx, env, trace,
           ntr):  # fmt: skip
@@ -902,14 +902,20 @@ def slide(key, n, x, u, t, j, m, r, kg, px, pz, sl, cpsi, spsi, psid, smat, mat,
     return x, t, j, ntr, state, tree_hit, z, vx, vz, w
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _drive(key, x, z, vx, vz, w, m, r, kg, px, pz, sl, cpsi, spsi, psid, smat, mat, tx,
            td, th, flags, par, slide_vn, stop_v, max_imp, drag_dt, ana_x, ana, env0,
            envdx, env, rec, rec_start, rec_on, trace):  # fmt: skip
-    """The stage loop of :func:`run_rock` on the bundles' fields (called by name
-    from :func:`run_rock` and :func:`run_rocks` only: numba counts references to
-    every array taken out of a tuple, so the per-rock loop takes them out of the
-    bundles once per run, not once per rock or per stage)."""
+    """The stage loop of :func:`run_rock` on the bundles' fields (called from
+    :func:`run_rock` and :func:`_run_rocks` only).
+
+    Speed: the stages are inlined (``inline="always"``: a call passing some forty
+    arrays per impact costs more than the impact) and this loop is compiled
+    without reference counting (``_nrt=False``: it allocates nothing, and numba
+    would otherwise count a reference to every array handed to an inlined stage,
+    at every impact). Calls keep fewer than 30 positional arguments: beyond that
+    CPython passes ``*args``, which numba's inliner refuses.
+    """
     x0, m0, r0, k0 = x, m, r, kg
     max_imp = int(max_imp)
     n = 0
