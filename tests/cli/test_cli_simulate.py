@@ -115,6 +115,28 @@ def test_effects_lists_and_describes(core, cli, fails):
     fails(cli("effects", "no_such_effect"), "unknown effect", EFFECTS[0].name)
 
 
+def test_effects_says_impact_table_export_and_held_from_the_metadata(core, cli):
+    """``fieldkit effects NAME`` prints what the consumers read (issue 21): whether
+    an ImpactTable informs it, how CRSP and RocFall take it, which parameters an
+    impact fit holds."""
+    r = cli("effects", "angle_dependent_restitution")
+    assert r.exit_code == 0
+    out = r.stdout
+    assert "from an ImpactTable: yes" in out
+    assert "export to CRSP: not mapped: CRSP's Rn depends on the impact velocity" in out
+    assert "export to RocFall: not mapped: RocFall's lumped-mass Rn" in out
+    assert out.count("held by an impact fit: ") == 2  # theta_ref_deg and a
+    r = cli("effects", "velocity_scaled_restitution")
+    assert "export to CRSP: mapped: CRSP's own scaling of Rn (K = 30 ft/s)" in r.stdout
+    assert "held by an impact fit" not in r.stdout
+    r = cli("effects", "air_drag")
+    assert "from an ImpactTable: no: acts in flight" in r.stdout
+    r = cli("effects", "affine_rebound")
+    assert "export to RocFall: not mapped: affine_rebound is not a physical law" in (
+        r.stdout
+    )
+
+
 # ---------------------------------------------------------------- issue 17 items
 
 #: RocFall's Table 7-1 colluvium (e_n 1.0 +- 0.04, e_t 0.62) on a 45 deg slope that
