@@ -3,8 +3,19 @@
 :func:`run_rock` follows one rock from its start until it stops, leaves the profile or
 reaches ``max_impacts``; :func:`run_rocks` runs many in parallel (``prange`` over
 rocks; every random number is a function of the rock's key, so results do not depend
-on threads). :mod:`fieldkit.model.reference` runs the same :func:`run_rock` source in
-the Python interpreter.
+on threads). :mod:`fieldkit.model.reference` runs the same source in the Python
+interpreter.
+
+Arguments come in named bundles (namedtuples, built in one place,
+:func:`fieldkit.model.simulate.kernel_inputs`): the rock's start (:class:`Rock`,
+:class:`Rocks`), the model (:class:`KernelModel`: :class:`Profile`, the material
+table with columns :data:`MATERIAL_COLUMNS`, :class:`Trees`, :class:`Effects`,
+:class:`Core`), the sampled outputs (:class:`Probe`, :class:`Probes`; analysis
+columns :data:`ANALYSIS_COLUMNS`), the impact rows (:class:`Record`,
+:class:`Records`; columns :data:`RECORD_COLUMNS`) and the outcomes
+(:class:`Outcomes`). A rock's life is three stages, :func:`fly`, :func:`impact` and
+:func:`slide`, looped by a short driver; :func:`restitution` and
+:func:`passive_normal_speed` are the impact laws every kernel shares.
 
 Flight (exact, lumped mass): the centre follows ``x = x0 + vx t``,
 ``z = z0 + vz t - g t^2 / 2``. The signed height above the line of segment j,
