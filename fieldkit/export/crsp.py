@@ -54,14 +54,15 @@ import numpy as np
 from fieldkit.errors import ArgumentError
 from fieldkit.export.fitted import with_error
 from fieldkit.export.lumped import (
-    RESTITUTION_LAWS,
     Coefficient,
     DocumentedRange,
     Written,
     closest_behaviour,
     effects_account,
+    export_rules,
     fit_coefficients,
     fit_lines,
+    foreign_normal_laws,
     no_rule,
     not_a_law,
     search_line,
@@ -254,12 +255,8 @@ def crsp_law(model: Model) -> list[str]:
             f"velocity_scaled_restitution.k_mps = {k:.4g} m/s ({m_to_ft(k):.4g} "
             "ft/s), but CRSP scales Rn with K = 30 ft/s (9.144 m/s)"
         )
-    for law in RESTITUTION_LAWS:
-        if law in model.effects and law not in (
-            "velocity_scaled_restitution",
-            "rotation_friction",
-        ):
-            reasons.append(f"{law}: CRSP has no such law")
+    for law in foreign_normal_laws(model, "CRSP"):
+        reasons.append(f"{law}: CRSP has no such law")
     low, high = COEFFICIENT_RANGE
     for name, material in model.materials.items():
         for field, target in (("e_n", "Rn"), ("e_t", "Rt")):
@@ -398,29 +395,9 @@ def _translation_lines(model: Model, emulated: Model) -> list[str]:
     ]
 
 
-#: How CRSP takes every effect of the registry (README "Notes").
-EFFECT_RULES: dict[str, tuple[bool, str]] = {
-    "velocity_scaled_restitution": (
-        True,
-        "CRSP's own scaling of Rn (K = 30 ft/s); another K, or no scaling, is "
-        "fitted in range under CRSP's law",
-    ),
-    "slope_roughness": (True, "each cell's S = r tan(dip SD)"),
-    "rotation_friction": (
-        False,
-        "CRSP computes the rotation itself (w = v_T / r and the shape's moment of "
-        "inertia, thesis §7.3.7); fieldkit's contact friction and coupling have no "
-        "CRSP input",
-    ),
-    "angle_dependent_restitution": (
-        False,
-        "CRSP's Rn depends on the impact velocity (eq. 7.1), not on the impact "
-        "angle (eq. 5.4): Rn, Rt are fitted in range to the rebounds it realises",
-    ),
-    "air_drag": (False, "CRSP is a lumped-mass model without air drag (thesis §7.2)"),
-    "mass_loss": (False, "CRSP's rock keeps its mass (no breakage)"),
-    "tree_impacts": (False, "no tree-impact input was found for CRSP 4.0"),
-}
+#: How CRSP takes every effect of the registry (README "Notes"): the effects'
+#: metadata (:attr:`fieldkit.model.effects.spec.EffectSpec.exports`).
+EFFECT_RULES: dict[str, tuple[bool, str]] = export_rules("CRSP")
 
 
 def m_to_ft(value_m: float | np.ndarray) -> float | np.ndarray:

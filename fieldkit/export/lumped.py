@@ -57,6 +57,47 @@ from fieldkit.model.model_file import Model
 RESTITUTION_LAWS = tuple(s.name for s in registry.EFFECTS if s.changes_rebound)
 
 
+def export_rules(target: str) -> dict[str, tuple[bool, str]]:
+    """Effect -> (mapped, how or why) for ``target``, from the effects' metadata
+    (:attr:`~fieldkit.model.effects.spec.EffectSpec.exports`; an effect without an
+    entry, the statistical alternative, is said by :func:`not_a_law`).
+
+    Examples
+    --------
+    >>> export_rules("CRSP")["velocity_scaled_restitution"][0]
+    True
+    """
+    return {
+        spec.name: (rule.mapped, rule.how)
+        for spec in registry.EFFECTS
+        if (rule := spec.export(target)) is not None
+    }
+
+
+def foreign_normal_laws(model: Model, target: str) -> list[str]:
+    """The active effects that change the normal rebound and that ``target`` does
+    not take (effect metadata): the target's own normal law replaces them.
+
+    Examples
+    --------
+    >>> from fieldkit.model.model_file import model_from_dict
+    >>> m = model_from_dict({"profile": {"x_m": [0, 10], "z_m": [5, 0],
+    ...   "material": "rock"}, "materials": {"rock": {"e_n": 0.3, "e_t": 0.8,
+    ...   "friction_deg": 25}}, "effects": {"angle_dependent_restitution": {},
+    ...   "velocity_scaled_restitution": {}, "rotation_friction": {}}, "body":
+    ...   {"mass_kg": 100, "radius_m": 0.2}, "seeder": {"x_m": 1, "z_m": 6}})
+    >>> foreign_normal_laws(m, "CRSP")
+    ['angle_dependent_restitution']
+    """
+    out = []
+    for spec in registry.EFFECTS:
+        rule = spec.export(target)
+        if spec.name in model.effects and spec.changes_normal_rebound:
+            if rule is None or not rule.mapped:
+                out.append(spec.name)
+    return out
+
+
 def not_a_law(name: str, target: str) -> str:
     """Why ``target`` cannot take effect ``name`` when the effect is the diagnosis's
     statistical alternative (:attr:`EffectSpec.kind <fieldkit.model.effects.spec.
@@ -147,10 +188,10 @@ def calibrated_normal_factor(model: Model, vin_abs: np.ndarray) -> np.ndarray | 
     without; None when another active law changes the normal rebound (its value
     depends on more than the normal speed)."""
     others = [
-        law
-        for law in RESTITUTION_LAWS
-        if law in model.effects
-        and law not in ("velocity_scaled_restitution", "rotation_friction")
+        name
+        for name in model.effects
+        if registry.effect(name).changes_normal_rebound
+        and name != "velocity_scaled_restitution"
     ]
     if others:
         return None

@@ -66,14 +66,15 @@ from scipy.stats import norm, truncnorm
 from fieldkit.errors import ArgumentError
 from fieldkit.export.fitted import with_error
 from fieldkit.export.lumped import (
-    RESTITUTION_LAWS,
     Coefficient,
     DocumentedRange,
     Written,
     closest_behaviour,
     effects_account,
+    export_rules,
     fit_coefficients,
     fit_lines,
+    foreign_normal_laws,
     no_rule,
     not_a_law,
     search_line,
@@ -83,6 +84,7 @@ from fieldkit.export.result import Export, Mapped
 from fieldkit.export.rocfall_keys import DISTRIBUTIONS, ROCK_KEYS
 from fieldkit.export.site import ExportSite
 from fieldkit.export.translation import translation_error
+from fieldkit.model.effects import registry
 from fieldkit.model.model_file import Model, model_from_dict, model_to_dict
 from fieldkit.outputs import csv_text, json_text
 
@@ -363,12 +365,8 @@ def rocfall_law(model: Model) -> tuple[bool, list[str]]:
             f"velocity_scaled_restitution.k_mps = {k:.4g} m/s, but RocFall scales "
             f"Rn with K = {ROCFALL_K_MPS:g} m/s"
         )
-    for law in RESTITUTION_LAWS:
-        if law in model.effects and law not in (
-            "velocity_scaled_restitution",
-            "rotation_friction",
-        ):
-            reasons.append(f"{law}: RocFall's lumped mass has no such law")
+    for law in foreign_normal_laws(model, "RocFall"):
+        reasons.append(f"{law}: RocFall's lumped mass has no such law")
     for name, m in model.materials.items():
         for field, key in (("e_n", "Rn"), ("e_t", "Rt")):
             value = getattr(m, field)
@@ -407,7 +405,7 @@ def _rocfall_model(text: str) -> Written:
     effects = {
         name: params
         for name, params in model.effects.items()
-        if name not in RESTITUTION_LAWS or name == "rotation_friction"
+        if not registry.effect(name).changes_normal_rebound
     }
     if scaled:
         effects["velocity_scaled_restitution"] = {"k_mps": ROCFALL_K_MPS}
@@ -842,31 +840,9 @@ def _mapped_rest(model: Model, written: Model) -> list[Mapped]:
     return out
 
 
-#: Effects RocFall (lumped mass) cannot represent -> why.
-_NO_EFFECT = {
-    "angle_dependent_restitution": "RocFall's lumped-mass Rn is scaled by velocity "
-    "or by mass only; no impact-angle law for Rn was found in its documentation: "
-    "Rn, Rt are fitted in range to the rebounds the law realises",
-    "mass_loss": "RocFall's lumped-mass rock keeps its mass (no breakage or abrasion)",
-    "tree_impacts": "RocFall's lumped mass has no trees (barriers only); the trees "
-    "are not exported",
-    "air_drag": "RocFall's lumped mass ignores air resistance",
-}
-#: How RocFall takes every effect of the registry (README "Notes").
-EFFECT_RULES: dict[str, tuple[bool, str]] = {
-    **{name: (False, why) for name, why in _NO_EFFECT.items()},
-    "velocity_scaled_restitution": (
-        True,
-        "'scale Rn by velocity' at RocFall's K = 9.144 m/s; another K or an Rn "
-        "above 1 is fitted in range under that law",
-    ),
-    "rotation_friction": (
-        True,
-        "'consider rotational velocity' (on/off only: RocFall's own rotation, its "
-        "friction and coupling are not written)",
-    ),
-    "slope_roughness": (True, "each material's slope roughness (SD of the dip)"),
-}
+#: How RocFall takes every effect of the registry (README "Notes"): the effects'
+#: metadata (:attr:`fieldkit.model.effects.spec.EffectSpec.exports`).
+EFFECT_RULES: dict[str, tuple[bool, str]] = export_rules("RocFall")
 
 
 def _unmapped(model: Model) -> list[tuple[str, str]]:
@@ -875,7 +851,7 @@ def _unmapped(model: Model) -> list[tuple[str, str]]:
         if name in EFFECT_RULES and EFFECT_RULES[name][0]:
             continue
         why = (
-            _NO_EFFECT.get(name)
+            EFFECT_RULES.get(name, (False, ""))[1]
             or not_a_law(name, "RocFall")
             or no_rule(name, "RocFall")
         )

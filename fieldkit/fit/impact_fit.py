@@ -94,13 +94,13 @@ from fieldkit.model.effects import registry
 from fieldkit.model.materials import MATERIAL_FIELDS
 from fieldkit.model.model_file import Model
 
-#: Effect parameters held at the model's value, with the reason (stated in notes).
+#: Effect parameters held at the model's value, with the reason (stated in notes):
+#: the parameters' metadata (:attr:`fieldkit.model.effects.spec.Parameter.held`).
 HELD: dict[str, str] = {
-    "angle_dependent_restitution.theta_ref_deg": "trades exactly with the material "
-    "e_n (e_n theta_ref^b is one number)",
-    "angle_dependent_restitution.a": "a = 0 or a > 0 selects the form of eq. 5.4; "
-    "with a > 0 it trades exactly with the material e_n",
-    "slope_roughness.scale": "acts through the slope the table records",
+    f"{spec.name}.{p.name}": p.held
+    for spec in registry.EFFECTS
+    for p in spec.parameters
+    if p.held
 }
 #: Fewest impacts an impact fit takes per fitted material, and fewest residual
 #: degrees of freedom (data - parameters). Below them the standard errors are not
@@ -483,9 +483,12 @@ class ImpactProblem:
             # the table's own impact velocities (not their regression
             # calibration): what the plausibility report applies the law to
             own = impact_inputs(self.table, model)
-            limit = max_realised_e_n, ImpactInputs(
-                *(getattr(own, f)[mask] for f in _ARRAY_FIELDS),
-                material_names=own.material_names,
+            limit = (
+                max_realised_e_n,
+                ImpactInputs(
+                    *(getattr(own, f)[mask] for f in _ARRAY_FIELDS),
+                    material_names=own.material_names,
+                ),
             )
         residuals = _Residuals(self, model, names, sub, observed, sd, keep, limit)
 
@@ -933,8 +936,7 @@ def _data_part(problem: ImpactProblem, fit, limit: float):
         f"penalty residual per impact on its e_n beyond {margin:g}, raised to "
         f"{REALISED_PENALTIES[-1]:g} x the excess): "
         + (
-            f"{active} impact(s) at the limit, the largest realised e_n "
-            f"{largest:.6f}"
+            f"{active} impact(s) at the limit, the largest realised e_n {largest:.6f}"
             if active
             else "no impact reaches it"
         )

@@ -3,8 +3,19 @@
 :func:`run_rock` follows one rock from its start until it stops, leaves the profile or
 reaches ``max_impacts``; :func:`run_rocks` runs many in parallel (``prange`` over
 rocks; every random number is a function of the rock's key, so results do not depend
-on threads). :mod:`fieldkit.model.reference` runs the same :func:`run_rock` source in
-the Python interpreter.
+on threads). :mod:`fieldkit.model.reference` runs the same source in the Python
+interpreter.
+
+Arguments come in named bundles (namedtuples, built in one place,
+:func:`fieldkit.model.simulate.kernel_inputs`): the rock's start (:class:`Rock`,
+:class:`Rocks`), the model (:class:`KernelModel`: :class:`Profile`, the material
+table with columns :data:`MATERIAL_COLUMNS`, :class:`Trees`, :class:`Effects`,
+:class:`Core`), the sampled outputs (:class:`Probe`, :class:`Probes`; analysis
+columns :data:`ANALYSIS_COLUMNS`), the impact rows (:class:`Record`,
+:class:`Records`; columns :data:`RECORD_COLUMNS`) and the outcomes
+(:class:`Outcomes`). A rock's life is three stages, :func:`fly`, :func:`impact` and
+:func:`slide`, looped by a short driver; :func:`restitution` and
+:func:`passive_normal_speed` are the impact laws every kernel shares.
 
 Flight (exact, lumped mass): the centre follows ``x = x0 + vx t``,
 ``z = z0 + vz t - g t^2 / 2``. The signed height above the line of segment j,
@@ -35,6 +46,7 @@ segment (the normal component is lost). Spin while sliding is rolling, ``-u/r``.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange
@@ -68,7 +80,7 @@ from fieldkit.model.results import (
 
 G = 9.81
 INF = math.inf
-#: Columns of a recorded impact row.
+#: Columns of a recorded impact row (``R_*`` name each column's index).
 RECORD_COLUMNS = (
     "t_s",
     "x_m",
@@ -87,8 +99,51 @@ RECORD_COLUMNS = (
     "tree_strike",
 )
 N_RECORD = len(RECORD_COLUMNS)
-#: Columns of an analysis-point record: crossed flag, speed, KE, RE, total, height.
-N_ANALYSIS = 6
+R_T = RECORD_COLUMNS.index("t_s")
+R_X = RECORD_COLUMNS.index("x_m")
+R_Z = RECORD_COLUMNS.index("z_m")
+R_SLOPE = RECORD_COLUMNS.index("slope_deg")
+R_VI_X = RECORD_COLUMNS.index("vi_x_mps")
+R_VI_Z = RECORD_COLUMNS.index("vi_z_mps")
+R_VF_X = RECORD_COLUMNS.index("vf_x_mps")
+R_VF_Z = RECORD_COLUMNS.index("vf_z_mps")
+R_MASS = RECORD_COLUMNS.index("mass_kg")
+R_RADIUS = RECORD_COLUMNS.index("radius_m")
+R_GYRATION = RECORD_COLUMNS.index("gyration_m")
+R_OMEGA_I = RECORD_COLUMNS.index("omega_i_radps")
+R_OMEGA_F = RECORD_COLUMNS.index("omega_f_radps")
+R_MATERIAL = RECORD_COLUMNS.index("material_index")
+R_TREE = RECORD_COLUMNS.index("tree_strike")
+#: Columns of an analysis-point record (``A_*`` name each column's index): crossed
+#: flag (1.0), speed [m/s], translational / rotational / total kinetic energy [J],
+#: centre height above the ground [m].
+ANALYSIS_COLUMNS = ("crossed", "speed_mps", "ke_j", "re_j", "total_j", "height_m")
+N_ANALYSIS = len(ANALYSIS_COLUMNS)
+A_CROSSED = ANALYSIS_COLUMNS.index("crossed")
+A_SPEED = ANALYSIS_COLUMNS.index("speed_mps")
+A_KE = ANALYSIS_COLUMNS.index("ke_j")
+A_RE = ANALYSIS_COLUMNS.index("re_j")
+A_TOTAL = ANALYSIS_COLUMNS.index("total_j")
+A_HEIGHT = ANALYSIS_COLUMNS.index("height_m")
+#: Columns of the material table (one row per material; ``M_*`` name the indices).
+MATERIAL_COLUMNS = (
+    "e_n",
+    "e_t",
+    "friction_deg",
+    "e_n_sd",
+    "e_t_sd",
+    "friction_deg_sd",
+    "roughness_m",
+    "roughness_deg_sd",
+)
+M_EN = MATERIAL_COLUMNS.index("e_n")
+M_ET = MATERIAL_COLUMNS.index("e_t")
+M_PHI = MATERIAL_COLUMNS.index("friction_deg")
+M_EN_SD = MATERIAL_COLUMNS.index("e_n_sd")
+M_ET_SD = MATERIAL_COLUMNS.index("e_t_sd")
+M_PHI_SD = MATERIAL_COLUMNS.index("friction_deg_sd")
+M_ROUGH = MATERIAL_COLUMNS.index("roughness_m")
+M_ROUGH_SD = MATERIAL_COLUMNS.index("roughness_deg_sd")
 #: Slide steps (segment passes) after which a rock is stopped as MAX_IMPACTS.
 MAX_SLIDE_STEPS = 100000
 
@@ -118,8 +173,136 @@ P_DRAG_CD = LAYOUT["air_drag.cd"]
 P_DRAG_RHO = LAYOUT["air_drag.air_density_kg_m3"]
 P_AFF_BN = LAYOUT["affine_rebound.b_n_mps"]
 P_AFF_BT = LAYOUT["affine_rebound.b_t_mps"]
-# Material table columns.
-M_EN, M_ET, M_PHI, M_EN_SD, M_ET_SD, M_PHI_SD, M_ROUGH, M_ROUGH_SD = range(8)
+
+
+# ---------------------------------------------------------------- named bundles
+# The kernel's arguments, grouped so that no two neighbours of one type can be
+# swapped silently. numba compiles namedtuples (of arrays and scalars, nested) with
+# ``cache=True`` and inside ``prange``; fieldkit.model.simulate builds them.
+class Rock(NamedTuple):
+    """One rock's start (scalars): random key, position, velocity, spin, body."""
+
+    key: np.uint64
+    x_m: float
+    z_m: float
+    vx_mps: float
+    vz_mps: float
+    omega_radps: float
+    mass_kg: float
+    radius_m: float
+    gyration_m: float
+
+
+class Rocks(NamedTuple):
+    """Many rocks' starts: the fields of :class:`Rock` as 1-D arrays (one per rock)."""
+
+    key: np.ndarray
+    x_m: np.ndarray
+    z_m: np.ndarray
+    vx_mps: np.ndarray
+    vz_mps: np.ndarray
+    omega_radps: np.ndarray
+    mass_kg: np.ndarray
+    radius_m: np.ndarray
+    gyration_m: np.ndarray
+
+
+class Profile(NamedTuple):
+    """The slope: vertices ``x_m, z_m`` and per segment its slope dz/dx, the cosine,
+    sine and degrees of its dip ``psi = -atan(dz/dx)`` and its material index."""
+
+    x_m: np.ndarray
+    z_m: np.ndarray
+    slope: np.ndarray
+    cos_psi: np.ndarray
+    sin_psi: np.ndarray
+    psi_deg: np.ndarray
+    material: np.ndarray
+
+
+class Trees(NamedTuple):
+    """Trees along the profile, sorted by ``x_m`` (empty arrays for none)."""
+
+    x_m: np.ndarray
+    diameter_m: np.ndarray
+    height_m: np.ndarray
+
+
+class Effects(NamedTuple):
+    """Effect switches ``flags`` (registry order, 1 = on) and the flat parameter
+    array ``par`` (registry :data:`~fieldkit.model.effects.registry.LAYOUT`)."""
+
+    flags: np.ndarray
+    par: np.ndarray
+
+
+class Core(NamedTuple):
+    """The model file's ``core`` settings (floats)."""
+
+    slide_vn_mps: float
+    stop_speed_mps: float
+    max_impacts: float
+    drag_dt_s: float
+
+
+class KernelModel(NamedTuple):
+    """Everything about the model the kernel reads; ``materials`` is the material
+    table (one row per material, columns :data:`MATERIAL_COLUMNS`)."""
+
+    profile: Profile
+    materials: np.ndarray
+    trees: Trees
+    effects: Effects
+    core: Core
+
+
+class Probe(NamedTuple):
+    """One rock's sampled outputs, written in place: ``values`` (analysis points x
+    :data:`ANALYSIS_COLUMNS`, NaN on entry) at ``x_m``; the bounce-height envelope
+    ``env`` (bins of ``env_dx_m`` from ``env_x0_m``, NaN on entry; zero bins for
+    none)."""
+
+    x_m: np.ndarray
+    values: np.ndarray
+    env_x0_m: float
+    env_dx_m: float
+    env: np.ndarray
+
+
+class Probes(NamedTuple):
+    """:class:`Probe` of many rocks: ``values`` (rocks, points, N_ANALYSIS), ``env``
+    (rocks, bins)."""
+
+    x_m: np.ndarray
+    values: np.ndarray
+    env_x0_m: float
+    env_dx_m: float
+    env: np.ndarray
+
+
+class Record(NamedTuple):
+    """Impact rows (columns :data:`RECORD_COLUMNS`): one rock's impact ``i`` goes to
+    ``rows[start + i]`` when ``on``."""
+
+    rows: np.ndarray
+    start: int
+    on: bool
+
+
+class Records(NamedTuple):
+    """:class:`Record` of many rocks: rock ``i`` writes from ``rows[offsets[i]]``."""
+
+    rows: np.ndarray
+    offsets: np.ndarray
+    on: bool
+
+
+class Outcomes(NamedTuple):
+    """Per-rock results of :func:`run_rocks`, written in place."""
+
+    impacts: np.ndarray
+    state: np.ndarray
+    runout_x_m: np.ndarray
 
 
 @njit(cache=True)
@@ -237,35 +420,14 @@ def _env_put(env, env0, envdx, xq, h, edge):
 
 
 @njit(cache=True)
-def _sweep_flight(
-    x0,
-    z0,
-    vx,
-    vz,
-    ax,
-    az,
-    t1,
-    px,
-    pz,
-    sl,
-    m,
-    r,
-    kg,
-    w,
-    ana_x,
-    ana,
-    env0,
-    envdx,
-    env,
-    trace,
-    ntr,
-):
+def _sweep_flight(x0, z0, vx, vz, ax, az, t1, px, pz, sl, m, kg, w, ana_x, ana, env0,
+                  envdx, env, trace, ntr):  # fmt: skip
     """Analysis-point crossings, envelope and trace of one flight piece ``[0, t1]``."""
     x1 = x0 + vx * t1 + 0.5 * ax * t1 * t1
     lo, hi = min(x0, x1), max(x0, x1)
     for a in range(ana_x.size):
         xa = ana_x[a]
-        if ana[a, 0] == 1.0 or xa < lo or xa > hi or vx == 0.0:
+        if ana[a, A_CROSSED] == 1.0 or xa < lo or xa > hi or vx == 0.0:
             continue
         ta = time_to_x(x0, vx, ax, xa)
         if ta > t1:
@@ -276,12 +438,12 @@ def _sweep_flight(
         v2 = vxa * vxa + vza * vza
         ke = 0.5 * m * v2
         re = 0.5 * m * kg * kg * w * w
-        ana[a, 0] = 1.0
-        ana[a, 1] = math.sqrt(v2)
-        ana[a, 2] = ke
-        ana[a, 3] = re
-        ana[a, 4] = ke + re
-        ana[a, 5] = za - ground_z(px, pz, sl, xa)
+        ana[a, A_CROSSED] = 1.0
+        ana[a, A_SPEED] = math.sqrt(v2)
+        ana[a, A_KE] = ke
+        ana[a, A_RE] = re
+        ana[a, A_TOTAL] = ke + re
+        ana[a, A_HEIGHT] = za - ground_z(px, pz, sl, xa)
     if env.size > 0 and vx != 0.0:
         # h(x) = z(x) - ground(x) is concave on each segment: its maximum over a bin
         # is at a bin edge, a vertex, a piece end or the stationary point.
@@ -327,25 +489,24 @@ def _sweep_flight(
 
 
 @njit(cache=True)
-def _sweep_slide(
-    xa, xb, sp, ad, cpsi, m, r, kg, px, pz, sl, ana_x, ana, env0, envdx, env, trace, ntr
-):
+def _sweep_slide(xa, xb, sp, ad, cpsi, m, r, kg, px, pz, sl, ana_x, ana, env0, envdx,
+                 env, trace, ntr):  # fmt: skip
     """Analysis crossings, envelope (height 0) and trace of a slide from xa to xb."""
     lo, hi = min(xa, xb), max(xa, xb)
     for a in range(ana_x.size):
         xq = ana_x[a]
-        if ana[a, 0] == 1.0 or xq < lo or xq > hi:
+        if ana[a, A_CROSSED] == 1.0 or xq < lo or xq > hi:
             continue
         v2 = sp * sp + 2.0 * ad * abs(xq - xa) / cpsi
         v = math.sqrt(v2) if v2 > 0.0 else 0.0
         ke = 0.5 * m * v * v
         re = 0.5 * m * kg * kg * (v / r) ** 2
-        ana[a, 0] = 1.0
-        ana[a, 1] = v
-        ana[a, 2] = ke
-        ana[a, 3] = re
-        ana[a, 4] = ke + re
-        ana[a, 5] = 0.0
+        ana[a, A_CROSSED] = 1.0
+        ana[a, A_SPEED] = v
+        ana[a, A_KE] = ke
+        ana[a, A_RE] = re
+        ana[a, A_TOTAL] = ke + re
+        ana[a, A_HEIGHT] = 0.0
     if env.size > 0:
         b0 = int(math.floor((lo - env0) / envdx))
         b1 = int(math.floor((hi - env0) / envdx))
@@ -461,58 +622,313 @@ def passive_normal_speed(vin, vit, w_i, vfn, vft, w_f, kg):
 
 
 @njit(cache=True)
-def run_rock(
-    key,
-    x,
-    z,
-    vx,
-    vz,
-    w,
-    m,
-    r,
-    kg,
-    px,
-    pz,
-    sl,
-    cpsi,
-    spsi,
-    psid,
-    smat,
-    mat,
-    tx,
-    td,
-    th,
-    flags,
-    par,
-    core,
-    ana_x,
-    ana,
-    env0,
-    envdx,
-    env,
-    rec,
-    rec_start,
-    rec_on,
-    trace,
-):
-    """Follow one rock; returns ``(impacts, state, runout_x_m, trace_points)``.
+def _flight_tree(key, n, x, z, vx, vz, ax, az, tc, px, pz, sl, tx, th, p_hit):
+    """The first tree the flight piece ``[0, tc)`` passes below its top and strikes
+    (one draw per tree passed): ``(index, time)``, index -1 for none."""
+    x_end = x + vx * tc + 0.5 * ax * tc * tc
+    lo, hi = min(x, x_end), max(x, x_end)
+    i0 = np.searchsorted(tx, lo, side="right")
+    i1 = np.searchsorted(tx, hi, side="right")
+    tt = 0.0
+    ii = i0 if vx > 0.0 else i1 - 1
+    for _ in range(i1 - i0):
+        tt = time_to_x(x, vx, ax, tx[ii])
+        if tt < tc:
+            zt = z + vz * tt + 0.5 * az * tt * tt
+            above = zt - ground_z(px, pz, sl, tx[ii])
+            if 0.0 < above < th[ii] and uniform(key, n, SLOT_TREE + ii) < p_hit:
+                return ii, tt
+        ii += 1 if vx > 0.0 else -1
+    return -1, tt
 
-    Arrays: profile vertices ``px, pz``; per segment slope dz/dx ``sl``, ``cos psi``,
-    ``sin psi``, ``psi`` [deg], material index; material table ``mat`` (columns
-    ``M_*``); trees ``tx, td, th``; effect ``flags`` and ``par`` (registry layout);
-    ``core`` = (slide_vn, stop_speed, max_impacts, drag_dt). Outputs written in place:
-    ``ana`` (analysis points x N_ANALYSIS, NaN-filled on entry), ``env`` (envelope
-    bins, NaN-filled), ``rec[rec_start + i]`` (impact rows when ``rec_on``) and
-    ``trace`` (x, z points; zero rows for none).
+
+@njit(cache=True, inline="always")
+def fly(key, n, x, z, vx, vz, w, m, r, kg, t, j, tree_hit, px, pz, sl, tx, td, th,
+        flags, par, drag_dt, ana_x, ana, env0, envdx, env, trace, ntr):  # fmt: skip
+    """The flight stage: from ``(x, z)`` with ``(vx, vz)`` over segment ``j`` until
+    the centre meets the profile or leaves it.
+
+    Exact parabolas (chains of constant-acceleration substeps with ``air_drag``);
+    trees passed below their top are struck with their probability
+    (``tree_impacts``). Returns ``(x, z, vx, vz, t, j, tree_hit, ntr, state,
+    exit_x)``: ``state`` -1 on a contact with segment ``j`` (``z`` then exactly on
+    its line), else ``EXITED_*`` with ``exit_x`` the profile end left.
     """
-    nseg = px.size - 1
-    slide_vn = core[0]
-    stop_v = core[1]
-    max_imp = int(core[2])
-    drag_dt = core[3]
-    m0, r0, k0, x_release = m, r, kg, x
     drag = flags[F_DRAG] == 1 and par[P_DRAG_CD] > 0.0
     trees = flags[F_TREE] == 1 and tx.size > 0 and par[P_TREE_P] > 0.0
+    nseg = px.size - 1
+    state = -1
+    exit_x = x
+    while True:
+        if drag:
+            k = air_drag.drag_factor(par[P_DRAG_CD], par[P_DRAG_RHO], r, m)
+            tmax = air_drag.substep_s(vx, vz, k, drag_dt)
+            ax, az = air_drag.substep_acceleration(vx, vz, k, G, tmax)
+        else:
+            ax, az, tmax = 0.0, -G, INF
+        jc, tc = piece_contact(px, pz, sl, j, x, z, vx, vz, ax, az, tmax)
+        if trees and vx != 0.0:
+            struck, tt = _flight_tree(
+                key, n, x, z, vx, vz, ax, az, tc, px, pz, sl, tx, th, par[P_TREE_P]
+            )
+            if struck >= 0:
+                ntr = _sweep_flight(
+                    x, z, vx, vz, ax, az, tt, px, pz, sl, m, kg, w, ana_x, ana, env0,
+                    envdx, env, trace, ntr,
+                )  # fmt: skip
+                z = z + vz * tt + 0.5 * az * tt * tt
+                x = tx[struck]
+                vx = vx + ax * tt
+                vz = vz + az * tt
+                t += tt
+                v = math.sqrt(vx * vx + vz * vz)
+                v_new = tree_impacts.speed_after_strike(
+                    v, m, td[struck], par[P_TREE_C], par[P_TREE_EXP]
+                )
+                scale = v_new / v if v > 0.0 else 0.0
+                vx *= scale
+                vz *= scale
+                tree_hit = 1.0
+                j = segment_at(px, x)
+                continue
+        ntr = _sweep_flight(
+            x, z, vx, vz, ax, az, tc, px, pz, sl, m, kg, w, ana_x, ana, env0, envdx,
+            env, trace, ntr,
+        )  # fmt: skip
+        x = x + vx * tc + 0.5 * ax * tc * tc
+        z = z + vz * tc + 0.5 * az * tc * tc
+        vx = vx + ax * tc
+        vz = vz + az * tc
+        t += tc
+        if jc >= 0:
+            j = jc
+            z = pz[j] + sl[j] * (x - px[j])  # exactly on the line
+            break
+        if jc == -2:
+            state = EXITED_DOWNSLOPE
+            exit_x = px[nseg]
+            break
+        if jc == -3:
+            state = EXITED_UPSLOPE
+            exit_x = px[0]
+            break
+        j = segment_at(px, x)
+    return x, z, vx, vz, t, j, tree_hit, ntr, state, exit_x
+
+
+@njit(cache=True, inline="always")
+def impact(key, n, x, z, vx, vz, w, t, j, m, r, kg, x0, m0, r0, k0, tree_hit, cpsi,
+           spsi, psid, smat, mat, flags, par, slide_vn, rec, rec_start,
+           rec_on):  # fmt: skip
+    """The impact stage: impact number ``n`` of the rock at ``(x, z)`` on segment
+    ``j`` with incoming ``(vx, vz)`` and spin ``w``.
+
+    Draws ``e_n, e_t`` of the segment's material, applies ``mass_loss`` (from the
+    rock's release ``x0`` and start mass, radius, gyration ``m0, r0, k0``) and
+    ``slope_roughness`` (a random tilt of the dip), the rebound laws
+    (:func:`restitution`, :func:`passive_normal_speed`) and writes the impact row.
+    Returns ``(vx, vz, w, m, r, kg, flying, u)``: the rebound velocity when the
+    rock flies on; when it starts sliding (rebound normal speed below
+    ``slide_vn_mps`` or into the segment) ``flying`` False, the incoming ``(vx,
+    vz)`` and ``u`` the velocity along the segment.
+    """
+    mi = smat[j]
+    e_n = mat[mi, M_EN]
+    if mat[mi, M_EN_SD] > 0.0:
+        e_n = max(0.0, e_n + mat[mi, M_EN_SD] * normal(key, n, SLOT_E_N))
+    e_t = mat[mi, M_ET]
+    if mat[mi, M_ET_SD] > 0.0:
+        e_t = max(0.0, e_t + mat[mi, M_ET_SD] * normal(key, n, SLOT_E_T))
+    if flags[F_MASS] == 1:
+        ratio = mass_loss.volume_ratio(x - x0, n, par[P_MASS_RATE], par[P_MASS_EXP])
+        cube = ratio ** (1.0 / 3.0)
+        m, r, kg = m0 * ratio, r0 * cube, k0 * cube
+    c = cpsi[j]
+    s = spsi[j]
+    psi = psid[j]
+    vit = vx * c - vz * s
+    vin = vx * s + vz * c
+    if flags[F_ROUGH] == 1:
+        sd = slope_roughness.dip_sd_rad(
+            mat[mi, M_ROUGH], mat[mi, M_ROUGH_SD], r, par[P_ROUGH]
+        )
+        if sd > 0.0:
+            delta = sd * normal(key, n, SLOT_ROUGHNESS)
+            for trial in range(3):
+                d = delta if trial == 0 else (-delta if trial == 1 else 0.0)
+                rad = math.radians(psid[j]) + d
+                c2 = math.cos(rad)
+                s2 = math.sin(rad)
+                if vx * s2 + vz * c2 < 0.0 or trial == 2:
+                    # the dip as the ImpactTable keeps it, in (-180, 180]
+                    # (a steep face tilted further reads as an overhang)
+                    psi = math.degrees(math.atan2(s2, c2))
+                    if psi <= -180.0:
+                        psi += 360.0
+                    c, s = c2, s2
+                    break
+            vit = vx * c - vz * s
+            vin = vx * s + vz * c
+    w_i = w
+    vfn, vft, w = restitution(vin, vit, e_n, mat[mi, M_EN], e_t, w, r, kg, flags, par)
+    # spin is carried energy only where rotation_friction couples it
+    k_spin = kg if flags[F_ROT] == 1 and par[P_ROT_C] > 0.0 else 0.0
+    vfn = passive_normal_speed(vin, vit, w_i, vfn, vft, w, k_spin)
+    vfx = vft * c + vfn * s
+    vfz = -vft * s + vfn * c
+    if rec_on:
+        row = rec_start + n - 1
+        rec[row, R_T] = t
+        rec[row, R_X] = x
+        rec[row, R_Z] = z
+        rec[row, R_SLOPE] = psi
+        rec[row, R_VI_X] = vx
+        rec[row, R_VI_Z] = vz
+        rec[row, R_VF_X] = vfx
+        rec[row, R_VF_Z] = vfz
+        rec[row, R_MASS] = m
+        rec[row, R_RADIUS] = r
+        rec[row, R_GYRATION] = kg
+        rec[row, R_OMEGA_I] = w_i
+        rec[row, R_OMEGA_F] = w
+        rec[row, R_MATERIAL] = mi
+        rec[row, R_TREE] = tree_hit
+    vn_real = vfx * spsi[j] + vfz * cpsi[j]
+    if vfn < slide_vn or vn_real <= 0.0:
+        u = vfx * cpsi[j] - vfz * spsi[j]
+        return vx, vz, w, m, r, kg, False, u
+    return vfx, vfz, w, m, r, kg, True, 0.0
+
+
+@njit(cache=True, inline="always")
+def slide(key, n, x, u, t, j, m, r, kg, px, pz, sl, cpsi, spsi, psid, smat, mat, tx,
+          td, flags, par, stop_v, ana_x, ana, env0, envdx, env, trace,
+          ntr):  # fmt: skip
+    """The slide stage (eq. 7.3): sliding / rolling from ``x`` on segment ``j`` with
+    velocity ``u`` along it after impact ``n``, segment by segment (a friction draw
+    at each entry), until the rock stops, leaves the profile, launches at a convex
+    break or takes :data:`MAX_SLIDE_STEPS` steps; trees on the way are struck with
+    their probability.
+
+    Returns ``(x, t, j, ntr, state, tree_hit, z, vx, vz, w)``: ``state`` -1 for a
+    launch, then ``z, vx, vz, w`` the take-off height, velocity and spin (zeros
+    otherwise); ``tree_hit`` 1.0 when a tree was struck.
+    """
+    trees = flags[F_TREE] == 1 and tx.size > 0 and par[P_TREE_P] > 0.0
+    nseg = px.size - 1
+    state = -1
+    entry = 0
+    tanphi = _friction_tan(mat, smat[j], key, n, entry)
+    tree_hit = 0.0
+    z = vx = vz = w = 0.0
+    for _ in range(MAX_SLIDE_STEPS):
+        c = cpsi[j]
+        s = spsi[j]
+        if u > 0.0:
+            dirn = 1.0
+        elif u < 0.0:
+            dirn = -1.0
+        else:
+            if abs(s) <= c * tanphi:
+                state = STOPPED
+                break
+            dirn = 1.0 if s > 0.0 else -1.0
+        sp = abs(u)
+        ad = dirn * G * s - G * c * tanphi  # acceleration along travel
+        length = ((px[j + 1] - x) if dirn > 0.0 else (x - px[j])) / c
+        if sp == 0.0 and length <= 1e-12:
+            state = STOPPED  # at rest in a notch
+            break
+        v2 = sp * sp + 2.0 * ad * length
+        if trees:
+            reach = length if v2 > 0.0 else sp * sp / (-2.0 * ad)
+            ii = _tree_struck(tx, x, x + dirn * reach * c, key, n, par[P_TREE_P])
+            if ii >= 0:
+                d = abs(tx[ii] - x) / c
+                vt2 = sp * sp + 2.0 * ad * d
+                vt = math.sqrt(vt2) if vt2 > 0.0 else 0.0
+                ntr = _sweep_slide(
+                    x, tx[ii], sp, ad, c, m, r, kg, px, pz, sl, ana_x, ana, env0,
+                    envdx, env, trace, ntr,
+                )  # fmt: skip
+                t += (vt - sp) / ad if ad != 0.0 else d / sp
+                x = tx[ii]
+                vt = tree_impacts.speed_after_strike(
+                    vt, m, td[ii], par[P_TREE_C], par[P_TREE_EXP]
+                )
+                u = dirn * vt
+                tree_hit = 1.0
+                continue
+        if v2 <= 0.0:
+            dist = sp * sp / (-2.0 * ad)
+            x_new = x + dirn * dist * c
+            ntr = _sweep_slide(
+                x, x_new, sp, ad, c, m, r, kg, px, pz, sl, ana_x, ana, env0, envdx,
+                env, trace, ntr,
+            )  # fmt: skip
+            t += sp / (-ad)
+            x = x_new
+            u = 0.0
+            continue
+        ve = math.sqrt(v2)
+        x_new = px[j + 1] if dirn > 0.0 else px[j]
+        ntr = _sweep_slide(
+            x, x_new, sp, ad, c, m, r, kg, px, pz, sl, ana_x, ana, env0, envdx, env,
+            trace, ntr,
+        )  # fmt: skip
+        t += (ve - sp) / ad if ad != 0.0 else length / sp
+        x = x_new
+        jn = j + (1 if dirn > 0.0 else -1)
+        if jn >= nseg:
+            state = EXITED_DOWNSLOPE
+            break
+        if jn < 0:
+            state = EXITED_UPSLOPE
+            break
+        u_end = dirn * ve
+        convex = psid[jn] > psid[j] if dirn > 0.0 else psid[jn] < psid[j]
+        if convex:
+            vx = u_end * c
+            vz = -u_end * s
+            w = -u_end / r
+            j = jn
+            z = pz[j] + sl[j] * (x - px[j])
+            break
+        u = u_end * (c * cpsi[jn] + s * spsi[jn])  # projection on segment jn
+        if abs(u) < stop_v:
+            u = 0.0
+        j = jn
+        entry += 1
+        tanphi = _friction_tan(mat, smat[j], key, n, entry)
+    else:
+        state = MAX_IMPACTS
+    if state >= 0:
+        if trace.shape[0] > ntr:
+            trace[ntr, 0] = x
+            trace[ntr, 1] = ground_z(px, pz, sl, x)
+            ntr += 1
+    else:
+        # the spin of the launch: rolling at the speed of the last segment entry
+        w = -u / r if u != 0.0 else w
+    return x, t, j, ntr, state, tree_hit, z, vx, vz, w
+
+
+@njit(cache=True, _nrt=False)
+def _drive(key, x, z, vx, vz, w, m, r, kg, px, pz, sl, cpsi, spsi, psid, smat, mat, tx,
+           td, th, flags, par, slide_vn, stop_v, max_imp, drag_dt, ana_x, ana, env0,
+           envdx, env, rec, rec_start, rec_on, trace):  # fmt: skip
+    """The stage loop of :func:`run_rock` on the bundles' fields (called from
+    :func:`run_rock` and :func:`_run_rocks` only).
+
+    Speed: the stages are inlined (``inline="always"``: a call passing some forty
+    arrays per impact costs more than the impact) and this loop is compiled
+    without reference counting (``_nrt=False``: it allocates nothing, and numba
+    would otherwise count a reference to every array handed to an inlined stage,
+    at every impact). Calls keep fewer than 30 positional arguments: beyond that
+    CPython passes ``*args``, which numba's inliner refuses.
+    """
+    x0, m0, r0, k0 = x, m, r, kg
+    max_imp = int(max_imp)
     n = 0
     t = 0.0
     ntr = 0
@@ -524,325 +940,40 @@ def run_rock(
     u = 0.0
     while state < 0:
         if flying:
-            while True:
-                if drag:
-                    k = air_drag.drag_factor(par[P_DRAG_CD], par[P_DRAG_RHO], r, m)
-                    tmax = air_drag.substep_s(vx, vz, k, drag_dt)
-                    ax, az = air_drag.substep_acceleration(vx, vz, k, G, tmax)
-                else:
-                    ax, az, tmax = 0.0, -G, INF
-                jc, tc = piece_contact(px, pz, sl, j, x, z, vx, vz, ax, az, tmax)
-                if trees and vx != 0.0:
-                    x_end = x + vx * tc + 0.5 * ax * tc * tc
-                    lo, hi = min(x, x_end), max(x, x_end)
-                    i0 = np.searchsorted(tx, lo, side="right")
-                    i1 = np.searchsorted(tx, hi, side="right")
-                    struck = -1
-                    tt = 0.0
-                    ii = i0 if vx > 0.0 else i1 - 1
-                    for _ in range(i1 - i0):
-                        tt = time_to_x(x, vx, ax, tx[ii])
-                        if tt < tc:
-                            zt = z + vz * tt + 0.5 * az * tt * tt
-                            above = zt - ground_z(px, pz, sl, tx[ii])
-                            if 0.0 < above < th[ii] and (
-                                uniform(key, n, SLOT_TREE + ii) < par[P_TREE_P]
-                            ):
-                                struck = ii
-                                break
-                        ii += 1 if vx > 0.0 else -1
-                    if struck >= 0:
-                        ntr = _sweep_flight(
-                            x,
-                            z,
-                            vx,
-                            vz,
-                            ax,
-                            az,
-                            tt,
-                            px,
-                            pz,
-                            sl,
-                            m,
-                            r,
-                            kg,
-                            w,
-                            ana_x,
-                            ana,
-                            env0,
-                            envdx,
-                            env,
-                            trace,
-                            ntr,
-                        )
-                        z = z + vz * tt + 0.5 * az * tt * tt
-                        x = tx[struck]
-                        vx = vx + ax * tt
-                        vz = vz + az * tt
-                        t += tt
-                        v = math.sqrt(vx * vx + vz * vz)
-                        v_new = tree_impacts.speed_after_strike(
-                            v, m, td[struck], par[P_TREE_C], par[P_TREE_EXP]
-                        )
-                        scale = v_new / v if v > 0.0 else 0.0
-                        vx *= scale
-                        vz *= scale
-                        tree_hit = 1.0
-                        j = segment_at(px, x)
-                        continue
-                ntr = _sweep_flight(
-                    x,
-                    z,
-                    vx,
-                    vz,
-                    ax,
-                    az,
-                    tc,
-                    px,
-                    pz,
-                    sl,
-                    m,
-                    r,
-                    kg,
-                    w,
-                    ana_x,
-                    ana,
-                    env0,
-                    envdx,
-                    env,
-                    trace,
-                    ntr,
-                )
-                x = x + vx * tc + 0.5 * ax * tc * tc
-                z = z + vz * tc + 0.5 * az * tc * tc
-                vx = vx + ax * tc
-                vz = vz + az * tc
-                t += tc
-                if jc >= 0:
-                    j = jc
-                    z = pz[j] + sl[j] * (x - px[j])  # exactly on the line
-                    break
-                if jc == -2:
-                    state = EXITED_DOWNSLOPE
-                    runout = px[nseg]
-                    break
-                if jc == -3:
-                    state = EXITED_UPSLOPE
-                    runout = px[0]
-                    break
-                j = segment_at(px, x)
+            x, z, vx, vz, t, j, tree_hit, ntr, state, exit_x = fly(
+                key, n, x, z, vx, vz, w, m, r, kg, t, j, tree_hit, px, pz, sl, tx, td,
+                th, flags, par, drag_dt, ana_x, ana, env0, envdx, env, trace, ntr,
+            )  # fmt: skip
             if state >= 0:
+                runout = exit_x
                 break
             if n >= max_imp:
                 state = MAX_IMPACTS
                 runout = x
                 break
             n += 1
-            # ---- impact on segment j ----
-            mi = smat[j]
-            e_n = mat[mi, M_EN]
-            if mat[mi, M_EN_SD] > 0.0:
-                e_n = max(0.0, e_n + mat[mi, M_EN_SD] * normal(key, n, SLOT_E_N))
-            e_t = mat[mi, M_ET]
-            if mat[mi, M_ET_SD] > 0.0:
-                e_t = max(0.0, e_t + mat[mi, M_ET_SD] * normal(key, n, SLOT_E_T))
-            if flags[F_MASS] == 1:
-                ratio = mass_loss.volume_ratio(
-                    x - x_release, n, par[P_MASS_RATE], par[P_MASS_EXP]
-                )
-                cube = ratio ** (1.0 / 3.0)
-                m, r, kg = m0 * ratio, r0 * cube, k0 * cube
-            c = cpsi[j]
-            s = spsi[j]
-            psi = psid[j]
-            vit = vx * c - vz * s
-            vin = vx * s + vz * c
-            if flags[F_ROUGH] == 1:
-                sd = slope_roughness.dip_sd_rad(
-                    mat[mi, M_ROUGH], mat[mi, M_ROUGH_SD], r, par[P_ROUGH]
-                )
-                if sd > 0.0:
-                    delta = sd * normal(key, n, SLOT_ROUGHNESS)
-                    for trial in range(3):
-                        d = delta if trial == 0 else (-delta if trial == 1 else 0.0)
-                        rad = math.radians(psid[j]) + d
-                        c2 = math.cos(rad)
-                        s2 = math.sin(rad)
-                        if vx * s2 + vz * c2 < 0.0 or trial == 2:
-                            # the dip as the ImpactTable keeps it, in (-180, 180]
-                            # (a steep face tilted further reads as an overhang)
-                            psi = math.degrees(math.atan2(s2, c2))
-                            if psi <= -180.0:
-                                psi += 360.0
-                            c, s = c2, s2
-                            break
-                    vit = vx * c - vz * s
-                    vin = vx * s + vz * c
-            w_i = w
-            vfn, vft, w = restitution(
-                vin, vit, e_n, mat[mi, M_EN], e_t, w, r, kg, flags, par
-            )
-            # spin is carried energy only where rotation_friction couples it
-            k_spin = kg if flags[F_ROT] == 1 and par[P_ROT_C] > 0.0 else 0.0
-            vfn = passive_normal_speed(vin, vit, w_i, vfn, vft, w, k_spin)
-            vfx = vft * c + vfn * s
-            vfz = -vft * s + vfn * c
-            if rec_on:
-                row = rec_start + n - 1
-                rec[row, 0] = t
-                rec[row, 1] = x
-                rec[row, 2] = z
-                rec[row, 3] = psi
-                rec[row, 4] = vx
-                rec[row, 5] = vz
-                rec[row, 6] = vfx
-                rec[row, 7] = vfz
-                rec[row, 8] = m
-                rec[row, 9] = r
-                rec[row, 10] = kg
-                rec[row, 11] = w_i
-                rec[row, 12] = w
-                rec[row, 13] = mi
-                rec[row, 14] = tree_hit
+            vx, vz, w, m, r, kg, flying, u = impact(
+                key, n, x, z, vx, vz, w, t, j, m, r, kg, x0, m0, r0, k0, tree_hit, cpsi,
+                spsi, psid, smat, mat, flags, par, slide_vn, rec, rec_start, rec_on,
+            )  # fmt: skip
             tree_hit = 0.0
             if trace.shape[0] > ntr:
                 trace[ntr, 0] = x
                 trace[ntr, 1] = z
                 ntr += 1
-            vn_real = vfx * spsi[j] + vfz * cpsi[j]
-            if vfn < slide_vn or vn_real <= 0.0:
-                flying = False
-                u = vfx * cpsi[j] - vfz * spsi[j]
-                entry = 0
-                tanphi = _friction_tan(mat, mi, key, n, entry)
-            else:
-                vx, vz = vfx, vfz
         else:
-            # ---- sliding / rolling on segment j (eq. 7.3) ----
-            for _ in range(MAX_SLIDE_STEPS):
-                c = cpsi[j]
-                s = spsi[j]
-                if u > 0.0:
-                    dirn = 1.0
-                elif u < 0.0:
-                    dirn = -1.0
-                else:
-                    if abs(s) <= c * tanphi:
-                        state = STOPPED
-                        break
-                    dirn = 1.0 if s > 0.0 else -1.0
-                sp = abs(u)
-                ad = dirn * G * s - G * c * tanphi  # acceleration along travel
-                length = ((px[j + 1] - x) if dirn > 0.0 else (x - px[j])) / c
-                if sp == 0.0 and length <= 1e-12:
-                    state = STOPPED  # at rest in a notch
-                    break
-                v2 = sp * sp + 2.0 * ad * length
-                if trees:
-                    reach = length if v2 > 0.0 else sp * sp / (-2.0 * ad)
-                    ii = _tree_struck(
-                        tx, x, x + dirn * reach * c, key, n, par[P_TREE_P]
-                    )
-                    if ii >= 0:
-                        d = abs(tx[ii] - x) / c
-                        vt2 = sp * sp + 2.0 * ad * d
-                        vt = math.sqrt(vt2) if vt2 > 0.0 else 0.0
-                        ntr = _sweep_slide(
-                            x, tx[ii], sp, ad, c, m, r, kg, px, pz, sl,
-                            ana_x, ana, env0, envdx, env, trace, ntr,
-                        )  # fmt: skip
-                        t += (vt - sp) / ad if ad != 0.0 else d / sp
-                        x = tx[ii]
-                        vt = tree_impacts.speed_after_strike(
-                            vt, m, td[ii], par[P_TREE_C], par[P_TREE_EXP]
-                        )
-                        u = dirn * vt
-                        tree_hit = 1.0
-                        continue
-                if v2 <= 0.0:
-                    dist = sp * sp / (-2.0 * ad)
-                    x_new = x + dirn * dist * c
-                    ntr = _sweep_slide(
-                        x,
-                        x_new,
-                        sp,
-                        ad,
-                        c,
-                        m,
-                        r,
-                        kg,
-                        px,
-                        pz,
-                        sl,
-                        ana_x,
-                        ana,
-                        env0,
-                        envdx,
-                        env,
-                        trace,
-                        ntr,
-                    )
-                    t += sp / (-ad)
-                    x = x_new
-                    u = 0.0
-                    continue
-                ve = math.sqrt(v2)
-                x_new = px[j + 1] if dirn > 0.0 else px[j]
-                ntr = _sweep_slide(
-                    x,
-                    x_new,
-                    sp,
-                    ad,
-                    c,
-                    m,
-                    r,
-                    kg,
-                    px,
-                    pz,
-                    sl,
-                    ana_x,
-                    ana,
-                    env0,
-                    envdx,
-                    env,
-                    trace,
-                    ntr,
-                )
-                t += (ve - sp) / ad if ad != 0.0 else length / sp
-                x = x_new
-                jn = j + (1 if dirn > 0.0 else -1)
-                if jn >= nseg:
-                    state = EXITED_DOWNSLOPE
-                    break
-                if jn < 0:
-                    state = EXITED_UPSLOPE
-                    break
-                u_end = dirn * ve
-                convex = psid[jn] > psid[j] if dirn > 0.0 else psid[jn] < psid[j]
-                if convex:
-                    vx = u_end * c
-                    vz = -u_end * s
-                    w = -u_end / r
-                    j = jn
-                    z = pz[j] + sl[j] * (x - px[j])
-                    flying = True
-                    break
-                u = u_end * (c * cpsi[jn] + s * spsi[jn])  # projection on segment jn
-                if abs(u) < stop_v:
-                    u = 0.0
-                j = jn
-                entry += 1
-                tanphi = _friction_tan(mat, smat[j], key, n, entry)
-            else:
-                state = MAX_IMPACTS
+            x, t, j, ntr, state, hit, z_l, vx_l, vz_l, w_l = slide(
+                key, n, x, u, t, j, m, r, kg, px, pz, sl, cpsi, spsi, psid, smat,
+                mat, tx, td, flags, par, stop_v, ana_x, ana, env0, envdx, env,
+                trace, ntr,
+            )  # fmt: skip
+            if hit == 1.0:
+                tree_hit = 1.0
             if state >= 0:
                 runout = x
-                if trace.shape[0] > ntr:
-                    trace[ntr, 0] = x
-                    trace[ntr, 1] = ground_z(px, pz, sl, x)
-                    ntr += 1
             else:
-                w = -u / r if u != 0.0 else w
+                z, vx, vz, w = z_l, vx_l, vz_l, w_l
+                flying = True
     if state != STOPPED and trace.shape[0] > ntr:
         trace[ntr, 0] = x if state == MAX_IMPACTS else runout
         trace[ntr, 1] = z
@@ -850,80 +981,60 @@ def run_rock(
     return n, state, runout, ntr
 
 
+@njit(cache=True)
+def run_rock(rock, model, probe, record, trace):
+    """Follow one rock; returns ``(impacts, state, runout_x_m, trace_points)``.
+
+    The driver of the three stages :func:`fly`, :func:`impact` and :func:`slide`.
+    ``rock`` a :class:`Rock`, ``model`` a :class:`KernelModel`; outputs written in
+    place: ``probe`` (:class:`Probe`), ``record`` (:class:`Record`, impact rows when
+    ``record.on``) and ``trace`` (x, z points; zero rows for none).
+    """
+    prof, trees, effects, core = model.profile, model.trees, model.effects, model.core
+    return _drive(
+        rock.key, rock.x_m, rock.z_m, rock.vx_mps, rock.vz_mps, rock.omega_radps,
+        rock.mass_kg, rock.radius_m, rock.gyration_m, prof.x_m, prof.z_m, prof.slope,
+        prof.cos_psi, prof.sin_psi, prof.psi_deg, prof.material, model.materials,
+        trees.x_m, trees.diameter_m, trees.height_m, effects.flags, effects.par,
+        core.slide_vn_mps, core.stop_speed_mps, core.max_impacts, core.drag_dt_s,
+        probe.x_m, probe.values, probe.env_x0_m, probe.env_dx_m, probe.env,
+        record.rows, record.start, record.on, trace,
+    )  # fmt: skip
+
+
+@njit(cache=True)
+def run_rocks(rocks, model, probes, records, out):
+    """:func:`run_rock` over all ``rocks`` (:class:`Rocks`) in parallel; outputs
+    written in place (``probes`` :class:`Probes`, ``records`` :class:`Records`,
+    ``out`` :class:`Outcomes`)."""
+    prof, trees, effects, core = model.profile, model.trees, model.effects, model.core
+    _run_rocks(
+        rocks.key, rocks.x_m, rocks.z_m, rocks.vx_mps, rocks.vz_mps,
+        rocks.omega_radps, rocks.mass_kg, rocks.radius_m, rocks.gyration_m,
+        prof.x_m, prof.z_m, prof.slope, prof.cos_psi, prof.sin_psi, prof.psi_deg,
+        prof.material, model.materials, trees.x_m, trees.diameter_m, trees.height_m,
+        effects.flags, effects.par, core.slide_vn_mps, core.stop_speed_mps,
+        core.max_impacts, core.drag_dt_s, probes.x_m, probes.values,
+        probes.env_x0_m, probes.env_dx_m, probes.env, records.rows, records.offsets,
+        records.on, out.impacts, out.state, out.runout_x_m,
+    )  # fmt: skip
+
+
 @njit(cache=True, parallel=True)
-def run_rocks(
-    keys,
-    x,
-    z,
-    vx,
-    vz,
-    w,
-    m,
-    r,
-    kg,
-    px,
-    pz,
-    sl,
-    cpsi,
-    spsi,
-    psid,
-    smat,
-    mat,
-    tx,
-    td,
-    th,
-    flags,
-    par,
-    core,
-    ana_x,
-    ana,
-    env0,
-    envdx,
-    env,
-    rec,
-    rec_offsets,
-    rec_on,
-    impacts,
-    states,
-    runout,
-):
-    """:func:`run_rock` over all rocks in parallel; outputs written in place."""
+def _run_rocks(key, x, z, vx, vz, w, m, r, kg, px, pz, sl, cpsi, spsi, psid, smat,
+               mat, tx, td, th, flags, par, slide_vn, stop_v, max_imp, drag_dt, ana_x,
+               ana, env0, envdx, env, rows, offsets, rec_on, impacts, states,
+               runout):  # fmt: skip
+    """The ``prange`` loop of :func:`run_rocks` on the bundles' fields (numba's
+    ``prange`` cannot hand a tuple holding arrays to its worker function)."""
     no_trace = np.zeros((0, 2))
-    for i in prange(keys.size):
-        n, st, ro, _ = run_rock(
-            keys[i],
-            x[i],
-            z[i],
-            vx[i],
-            vz[i],
-            w[i],
-            m[i],
-            r[i],
-            kg[i],
-            px,
-            pz,
-            sl,
-            cpsi,
-            spsi,
-            psid,
-            smat,
-            mat,
-            tx,
-            td,
-            th,
-            flags,
-            par,
-            core,
-            ana_x,
-            ana[i],
-            env0,
-            envdx,
-            env[i],
-            rec,
-            rec_offsets[i],
-            rec_on,
-            no_trace,
-        )
+    for i in prange(key.size):
+        n, st, ro, _ = _drive(
+            key[i], x[i], z[i], vx[i], vz[i], w[i], m[i], r[i], kg[i], px, pz, sl,
+            cpsi, spsi, psid, smat, mat, tx, td, th, flags, par, slide_vn, stop_v,
+            max_imp, drag_dt, ana_x, ana[i], env0, envdx, env[i], rows, offsets[i],
+            rec_on, no_trace,
+        )  # fmt: skip
         impacts[i] = n
         states[i] = st
         runout[i] = ro

@@ -1,13 +1,14 @@
 """One rock at a time in the Python interpreter: the benchmark baseline and cross-check.
 
 :func:`simulate_one_rock` runs the *same source* as the compiled kernel
-(:func:`fieldkit.model.kernel.run_rock`, through numba's ``py_func``) in the Python
-interpreter, with the same random numbers: for the same model, key and start it
-returns the same impacts as :func:`fieldkit.model.simulate.simulate` (tests check
-agreement to 1e-12). Small helpers it calls (root finding, random streams, effect
-hooks) stay compiled. :func:`simulate_reference` draws starts and keys exactly as
-``simulate`` does, so ``simulate_reference(model, n, default_rng(s))`` reproduces
-``simulate(model, n, default_rng(s))`` rock by rock, at interpreter speed.
+(:func:`fieldkit.model.kernel.run_rock` and its stages ``fly``, ``impact``,
+``slide``, through numba's ``py_func``) in the Python interpreter, with the same
+random numbers: for the same model, key and start it returns the same impacts as
+:func:`fieldkit.model.simulate.simulate` (tests check agreement to 1e-12). Small
+helpers it calls (root finding, random streams, effect hooks) stay compiled.
+:func:`simulate_reference` draws starts and keys exactly as ``simulate`` does, so
+``simulate_reference(model, n, default_rng(s))`` reproduces ``simulate(model, n,
+default_rng(s))`` rock by rock, at interpreter speed.
 
 An analytic reference written independently of this code lives in the tests
 (tests/model/test_reference_agreement.py).
@@ -15,6 +16,8 @@ An analytic reference written independently of this code lives in the tests
 
 from __future__ import annotations
 
+import types
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,6 +38,21 @@ class OneRock:
     def column(self, name: str) -> np.ndarray:
         """One column of :attr:`impacts` by name (e.g. ``"vf_x_mps"``)."""
         return self.impacts[:, kernel.RECORD_COLUMNS.index(name)]
+
+
+#: The kernel's functions the reference interprets: the driver and its stages
+#: (the helpers they call -- contact, sweeps, laws -- run compiled).
+INTERPRETED = ("run_rock", "_drive", "fly", "impact", "slide")
+
+
+def _interpreted_run_rock() -> Callable:
+    """:func:`kernel.run_rock`'s Python source, calling the Python source of the
+    other functions :data:`INTERPRETED`."""
+    names = dict(vars(kernel))
+    for name in INTERPRETED:
+        py = getattr(kernel, name).py_func
+        names[name] = types.FunctionType(py.__code__, names, name, py.__defaults__)
+    return names["run_rock"]
 
 
 def simulate_one_rock(
@@ -64,9 +82,9 @@ def simulate_one_rock(
     inputs = kernel_inputs(model)
     mass = model.body.mass_kg if mass_kg is None else float(mass_kg)
     radius, gyration = body_of(model, np.array([mass]))
-    max_impacts = int(inputs.core[2])
+    max_impacts = int(inputs.model.core.max_impacts)
     rec = np.zeros((max_impacts, kernel.N_RECORD))
-    n, state, runout, _ = kernel.run_rock.py_func(
+    rock = kernel.Rock(
         np.uint64(key),
         float(x_m),
         float(z_m),
@@ -76,16 +94,16 @@ def simulate_one_rock(
         mass,
         float(radius[0]),
         float(gyration[0]),
-        *inputs.profile_args(),
+    )
+    probe = kernel.Probe(
         np.zeros(0),
         np.full((0, kernel.N_ANALYSIS), np.nan),
-        float(inputs.px[0]),
+        float(inputs.model.profile.x_m[0]),
         1.0,
         np.zeros(0, np.float32),
-        rec,
-        0,
-        True,
-        np.zeros((0, 2)),
+    )
+    n, state, runout, _ = _interpreted_run_rock()(
+        rock, inputs.model, probe, kernel.Record(rec, 0, True), np.zeros((0, 2))
     )
     return OneRock(impacts=rec[:n].copy(), state=int(state), runout_x_m=float(runout))
 

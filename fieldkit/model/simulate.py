@@ -152,42 +152,15 @@ def check_run(
 
 @dataclass(frozen=True)
 class KernelInputs:
-    """The model as the kernel's flat arrays (shared by simulate and reference)."""
+    """The model as the kernel reads it (shared by simulate and reference).
 
-    px: np.ndarray
-    pz: np.ndarray
-    sl: np.ndarray
-    cpsi: np.ndarray
-    spsi: np.ndarray
-    psid: np.ndarray
-    smat: np.ndarray
-    mat: np.ndarray
+    ``model`` is the :class:`fieldkit.model.kernel.KernelModel` bundle (profile,
+    material table, trees, effects, core); ``material_names`` the material table's
+    rows in order.
+    """
+
+    model: kernel.KernelModel
     material_names: tuple[str, ...]
-    tx: np.ndarray
-    td: np.ndarray
-    th: np.ndarray
-    flags: np.ndarray
-    par: np.ndarray
-    core: np.ndarray
-
-    def profile_args(self) -> tuple:
-        """Positional arguments of :func:`kernel.run_rock` after the rock state."""
-        return (
-            self.px,
-            self.pz,
-            self.sl,
-            self.cpsi,
-            self.spsi,
-            self.psid,
-            self.smat,
-            self.mat,
-            self.tx,
-            self.td,
-            self.th,
-            self.flags,
-            self.par,
-            self.core,
-        )
 
 
 #: A one-segment model that exercises every argument type of the kernel.
@@ -222,56 +195,62 @@ def warm_kernel() -> float:
 
 
 def kernel_inputs(model: Model) -> KernelInputs:
-    """Flatten ``model`` into :class:`KernelInputs`."""
+    """Flatten ``model`` into :class:`KernelInputs` (the one place the kernel's
+    bundles are built from a model)."""
     prof = model.profile
     px = np.ascontiguousarray(prof.x_m, float)
     pz = np.ascontiguousarray(prof.z_m, float)
     sl = np.diff(pz) / np.diff(px)
     psi = -np.arctan(sl)
     names = tuple(model.materials)
-    mat = np.array(
+    materials = np.array(
         [
-            [
-                m.e_n,
-                m.e_t,
-                m.friction_deg,
-                m.e_n_sd,
-                m.e_t_sd,
-                m.friction_deg_sd,
-                m.roughness_m,
-                m.roughness_deg_sd,
-            ]
+            [getattr(m, column) for column in kernel.MATERIAL_COLUMNS]
             for m in model.materials.values()
         ],
         float,
     )
-    smat = np.array([names.index(name) for name in prof.material], np.int64)
     flags, par = registry.kernel_arrays(model.effects)
     trees = model.trees
     empty = np.zeros(0)
-    core = np.array(
-        [
-            model.core[k]
-            for k in ("slide_vn_mps", "stop_speed_mps", "max_impacts", "drag_dt_s")
-        ],
-        float,
+
+    def tree_column(name: str) -> np.ndarray:
+        if trees is None:
+            return empty
+        return np.ascontiguousarray(getattr(trees, name), float)
+
+    bundle = kernel.KernelModel(
+        profile=kernel.Profile(
+            x_m=px,
+            z_m=pz,
+            slope=sl,
+            cos_psi=np.cos(psi),
+            sin_psi=np.sin(psi),
+            psi_deg=np.degrees(psi),
+            material=np.array([names.index(name) for name in prof.material], np.int64),
+        ),
+        materials=materials,
+        trees=kernel.Trees(*(tree_column(name) for name in kernel.Trees._fields)),
+        effects=kernel.Effects(flags=flags, par=par),
+        core=kernel.Core(*(float(model.core[k]) for k in kernel.Core._fields)),
     )
-    return KernelInputs(
-        px=px,
-        pz=pz,
-        sl=sl,
-        cpsi=np.cos(psi),
-        spsi=np.sin(psi),
-        psid=np.degrees(psi),
-        smat=smat,
-        mat=mat,
-        material_names=names,
-        tx=empty if trees is None else np.ascontiguousarray(trees.x_m, float),
-        td=empty if trees is None else np.ascontiguousarray(trees.diameter_m, float),
-        th=empty if trees is None else np.ascontiguousarray(trees.height_m, float),
-        flags=flags,
-        par=par,
-        core=core,
+    return KernelInputs(model=bundle, material_names=names)
+
+
+def kernel_rocks(
+    starts: Starts, keys: np.ndarray, radius: np.ndarray, gyration: np.ndarray
+) -> kernel.Rocks:
+    """The rocks' starts as the kernel's :class:`~fieldkit.model.kernel.Rocks`."""
+    return kernel.Rocks(
+        key=keys,
+        x_m=starts.x_m,
+        z_m=starts.z_m,
+        vx_mps=starts.vx_mps,
+        vz_mps=starts.vz_mps,
+        omega_radps=starts.omega_radps,
+        mass_kg=starts.mass_kg,
+        radius_m=radius,
+        gyration_m=gyration,
     )
 
 
@@ -413,7 +392,7 @@ def simulate(
     radius, gyration = body_of(model, starts.mass_kg)
     ana_x = np.asarray(analysis_x_m, float).reshape(-1)
     ana = np.full((rocks, ana_x.size, kernel.N_ANALYSIS), np.nan)
-    x0, x1 = inputs.px[0], inputs.px[-1]
+    x0, x1 = inputs.model.profile.x_m[0], inputs.model.profile.x_m[-1]
     if envelope_dx_m is not None:
         bins = max(1, math.ceil((x1 - x0) / envelope_dx_m))
         edges = x0 + envelope_dx_m * np.arange(bins + 1)
@@ -430,33 +409,18 @@ def simulate(
     tables: list[ImpactTable] = []
     wall = 0.0
     no_rec = np.zeros((0, kernel.N_RECORD))
+    all_rocks = kernel_rocks(starts, keys, radius, gyration)
     for a in range(0, rocks, chunk):
         b = min(rocks, a + chunk)
         sel = slice(a, b)
 
         def run(rec, offsets, on, sel=sel):
             kernel.run_rocks(
-                keys[sel],
-                starts.x_m[sel],
-                starts.z_m[sel],
-                starts.vx_mps[sel],
-                starts.vz_mps[sel],
-                starts.omega_radps[sel],
-                starts.mass_kg[sel],
-                radius[sel],
-                gyration[sel],
-                *inputs.profile_args(),
-                ana_x,
-                ana[sel],
-                float(x0),
-                envdx,
-                env[sel],
-                rec,
-                offsets,
-                on,
-                impacts[sel],
-                states[sel],
-                runout[sel],
+                kernel.Rocks(*(field[sel] for field in all_rocks)),
+                inputs.model,
+                kernel.Probes(ana_x, ana[sel], float(x0), envdx, env[sel]),
+                kernel.Records(rec, offsets, on),
+                kernel.Outcomes(impacts[sel], states[sel], runout[sel]),
             )
 
         tic = time.perf_counter()
@@ -480,12 +444,12 @@ def simulate(
     analysis = [
         AnalysisPoint(
             x_m=float(xa),
-            crossed=ana[:, i, 0] == 1.0,
-            speed_mps=ana[:, i, 1],
-            ke_j=ana[:, i, 2],
-            re_j=ana[:, i, 3],
-            total_j=ana[:, i, 4],
-            height_m=ana[:, i, 5],
+            crossed=ana[:, i, kernel.A_CROSSED] == 1.0,
+            speed_mps=ana[:, i, kernel.A_SPEED],
+            ke_j=ana[:, i, kernel.A_KE],
+            re_j=ana[:, i, kernel.A_RE],
+            total_j=ana[:, i, kernel.A_TOTAL],
+            height_m=ana[:, i, kernel.A_HEIGHT],
         )
         for i, xa in enumerate(ana_x)
     ]
@@ -494,24 +458,12 @@ def simulate(
         trace = np.zeros((TRACE_POINTS, 2))
         scratch_ana = np.full((0, kernel.N_ANALYSIS), np.nan)
         *_, count = kernel.run_rock(
-            keys[i],
-            starts.x_m[i],
-            starts.z_m[i],
-            starts.vx_mps[i],
-            starts.vz_mps[i],
-            starts.omega_radps[i],
-            starts.mass_kg[i],
-            radius[i],
-            gyration[i],
-            *inputs.profile_args(),
-            np.zeros(0),
-            scratch_ana,
-            float(x0),
-            1.0,
-            np.zeros(0, np.float32),
-            no_rec,
-            0,
-            False,
+            kernel.Rock(*(field[i] for field in all_rocks)),
+            inputs.model,
+            kernel.Probe(
+                np.zeros(0), scratch_ana, float(x0), 1.0, np.zeros(0, np.float32)
+            ),
+            kernel.Record(no_rec, 0, False),
             trace,
         )
         paths.append(trace[:count].copy())

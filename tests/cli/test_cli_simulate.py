@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from fieldkit.cli.simulate import parse_measured
@@ -113,6 +114,28 @@ def test_effects_lists_and_describes(core, cli, fails):
     one = cli("effects", EFFECTS[0].name)
     assert one.exit_code == 0 and EFFECTS[0].parameters[0].name in one.stdout
     fails(cli("effects", "no_such_effect"), "unknown effect", EFFECTS[0].name)
+
+
+def test_effects_says_impact_table_export_and_held_from_the_metadata(core, cli):
+    """``fieldkit effects NAME`` prints what the consumers read (issue 21): whether
+    an ImpactTable informs it, how CRSP and RocFall take it, which parameters an
+    impact fit holds."""
+    r = cli("effects", "angle_dependent_restitution")
+    assert r.exit_code == 0
+    out = r.stdout
+    assert "from an ImpactTable: yes" in out
+    assert "export to CRSP: not mapped: CRSP's Rn depends on the impact velocity" in out
+    assert "export to RocFall: not mapped: RocFall's lumped-mass Rn" in out
+    assert out.count("held by an impact fit: ") == 2  # theta_ref_deg and a
+    r = cli("effects", "velocity_scaled_restitution")
+    assert "export to CRSP: mapped: CRSP's own scaling of Rn (K = 30 ft/s)" in r.stdout
+    assert "held by an impact fit" not in r.stdout
+    r = cli("effects", "air_drag")
+    assert "from an ImpactTable: no: acts in flight" in r.stdout
+    r = cli("effects", "affine_rebound")
+    assert "export to RocFall: not mapped: affine_rebound is not a physical law" in (
+        r.stdout
+    )
 
 
 # ---------------------------------------------------------------- issue 17 items
@@ -482,3 +505,35 @@ def test_readme_run_figures_say_what_the_profile_end_hides(core, cli, tmp_path, 
     above = [ln for ln in heights.get_lines() if ln.get_linewidth() == 0.9]
     assert len(above) == 20 and heights.get_ylabel().startswith("centre above")
     assert max(max(ln.get_ydata()) for ln in above) > 20.0
+
+
+def test_simulate_every_effect_matches_the_interpreted_stages(core, cli, tmp_path):
+    """Issue 21, item 1: ``fieldkit simulate`` runs the kernel through its named
+    bundles; its impacts with every effect on (trees, sliding, the alternative
+    included) are those of the interpreted driver and stages (``fly``, ``impact``,
+    ``slide``), rock by rock."""
+    from fieldkit.impact_table import ImpactTable
+    from fieldkit.model import kernel
+    from fieldkit.model.effects.registry import EFFECTS
+    from fieldkit.model.model_file import read_model
+    from fieldkit.model.reference import INTERPRETED, simulate_reference
+
+    assert {"fly", "impact", "slide"} <= set(INTERPRETED)
+    data = json.loads(MODEL.read_text())
+    data["effects"] = {spec.name: {} for spec in EFFECTS}
+    data["trees"] = {"x_m": [20.0, 45.0, 70.0], "diameter_m": [0.3, 0.4, 0.3],
+                     "height_m": [12.0, 15.0, 10.0]}  # fmt: skip
+    model_path = tmp_path / "every.json"
+    model_path.write_text(json.dumps(data))
+    out = tmp_path / "impacts.parquet"
+    r = cli("simulate", model_path, "--rocks", "30", "--seed", "4", "--impacts", out)
+    assert r.exit_code == 0, r.stderr
+    assert f"wrote {out}" in r.stdout
+    frame = ImpactTable.read(out).frame
+    refs = simulate_reference(read_model(model_path), 30, np.random.default_rng(4))
+    assert len(frame) == sum(len(one.impacts) for one in refs) > 30
+    for rock, one in enumerate(refs):
+        rows = frame[frame["path_id"].astype(str) == str(rock)]
+        for name in ("x_m", "vi_x_mps", "vf_z_mps", "omega_f_radps", "mass_kg"):
+            want = one.impacts[:, kernel.RECORD_COLUMNS.index(name)]
+            assert np.array_equal(rows[name].to_numpy(float), want), (rock, name)

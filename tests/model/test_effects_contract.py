@@ -13,6 +13,7 @@ from model_builders import build, same_result
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.model import simulate
 from fieldkit.model.effects.registry import BY_NAME, EFFECTS, describe, effect
+from fieldkit.model.effects.spec import EXPORT_TARGETS, NORMAL_REBOUND, REBOUND, Export
 
 NAMES = [spec.name for spec in EFFECTS]
 CONTRACT = {
@@ -45,6 +46,60 @@ def test_metadata_is_complete_and_defaults_in_bounds(name):
     text = describe(name)
     for p in spec.parameters:
         assert f"{name}.{p.name}" in text
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_metadata_answers_what_consumers_ask(name):
+    """Rebound, ImpactTable, export: every consumer reads these (issue 21)."""
+    spec = effect(name)
+    # changes_rebound is exactly "writes a part of the rebound"; the normal part
+    # is what a target with another normal law cannot take
+    assert spec.changes_rebound == bool(set(spec.writes) & set(REBOUND)), name
+    assert spec.changes_normal_rebound == bool(set(spec.writes) & set(NORMAL_REBOUND))
+    assert spec.changes_rebound <= (spec.stage == "impact")
+    # a flight-stage effect leaves no mark on one impact: it must say why
+    assert bool(spec.not_from_impacts) >= (spec.stage != "impact")
+    # every law says how each lumped target takes it; the alternative none
+    if spec.is_law:
+        assert set(spec.exports) == set(EXPORT_TARGETS), name
+        for target in EXPORT_TARGETS:
+            rule = spec.export(target)
+            assert isinstance(rule, Export) and rule.how, (name, target)
+    else:
+        assert dict(spec.exports) == {}
+    for p in spec.parameters:
+        assert isinstance(p.held, str)
+    text = describe(name)
+    for target in EXPORT_TARGETS:
+        assert f"export to {target}: " in text
+    held = [p.held for p in spec.parameters if p.held]
+    assert text.count("held by an impact fit: ") == len(held)
+    for why in held:
+        assert f"held by an impact fit: {why}" in text
+
+
+def test_consumers_read_the_metadata():
+    from fieldkit.diagnose.candidates import IMPACT_CANDIDATES
+    from fieldkit.export import crsp, lumped, rocfall
+    from fieldkit.fit.impact_fit import HELD
+
+    assert set(IMPACT_CANDIDATES) == {s.name for s in EFFECTS if not s.not_from_impacts}
+    rebound = {s.name for s in EFFECTS if s.changes_rebound}
+    assert set(lumped.RESTITUTION_LAWS) == rebound
+    for module, target in ((crsp, "CRSP"), (rocfall, "RocFall")):
+        assert module.EFFECT_RULES == {
+            s.name: (s.exports[target].mapped, s.exports[target].how)
+            for s in EFFECTS
+            if s.is_law
+        }
+    assert HELD == {
+        f"{s.name}.{p.name}": p.held for s in EFFECTS for p in s.parameters if p.held
+    }
+    assert set(HELD) == {
+        "angle_dependent_restitution.theta_ref_deg",
+        "angle_dependent_restitution.a",
+        "slope_roughness.scale",
+    }
 
 
 @pytest.mark.parametrize("name", NAMES)

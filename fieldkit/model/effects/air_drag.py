@@ -17,7 +17,7 @@ import math
 
 from numba import njit
 
-from fieldkit.model.effects.spec import EffectSpec, Parameter
+from fieldkit.model.effects.spec import EffectSpec, Export, Parameter
 
 SPEC = EffectSpec(
     name="air_drag",
@@ -41,6 +41,16 @@ SPEC = EffectSpec(
     writes=("vi_x_mps", "vi_z_mps"),
     not_from_impacts="acts in flight; diagnose a video track (flight "
     "residuals) instead",
+    exports={
+        "CRSP": Export(
+            False,
+            "CRSP is a lumped-mass model without air drag (thesis §7.2)",
+        ),
+        "RocFall": Export(
+            False,
+            "RocFall's lumped mass ignores air resistance",
+        ),
+    },
 )
 
 

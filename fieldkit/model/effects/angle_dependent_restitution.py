@@ -19,7 +19,7 @@ import math
 
 from numba import njit
 
-from fieldkit.model.effects.spec import EffectSpec, Parameter
+from fieldkit.model.effects.spec import EffectSpec, Export, Parameter
 
 SPEC = EffectSpec(
     name="angle_dependent_restitution",
@@ -37,6 +37,7 @@ SPEC = EffectSpec(
             "deg",
             "impact angle at which e_n equals the material e_n",
             None,
+            held="trades exactly with the material e_n (e_n theta_ref^b is one number)",
         ),
         Parameter(
             "a",
@@ -46,12 +47,27 @@ SPEC = EffectSpec(
             "-",
             "literal eq. 5.4 coefficient (thesis 19.5); 0 = scale the material e_n",
             0.0,
+            held="a = 0 or a > 0 selects the form of eq. 5.4; with a > 0 it trades "
+            "exactly with the material e_n",
         ),
     ),
     reference="thesis eq. 5.4, section 5.2.3",
     reads=("theta_i_deg", "e_n"),
     writes=("e_n",),
     changes_rebound=True,
+    exports={
+        "CRSP": Export(
+            False,
+            "CRSP's Rn depends on the impact velocity (eq. 7.1), not on the impact "
+            "angle (eq. 5.4): Rn, Rt are fitted in range to the rebounds it realises",
+        ),
+        "RocFall": Export(
+            False,
+            "RocFall's lumped-mass Rn is scaled by velocity or by mass only; no "
+            "impact-angle law for Rn was found in its documentation: Rn, Rt are "
+            "fitted in range to the rebounds the law realises",
+        ),
+    },
 )
 
 THETA_MIN_DEG = 1.0

@@ -17,7 +17,7 @@ import math
 
 from numba import njit
 
-from fieldkit.model.effects.spec import EffectSpec, Parameter
+from fieldkit.model.effects.spec import EffectSpec, Export, Parameter
 
 SPEC = EffectSpec(
     name="mass_loss",
@@ -37,6 +37,16 @@ SPEC = EffectSpec(
     writes=("mass_kg", "radius_m", "gyration_m"),
     not_from_impacts="changes mass and size along the path, not the rebound "
     "velocities an impact table measures",
+    exports={
+        "CRSP": Export(
+            False,
+            "CRSP's rock keeps its mass (no breakage)",
+        ),
+        "RocFall": Export(
+            False,
+            "RocFall's lumped-mass rock keeps its mass (no breakage or abrasion)",
+        ),
+    },
 )
 
 

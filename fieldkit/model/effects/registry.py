@@ -25,7 +25,7 @@ from fieldkit.model.effects import (
     tree_impacts,
     velocity_scaled_restitution,
 )
-from fieldkit.model.effects.spec import EffectSpec, Parameter
+from fieldkit.model.effects.spec import EXPORT_TARGETS, EffectSpec, Parameter
 
 __all__ = ["EFFECTS", "BY_NAME", "EffectSpec", "Parameter", "effect", "describe"]
 
@@ -159,9 +159,22 @@ def describe(name: str) -> str:
             f"    {spec.name}.{p.name} [{p.units}] default {p.default:g}, bounds "
             f"[{p.lower:g}, {p.upper:g}], neutral {neutral}: {p.description}"
         )
+        if p.held:
+            lines.append(f"      held by an impact fit: {p.held}")
     if spec.reads or spec.writes:
         lines.append(
             f"  reads: {', '.join(spec.reads) or '-'}; writes: "
             f"{', '.join(spec.writes) or '-'}"
         )
+    lines.append(
+        "  from an ImpactTable: "
+        + (f"no: {spec.not_from_impacts}" if spec.not_from_impacts else "yes")
+    )
+    for target in EXPORT_TARGETS:
+        rule = spec.export(target)
+        if rule is None:
+            text = f"not mapped: {spec.name} is not a physical law"
+        else:
+            text = f"{'mapped' if rule.mapped else 'not mapped'}: {rule.how}"
+        lines.append(f"  export to {target}: {text}")
     return "\n".join(lines)

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from fieldkit.model.effects.spec import EffectSpec, Parameter
+from fieldkit.model.effects.spec import EffectSpec, Export, Parameter
 
 SPEC = EffectSpec(
     name="rotation_friction",
@@ -47,6 +47,19 @@ SPEC = EffectSpec(
     reads=("vit_mps", "vin_mps", "omega_i_radps", "radius_m", "gyration_m"),
     writes=("vft_mps", "omega_f_radps"),
     changes_rebound=True,
+    exports={
+        "CRSP": Export(
+            False,
+            "CRSP computes the rotation itself (w = v_T / r and the shape's moment of "
+            "inertia, thesis §7.3.7); fieldkit's contact friction and coupling have "
+            "no CRSP input",
+        ),
+        "RocFall": Export(
+            True,
+            "'consider rotational velocity' (on/off only: RocFall's own rotation, its "
+            "friction and coupling are not written)",
+        ),
+    },
 )
 
 

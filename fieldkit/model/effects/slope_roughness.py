@@ -18,7 +18,7 @@ import math
 
 from numba import njit
 
-from fieldkit.model.effects.spec import EffectSpec, Parameter
+from fieldkit.model.effects.spec import EffectSpec, Export, Parameter
 
 SPEC = EffectSpec(
     name="slope_roughness",
@@ -26,13 +26,32 @@ SPEC = EffectSpec(
     summary="random local slope at each impact; small blocks feel rougher ground",
     physics="psi' = psi + N(0, scale * hypot(atan(s/r), sd_psi))",
     parameters=(
-        Parameter("scale", 1.0, 0.0, 5.0, "-", "multiplier on the dip SD", 0.0),
+        Parameter(
+            "scale",
+            1.0,
+            0.0,
+            5.0,
+            "-",
+            "multiplier on the dip SD",
+            0.0,
+            held="acts through the slope the table records",
+        ),
     ),
     reference="thesis eq. 7.4, section 7.3.6; RocFall Table 7-1",
     reads=("slope_deg", "radius_m"),
     writes=("slope_deg",),
     not_from_impacts="a random local slope scatters rebounds without biasing "
     "them: it shows as a reduced chi-square above 1, not as a held-out gain",
+    exports={
+        "CRSP": Export(
+            True,
+            "each cell's S = r tan(dip SD)",
+        ),
+        "RocFall": Export(
+            True,
+            "each material's slope roughness (SD of the dip)",
+        ),
+    },
 )
 
 

@@ -18,7 +18,7 @@ import math
 
 from numba import njit
 
-from fieldkit.model.effects.spec import EffectSpec, Parameter
+from fieldkit.model.effects.spec import EffectSpec, Export, Parameter
 
 SPEC = EffectSpec(
     name="tree_impacts",
@@ -53,6 +53,17 @@ SPEC = EffectSpec(
     writes=("vi_x_mps", "vi_z_mps", "tree_strike"),
     not_from_impacts="acts in flight; reduced impact velocities come from "
     "flights assumed ballistic, so the table cannot show it",
+    exports={
+        "CRSP": Export(
+            False,
+            "no tree-impact input was found for CRSP 4.0",
+        ),
+        "RocFall": Export(
+            False,
+            "RocFall's lumped mass has no trees (barriers only); the trees are not "
+            "exported",
+        ),
+    },
 )
 
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from fieldkit.model.effects.spec import EffectSpec, Parameter
+from fieldkit.model.effects.spec import EffectSpec, Export, Parameter
 
 SPEC = EffectSpec(
     name="velocity_scaled_restitution",
@@ -30,6 +30,18 @@ SPEC = EffectSpec(
     reads=("vin_mps",),
     writes=("vfn_mps",),
     changes_rebound=True,
+    exports={
+        "CRSP": Export(
+            True,
+            "CRSP's own scaling of Rn (K = 30 ft/s); another K, or no scaling, is "
+            "fitted in range under CRSP's law",
+        ),
+        "RocFall": Export(
+            True,
+            "'scale Rn by velocity' at RocFall's K = 9.144 m/s; another K or an Rn "
+            "above 1 is fitted in range under that law",
+        ),
+    },
 )
 
 
