@@ -66,13 +66,15 @@ DEPOSIT_COLUMNS = ("trajectory_id", "x_m", "y_m")
 @dataclass(frozen=True)
 class PlanRun:
     """One observed run: release point, block, observed deposit (all in metres,
-    kilograms; plan coordinates of the DEM)."""
+    kilograms; plan coordinates of the DEM); ``group`` the block's id where the
+    release file gives ``block_id`` (to stratify folds by)."""
 
     run_id: str
     release_xy: np.ndarray
     deposit_xy: np.ndarray
     mass_kg: float
     radius_m: float
+    group: str = ""
 
 
 def _read_rows(path: str, needed: Sequence[str]) -> list[dict[str, str]]:
@@ -121,16 +123,23 @@ def read_plan_runs(release_csv: str, deposit_csv: str) -> list[PlanRun]:
     for line, row in enumerate(dep, start=2):
         tid = row["trajectory_id"]
         if tid in deposits:
-            raise InputFileError(f"trajectory_id {tid} appears twice",
-                                 source=str(deposit_csv), where=f"row {line}")  # fmt: skip
-        deposits[tid] = np.array([_number(row, c, str(deposit_csv), line)
-                                  for c in ("x_m", "y_m")])  # fmt: skip
+            raise InputFileError(
+                f"trajectory_id {tid} appears twice",
+                source=str(deposit_csv),
+                where=f"row {line}",
+            )
+        deposits[tid] = np.array(
+            [_number(row, c, str(deposit_csv), line) for c in ("x_m", "y_m")]
+        )
     runs, seen = [], set()
     for line, row in enumerate(rel, start=2):
         tid = row["trajectory_id"]
         if tid in seen:
-            raise InputFileError(f"trajectory_id {tid} appears twice",
-                                 source=str(release_csv), where=f"row {line}")  # fmt: skip
+            raise InputFileError(
+                f"trajectory_id {tid} appears twice",
+                source=str(release_csv),
+                where=f"row {line}",
+            )
         seen.add(tid)
         if tid not in deposits:
             raise InputFileError(
@@ -141,10 +150,21 @@ def read_plan_runs(release_csv: str, deposit_csv: str) -> list[PlanRun]:
         v = {c: _number(row, c, str(release_csv), line) for c in RELEASE_COLUMNS[1:]}
         for c in ("mass_kg", "radius_m"):
             if not v[c] > 0:
-                raise InputFileError(f"{c}: must be > 0 (got {v[c]:g})",
-                                     source=str(release_csv), where=f"row {line}")  # fmt: skip
-        runs.append(PlanRun(tid, np.array([v["x_m"], v["y_m"]]), deposits[tid],
-                            v["mass_kg"], v["radius_m"]))  # fmt: skip
+                raise InputFileError(
+                    f"{c}: must be > 0 (got {v[c]:g})",
+                    source=str(release_csv),
+                    where=f"row {line}",
+                )
+        runs.append(
+            PlanRun(
+                tid,
+                np.array([v["x_m"], v["y_m"]]),
+                deposits[tid],
+                v["mass_kg"],
+                v["radius_m"],
+                str(row.get("block_id", "")),
+            )
+        )
     return runs
 
 
@@ -182,15 +202,18 @@ def with_parameters3d(model: Model3D, values: dict[str, float]) -> Model3D:
     core = dict(model.core)
     for key, value in values.items():
         if key not in known:
-            raise ArgumentError(f"{key}: unknown parameter (known: "
-                                f"{', '.join(known)})", source="values")  # fmt: skip
+            raise ArgumentError(
+                f"{key}: unknown parameter (known: {', '.join(known)})", source="values"
+            )
         value = float(value)
         parts = key.split(".")
         if parts[0] == "materials":
             lo, hi = MATERIAL_FIELDS[parts[2]][:2]
             if not lo <= value <= hi:
-                raise ArgumentError(f"{key}: must be in [{lo:g}, {hi:g}] "
-                                    f"(got {value:g})", source="values")  # fmt: skip
+                raise ArgumentError(
+                    f"{key}: must be in [{lo:g}, {hi:g}] (got {value:g})",
+                    source="values",
+                )
             materials[parts[1]] = replace(materials[parts[1]], **{parts[2]: value})
         elif parts[0] == "core":
             core[parts[1]] = value
@@ -205,12 +228,17 @@ def run_model(model: Model3D, run: PlanRun) -> Model3D:
     """``model`` released from ``run``'s release point with ``run``'s block (its
     mass and radius; the radius of gyration scaled with the radius)."""
     r0 = model.body.radius_m
-    body = replace(model.body, mass_kg=run.mass_kg, radius_m=run.radius_m,
-                   gyration_m=model.body.gyration_m * run.radius_m / r0)  # fmt: skip
+    body = replace(
+        model.body,
+        mass_kg=run.mass_kg,
+        radius_m=run.radius_m,
+        gyration_m=model.body.gyration_m * run.radius_m / r0,
+    )
     x, y = run.release_xy
     z = model.terrain.height(float(x), float(y))
-    return replace(model, body=body, releases=np.array([[x, y, z]]),
-                   release_weights=np.ones(1))  # fmt: skip
+    return replace(
+        model, body=body, releases=np.array([[x, y, z]]), release_weights=np.ones(1)
+    )
 
 
 @dataclass(frozen=True)
@@ -244,8 +272,12 @@ def plan_ensembles(
     with one_kernel_thread():
         for r, run in enumerate(runs):
             key = [seed, r] if stream is None else [seed, stream, r]
-            res = simulate3d(run_model(model, run), rocks,
-                             np.random.default_rng(key), keep_paths=False)
+            res = simulate3d(
+                run_model(model, run),
+                rocks,
+                np.random.default_rng(key),
+                keep_paths=False,
+            )
             out.append(res.deposit_xyz[:, :2].copy())
             exited += int(np.sum(res.state == EXITED))
     return PlanEnsembles(out, exited, rocks * len(runs))
@@ -255,13 +287,21 @@ def plan_objective_terms(
     ensembles: Sequence[np.ndarray], runs: Sequence[PlanRun]
 ) -> tuple[np.ndarray, np.ndarray]:
     """Per-run fair energy score [m] and fair distance CRPS [m]."""
-    es = np.array([energy_score(e, r.deposit_xy, fair=True)
-                   for e, r in zip(ensembles, runs, strict=True)])  # fmt: skip
-    crps = np.array([
-        fair_crps(np.hypot(*(e - r.release_xy).T),
-                  float(np.hypot(*(r.deposit_xy - r.release_xy))))
-        for e, r in zip(ensembles, runs, strict=True)
-    ])  # fmt: skip
+    es = np.array(
+        [
+            energy_score(e, r.deposit_xy, fair=True)
+            for e, r in zip(ensembles, runs, strict=True)
+        ]
+    )
+    crps = np.array(
+        [
+            fair_crps(
+                np.hypot(*(e - r.release_xy).T),
+                float(np.hypot(*(r.deposit_xy - r.release_xy))),
+            )
+            for e, r in zip(ensembles, runs, strict=True)
+        ]
+    )
     return es, crps
 
 
@@ -288,18 +328,26 @@ class PlanFitResult:
     def lines(self) -> list[str]:
         """Report lines: every parameter start -> optimum, the objective."""
         out = [
-            f"objective (mean fair energy score in plan"
-            + (f" + {self.distance_weight:g} x distance CRPS" if self.distance_weight
-               else "")
+            "objective (mean fair energy score in plan"
+            + (
+                f" + {self.distance_weight:g} x distance CRPS"
+                if self.distance_weight
+                else ""
+            )
             + f"): start {self.objective_start:.3f} m -> optimum {self.objective:.3f}"
             f" m after {self.evaluations} evaluations"
-        ]  # fmt: skip
-        for n, s, v, lo, hi in zip(self.names, self.start, self.values, self.lower,
-                                   self.upper, strict=True):  # fmt: skip
-            bound = " (at a search bound)" if np.isclose(v, lo) or np.isclose(v, hi) else ""
+        ]
+        for n, s, v, lo, hi in zip(
+            self.names, self.start, self.values, self.lower, self.upper, strict=True
+        ):
+            bound = (
+                " (at a search bound)" if np.isclose(v, lo) or np.isclose(v, hi) else ""
+            )
             out.append(f"  {n}: {s:.4g} -> {v:.4g} [{lo:g}, {hi:g}]{bound}")
-        out.append(f"  rocks that left the DEM at the optimum: "
-                   f"{100 * self.exited_share:.1f} % (scored at their exit point)")
+        out.append(
+            f"  rocks that left the DEM at the optimum: "
+            f"{100 * self.exited_share:.1f} % (scored at their exit point)"
+        )
         return out + [f"  note: {n}" for n in self.notes]
 
 
@@ -351,19 +399,27 @@ def fit_plan(
     if not runs:
         raise ArgumentError("no runs to fit", source="runs")
     if not (isinstance(rocks, int | np.integer) and 2 <= rocks <= 20_000):
-        raise ArgumentError(f"rocks must be 2..20,000 (got {rocks}): the fair "
-                            "energy score needs two members", source="rocks")  # fmt: skip
+        raise ArgumentError(
+            f"rocks must be 2..20,000 (got {rocks}): the fair "
+            "energy score needs two members",
+            source="rocks",
+        )
     if not (math.isfinite(distance_weight) and distance_weight >= 0):
-        raise ArgumentError(f"distance_weight must be >= 0 (got {distance_weight})",
-                            source="distance_weight")  # fmt: skip
+        raise ArgumentError(
+            f"distance_weight must be >= 0 (got {distance_weight})",
+            source="distance_weight",
+        )
     names = list(free)
     if not names:
         raise ArgumentError("no free parameters", source="free")
     known = parameters3d(base_model)
     unknown = [n for n in names if n not in known]
     if unknown:
-        raise ArgumentError(f"{', '.join(unknown)}: not parameters of the model "
-                            f"(known: {', '.join(known)})", source="free")  # fmt: skip
+        raise ArgumentError(
+            f"{', '.join(unknown)}: not parameters of the model "
+            f"(known: {', '.join(known)})",
+            source="free",
+        )
     box = [(bounds or {}).get(n) or parameter_bounds(n) for n in names]
     lower = np.array([b[0] for b in box], float)
     upper = np.array([b[1] for b in box], float)
@@ -394,13 +450,15 @@ def fit_plan(
 
     u0 = (x0 - lower) / span
     f0 = f(u0)
-    say(f"fit {p} parameters to {len(runs)} runs ({rocks} rocks each): start "
-        f"{f0:.3f} m")  # fmt: skip
+    say(
+        f"fit {p} parameters to {len(runs)} runs ({rocks} rocks each): start {f0:.3f} m"
+    )
     budget = max_evaluations or max(100, 40 * p)
     starts = [u0]
     if screen > 0:
-        sobol = qmc.Sobol(p, scramble=True,
-                          seed=np.random.default_rng([seed, SCREEN_STREAM]))  # fmt: skip
+        sobol = qmc.Sobol(
+            p, scramble=True, seed=np.random.default_rng([seed, SCREEN_STREAM])
+        )
         points = sobol.random(screen)
         values = np.array([f(u) for u in points])
         best = int(np.argmin(values))
@@ -408,8 +466,7 @@ def fit_plan(
         if values[best] < f0:
             starts.append(points[best])
     first = int(budget * 0.7) // len(starts)
-    u1, f1, _ = min((_minimise(f, u, 0.15, first) for u in starts),
-                    key=lambda r: r[1])  # fmt: skip
+    u1, f1, _ = min((_minimise(f, u, 0.15, first) for u in starts), key=lambda r: r[1])
     u2, f2, _ = _minimise(f, u1, 0.05, max(budget - first * len(starts), p + 2))
     u_best, f_best = (u2, f2) if f2 <= f1 else (u1, f1)
     x_best = to_x(u_best)
@@ -420,8 +477,16 @@ def fit_plan(
     if not math.isclose(f_check, f_best, rel_tol=1e-9, abs_tol=1e-9):
         notes.append(f"the optimum re-evaluates to {f_check:.3f} m")  # never expected
     return PlanFitResult(
-        names=names, start=x0, values=x_best, lower=lower, upper=upper,
-        objective_start=f0, objective=f_best, evaluations=evaluations, model=model,
-        exited_share=last_exited[0], distance_weight=float(distance_weight),
+        names=names,
+        start=x0,
+        values=x_best,
+        lower=lower,
+        upper=upper,
+        objective_start=f0,
+        objective=f_best,
+        evaluations=evaluations,
+        model=model,
+        exited_share=last_exited[0],
+        distance_weight=float(distance_weight),
         notes=notes,
-    )  # fmt: skip
+    )
