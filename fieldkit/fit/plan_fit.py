@@ -226,7 +226,13 @@ def with_parameters3d(model: Model3D, values: dict[str, float]) -> Model3D:
 
 def run_model(model: Model3D, run: PlanRun) -> Model3D:
     """``model`` released from ``run``'s release point with ``run``'s block (its
-    mass and radius; the radius of gyration scaled with the radius)."""
+    mass and radius; the radius of gyration scaled with the radius).
+
+    Raises
+    ------
+    ArgumentError
+        The release is off the DEM's surface (names the run).
+    """
     r0 = model.body.radius_m
     body = replace(
         model.body,
@@ -236,6 +242,12 @@ def run_model(model: Model3D, run: PlanRun) -> Model3D:
     )
     x, y = run.release_xy
     z = model.terrain.height(float(x), float(y))
+    if not math.isfinite(z):
+        raise ArgumentError(
+            f"run {run.run_id}: release (x {x:g}, y {y:g}) is off the DEM's surface "
+            "(outside its cell centres or beside nodata)",
+            source="runs",
+        )
     return replace(
         model, body=body, releases=np.array([[x, y, z]]), release_weights=np.ones(1)
     )

@@ -197,3 +197,12 @@ def test_fit_plan_refuses_one_rock():
         fit_plan(
             observed_runs(model, 2), model, ["materials.ground.friction_deg"], rocks=1
         )
+
+
+def test_a_release_off_the_dem_is_named_in_one_line():
+    model = bent_plane_model(20.0)
+    runs = [PlanRun("far", np.array([500.0, 75.0]), np.zeros(2), 100.0, 0.2)]
+    with pytest.raises(ArgumentError) as err:
+        fit_plan(runs, model, ["materials.ground.friction_deg"], rocks=5)
+    assert "run far: release (x 500, y 75) is off the DEM" in str(err.value)
+    assert "\n" not in str(err.value)
