@@ -79,6 +79,10 @@ from fieldkit.model.results import (
 )
 
 G = 9.81
+#: Smallest increase of the dip [deg] at a vertex that launches a sliding rock (a
+#: convex break): far below any surveyed break, far above the rounding of collinear
+#: vertices (found by the 3-D kernel's comparison, issue 21).
+CONVEX_BREAK_DEG = 1e-6
 INF = math.inf
 #: Columns of a recorded impact row (``R_*`` name each column's index).
 RECORD_COLUMNS = (
@@ -886,7 +890,13 @@ def slide(key, n, x, u, t, j, m, r, kg, px, pz, sl, cpsi, spsi, psid, smat, mat,
             state = EXITED_UPSLOPE
             break
         u_end = dirn * ve
-        convex = psid[jn] > psid[j] if dirn > 0.0 else psid[jn] < psid[j]
+        # A convex break needs the dip to grow by more than rounding: collinear
+        # vertices (a DEM section's, 1e-13 deg apart) would launch the rock and land
+        # it again at every vertex, losing speed to e_t each time.
+        if dirn > 0.0:
+            convex = psid[jn] > psid[j] + CONVEX_BREAK_DEG
+        else:
+            convex = psid[jn] < psid[j] - CONVEX_BREAK_DEG
         if convex:
             vx = u_end * c
             vz = -u_end * s
