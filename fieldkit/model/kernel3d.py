@@ -71,6 +71,7 @@ from numba import njit, prange
 from fieldkit.model.effects import mass_loss, slope_roughness
 from fieldkit.model.effects.registry import EFFECTS, LAYOUT
 from fieldkit.model.kernel import (
+    MATERIAL_COLUMNS,
     descending_root,
     passive_normal_speed,
     restitution,
@@ -113,7 +114,10 @@ P_MASS_EXP = LAYOUT["mass_loss.impact_exponent"]
 P_ROUGH = LAYOUT["slope_roughness.scale"]
 P_ROT_C = LAYOUT["rotation_friction.coupling"]
 #: Material table columns (as the 2-D kernel's).
-M_EN, M_ET, M_PHI, M_EN_SD, M_ET_SD, M_PHI_SD, M_ROUGH, M_ROUGH_SD = range(8)
+# the 2-D kernel's material table, column for column
+M_EN, M_ET, M_PHI, M_EN_SD, M_ET_SD, M_PHI_SD, M_ROUGH, M_ROUGH_SD = range(
+    len(MATERIAL_COLUMNS)
+)
 
 #: The ground: the terrain grid (:data:`fieldkit.model.terrain.Grid` fields) and the
 #: material index of every cell (int64, the grid's shape).

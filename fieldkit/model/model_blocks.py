@@ -73,6 +73,30 @@ def refuse_unknown(data: dict, known: set[str], where: str, source: str) -> None
             )
 
 
+def number_lists(
+    data: dict, keys: tuple[str, ...], where: str, source: str
+) -> dict[str, np.ndarray]:
+    """Each of ``keys`` of ``data`` as a finite 1-D float array (a block of lists of
+    numbers, e.g. ``trees``); one-line errors at ``<where>.<key>``."""
+    arrays = {}
+    for key in keys:
+        if key not in data:
+            raise InputFileError("missing", source=source, where=f"{where}.{key}")
+        try:
+            if isinstance(data[key], str):
+                raise TypeError(key)
+            arrays[key] = np.asarray(data[key], float).reshape(-1)
+        except (TypeError, ValueError, OverflowError):
+            raise InputFileError(
+                "must be a list of numbers", source=source, where=f"{where}.{key}"
+            ) from None
+        if not np.all(np.isfinite(arrays[key])):
+            raise InputFileError(
+                "not all finite", source=source, where=f"{where}.{key}"
+            )
+    return arrays
+
+
 def read_effects(data: dict, source: str) -> dict[str, dict[str, float]]:
     """The model file's ``"effects"`` block, each effect validated by its registry
     entry (one-line errors naming ``effects.<name>``); 2-D and 3-D models alike."""

@@ -77,6 +77,7 @@ from fieldkit.model.model_blocks import (  # noqa: F401 (the model file's names)
     WHOLE_NUMBER_CORE,
     Body,
     Trees,
+    number_lists,
     read_body,
     read_core,
     read_effects,
@@ -496,20 +497,7 @@ def _seeder(data: dict, profile: Profile, source: str) -> Seeder:
 
 def _trees(data: dict, profile: Profile, source: str) -> Trees:
     _unknown(data, {"x_m", "diameter_m", "height_m"}, "trees", source)
-    arrays = {}
-    for key in ("x_m", "diameter_m", "height_m"):
-        if key not in data:
-            raise InputFileError("missing", source=source, where=f"trees.{key}")
-        try:
-            if isinstance(data[key], str):
-                raise TypeError(key)
-            arrays[key] = np.asarray(data[key], float).reshape(-1)
-        except (TypeError, ValueError, OverflowError):
-            raise InputFileError(
-                "must be a list of numbers", source=source, where=f"trees.{key}"
-            ) from None
-        if not np.all(np.isfinite(arrays[key])):
-            raise InputFileError("not all finite", source=source, where=f"trees.{key}")
+    arrays = number_lists(data, ("x_m", "diameter_m", "height_m"), "trees", source)
     n = arrays["x_m"].size
     for key in ("diameter_m", "height_m"):
         if arrays[key].size != n:

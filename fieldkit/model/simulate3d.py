@@ -20,6 +20,7 @@ import numpy as np
 from fieldkit.errors import ArgumentError
 from fieldkit.model import kernel3d
 from fieldkit.model.effects import registry
+from fieldkit.model.kernel import MATERIAL_COLUMNS
 from fieldkit.model.model3d import Model3D
 from fieldkit.model.model_file import CORE_DEFAULTS
 
@@ -70,16 +71,7 @@ def _material_table(materials: dict) -> np.ndarray:
     def get(m, name):
         return float(m[name] if isinstance(m, dict) else getattr(m, name))
 
-    cols = (
-        "e_n",
-        "e_t",
-        "friction_deg",
-        "e_n_sd",
-        "e_t_sd",
-        "friction_deg_sd",
-        "roughness_m",
-        "roughness_deg_sd",
-    )
+    cols = MATERIAL_COLUMNS  # the 2-D kernel's material table, column for column
     return np.array(
         [[get(m, c) if (not isinstance(m, dict) or c in m) else 0.0 for c in cols]
          for m in materials.values()],

@@ -57,6 +57,7 @@ from fieldkit.model.model_blocks import (
     BODY_BOUNDS,
     SEEDER_BOUNDS,
     TREE_BOUNDS,
+    number_lists,
     read_body,
     read_core,
     read_effects,
@@ -451,20 +452,8 @@ def _seeder3d(data: dict, source: str) -> Seeder3D:
 def _trees3d(data: dict, source: str) -> Trees3D:
     """Tree stems in plan: lists ``x_m, y_m, diameter_m`` of one length."""
     _unknown(data, {"x_m", "y_m", "diameter_m"}, "trees", source)
-    arrays = {}
-    for key in ("x_m", "y_m", "diameter_m"):
-        if key not in data:
-            raise InputFileError("missing", source=source, where=f"trees.{key}")
-        try:
-            if isinstance(data[key], str):
-                raise TypeError(key)
-            arrays[key] = np.asarray(data[key], float).reshape(-1)
-        except (TypeError, ValueError, OverflowError):
-            raise InputFileError(
-                "must be a list of numbers", source=source, where=f"trees.{key}"
-            ) from None
-        if not np.all(np.isfinite(arrays[key])):
-            raise InputFileError("not all finite", source=source, where=f"trees.{key}")
+    arrays = number_lists(data, ("x_m", "y_m", "diameter_m"), "trees", source)
+    for key in ("y_m", "diameter_m"):
         if arrays[key].size != arrays["x_m"].size:
             raise InputFileError(
                 f"has {arrays[key].size} values, trees.x_m has {arrays['x_m'].size}",
