@@ -34,6 +34,7 @@ FLAGS = {
     "output": "-o",
     "model": "--model",
     "report_dir": "--report",
+    "report": "--report",
     "releases": "--paths",
     "deposits": "--deposits",
     "dem": "--dem",
@@ -232,6 +233,36 @@ def _paths(options: dict) -> None:
     )
 
 
+def _plan(options: dict) -> None:
+    """A fit of a terrain (3-D) model to deposits in plan (cli/fit_plan.py)."""
+    from fieldkit.cli.fit_plan import fit_plan_command
+
+    if options["deposits"] is None:
+        raise ArgumentError(
+            "a fit of a terrain (3-D) model needs --paths and --deposits",
+            source="deposits",
+        )
+    if options["table_file"] is not None:
+        raise ArgumentError(
+            "give either an ImpactTable or --paths, not both", source="table_file"
+        )
+    fit_plan_command(
+        model_file=options["model_file"],
+        releases=options["releases"],
+        deposits=options["deposits"],
+        output=options["output"],
+        json_file=options["json_file"],
+        holdout_releases=options["holdout_releases"],
+        holdout_deposits=options["holdout_deposits"],
+        free=options["free"],
+        bounds=options["bound"],
+        rocks=options["rocks"],
+        seed=options["seed"],
+        screen=options["screen"],
+        given=options,
+    )
+
+
 @one_line_errors(flags=FLAGS)
 def fit(
     model_file: Annotated[
@@ -410,6 +441,11 @@ def fit(
     from fieldkit.fit.impact_fit import check_realised_limit
 
     check_realised_limit(max_realised_e_n)
+    from fieldkit.cli.fit_plan import is_terrain_model
+
+    if releases is not None and is_terrain_model(model_file):
+        _plan(locals())
+        return
     if releases is not None or deposits is not None or dem is not None:
         _paths(locals())
         return

@@ -1,0 +1,152 @@
+"""`fieldkit fit` on a terrain (3-D) model file: the plan fit through the CLI on a
+synthetic bent-plane DEM with a known friction angle (27 deg)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+SLOPE_DEG = 35.0
+TOE_Y_M = 40.0
+RELEASE_Y_M = 75.0
+TRUE_FRICTION_DEG = 27.0
+START_FRICTION_DEG = 15.0
+
+
+def write_site(folder: Path) -> None:
+    """A 35 deg plane dipping to -y onto a flat floor at y = 40 m (1 m cells, x
+    0-21 m, y 0-81 m) as an ESRI ASCII grid, and a 3-D model file on it whose
+    friction angle is 15 deg."""
+    y = np.arange(81) + 0.5
+    z = np.maximum(y - TOE_Y_M, 0.0) * math.tan(math.radians(SLOPE_DEG))
+    grid = np.repeat(z[:, None], 21, axis=1)[::-1]  # row 0 north in the file
+    rows = "\n".join(" ".join(f"{v:.6f}" for v in row) for row in grid)
+    (folder / "dem").mkdir()
+    (folder / "dem" / "plane.asc").write_text(
+        "ncols 21\nnrows 81\nxllcorner 0\nyllcorner 0\ncellsize 1\n"
+        f"NODATA_value -9999\n{rows}\n"
+    )
+    (folder / "dem" / "releases.csv").write_text("x_m,y_m\n10,75\n")
+    model = {
+        "terrain": {"dem": "dem/plane.asc", "materials": "ground",
+                    "releases": "dem/releases.csv"},
+        "materials": {"ground": {"e_n": 0.3, "e_t": 0.8,
+                                 "friction_deg": START_FRICTION_DEG,
+                                 "friction_deg_sd": 2.0}},
+        "body": {"mass_kg": 100.0, "radius_m": 0.2},
+    }  # fmt: skip
+    (folder / "model3d.json").write_text(json.dumps(model))
+
+
+def write_runs(folder: Path, model_file: Path, ids: range, stem: str) -> None:
+    """Runs ``ids`` released across the plane, each observed as one rock of the
+    true model (friction 27 deg) on a stream no fit uses."""
+    from fieldkit.fit.plan_fit import PlanRun, plan_ensembles, with_parameters3d
+    from fieldkit.model.model_file import read_model
+
+    truth = with_parameters3d(
+        read_model(model_file, terrain=True),
+        {"materials.ground.friction_deg": TRUE_FRICTION_DEG},
+    )
+    runs = [
+        PlanRun(f"r{i}", np.array([2.0 + 1.5 * i, RELEASE_Y_M - (i % 3)]),
+                np.zeros(2), 100.0, 0.2)
+        for i in ids
+    ]  # fmt: skip
+    ens = plan_ensembles(truth, runs, 1, 99, stream=7)
+    rel = ["trajectory_id,x_m,y_m,mass_kg,radius_m"]
+    dep = ["trajectory_id,x_m,y_m"]
+    for r, e in zip(runs, ens.deposits_xy, strict=True):
+        rel.append(f"{r.run_id},{r.release_xy[0]},{r.release_xy[1]},100,0.2")
+        dep.append(f"{r.run_id},{float(e[0, 0])!r},{float(e[0, 1])!r}")
+    (folder / f"{stem}_releases.csv").write_text("\n".join(rel) + "\n")
+    (folder / f"{stem}_deposits.csv").write_text("\n".join(dep) + "\n")
+
+
+@pytest.fixture()
+def plan_site(tmp_path) -> Path:
+    write_site(tmp_path)
+    write_runs(tmp_path, tmp_path / "model3d.json", range(8), "cal")
+    write_runs(tmp_path, tmp_path / "model3d.json", range(8, 12), "hold")
+    return tmp_path
+
+
+def test_fit_of_a_terrain_model_recovers_friction_and_writes_a_model_simulate_runs(
+    cli, plan_site, tmp_path
+):
+    site = plan_site
+    out = tmp_path / "out"
+    base_text = (site / "model3d.json").read_text()
+    result = cli(
+        "fit", "--model", site / "model3d.json",
+        "--paths", site / "cal_releases.csv", "--deposits", site / "cal_deposits.csv",
+        "--holdout-paths", site / "hold_releases.csv",
+        "--holdout-deposits", site / "hold_deposits.csv",
+        "--free", "materials.ground.friction_deg",
+        "--bound", "materials.ground.friction_deg=5,34",
+        "--rocks", "20", "--seed", "1",
+        "-o", out / "calibrated_3d.json", "--json", out / "fit.json",
+    )  # fmt: skip
+    assert result.exit_code == 0, result.stderr + result.stdout
+    text = result.stdout
+    assert "objective: mean over runs of the fair energy score" in text
+    assert "note: screen" not in text and "Sobol screen 0 points (default)" in text
+    assert f"wrote {out / 'calibrated_3d.json'}" in text
+    assert f"wrote {out / 'fit.json'}" in text
+    assert "one seed (1)" in text
+    fit = json.loads((out / "fit.json").read_text())
+    friction = fit["parameters"]["materials.ground.friction_deg"]
+    assert friction["start"] == START_FRICTION_DEG
+    assert friction["value"] == pytest.approx(TRUE_FRICTION_DEG, abs=1.5)
+    assert fit["objective_m"] < 0.5 * fit["objective_start_m"]
+    assert f"{fit['objective_start_m']:.3f} m -> optimum {fit['objective_m']:.3f}" in text
+    # held out: the calibrated model beats the start on energy score (paired)
+    comp = {(c["b"], c["score"]): c for c in fit["holdout"]["comparisons"]}
+    assert comp[("start", "energy_fair_m")]["mean_difference"] < 0
+    assert set(comp) == {(b, s) for b in ("start", "climatology")
+                         for s in ("energy_fair_m", "distance_crps_fair_m")}  # fmt: skip
+    # the calibrated file: fitted value in place, terrain files absolute, readable
+    calibrated = json.loads((out / "calibrated_3d.json").read_text())
+    assert calibrated["materials"]["ground"]["friction_deg"] == friction["value"]
+    assert Path(calibrated["terrain"]["dem"]) == (site / "dem" / "plane.asc").resolve()
+    assert calibrated["terrain"]["materials"] == "ground"
+    assert calibrated["provenance"]["fit"]["objective_m"] == fit["objective_m"]
+    assert (site / "model3d.json").read_text() == base_text  # input untouched
+    sim = cli("simulate", out / "calibrated_3d.json", "--rocks", "4", "--seed", "2",
+              "--summary", out / "sim" / "summary.json")  # fmt: skip
+    assert sim.exit_code == 0, sim.stderr + sim.stdout
+    assert (out / "sim" / "summary.json").is_file()
+
+
+def test_fit_of_a_terrain_model_refuses_a_dem_option_in_one_line(
+    cli, plan_site, tmp_path
+):
+    site = plan_site
+    result = cli(
+        "fit", "--model", site / "model3d.json",
+        "--paths", site / "cal_releases.csv", "--deposits", site / "cal_deposits.csv",
+        "--dem", site / "dem" / "plane.asc", "-o", tmp_path / "c.json",
+    )  # fmt: skip
+    assert result.exit_code == 2
+    assert "--dem" in result.stderr and "terrain (3-D)" in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "c.json").exists()
+
+
+def test_fit_of_a_terrain_model_names_a_bad_deposit_row(cli, plan_site, tmp_path):
+    site = plan_site
+    bad = site / "bad_deposits.csv"
+    bad.write_text((site / "cal_deposits.csv").read_text().replace("r3,", "r3,x", 1))
+    result = cli(
+        "fit", "--model", site / "model3d.json",
+        "--paths", site / "cal_releases.csv", "--deposits", bad,
+        "-o", tmp_path / "c.json",
+    )  # fmt: skip
+    assert result.exit_code == 1
+    assert "row 5" in result.stderr and "x_m" in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "c.json").exists()
