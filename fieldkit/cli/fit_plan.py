@@ -189,10 +189,20 @@ def fit_plan_command(
             "objective_m": result.objective,
             "exited_share": result.exited_share,
             "parameters": {
-                n: {"start": float(s), "value": float(v), "lower": float(lo),
-                    "upper": float(hi)}
-                for n, s, v, lo, hi in zip(result.names, result.start, result.values,
-                                           result.lower, result.upper, strict=True)
+                n: {
+                    "start": float(s),
+                    "value": float(v),
+                    "lower": float(lo),
+                    "upper": float(hi),
+                }
+                for n, s, v, lo, hi in zip(
+                    result.names,
+                    result.start,
+                    result.values,
+                    result.lower,
+                    result.upper,
+                    strict=True,
+                )
             },  # fmt: skip
         }
         held_lines: list[str] = []
@@ -207,9 +217,12 @@ def fit_plan_command(
                       "each, calibrated and start)"):  # fmt: skip
                 scores = {
                     name: score_runs(
-                        plan_ensembles(m, hold, HOLDOUT_ROCKS, seed,
-                                       stream=HOLDOUT_STREAM).deposits_xy,
-                        rel, dep, u,
+                        plan_ensembles(
+                            m, hold, HOLDOUT_ROCKS, seed, stream=HOLDOUT_STREAM
+                        ).deposits_xy,
+                        rel,
+                        dep,
+                        u,
                     )  # fmt: skip
                     for name, m in (("calibrated", result.model), ("start", model))
                 }
@@ -256,4 +269,3 @@ def fit_plan_command(
         "its file names made absolute"
     )
     report_written(written)
-
