@@ -424,6 +424,16 @@ def fit(
     uncertainty over runs; held-out runs, when given, are scored for the
     calibrated model, the starting model and the climatology (the calibration
     runs' observed runouts). The README shows it on the Tschamut 2014 runs.
+    With a terrain (3-D) model file, --paths and --deposits (no --dem: the
+    model's own DEM) calibrate the 3-D model in plan: each run simulated from
+    its own release with its own block, objective the mean fair energy score of
+    the deposits (fieldkit.fit.plan_fit; --rocks per run, default 60, --seed,
+    --screen, --free, default e_n, e_t, friction_deg of every material,
+    --bound); held-out runs are scored (fair energy score, fair distance CRPS)
+    for the calibrated model, the start and the climatology with paired
+    differences +- SE over runs (one seed). The calibrated file is the base
+    file with the fitted values and provenance.fit; its terrain block's file
+    names are made absolute.
     With --paths alone, the file is an ImpactTable from reduce and each path is
     fitted on the model's own profile: its runout, flight heights, impact spacing
     and speeds at the impacts.
