@@ -161,6 +161,16 @@ def fit_plan_command(
                 source="bound",
             )
         runs = read_plan_runs(releases, deposits)
+        groups = duplicate_runs(
+            np.array([r.release_xy for r in runs]),
+            np.array([r.deposit_xy for r in runs]),
+        )
+        for g in groups:
+            said.append(
+                f"runs {' = '.join(runs[i].run_id for i in g)} have the same release "
+                "and deposit (a run recorded twice): counted once"
+            )
+        runs = [runs[i] for i in unique_runs(len(runs), groups)]
         hold = None
         if holdout_releases is not None:
             hold = read_plan_runs(holdout_releases, holdout_deposits)
@@ -209,10 +219,9 @@ def fit_plan_command(
         if hold is not None:
             cal_rel = np.array([r.release_xy for r in runs])
             cal_dep = np.array([r.deposit_xy for r in runs])
-            keep = unique_runs(len(runs), duplicate_runs(cal_rel, cal_dep))
             rel = np.array([r.release_xy for r in hold])
             dep = np.array([r.deposit_xy for r in hold])
-            u = mean_direction(cal_rel[keep], cal_dep[keep])
+            u = mean_direction(cal_rel, cal_dep)
             with step(f"scoring {len(hold)} held-out runs ({HOLDOUT_ROCKS} rocks "
                       "each, calibrated and start)"):  # fmt: skip
                 scores = {
@@ -227,7 +236,7 @@ def fit_plan_command(
                     for name, m in (("calibrated", result.model), ("start", model))
                 }
             scores["climatology"] = score_runs(
-                plan_climatology(cal_rel[keep], cal_dep[keep], rel), rel, dep, u
+                plan_climatology(cal_rel, cal_dep, rel), rel, dep, u
             )
             held_lines.append(
                 f"held-out: {len(hold)} runs, {HOLDOUT_ROCKS} rocks per run on streams "

@@ -71,6 +71,10 @@ def write_runs(folder: Path, model_file: Path, ids: range, stem: str) -> None:
 def plan_site(tmp_path) -> Path:
     write_site(tmp_path)
     write_runs(tmp_path, tmp_path / "model3d.json", range(8), "cal")
+    for stem in ("cal_releases", "cal_deposits"):  # r0 recorded twice, as r0b
+        path = tmp_path / f"{stem}.csv"
+        lines = path.read_text().splitlines()
+        path.write_text("\n".join([*lines, lines[1].replace("r0,", "r0b,", 1)]) + "\n")
     write_runs(tmp_path, tmp_path / "model3d.json", range(8, 12), "hold")
     return tmp_path
 
@@ -98,9 +102,11 @@ def test_fit_of_a_terrain_model_recovers_friction_and_writes_a_model_simulate_ru
     assert f"wrote {out / 'calibrated_3d.json'}" in text
     assert f"wrote {out / 'fit.json'}" in text
     assert "one seed (1)" in text
+    assert "runs r0 = r0b have the same release and deposit" in text
     fit = json.loads((out / "fit.json").read_text())
     friction = fit["parameters"]["materials.ground.friction_deg"]
     assert friction["start"] == START_FRICTION_DEG
+    assert fit["runs"] == 8  # r0b counted once
     assert friction["value"] == pytest.approx(TRUE_FRICTION_DEG, abs=1.5)
     assert fit["objective_m"] < 0.5 * fit["objective_start_m"]
     assert (
