@@ -11,13 +11,14 @@ reads from wherever it is written.
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
 import typer
 
 from fieldkit.cli.progress import report_written, step
-from fieldkit.errors import ArgumentError
+from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.outputs import OutputSet, write_json
 
 #: Settings of the 3-D plan fit left unset on the command line take these values.
@@ -48,6 +49,20 @@ def default_free3d(model) -> list[str]:
         for m in model.materials
         for k in ("e_n", "e_t", "friction_deg")
     ]
+
+
+def check_releases_on_dem(runs, terrain, path: Path) -> None:
+    """Refuse, naming the file and row, a release off the DEM's surface (before
+    any simulation; rows in the file's order, as :func:`read_plan_runs` keeps)."""
+    for row, run in enumerate(runs, start=2):
+        x, y = (float(v) for v in run.release_xy)
+        if not math.isfinite(terrain.height(x, y)):
+            raise InputFileError(
+                f"run {run.run_id}: release (x {x:g}, y {y:g}) is off the model's "
+                "DEM (outside its cell centres or beside nodata)",
+                source=str(path),
+                where=f"row {row}",
+            )
 
 
 def calibrated_model_dict(model_file: Path, values: dict[str, float],
@@ -161,6 +176,7 @@ def fit_plan_command(
                 source="bound",
             )
         runs = read_plan_runs(releases, deposits)
+        check_releases_on_dem(runs, model.terrain, releases)
         groups = duplicate_runs(
             np.array([r.release_xy for r in runs]),
             np.array([r.deposit_xy for r in runs]),
@@ -174,6 +190,7 @@ def fit_plan_command(
         hold = None
         if holdout_releases is not None:
             hold = read_plan_runs(holdout_releases, holdout_deposits)
+            check_releases_on_dem(hold, model.terrain, holdout_releases)
         for line in said:
             typer.echo(f"note: {line}")
         typer.echo(

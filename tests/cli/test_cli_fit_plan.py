@@ -158,3 +158,24 @@ def test_fit_of_a_terrain_model_names_a_bad_deposit_row(cli, plan_site, tmp_path
     assert "row 5" in result.stderr and "x_m" in result.stderr
     assert len(result.stderr.strip().splitlines()) == 1
     assert not (tmp_path / "c.json").exists()
+
+
+def test_fit_of_a_terrain_model_names_a_held_out_release_off_the_dem(
+    cli, plan_site, tmp_path
+):
+    site = plan_site
+    bad = site / "off_releases.csv"
+    lines = (site / "hold_releases.csv").read_text().splitlines()
+    lines[2] = "r9,500,74,100,0.2"
+    bad.write_text("\n".join(lines) + "\n")
+    result = cli(
+        "fit", "--model", site / "model3d.json",
+        "--paths", site / "cal_releases.csv", "--deposits", site / "cal_deposits.csv",
+        "--holdout-paths", bad, "--holdout-deposits", site / "hold_deposits.csv",
+        "-o", tmp_path / "c.json",
+    )  # fmt: skip
+    assert result.exit_code == 1
+    assert f"{bad}: row 3: run r9: release (x 500, y 74) is off" in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1
+    assert "fitting" not in result.stderr  # refused before any simulation
+    assert not (tmp_path / "c.json").exists()
