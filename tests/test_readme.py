@@ -53,8 +53,8 @@ def test_shell_blocks_run(repo_copy, shell_commands, run_shell, monkeypatch):
     before = {p.name for p in repo_copy.iterdir()}
     ran = run_blocks(selected, repo_copy, shell_commands, run_shell, monkeypatch)
     # --version, reduce, impact, fence, view (2), effects, simulate, simulate (3-D),
-    # profile, synth,
-    # fit, fit --paths (2), fit (3-D), diagnose, synth --track, diagnose (track), synth --survey,
+    # profile, synth, fit, fit --paths (2), fit (3-D), diagnose, synth --track,
+    # diagnose (track), synth --survey,
     # reduce --campaign, diagnose (campaign), export (3), import-model,
     # import-results; the video block runs when slow
     assert ran == 26
