@@ -551,6 +551,17 @@ def _friction_tan(mat, mi, key, n, entry):
     return math.tan(math.radians(min(phi, 89.9)))
 
 
+@njit(cache=True, inline="always")
+def drawn_restitution(e_n, e_n_sd, e_t, e_t_sd, key, n):
+    """This impact's ``(e_n, e_t)``: the material's means with their scatter drawn
+    on the impact's own slots (clipped at 0); shared by the 2-D and 3-D kernels."""
+    if e_n_sd > 0.0:
+        e_n = max(0.0, e_n + e_n_sd * normal(key, n, SLOT_E_N))
+    if e_t_sd > 0.0:
+        e_t = max(0.0, e_t + e_t_sd * normal(key, n, SLOT_E_T))
+    return e_n, e_t
+
+
 @njit(cache=True)
 def restitution(vin, vit, e_n, e_n_mean, e_t, omega_i, r, kg, flags, par):
     """``(vfn, vft, omega_f)`` of one impact in local axes: the impact stage's laws.
@@ -737,12 +748,9 @@ def impact(key, n, x, z, vx, vz, w, t, j, m, r, kg, x0, m0, r0, k0, tree_hit, cp
     vz)`` and ``u`` the velocity along the segment.
     """
     mi = smat[j]
-    e_n = mat[mi, M_EN]
-    if mat[mi, M_EN_SD] > 0.0:
-        e_n = max(0.0, e_n + mat[mi, M_EN_SD] * normal(key, n, SLOT_E_N))
-    e_t = mat[mi, M_ET]
-    if mat[mi, M_ET_SD] > 0.0:
-        e_t = max(0.0, e_t + mat[mi, M_ET_SD] * normal(key, n, SLOT_E_T))
+    e_n, e_t = drawn_restitution(
+        mat[mi, M_EN], mat[mi, M_EN_SD], mat[mi, M_ET], mat[mi, M_ET_SD], key, n
+    )
     if flags[F_MASS] == 1:
         ratio = mass_loss.volume_ratio(x - x0, n, par[P_MASS_RATE], par[P_MASS_EXP])
         cube = ratio ** (1.0 / 3.0)

@@ -73,13 +73,12 @@ from fieldkit.model.effects.registry import EFFECTS, LAYOUT
 from fieldkit.model.kernel import (
     MATERIAL_COLUMNS,
     descending_root,
+    drawn_restitution,
     passive_normal_speed,
     restitution,
     time_to_x,
 )
 from fieldkit.model.random_streams import (
-    SLOT_E_N,
-    SLOT_E_T,
     SLOT_FRICTION,
     SLOT_ROUGHNESS,
     normal,
@@ -294,12 +293,9 @@ def impact(gr, mat, flags, par, key, n, x, y, vx, vy, vz, w, r, kg):
     h, gx, gy = surface_at(gr, x, y)
     nx, ny, nz = _unit_normal(gx, gy)
     mi, _ = _cell_material(gr, x, y)
-    e_n = mat[mi, M_EN]
-    if mat[mi, M_EN_SD] > 0.0:
-        e_n = max(0.0, e_n + mat[mi, M_EN_SD] * normal(key, n, SLOT_E_N))
-    e_t = mat[mi, M_ET]
-    if mat[mi, M_ET_SD] > 0.0:
-        e_t = max(0.0, e_t + mat[mi, M_ET_SD] * normal(key, n, SLOT_E_T))
+    e_n, e_t = drawn_restitution(
+        mat[mi, M_EN], mat[mi, M_EN_SD], mat[mi, M_ET], mat[mi, M_ET_SD], key, n
+    )
     vin = vx * nx + vy * ny + vz * nz
     tx = vx - vin * nx
     ty = vy - vin * ny
