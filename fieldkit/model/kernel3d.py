@@ -282,6 +282,21 @@ def _sample_flight(gr, path, k, on, x, y, z, vx, vy, vz, t1, sample_m, m, re):
     return k
 
 
+@njit(cache=True, inline="always")
+def _local_axes(vx, vy, vz, nx, ny, nz):
+    """``(vin, vit, tx, ty, tz)``: the velocity's normal component on the unit
+    normal ``n``, its tangential speed and the unit tangent T along it (in the plane
+    of incidence); T is the bare tangential velocity when ``vit`` is not positive."""
+    vin = vx * nx + vy * ny + vz * nz
+    tx = vx - vin * nx
+    ty = vy - vin * ny
+    tz = vz - vin * nz
+    vit = math.sqrt(tx * tx + ty * ty + tz * tz)
+    if vit > 0.0:
+        return vin, vit, tx / vit, ty / vit, tz / vit
+    return vin, vit, tx, ty, tz
+
+
 @njit(cache=True)
 def impact(gr, mat, flags, par, key, n, x, y, vx, vy, vz, w, r, kg):
     """One impact at ``(x, y)`` on the surface; returns the rebound and its axes.
@@ -296,14 +311,9 @@ def impact(gr, mat, flags, par, key, n, x, y, vx, vy, vz, w, r, kg):
     e_n, e_t = drawn_restitution(
         mat[mi, M_EN], mat[mi, M_EN_SD], mat[mi, M_ET], mat[mi, M_ET_SD], key, n
     )
-    vin = vx * nx + vy * ny + vz * nz
-    tx = vx - vin * nx
-    ty = vy - vin * ny
-    tz = vz - vin * nz
-    vit = math.sqrt(tx * tx + ty * ty + tz * tz)
-    if vit > 0.0:
-        tx, ty, tz = tx / vit, ty / vit, tz / vit
-    else:  # normal incidence: T down the fall line (or along x on level ground)
+    vin, vit, tx, ty, tz = _local_axes(vx, vy, vz, nx, ny, nz)
+    if not vit > 0.0:
+        # normal incidence: T down the fall line (or along x on level ground)
         tx, ty, tz = nx * nz, ny * nz, nz * nz - 1.0
         tn = math.sqrt(tx * tx + ty * ty + tz * tz)
         if tn > 1e-12:
@@ -333,13 +343,7 @@ def impact(gr, mat, flags, par, key, n, x, y, vx, vy, vz, w, r, kg):
                 if vx * mx + vy * my + vz * mz < 0.0 or trial == 2:
                     nx, ny, nz = mx, my, mz
                     break
-            vin = vx * nx + vy * ny + vz * nz
-            tx = vx - vin * nx
-            ty = vy - vin * ny
-            tz = vz - vin * nz
-            vit = math.sqrt(tx * tx + ty * ty + tz * tz)
-            if vit > 0.0:
-                tx, ty, tz = tx / vit, ty / vit, tz / vit
+            vin, vit, tx, ty, tz = _local_axes(vx, vy, vz, nx, ny, nz)
     vfn, vft, w_f = restitution(vin, vit, e_n, mat[mi, M_EN], e_t, w, r, kg, flags, par)
     k_spin = kg if flags[F_ROT] == 1 and par[P_ROT_C] > 0.0 else 0.0
     vfn = passive_normal_speed(vin, vit, w, vfn, vft, w_f, k_spin)
