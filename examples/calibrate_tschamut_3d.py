@@ -13,17 +13,32 @@ Issue 21, item 3. On the fixed split (tests/data/tschamut2014/calibration_split:
    (:func:`fieldkit.fit.plan_scores.section_to_plan`);
 3. score on the held-out runs, with streams no fit uses
    (``default_rng([seed, HOLDOUT_STREAM, run])``): the 3-D calibrated model, the
-   3-D start, the 2-D calibrated model and the climatology in plan (the calibration
-   runs' release-to-deposit vectors) -- fair energy score, fair distance CRPS,
-   fair lateral CRPS, 90 % distance coverage, mean distance error -- each
-   comparison paired, with its SE over runs, over seeds 1, 2, 3 (a fit per seed).
+   3-D start, the 2-D calibrated model, the climatology in plan (the calibration
+   runs' release-to-deposit vectors) and the climatology of the run's own block
+   (the most per-run information an empirical forecast has here) -- fair energy
+   score, fair distance CRPS, fair lateral CRPS, 90 % distance coverage, mean
+   distance error -- each comparison paired, with its SE over runs, over seeds 1,
+   2, 3 (a fit per seed).
+
+Two assumptions, each shown moved in a last table:
+
+* **The tracked extent.** The observed deposits are the last samples of the
+  laser-scan tracks, and six lie within 1.5 m of the scan's southern edge: rocks
+  seen leaving. Every forecast is censored at its first exit from the scanned area
+  as the observations are (:mod:`fieldkit.fit.tracked_extent`), taken as the DEM
+  less metadata.json's ``padding_m`` (the proxy DEM was built from the scan's
+  ground points and padded by 45 m; beyond, its ground is the trend plane falling
+  at 22 degrees, so rocks there ran on to the grid's edge).
+* **The release.** The model file drops each block 0.5 m onto the DEM (its
+  provenance says why); at rest, a block on a cell flatter than its friction
+  angle never moves (run v086's release, 12 degrees).
 
 With ``--full``, also repeated 5-fold cross-validation over the 79 distinct runs
 (2 repeats, stratified by block, seed 1): 3-D calibrated against the climatology.
 
 Sizes (default / ``--full``): 3-D fit 60 / 100 rocks per run and 80 / 160
-evaluations (Sobol screen 0 / 16 points); held-out 200 / 500 rocks per run; 25 s /
-7 min measured (the k-fold's ten fits 6 min of it).
+evaluations (Sobol screen 0 / 16 points); held-out 200 / 500 rocks per run; about
+80 s / 12 min measured (the five fixed-split cases; the k-fold's ten fits).
 
 Run:  python examples/calibrate_tschamut_3d.py [OUT_DIR] [--full]
 """
@@ -33,6 +48,7 @@ from __future__ import annotations
 import json
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -51,6 +67,13 @@ from fieldkit.fit.plan_scores import (
     section_to_plan,
     unique_runs,
 )
+from fieldkit.fit.tracked_extent import (
+    Extent,
+    censor_chainage,
+    censor_straight_ensembles,
+    clip_model,
+    exit_chainage,
+)
 from fieldkit.io.dem import read_dem
 from fieldkit.io.path_observations import read_release_deposit
 from fieldkit.model.model_file import read_model
@@ -68,6 +91,10 @@ SEEDS = (1, 2, 3)
 SMALL = {"fit_rocks": 60, "evaluations": 80, "screen": 0, "holdout_rocks": 200}
 FULL = {"fit_rocks": 100, "evaluations": 160, "screen": 16, "holdout_rocks": 500}
 SCORES = ("energy_fair_m", "distance_crps_fair_m", "lateral_crps_fair_m")
+#: The release drop of the model file's seeder [m] (its provenance says why).
+DROP_M = float(
+    json.loads(MODEL_3D.read_text(encoding="utf-8"))["seeder"].get("height_m", 0.0)
+)
 
 
 def _xy(runs, what):
@@ -86,28 +113,59 @@ def _plan3d(model, runs, rocks, seed):
     return ens.deposits_xy, ens.exited_share
 
 
-def _plan2d(model_2d, hold_obs, rocks, seed):
+def _plan2d(model_2d, hold_obs, rocks, seed, extent):
+    """The 2-D model's stops on each held-out run's section, in plan; with an
+    extent, censored where the section leaves it (as the 3-D rocks are)."""
     runs = path_runs(
         hold_obs, read_dem(DATA / "terrain.asc"), model_2d, section="descent"
     )
-    out = []
+    out, cut = [], 0
     with one_kernel_thread():
         for i, run in enumerate(runs):
             rng = np.random.default_rng([seed, plan_fit.HOLDOUT_STREAM, i])
-            stops = np.asarray(simulate(run.model, rocks, rng).runout_x_m, float)
-            out.append(
-                section_to_plan(
-                    run.observations["section_x_m"],
-                    run.observations["section_y_m"],
-                    stops - float(run.model.seeder.x_m),
-                )
-            )
+            sx = run.observations["section_x_m"]
+            sy = run.observations["section_y_m"]
+            c = np.asarray(simulate(run.model, rocks, rng).runout_x_m, float)
+            c = c - float(run.model.seeder.x_m)
+            if extent is not None:
+                c, was_cut = censor_chainage(c, exit_chainage(sx, sy, extent))
+                cut += int(was_cut.sum())
+            out.append(section_to_plan(sx, sy, c))
+    return out, cut / (rocks * len(runs))
+
+
+def _climatology(cal_rel, cal_dep, rel, extent):
+    ens = plan_climatology(cal_rel, cal_dep, rel)
+    if extent is None:
+        return ens, 0.0
+    return censor_straight_ensembles(rel, ens, extent)
+
+
+def _block_climatology(cal, hold, cal_rel, cal_dep, rel, extent):
+    """The climatology of the held-out run's own block only (6 or 5 vectors): the
+    most per-run information an empirical forecast has here."""
+    g = np.array([r.group for r in cal])
+    out = []
+    for i, r in enumerate(hold):
+        ens, _ = _climatology(cal_rel[g == r.group], cal_dep[g == r.group],
+                              rel[[i]], extent)  # fmt: skip
+        out.append(ens[0])
     return out
 
 
-def fixed_split(settings: dict) -> dict:
-    base3d = read_model(MODEL_3D, terrain=True)
-    base2d = read_model(MODEL_2D)
+def tracked_extent() -> Extent:
+    """The area the laser scan tracked, as the terrain proxy records it: the DEM
+    less its ``padding_m`` on every side (metadata.json; the proxy was built from
+    the scan's ground points and padded by that much)."""
+    meta = json.loads((DATA / "metadata.json").read_text(encoding="utf-8"))
+    t = meta["terrain_proxy"]
+    pad, cell = t["padding_m"], t["cellsize_m"]
+    x0, y0 = t["xllcorner_m"], t["yllcorner_m"]
+    return Extent(x0 + pad, y0 + pad, x0 + t["ncols"] * cell - pad,
+                  y0 + t["nrows"] * cell - pad)  # fmt: skip
+
+
+def _runs():
     cal = _dedupe(
         plan_fit.read_plan_runs(
             SPLIT / "calibration_release_points.csv",
@@ -117,6 +175,29 @@ def fixed_split(settings: dict) -> dict:
     hold = plan_fit.read_plan_runs(
         SPLIT / "holdout_release_points.csv", SPLIT / "holdout_observed_deposition.csv"
     )
+    return cal, hold
+
+
+def _model3d(extent, height):
+    """The 3-D start model with the release drop ``height`` [m], on the DEM
+    clipped to ``extent`` (None: the whole DEM); and the extent all forecasts are
+    censored on (the clipped surface's)."""
+    base = read_model(MODEL_3D, terrain=True)
+    base = replace(base, seeder=replace(base.seeder, height_m=height))
+    if extent is None:
+        return base, None
+    return clip_model(base, extent)
+
+
+def fixed_split(settings: dict, extent: Extent | None, height: float,
+                verbose: bool = True) -> dict:  # fmt: skip
+    """The fixed split over seeds 1-3: fits, held-out scores, paired comparisons.
+    ``extent``: censor every forecast at the tracked extent (None: not);
+    ``height``: the release drop [m]."""
+    say = print if verbose else (lambda *a, **k: None)
+    base3d, censor = _model3d(extent, height)
+    base2d = read_model(MODEL_2D)
+    cal, hold = _runs()
     cal_obs = read_release_deposit(
         SPLIT / "calibration_release_points.csv",
         SPLIT / "calibration_observed_deposition.csv",
@@ -130,22 +211,31 @@ def fixed_split(settings: dict) -> dict:
     cal_rel, cal_dep = _xy(cal, "release_xy"), _xy(cal, "deposit_xy")
     rel, dep = _xy(hold, "release_xy"), _xy(hold, "deposit_xy")
     u = mean_direction(cal_rel, cal_dep)
-    print(
+    say(
         f"fixed split: {len(cal)} calibration runs (v033 = v034 counted once), "
         f"{len(hold)} held-out runs; seeds {', '.join(map(str, SEEDS))}"
     )
-    print(
+    say(
         f"sizes: 3-D fit {settings['fit_rocks']} rocks per run, "
         f"{settings['evaluations']} evaluations, Sobol screen {settings['screen']}; "
         f"2-D fit 40 rocks, no bootstrap; held-out {settings['holdout_rocks']} "
         "rocks per run on streams no fit uses"
     )
-    forecasts: dict[str, list] = {
-        "3-D calibrated": [],
-        "3-D start": [],
-        "2-D calibrated": [],
-    }
-    exited = {"3-D calibrated": [], "3-D start": []}
+    say(f"release: a drop of {height:g} m onto the DEM (assumed; model seeder)")
+    if censor is None:
+        say("tracked extent: none -- every forecast scored where its rocks stop")
+    else:
+        say(
+            f"tracked extent {censor.describe()} (the scan's, assumed: "
+            "metadata.json's DEM less its padding, to the cell centres inside): "
+            "every forecast censored at its first exit, as the observed last "
+            "samples are"
+        )
+    # the sensitivity cases (verbose False) need only the 3-D calibrated model
+    names = ("3-D calibrated", "3-D start", "2-D calibrated") if verbose else (
+        "3-D calibrated",)  # fmt: skip
+    forecasts: dict[str, list] = {name: [] for name in names}
+    exited = {name: [] for name in forecasts}
     for seed in SEEDS:
         tic = time.perf_counter()
         fit = plan_fit.fit_plan(
@@ -157,9 +247,18 @@ def fixed_split(settings: dict) -> dict:
             max_evaluations=settings["evaluations"],
             screen=settings["screen"],
         )
-        print(f"seed {seed}: 3-D fit in {time.perf_counter() - tic:.1f} s")
+        say(f"seed {seed}: 3-D fit in {time.perf_counter() - tic:.1f} s")
         for line in fit.lines():
-            print("  " + line)
+            say("  " + line)
+        rocks = settings["holdout_rocks"]
+        ens, share = _plan3d(fit.model, hold, rocks, seed)
+        forecasts["3-D calibrated"].append(score_runs(ens, rel, dep, u))
+        exited["3-D calibrated"].append(share)
+        if not verbose:
+            continue
+        ens, share = _plan3d(base3d, hold, rocks, seed)
+        forecasts["3-D start"].append(score_runs(ens, rel, dep, u))
+        exited["3-D start"].append(share)
         tic = time.perf_counter()
         fit2d = fit_paths(
             cal2d,
@@ -172,38 +271,45 @@ def fixed_split(settings: dict) -> dict:
             profile_seeds=0,
             slice_points=0,
         )
-        print(
+        say(
             f"seed {seed}: 2-D fit in {time.perf_counter() - tic:.1f} s: "
             + ", ".join(
                 f"{n.split('.')[-1]} {v:.3g}"
                 for n, v in zip(fit2d.names, fit2d.values, strict=True)
             )
         )
-        rocks = settings["holdout_rocks"]
-        for name, model in (("3-D calibrated", fit.model), ("3-D start", base3d)):
-            ens, share = _plan3d(model, hold, rocks, seed)
-            forecasts[name].append(score_runs(ens, rel, dep, u))
-            exited[name].append(share)
-        ens2d = _plan2d(fit2d.model, hold_obs, rocks, seed)
+        ens2d, share = _plan2d(fit2d.model, hold_obs, rocks, seed, censor)
         forecasts["2-D calibrated"].append(score_runs(ens2d, rel, dep, u))
-    clim = score_runs(plan_climatology(cal_rel, cal_dep, rel), rel, dep, u)
-    print()
-    print(
+        exited["2-D calibrated"].append(share)
+    ens_c, clim_cut = _climatology(cal_rel, cal_dep, rel, censor)
+    clim = score_runs(ens_c, rel, dep, u)
+    block = score_runs(
+        _block_climatology(cal, hold, cal_rel, cal_dep, rel, censor), rel, dep, u
+    )
+    exited["climatology"] = [clim_cut]
+    say()
+    say(
         f"held-out scores, mean over {len(hold)} runs and seeds 1-3 (lower is "
-        "better; fair scores)"
+        "better; fair scores; 'left': share of members censored at the DEM's "
+        "or the tracked extent's edge)"
     )
-    print(
-        f"{'forecast':<16}{'energy':>9}{'dist CRPS':>11}{'lat CRPS':>10}"
-        f"{'cov90':>7}{'mean dist err':>15}{'exited':>8}"
+    say(
+        f"{'forecast':<22}{'energy':>8}{'dist CRPS':>11}{'lat CRPS':>10}"
+        f"{'cov90':>7}{'mean dist err':>15}{'left':>8}"
     )
-    summary: dict = {"forecasts": {}, "comparisons": []}
-    rows = {**forecasts, "climatology": [clim]}
+    summary: dict = {
+        "release_drop_m": height,
+        "tracked_extent": None if censor is None else list(vars(censor).values()),
+        "forecasts": {},
+        "comparisons": [],
+    }
+    rows = {**forecasts, "climatology": [clim], "climatology of the block": [block]}
     for name, per_seed in rows.items():
         s = [p.summary() for p in per_seed]
         mean = {k: float(np.mean([x[k] for x in s])) for k in s[0]}
         ex = exited.get(name)
-        print(
-            f"{name:<16}{mean['energy_fair_m']:9.2f}"
+        say(
+            f"{name:<22}{mean['energy_fair_m']:8.2f}"
             f"{mean['distance_crps_fair_m']:11.2f}"
             f"{mean['lateral_crps_fair_m']:10.2f}"
             f"{100 * mean['distance_coverage_90']:6.0f}%"
@@ -211,31 +317,70 @@ def fixed_split(settings: dict) -> dict:
             + (f"{100 * np.mean(ex):7.1f}%" if ex else "       -")
         )
         summary["forecasts"][name] = mean | (
-            {"exited_share": float(np.mean(ex))} if ex else {}
+            {"left_share": float(np.mean(ex))} if ex else {}
         )
-    print(
+    say(
         f"(observed mean distance {mean['distance_observed_mean_m']:.1f} m; "
         "mean dist err = predicted - observed mean distance)"
     )
-    print()
-    print("paired comparisons (A - B, SE over runs; negative: A better)")
-    a_scores = forecasts["3-D calibrated"]
-    for other in ("climatology", "2-D calibrated", "3-D start"):
+    say()
+    say("paired comparisons (A - B, SE over runs; negative: A better)")
+    pairs = [("3-D calibrated", o) for o in
+             ("climatology", "2-D calibrated", "3-D start") if o in rows]  # fmt: skip
+    pairs.append(("climatology of the block", "climatology"))
+    for a_name, other in pairs:
         for score in SCORES:
-            a = np.array([getattr(p, score) for p in a_scores])
-            b = (
-                getattr(clim, score)
-                if other == "climatology"
-                else np.array([getattr(p, score) for p in rows[other]])
-            )
-            c = paired_comparison(a, b, score, "3-D calibrated", other, seeds=SEEDS)
-            print("\n".join(c.lines()))
+            a = np.array([getattr(p, score) for p in rows[a_name]])
+            b = np.array([getattr(p, score) for p in rows[other]])
+            if b.shape[0] == 1:
+                b = b[0]
+            if a.shape[0] == 1:
+                a = a[0]
+            c = paired_comparison(a, b, score, a_name, other,
+                                  seeds=SEEDS if a.ndim == 2 else [0])  # fmt: skip
+            say("\n".join(c.lines()))
             summary["comparisons"].append(c.to_dict())
     return summary
 
 
+def sensitivity(settings: dict, main: dict) -> list[dict]:
+    """The fixed split's 3-D calibrated model against the climatology as the two
+    assumptions move: the tracked extent (on / off) and the release drop."""
+    cases = [(True, 0.0), (False, DROP_M), (False, 0.0), (True, 1.0)]
+    print()
+    print(
+        "how the verdict moves with the assumptions (3-D calibrated - climatology, "
+        "paired SE over runs, seeds 1-3)"
+    )
+    print(
+        f"{'tracked extent':<16}{'drop':>6}{'3-D energy':>12}{'clim':>7}"
+        f"{'difference':>17}{'3-D dist':>10}{'clim':>7}{'difference':>17}"
+    )
+    out = []
+    for on, height in [(True, DROP_M), *cases]:
+        s = (
+            main
+            if (on, height) == (True, DROP_M)
+            else fixed_split(
+                settings, tracked_extent() if on else None, height, verbose=False
+            )
+        )
+        c = {(x["a"], x["b"], x["score"]): x for x in s["comparisons"]}
+        e = c[("3-D calibrated", "climatology", "energy_fair_m")]
+        d = c[("3-D calibrated", "climatology", "distance_crps_fair_m")]
+        print(
+            f"{'on' if on else 'off':<16}{height:5.1f}m{e['mean_a']:12.2f}"
+            f"{e['mean_b']:7.2f}{e['mean_difference']:+10.2f} +- {e['se']:4.2f}"
+            f"{d['mean_a']:10.2f}{d['mean_b']:7.2f}"
+            f"{d['mean_difference']:+10.2f} +- {d['se']:4.2f}"
+        )
+        out.append({"tracked_extent": on, "release_drop_m": height,
+                    "energy": e, "distance_crps": d})  # fmt: skip
+    return out
+
+
 def kfold(settings: dict, repeats: int = 2, k: int = 5, seed: int = 1) -> dict:
-    base3d = read_model(MODEL_3D, terrain=True)
+    base3d, censor = _model3d(tracked_extent(), DROP_M)
     runs = _dedupe(
         plan_fit.read_plan_runs(
             DATA / "release_points.csv", DATA / "observed_deposition.csv"
@@ -264,9 +409,9 @@ def kfold(settings: dict, repeats: int = 2, k: int = 5, seed: int = 1) -> dict:
             ("3-D", ens),
             (
                 "clim",
-                plan_climatology(
-                    rel[f.calibration], dep[f.calibration], rel[f.holdout]
-                ),
+                _climatology(
+                    rel[f.calibration], dep[f.calibration], rel[f.holdout], censor
+                )[0],
             ),
         ):
             s = score_runs(e, rel[f.holdout], dep[f.holdout], u)
@@ -299,7 +444,12 @@ def main(argv: list[str]) -> None:
     args = [a for a in argv if a != "--full"]
     out = Path(args[0]) if args else Path("out") / "calibrate_tschamut_3d"
     settings = FULL if full else SMALL
-    summary = {"settings": settings, "fixed_split": fixed_split(settings)}
+    main_split = fixed_split(settings, tracked_extent(), DROP_M)
+    summary = {
+        "settings": settings,
+        "fixed_split": main_split,
+        "sensitivity": sensitivity(settings, main_split),
+    }
     if full:
         summary["kfold"] = kfold(settings)
     out.mkdir(parents=True, exist_ok=True)

@@ -57,6 +57,8 @@ FLAGS = {
     "at": "--at",
     "measured": "--measured",
     "design_rocks": "--design-rocks",
+    "tracked_extent": "--tracked-extent",
+    "holdout_seeds": "--holdout-seeds",
     **SUSPECT_FLAGS,
 }
 
@@ -260,6 +262,8 @@ def _plan(options: dict) -> None:
         seed=options["seed"],
         screen=options["screen"],
         given=options,
+        tracked_extent=options["tracked_extent"],
+        holdout_seeds=options["holdout_seeds"],
     )
 
 
@@ -392,6 +396,24 @@ def fit(
     flagged: FlaggedOpt = "keep",
     assumed_theta0: AssumedOpt = "keep",
     leave_out: LeaveOutOpt = True,
+    tracked_extent: Annotated[
+        str | None,
+        typer.Option(
+            "--tracked-extent",
+            help="3-D fit: XMIN,YMIN,XMAX,YMAX [m], the area the survey tracked "
+            "the blocks in: every simulated rock ends at its first exit from it, as "
+            "an observed last tracked position does (and so do the climatology's "
+            "vectors). Default: none, rocks scored where they stop or leave the DEM.",
+        ),
+    ] = None,
+    holdout_seeds: Annotated[
+        int | None,
+        typer.Option(
+            "--holdout-seeds",
+            help="3-D fit: fits (seeds --seed, --seed + 1, ...) the held-out "
+            "comparison averages over (1 to 20; default 3).",
+        ),
+    ] = None,
 ) -> None:
     """Fit restitution and effect parameters to measured impacts (weighted LSQ).
 
@@ -456,6 +478,13 @@ def fit(
     if releases is not None and is_terrain_model(model_file):
         _plan(locals())
         return
+    for name in ("tracked_extent", "holdout_seeds"):
+        if locals()[name] is not None:
+            raise ArgumentError(
+                "for a fit of a terrain (3-D) model only (a model file with a "
+                "terrain block, with --paths and --deposits)",
+                source=name,
+            )
     if releases is not None or deposits is not None or dem is not None:
         _paths(locals())
         return

@@ -25,6 +25,8 @@ from fieldkit.outputs import OutputSet, write_json
 PLAN_DEFAULTS = {"rocks": 60, "seed": 0, "screen": 0}
 #: Held-out scoring: rocks per run (on streams no fit uses).
 HOLDOUT_ROCKS = 200
+#: Held-out scoring: fits (seeds seed, seed + 1, ...) the comparison averages over.
+HOLDOUT_SEEDS = 3
 #: Scores of the held-out comparison.
 HOLDOUT_SCORES = ("energy_fair_m", "distance_crps_fair_m")
 #: Options of the profile path fit that a 3-D fit has no use for (refused).
@@ -114,24 +116,15 @@ def fit_plan_command(
     seed: int | None,
     screen: int | None,
     given: dict,
+    tracked_extent: str | None = None,
+    holdout_seeds: int | None = None,
 ) -> None:
     """Run the 3-D plan fit (module docstring). ``given``: the other options of
     `fieldkit fit` as given (those of :data:`NOT_3D` are refused)."""
     from fieldkit.cli.fit_paths import parse_bounds
-    from fieldkit.fit.plan_fit import (
-        HOLDOUT_STREAM,
-        fit_plan,
-        plan_ensembles,
-        read_plan_runs,
-    )
-    from fieldkit.fit.plan_scores import (
-        duplicate_runs,
-        mean_direction,
-        paired_comparison,
-        plan_climatology,
-        score_runs,
-        unique_runs,
-    )
+    from fieldkit.fit.plan_fit import fit_plan, read_plan_runs
+    from fieldkit.fit.plan_scores import duplicate_runs, unique_runs
+    from fieldkit.fit.tracked_extent import clip_model, parse_extent
     from fieldkit.model.model_file import read_model
 
     bad = [name for name in NOT_3D if given.get(name) not in (None, [], False)]
@@ -158,6 +151,22 @@ def fit_plan_command(
         said.append(f"Sobol screen {screen} points (default)")
     if screen < 0:
         raise ArgumentError(f"must be >= 0 (got {screen})", source="screen")
+    extent = (
+        None
+        if tracked_extent is None
+        else parse_extent(tracked_extent, "tracked_extent")
+    )
+    if holdout_seeds is not None and holdout_releases is None:
+        raise ArgumentError("needs --holdout-paths and --holdout-deposits",
+                            source="holdout_seeds")  # fmt: skip
+    if holdout_seeds is None:
+        holdout_seeds = HOLDOUT_SEEDS
+        if holdout_releases is not None:
+            said.append(f"held-out comparison over {holdout_seeds} fits (seeds "
+                        f"{seed}..{seed + holdout_seeds - 1}; default)")  # fmt: skip
+    if not 1 <= holdout_seeds <= 20:
+        raise ArgumentError(f"must be 1..20 (got {holdout_seeds})",
+                            source="holdout_seeds")  # fmt: skip
     box = parse_bounds(bounds)
     inputs = [model_file, releases, deposits, holdout_releases, holdout_deposits]
     with OutputSet(inputs=[p for p in inputs if p is not None]) as outputs:
@@ -177,6 +186,21 @@ def fit_plan_command(
             )
         runs = read_plan_runs(releases, deposits)
         check_releases_on_dem(runs, model.terrain, releases)
+        censor = None
+        if extent is not None:
+            model_fit, censor = clip_model(model, extent)
+            check_releases_on_dem(runs, model_fit.terrain, releases)
+            outside = [r.run_id for r in runs if not censor.contains(r.deposit_xy)]
+            said.append(
+                f"tracked extent {censor.describe()} (the cell centres inside "
+                f"{extent.describe()}): every simulated rock ends at its first exit "
+                "from it, as an observed last tracked position does; the "
+                "climatology's vectors are cut there too"
+                + (f"; observed deposits outside it: {', '.join(outside)}"
+                   if outside else "")
+            )  # fmt: skip
+        else:
+            model_fit = model
         groups = duplicate_runs(
             np.array([r.release_xy for r in runs]),
             np.array([r.deposit_xy for r in runs]),
@@ -190,7 +214,7 @@ def fit_plan_command(
         hold = None
         if holdout_releases is not None:
             hold = read_plan_runs(holdout_releases, holdout_deposits)
-            check_releases_on_dem(hold, model.terrain, holdout_releases)
+            check_releases_on_dem(hold, model_fit.terrain, holdout_releases)
         for line in said:
             typer.echo(f"note: {line}")
         typer.echo(
@@ -200,7 +224,7 @@ def fit_plan_command(
         )
         with step(f"fitting {len(names)} parameters of {model_file.name} "
                   f"({len(runs)} runs x {rocks} rocks per evaluation)"):  # fmt: skip
-            result = fit_plan(runs, model, names, rocks=rocks, seed=seed,
+            result = fit_plan(runs, model_fit, names, rocks=rocks, seed=seed,
                               screen=screen, bounds=box)  # fmt: skip
         fit_record = {
             "method": "3-D plan fit (fieldkit.fit.plan_fit.fit_plan)",
@@ -211,6 +235,9 @@ def fit_plan_command(
             "rocks": rocks,
             "seed": seed,
             "screen": screen,
+            "tracked_extent_m": None
+            if censor is None
+            else [censor.x_min, censor.y_min, censor.x_max, censor.y_max],
             "evaluations": result.evaluations,
             "objective_start_m": result.objective_start,
             "objective_m": result.objective,
@@ -234,48 +261,18 @@ def fit_plan_command(
         }
         held_lines: list[str] = []
         if hold is not None:
-            cal_rel = np.array([r.release_xy for r in runs])
-            cal_dep = np.array([r.deposit_xy for r in runs])
-            rel = np.array([r.release_xy for r in hold])
-            dep = np.array([r.deposit_xy for r in hold])
-            u = mean_direction(cal_rel, cal_dep)
-            with step(f"scoring {len(hold)} held-out runs ({HOLDOUT_ROCKS} rocks "
-                      "each, calibrated and start)"):  # fmt: skip
-                scores = {
-                    name: score_runs(
-                        plan_ensembles(
-                            m, hold, HOLDOUT_ROCKS, seed, stream=HOLDOUT_STREAM
-                        ).deposits_xy,
-                        rel,
-                        dep,
-                        u,
-                    )  # fmt: skip
-                    for name, m in (("calibrated", result.model), ("start", model))
-                }
-            scores["climatology"] = score_runs(
-                plan_climatology(cal_rel, cal_dep, rel), rel, dep, u
-            )
-            held_lines.append(
-                f"held-out: {len(hold)} runs, {HOLDOUT_ROCKS} rocks per run on streams "
-                f"no fit uses, one seed ({seed}): the SE is over runs only; "
-                "lower is better, A - B < 0: A better"
-            )
-            comparisons = []
-            for other in ("start", "climatology"):
-                for score in HOLDOUT_SCORES:
-                    c = paired_comparison(
-                        np.asarray(getattr(scores["calibrated"], score))[None, :],
-                        np.asarray(getattr(scores[other], score))[None, :],
-                        score, "calibrated", other, seeds=[seed],
-                    )  # fmt: skip
-                    held_lines += c.lines()
-                    comparisons.append(c.to_dict())
+            seeds = [seed + k for k in range(holdout_seeds)]
+            held, comparisons = _holdout(
+                runs, hold, result, model_fit, names, censor,
+                rocks=rocks, seeds=seeds, screen=screen, bounds=box,
+            )  # fmt: skip
+            held_lines += held
             fit_record["holdout"] = {
                 "paths": str(holdout_releases),
                 "deposits": str(holdout_deposits),
                 "runs": len(hold),
                 "rocks": HOLDOUT_ROCKS,
-                "seed": seed,
+                "seeds": seeds,
                 "comparisons": comparisons,
             }
         data = calibrated_model_dict(
@@ -295,3 +292,56 @@ def fit_plan_command(
         "its file names made absolute"
     )
     report_written(written)
+
+
+def _holdout(runs, hold, result, model_fit, names, censor, *, rocks, seeds, screen,
+             bounds) -> tuple[list[str], list[dict]]:  # fmt: skip
+    """Held-out scores of the calibrated model (refitted at every seed after the
+    first), the start and the climatology; paired comparisons over the seeds."""
+    from fieldkit.fit.plan_fit import HOLDOUT_STREAM, fit_plan, plan_ensembles
+    from fieldkit.fit.plan_scores import (
+        mean_direction,
+        paired_comparison,
+        plan_climatology,
+        score_runs,
+    )
+    from fieldkit.fit.tracked_extent import censor_straight_ensembles
+
+    cal_rel = np.array([r.release_xy for r in runs])
+    cal_dep = np.array([r.deposit_xy for r in runs])
+    rel = np.array([r.release_xy for r in hold])
+    dep = np.array([r.deposit_xy for r in hold])
+    u = mean_direction(cal_rel, cal_dep)
+    per_seed: dict[str, list] = {"calibrated": [], "start": []}
+    with step(f"scoring {len(hold)} held-out runs ({HOLDOUT_ROCKS} rocks each, "
+              f"calibrated and start) over {len(seeds)} seed(s)"
+              + (", refitting at each" if len(seeds) > 1 else "")):  # fmt: skip
+        for k, s in enumerate(seeds):
+            fitted = result.model if k == 0 else fit_plan(
+                runs, model_fit, names, rocks=rocks, seed=s, screen=screen,
+                bounds=bounds).model  # fmt: skip
+            for name, m in (("calibrated", fitted), ("start", model_fit)):
+                ens = plan_ensembles(m, hold, HOLDOUT_ROCKS, s, stream=HOLDOUT_STREAM)
+                per_seed[name].append(score_runs(ens.deposits_xy, rel, dep, u))
+    clim = plan_climatology(cal_rel, cal_dep, rel)
+    if censor is not None:
+        clim, _ = censor_straight_ensembles(rel, clim, censor)
+    clim_scores = score_runs(clim, rel, dep, u)
+    lines = [
+        f"held-out: {len(hold)} runs, {HOLDOUT_ROCKS} rocks per run on streams no "
+        f"fit uses, {len(seeds)} fit(s) (seeds {', '.join(map(str, seeds))}); SE "
+        "over runs of the seed-averaged differences; lower is better, A - B < 0: "
+        "A better"
+    ]
+    comparisons = []
+    for other in ("start", "climatology"):
+        for score in HOLDOUT_SCORES:
+            a = np.array([getattr(p, score) for p in per_seed["calibrated"]])
+            if other == "climatology":
+                b = np.asarray(getattr(clim_scores, score))
+            else:
+                b = np.array([getattr(p, score) for p in per_seed[other]])
+            c = paired_comparison(a, b, score, "calibrated", other, seeds=seeds)
+            lines += c.lines()
+            comparisons.append(c.to_dict())
+    return lines, comparisons

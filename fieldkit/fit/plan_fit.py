@@ -357,7 +357,7 @@ class PlanFitResult:
             )
             out.append(f"  {n}: {s:.4g} -> {v:.4g} [{lo:g}, {hi:g}]{bound}")
         out.append(
-            f"  rocks that left the DEM at the optimum: "
+            f"  rocks that left the DEM (or a tracked extent) at the optimum: "
             f"{100 * self.exited_share:.1f} % (scored at their exit point)"
         )
         return out + [f"  note: {n}" for n in self.notes]

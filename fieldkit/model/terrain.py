@@ -114,6 +114,43 @@ class Terrain:
                  np.ascontiguousarray(by).reshape(-1), out)  # fmt: skip
         return out.reshape(bx.shape)
 
+    def clipped(self, x_min: float, y_min: float, x_max: float,
+                y_max: float) -> Terrain:  # fmt: skip
+        """The DEM with every cell whose centre lies outside the rectangle set to
+        nodata: a rock ends where it leaves what is kept (the kernel's 'left the
+        DEM'). The surface of the result spans the kept centres, so it ends up to
+        half a cell inside the rectangle (:meth:`surface_extent`).
+
+        Examples
+        --------
+        >>> t = Terrain(0.0, 0.0, 1.0, np.zeros((4, 4))).clipped(0.0, 0.0, 2.9, 9.0)
+        >>> t.surface_extent()
+        (0.5, 0.5, 2.5, 3.5)
+        """
+        ny, nx = self.shape
+        xc = self.x0_m + self.cell_m * (np.arange(nx) + 0.5)
+        yc = self.y0_m + self.cell_m * (np.arange(ny) + 0.5)
+        out = ~((yc >= y_min) & (yc <= y_max))[:, None] | ~(
+            (xc >= x_min) & (xc <= x_max)
+        )[None, :]
+        z = self.z.copy()
+        z[out] = np.nan
+        return Terrain(self.x0_m, self.y0_m, self.cell_m, z, self.crs)
+
+    def surface_extent(self) -> tuple[float, float, float, float]:
+        """``(x_min, y_min, x_max, y_max)`` of the centres holding data: the
+        rectangle the surface spans (nodata holes inside it are not excluded)."""
+        rows, cols = np.nonzero(np.isfinite(self.z))
+        if rows.size == 0:
+            raise ArgumentError("the DEM holds no data", source="z")
+        half = 0.5 * self.cell_m
+        return (
+            float(self.x0_m + half + self.cell_m * cols.min()),
+            float(self.y0_m + half + self.cell_m * rows.min()),
+            float(self.x0_m + half + self.cell_m * cols.max()),
+            float(self.y0_m + half + self.cell_m * rows.max()),
+        )
+
     def normal(self, x_m: float, y_m: float) -> tuple[float, float, float]:
         """Upward unit normal at ``(x_m, y_m)``; NaNs off the surface."""
         nx, ny, nz = normal(self.grid(), float(x_m), float(y_m))

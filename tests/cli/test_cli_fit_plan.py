@@ -101,7 +101,8 @@ def test_fit_of_a_terrain_model_recovers_friction_and_writes_a_model_simulate_ru
     assert "note: screen" not in text and "Sobol screen 0 points (default)" in text
     assert f"wrote {out / 'calibrated_3d.json'}" in text
     assert f"wrote {out / 'fit.json'}" in text
-    assert "one seed (1)" in text
+    assert "3 fit(s) (seeds 1, 2, 3)" in text  # refitted at seeds 2 and 3
+    assert "held-out comparison over 3 fits (seeds 1..3; default)" in text
     assert "runs r0 = r0b have the same release and deposit" in text
     fit = json.loads((out / "fit.json").read_text())
     friction = fit["parameters"]["materials.ground.friction_deg"]
@@ -113,7 +114,9 @@ def test_fit_of_a_terrain_model_recovers_friction_and_writes_a_model_simulate_ru
         f"{fit['objective_start_m']:.3f} m -> optimum {fit['objective_m']:.3f}" in text
     )
     # held out: the calibrated model beats the start on energy score (paired)
+    assert fit["holdout"]["seeds"] == [1, 2, 3] and fit["tracked_extent_m"] is None
     comp = {(c["b"], c["score"]): c for c in fit["holdout"]["comparisons"]}
+    assert comp[("start", "energy_fair_m")]["seeds"] == [1, 2, 3]
     assert comp[("start", "energy_fair_m")]["mean_difference"] < 0
     scores = ("energy_fair_m", "distance_crps_fair_m")
     assert set(comp) == {(b, s) for b in ("start", "climatology") for s in scores}
@@ -179,3 +182,61 @@ def test_fit_of_a_terrain_model_names_a_held_out_release_off_the_dem(
     assert len(result.stderr.strip().splitlines()) == 1
     assert "fitting" not in result.stderr  # refused before any simulation
     assert not (tmp_path / "c.json").exists()
+
+
+def test_tracked_extent_censors_rocks_at_its_edge_and_is_recorded(
+    cli, plan_site, tmp_path
+):
+    """--tracked-extent 0,45,21,81 keeps the centres y >= 45.5 m (the rocks' end
+    there: tests/fit/test_tracked_extent.py); the observed deposits below it are
+    named, the extent recorded."""
+    site = plan_site
+    out = tmp_path / "out"
+    result = cli(
+        "fit", "--model", site / "model3d.json",
+        "--paths", site / "cal_releases.csv", "--deposits", site / "cal_deposits.csv",
+        "--free", "materials.ground.friction_deg", "--rocks", "4", "--seed", "1",
+        "--tracked-extent", "0,45,21,81",
+        "-o", out / "c.json", "--json", out / "fit.json",
+    )  # fmt: skip
+    assert result.exit_code == 0, result.stderr + result.stdout
+    assert (
+        "note: tracked extent x 0.5..20.5 m, y 45.5..80.5 m (the cell centres inside "
+        "x 0..21 m, y 45..81 m)" in result.stdout
+    )
+    assert "observed deposits outside it: r0, r1" in result.stdout
+    fit = json.loads((out / "fit.json").read_text())
+    assert fit["tracked_extent_m"] == [0.5, 45.5, 20.5, 80.5]
+
+
+@pytest.mark.parametrize(
+    ("args", "flag", "words"),
+    [
+        (("--tracked-extent", "0,45,21"), "--tracked-extent", "four numbers"),
+        (("--tracked-extent", "5,45,1,81"), "--tracked-extent", "x_min < x_max"),
+        (("--holdout-seeds", "2"), "--holdout-seeds", "needs --holdout-paths"),
+    ],
+)
+def test_bad_tracked_extent_or_seeds_is_one_line(cli, plan_site, tmp_path, args,
+                                                  flag, words):  # fmt: skip
+    site = plan_site
+    result = cli(
+        "fit", "--model", site / "model3d.json",
+        "--paths", site / "cal_releases.csv", "--deposits", site / "cal_deposits.csv",
+        *args, "-o", tmp_path / "c.json",
+    )  # fmt: skip
+    assert result.exit_code == 1
+    assert flag in result.stderr and words in result.stderr, result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "c.json").exists()
+
+
+def test_tracked_extent_is_refused_by_a_profile_fit(cli, repo, tmp_path):
+    result = cli(
+        "fit", "out/none.csv", "--model",
+        repo / "surveys/tornado_mountain/model_rocfall_table_7_1.json",
+        "--tracked-extent", "0,0,1,1", "-o", tmp_path / "c.json",
+    )  # fmt: skip
+    assert result.exit_code == 1
+    assert "--tracked-extent" in result.stderr and "terrain (3-D)" in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1

@@ -19,6 +19,8 @@ from fieldkit.fit.plan_fit import (
     read_plan_runs,
     with_parameters3d,
 )
+from fieldkit.fit.tracked_extent import Extent, clip_model
+from fieldkit.model.kernel3d import SLIDE_STEP_CELLS
 from fieldkit.model.materials import Material
 from fieldkit.model.model3d import Model3D, Seeder3D
 from fieldkit.model.model_file import Body
@@ -206,3 +208,24 @@ def test_a_release_off_the_dem_is_named_in_one_line():
         fit_plan(runs, model, ["materials.ground.friction_deg"], rocks=5)
     assert "run far: release (x 500, y 75) is off the DEM" in str(err.value)
     assert "\n" not in str(err.value)
+
+
+def test_rocks_leaving_the_tracked_extent_end_on_its_edge():
+    """Without the extent every rock stops on the floor (y < 40 m); clipped to
+    y >= 45 m (centres from 45.5 m) each ends where it crosses y = 45.5 m."""
+    model = bent_plane_model(TRUE_FRICTION_DEG)
+    runs = [PlanRun(f"r{i}", np.array([4.0 + 3 * i, 75.0]), np.zeros(2), 100.0, 0.2)
+            for i in range(4)]  # fmt: skip
+    free = plan_ensembles(model, runs, 20, 1)
+    assert free.exited == 0
+    assert max(float(e[:, 1].max()) for e in free.deposits_xy) < 40.0
+    clipped, edge = clip_model(model, Extent(0.0, 45.0, 21.0, 81.0))
+    assert edge == Extent(0.5, 45.5, 20.5, 80.5)
+    ens = plan_ensembles(clipped, runs, 20, 1)
+    assert ens.exited == 80
+    y = np.concatenate([e[:, 1] for e in ens.deposits_xy])
+    # a sliding rock's exit point is its last position on the surface: within
+    # one slide step (kernel3d.SLIDE_STEP_CELLS = 0.1 cell) of the edge
+    assert y.min() >= 45.5 and y.max() <= 45.5 + SLIDE_STEP_CELLS * 1.0
+    with pytest.raises(ArgumentError, match="fewer than 2 x 2"):
+        clip_model(model, Extent(0.0, 0.0, 1.2, 1.2))
