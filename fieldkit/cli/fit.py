@@ -456,8 +456,8 @@ def fit(
     differences +- SE over runs, over --holdout-seeds fits (default 3);
     --tracked-extent censors every forecast at the surveyed area's edge. The
     calibrated file is the base file with the fitted values and provenance.fit;
-    its terrain block's file
-    names are made relative to the calibrated file's folder.
+    its terrain block's file names are made relative to the calibrated file's
+    folder.
     With --paths alone, the file is an ImpactTable from reduce and each path is
     fitted on the model's own profile: its runout, flight heights, impact spacing
     and speeds at the impacts.
