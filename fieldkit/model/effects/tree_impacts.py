@@ -63,6 +63,19 @@ SPEC = EffectSpec(
             "RocFall's lumped mass has no trees (barriers only); the trees are not "
             "exported",
         ),
+        "RAMMS": Export(
+            False,
+            "forest is set in RAMMS by polygons (not written)",
+        ),
+        "Rockyfor3D": Export(
+            False,
+            "Rockyfor3D's forest inputs (tree file or nrtrees/dbh grids, §2.2) are not"
+            " written: the run is without forest",
+        ),
+        "r.stone": Export(
+            False,
+            "r.stone has no forest or tree input",
+        ),
     },
 )
 
