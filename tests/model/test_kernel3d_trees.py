@@ -13,13 +13,13 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from test_kernel3d import BODY, grid_of, model_on, plane
 
 from fieldkit.errors import ArgumentError
 from fieldkit.model import kernel3d
 from fieldkit.model.model3d import Seeder3D
 from fieldkit.model.simulate3d import simulate3d
 from fieldkit.model.terrain_file import Trees3D
-from test_kernel3d import BODY, grid_of, model_on, plane
 
 G = 9.81
 R_ROCK = BODY.radius_m
@@ -74,8 +74,8 @@ def test_a_rock_sliding_down_a_plane_at_a_tree_loses_the_laws_energy():
     assert p["y_m"][i] == pytest.approx(y0, abs=1e-9)
     # eq. 7.3 on the plane, down the fall line from rest
     along = (tree_x - reach - x0) / math.cos(math.radians(beta))
-    acc = G * (math.sin(math.radians(beta))
-               - math.cos(math.radians(beta)) * math.tan(math.radians(phi)))  # fmt: skip
+    b, f = math.radians(beta), math.radians(phi)
+    acc = G * (math.sin(b) - math.cos(b) * math.tan(f))
     v_before = math.sqrt(2.0 * acc * along)
     assert p["speed_mps"][i] == pytest.approx(v_before, rel=1e-9)
     # the law at the strike (exact on the speed there; slide steps end 1e-9 cell
