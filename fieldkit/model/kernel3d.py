@@ -132,9 +132,7 @@ Settings = namedtuple(
 #: [m], trunk ``diameter`` [m], ``top_z`` (the ground at the stem plus the tree's
 #: height) [m], sorted by cell; the stems of cell ``row * nx + col`` are
 #: ``cell_start[cell] .. cell_start[cell + 1]``; ``max_half`` the largest d/2 [m].
-Stems = namedtuple(
-    "Stems", ("x", "y", "diameter", "top_z", "cell_start", "max_half")
-)
+Stems = namedtuple("Stems", ("x", "y", "diameter", "top_z", "cell_start", "max_half"))
 #: Sampled path buffers (flat, one entry per sample).
 Path = namedtuple(
     "Path", ("x_m", "y_m", "z_m", "speed_mps", "ke_j", "re_j", "height_m")

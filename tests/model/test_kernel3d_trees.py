@@ -119,12 +119,8 @@ def test_a_flight_strikes_a_tree_and_flies_on_with_the_speed_left():
     assert res.tree_strikes_per_rock.tolist() == [1]
 
 
-@pytest.mark.parametrize(
-    ("offset_m", "struck"), [(+0.01, False), (-0.01, True)]
-)
-def test_a_tree_beside_the_lane_is_struck_only_within_d_over_2_plus_r(
-    offset_m, struck
-):
+@pytest.mark.parametrize(("offset_m", "struck"), [(+0.01, False), (-0.01, True)])
+def test_a_tree_beside_the_lane_is_struck_only_within_d_over_2_plus_r(offset_m, struck):
     d, x0, y0 = 0.3, 10.0, 20.0
     reach = d / 2 + R_ROCK
     res = flat_flight(x0 + 6.0, y0 + reach + offset_m, d, 20.0)
