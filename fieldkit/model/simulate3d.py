@@ -319,10 +319,10 @@ def simulate3d(
         stems = kernel3d.stems_of(tr.x_m, tr.y_m, tr.diameter_m, tr.height_m, terrain)
         off = len(tr.x_m) - stems.x.size
         notes.append(
-            f"tree_impacts: {stems.x.size} stems struck where a rock's centre passes "
-            "within d/2 + r of one below its top (hit_probability 1: 3-D strikes "
-            "are geometric)"
-            + (f"; {off} stems off the DEM's surface are never reached" if off else "")
+            f"tree_impacts: {stems.x.size} stems on the DEM, each struck where a "
+            "rock's centre passes within d/2 + r of it below its top "
+            "(hit_probability 1: 3-D strikes are geometric)"
+            + (f"; {off} stem(s) off the DEM's surface never reached" if off else "")
         )
     d = draw_rocks3d(model, rocks, rng)
     impacts = np.zeros(rocks, np.int64)
