@@ -52,12 +52,32 @@ ever shorter steps. On an inclined plane and along a groove the scheme is exact;
 a profile extruded along y it follows the 2-D kernel's exact slide
 (tests/model/test_kernel3d.py).
 
+Trees (``tree_impacts``, thesis §6.6): a stem stands at ``(x, y)`` with trunk
+diameter ``d`` and a top ``height`` above the ground at the stem. The rock strikes
+it where its centre enters the vertical cylinder of radius ``d/2 + r`` about the
+stem below the top -- through the side, or through the top while over the disc
+(:func:`stem_struck`). In flight the plan projection is a straight line (no drag)
+and the height a parabola in time, so the entry is a root of two quadratics, exact
+like the contact; a slide step is short and is taken along its chord, the speed at
+the strike from ``v^2`` linear along the step (exact on a plane). At the strike the
+trunk takes the 2-D law's energy
+(:func:`fieldkit.model.effects.tree_impacts.speed_after_strike`, capped at the
+kinetic energy), the direction of travel and the spin are kept, and the rock flies
+or slides on from there; the stem just struck is passed through (as 2-D passes
+the tree), and can be struck again only after the rock has left its disc. The
+strike is geometric and certain: ``hit_probability`` must be 1 in 3-D
+(:func:`fieldkit.model.simulate3d.tree_hit_probability` says why). Stems are
+binned into the DEM's cells (:func:`stems_of`) and only the cells within
+``max(d)/2 + r`` of a piece's plan segment are searched, so a rock far from the
+trees pays for the empty cells around it, not for the number of trees. The next
+impact row is flagged ``tree_strike``.
+
 Randomness: every draw is ``f(key, impact number, slot)``
 (:mod:`fieldkit.model.random_streams`, the 2-D slots; the tilt across the plane of
 incidence uses :data:`SLOT_ROUGHNESS_LATERAL`), so threads and chunks do not change
-results. ``mass_loss`` uses the plan distance from the release point (2-D: the
-horizontal distance). Not yet in 3-D: ``tree_impacts``, ``air_drag``
-(:data:`NOT_IN_3D`; :func:`fieldkit.model.simulate3d.simulate3d` refuses them).
+results; tree strikes draw nothing. ``mass_loss`` uses the plan distance from the
+release point (2-D: the horizontal distance). Not yet in 3-D: ``air_drag``
+(:data:`NOT_IN_3D`; :func:`fieldkit.model.simulate3d.simulate3d` refuses it).
 """
 
 from __future__ import annotations
