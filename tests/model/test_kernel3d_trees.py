@@ -205,3 +205,19 @@ def test_hit_probability_other_than_1_is_refused_in_3d():
                                     | {"hit_probability": 0.5}})  # fmt: skip
     with pytest.raises(ArgumentError, match="hit_probability is 0.5; in 3-D"):
         simulate3d(model, 1, np.random.default_rng(0))
+
+
+def test_strikes_do_not_depend_on_chunks():
+    t = grid_of(plane(35.0, 20.0), 60, 60)
+    seeder = Seeder3D(height_m=1.0, vx_mps=2.0, vy_sd_mps=1.0)
+    model = model_on(t, [(5.0, 20.0)], seeder=seeder, e_n=0.4, e_n_sd=0.1,
+                     effects=TREES)  # fmt: skip
+    rng = np.random.default_rng(8)
+    model = with_trees(model, rng.uniform(5, 55, 300), rng.uniform(5, 55, 300),
+                       rng.uniform(0.1, 0.5, 300), rng.uniform(5, 25, 300))  # fmt: skip
+    a = simulate3d(model, 120, np.random.default_rng(3))
+    b = simulate3d(model, 120, np.random.default_rng(3), chunk_rocks=7)
+    assert a.tree_strikes_per_rock.sum() > 20
+    assert np.array_equal(a.tree_strikes_per_rock, b.tree_strikes_per_rock)
+    assert np.array_equal(a.deposit_xyz, b.deposit_xyz)
+    assert np.array_equal(a.path["speed_mps"], b.path["speed_mps"])
