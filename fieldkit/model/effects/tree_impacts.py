@@ -36,7 +36,7 @@ SPEC = EffectSpec(
             0.0,
             1.0,
             "-",
-            "chance a passing tree is struck",
+            "chance a passing tree is struck (2-D; 1 in 3-D: strikes are geometric)",
             0.0,
         ),
         Parameter(
