@@ -19,15 +19,21 @@ above), velocity ``(vx, vy, vz)`` and spin with their SDs, mass with its SD (at 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from fieldkit.model.model_blocks import Body
 from fieldkit.model.terrain import Terrain
 
-if TYPE_CHECKING:
-    from fieldkit.model.terrain_file import Trees3D
+
+@dataclass(frozen=True)
+class Trees3D:
+    """Trees in plan: stem position [m], trunk diameter [m] and tree height [m]."""
+
+    x_m: np.ndarray
+    y_m: np.ndarray
+    diameter_m: np.ndarray
+    height_m: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -73,7 +79,7 @@ class Model3D:
         Core settings (as in 2-D: slide_vn_mps, stop_speed_mps, max_impacts, ...).
     trees
         Tree stems in plan with their trunk diameters and heights
-        (:class:`fieldkit.model.terrain_file.Trees3D`), struck with
+        (:class:`Trees3D`), struck with
         ``tree_impacts`` on; or None.
     crs
         The DEM's coordinate reference system (WKT) or None.

@@ -55,7 +55,7 @@ from fieldkit.errors import InputFileError
 from fieldkit.io.dem import DemGrid, read_dem
 from fieldkit.io.releases import cells_inside, read_releases
 from fieldkit.model.materials import Material, check_number
-from fieldkit.model.model3d import Model3D, Seeder3D
+from fieldkit.model.model3d import Model3D, Seeder3D, Trees3D
 from fieldkit.model.model_blocks import (
     BODY_BOUNDS,
     SEEDER_BOUNDS,
@@ -89,16 +89,6 @@ _UNITS = {"m": "m", "mps": "m/s", "radps": "rad/s", "kg": "kg"}
 MAX_ANALYSIS_LINES = 100
 #: Most points an analysis line may have.
 MAX_LINE_VERTICES = 10_000
-
-
-@dataclass(frozen=True)
-class Trees3D:
-    """Trees in plan: stem position [m], trunk diameter [m] and tree height [m]."""
-
-    x_m: np.ndarray
-    y_m: np.ndarray
-    diameter_m: np.ndarray
-    height_m: np.ndarray
 
 
 @dataclass(frozen=True)

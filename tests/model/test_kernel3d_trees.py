@@ -17,9 +17,8 @@ from test_kernel3d import BODY, grid_of, model_on, plane
 
 from fieldkit.errors import ArgumentError
 from fieldkit.model import kernel3d
-from fieldkit.model.model3d import Seeder3D
+from fieldkit.model.model3d import Seeder3D, Trees3D
 from fieldkit.model.simulate3d import simulate3d
-from fieldkit.model.terrain_file import Trees3D
 
 G = 9.81
 R_ROCK = BODY.radius_m
