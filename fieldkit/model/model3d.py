@@ -25,6 +25,13 @@ import numpy as np
 from fieldkit.model.model_blocks import Body
 from fieldkit.model.terrain import Terrain
 
+#: Why ``tree_impacts.hit_probability`` is 1 in 3-D (read by the model-file reader
+#: and :func:`fieldkit.model.simulate3d.tree_hit_probability`).
+WHY_HIT_PROBABILITY_1 = (
+    "in 3-D the stems are placed and a strike is geometric (the rock centre within "
+    "d/2 + r of a stem, below its top), so it must be 1"
+)
+
 
 @dataclass(frozen=True)
 class Trees3D:

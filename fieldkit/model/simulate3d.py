@@ -21,7 +21,7 @@ from fieldkit.errors import ArgumentError
 from fieldkit.model import kernel3d
 from fieldkit.model.effects import registry
 from fieldkit.model.kernel import MATERIAL_COLUMNS
-from fieldkit.model.model3d import Model3D
+from fieldkit.model.model3d import WHY_HIT_PROBABILITY_1, Model3D
 from fieldkit.model.model_file import CORE_DEFAULTS
 
 #: Rocks per kernel call.
@@ -145,12 +145,6 @@ def check_model3d(model: Model3D) -> None:
 
 
 #: Why a 3-D model's ``tree_impacts.hit_probability`` must be 1.
-WHY_HIT_PROBABILITY_1 = (
-    "in 3-D the stems are placed and a strike is geometric (the rock centre within "
-    "d/2 + r of a stem, below its top), so it must be 1"
-)
-
-
 def tree_hit_probability(params: dict, *, source: str = "model") -> None:
     """Refuse a 3-D ``tree_impacts.hit_probability`` other than 1.
 

@@ -55,7 +55,12 @@ from fieldkit.errors import InputFileError
 from fieldkit.io.dem import DemGrid, read_dem
 from fieldkit.io.releases import cells_inside, read_releases
 from fieldkit.model.materials import Material, check_number
-from fieldkit.model.model3d import Model3D, Seeder3D, Trees3D
+from fieldkit.model.model3d import (
+    WHY_HIT_PROBABILITY_1,
+    Model3D,
+    Seeder3D,
+    Trees3D,
+)
 from fieldkit.model.model_blocks import (
     BODY_BOUNDS,
     SEEDER_BOUNDS,
@@ -449,7 +454,6 @@ def _tree_effect3d(data: dict, params: dict, source: str) -> dict:
     """``tree_impacts`` of a 3-D model: ``hit_probability`` 1 (the strike is
     geometric; :func:`fieldkit.model.simulate3d.tree_hit_probability`), given as 1
     or left out (2-D's default, 0.5, is not taken)."""
-    from fieldkit.model.simulate3d import WHY_HIT_PROBABILITY_1
 
     given = data["effects"]["tree_impacts"]
     params = dict(params)
