@@ -169,6 +169,29 @@ EXTENSION_COLUMNS: tuple[Column, ...] = (
         "standard uncertainty of a tree-strike height the reduction used [m]",
     ),
     Column(
+        "y_m",
+        "float",
+        False,
+        "3-D rows: contact y in the DEM's coordinates [m] (x_m, z_m: its x and "
+        "elevation)",
+    ),
+    *(
+        Column(f"normal_{a}", "float", False, f"3-D rows: unit normal N, DEM {a} [-]")
+        for a in "xyz"
+    ),
+    *(
+        Column(
+            f"tangent_{a}",
+            "float",
+            False,
+            f"3-D rows: unit tangent T (plane of incidence), DEM {a} [-]",
+        )
+        for a in "xyz"
+    ),
+    Column(
+        "dip_deg", "float", False, "3-D rows: dip of the surface N is normal to [deg]"
+    ),
+    Column(
         "vin_vfn_corr",
         "float",
         False,

@@ -130,7 +130,11 @@ Path = namedtuple(
     "Path", ("x_m", "y_m", "z_m", "speed_mps", "ke_j", "re_j", "height_m")
 )
 PATH_FIELDS = Path._fields
-#: Columns of a recorded impact row.
+#: Columns of a recorded impact row (``R_*`` name each column's index): the rock,
+#: the contact (DEM coordinates), the material index, the local-axes speeds, spin
+#: before and after, the unit normal N the impact used (tilted by roughness) and
+#: the unit tangent T (in the plane of incidence, along the incoming tangential
+#: velocity), all in DEM axes, and the body at the impact (after mass loss).
 IMPACT_COLUMNS = (
     "rock",
     "x_m",
@@ -146,8 +150,34 @@ IMPACT_COLUMNS = (
     "normal_x",
     "normal_y",
     "normal_z",
+    "tangent_x",
+    "tangent_y",
+    "tangent_z",
+    "mass_kg",
+    "radius_m",
+    "gyration_m",
 )
 N_IMPACT = len(IMPACT_COLUMNS)
+R_ROCK = IMPACT_COLUMNS.index("rock")
+R_X = IMPACT_COLUMNS.index("x_m")
+R_Y = IMPACT_COLUMNS.index("y_m")
+R_Z = IMPACT_COLUMNS.index("z_m")
+R_MATERIAL = IMPACT_COLUMNS.index("material_index")
+R_VIN = IMPACT_COLUMNS.index("vin_mps")
+R_VIT = IMPACT_COLUMNS.index("vit_mps")
+R_VFN = IMPACT_COLUMNS.index("vfn_mps")
+R_VFT = IMPACT_COLUMNS.index("vft_mps")
+R_OMEGA_I = IMPACT_COLUMNS.index("omega_i_radps")
+R_OMEGA_F = IMPACT_COLUMNS.index("omega_f_radps")
+R_NX = IMPACT_COLUMNS.index("normal_x")
+R_NY = IMPACT_COLUMNS.index("normal_y")
+R_NZ = IMPACT_COLUMNS.index("normal_z")
+R_TX = IMPACT_COLUMNS.index("tangent_x")
+R_TY = IMPACT_COLUMNS.index("tangent_y")
+R_TZ = IMPACT_COLUMNS.index("tangent_z")
+R_MASS = IMPACT_COLUMNS.index("mass_kg")
+R_RADIUS = IMPACT_COLUMNS.index("radius_m")
+R_GYRATION = IMPACT_COLUMNS.index("gyration_m")
 
 
 @njit(cache=True)
@@ -301,9 +331,9 @@ def _local_axes(vx, vy, vz, nx, ny, nz):
 def impact(gr, mat, flags, par, key, n, x, y, vx, vy, vz, w, r, kg):
     """One impact at ``(x, y)`` on the surface; returns the rebound and its axes.
 
-    Returns ``(vfx, vfy, vfz, w_f, vin, vit, vfn, vft, nx, ny, nz, mi)``: rebound
-    velocity and spin, the local-axes speeds, the normal used (tilted by roughness)
-    and the material index.
+    Returns ``(vfx, vfy, vfz, w_f, vin, vit, vfn, vft, nx, ny, nz, tx, ty, tz,
+    mi)``: rebound velocity and spin, the local-axes speeds, the normal used
+    (tilted by roughness), the unit tangent T and the material index.
     """
     h, gx, gy = surface_at(gr, x, y)
     nx, ny, nz = _unit_normal(gx, gy)
@@ -350,7 +380,7 @@ def impact(gr, mat, flags, par, key, n, x, y, vx, vy, vz, w, r, kg):
     vfx = vft * tx + vfn * nx
     vfy = vft * ty + vfn * ny
     vfz = vft * tz + vfn * nz
-    return vfx, vfy, vfz, w_f, vin, vit, vfn, vft, nx, ny, nz, mi
+    return vfx, vfy, vfz, w_f, vin, vit, vfn, vft, nx, ny, nz, tx, ty, tz, mi
 
 
 @njit(cache=True)
@@ -418,25 +448,31 @@ def run_rock(
                 m, r, kg = m0 * ratio, r0 * cube, k0 * cube
                 kr = kg * kg
             w_i = w
-            vfx, vfy, vfz, w, vin, vit, vfn, vft, nnx, nny, nnz, mi = impact(
-                gr, mat, flags, par, key, n, x, y, vx, vy, vz, w, r, kg
+            vfx, vfy, vfz, w, vin, vit, vfn, vft, nnx, nny, nnz, tx, ty, tz, mi = (
+                impact(gr, mat, flags, par, key, n, x, y, vx, vy, vz, w, r, kg)
             )
             if rec_on:
                 row = rec_start + n - 1
-                rec[row, 0] = rock
-                rec[row, 1] = x
-                rec[row, 2] = y
-                rec[row, 3] = z
-                rec[row, 4] = mi
-                rec[row, 5] = vin
-                rec[row, 6] = vit
-                rec[row, 7] = vfn
-                rec[row, 8] = vft
-                rec[row, 9] = w_i
-                rec[row, 10] = w
-                rec[row, 11] = nnx
-                rec[row, 12] = nny
-                rec[row, 13] = nnz
+                rec[row, R_ROCK] = rock
+                rec[row, R_X] = x
+                rec[row, R_Y] = y
+                rec[row, R_Z] = z
+                rec[row, R_MATERIAL] = mi
+                rec[row, R_VIN] = vin
+                rec[row, R_VIT] = vit
+                rec[row, R_VFN] = vfn
+                rec[row, R_VFT] = vft
+                rec[row, R_OMEGA_I] = w_i
+                rec[row, R_OMEGA_F] = w
+                rec[row, R_NX] = nnx
+                rec[row, R_NY] = nny
+                rec[row, R_NZ] = nnz
+                rec[row, R_TX] = tx
+                rec[row, R_TY] = ty
+                rec[row, R_TZ] = tz
+                rec[row, R_MASS] = m
+                rec[row, R_RADIUS] = r
+                rec[row, R_GYRATION] = kg
             h, gx, gy = surface_at(gr, x, y)
             nx, ny, nz = _unit_normal(gx, gy)
             vn_real = vfx * nx + vfy * ny + vfz * nz
