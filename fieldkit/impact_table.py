@@ -320,6 +320,7 @@ MAX_PLAUSIBLE_FLIGHT_HEIGHT_M = 10.0
 #: the error model's standard uncertainties not negative.
 READ_BOUNDS: dict[str, tuple[float, float, str, str]] = {
     "x_m": (-1.0e7, 1.0e7, "m", "a distance along a fall path"),
+    "y_m": (-1.0e7, 1.0e7, "m", "a plan coordinate (3-D rows)"),
     "z_m": (-11_000.0, 11_000.0, "m", "an elevation on Earth"),
     "mass_kg": (MIN_MASS_KG, MAX_MASS_KG, "kg", "a rock's mass (1 g to 10,000 t)"),
     "radius_m": (MIN_LENGTH_M, MAX_LENGTH_M, "m", "a rock's contact radius"),

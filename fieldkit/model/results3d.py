@@ -72,7 +72,7 @@ def simulator3d():
     -------
     callable
         :func:`fieldkit.model.simulate3d.simulate3d` -- ``(model, rocks, rng, *,
-        sample_m=None, record_impacts=False) -> Result3D``.
+        sample_m=None, record_impacts=False, on_impact_rows=None) -> Result3D``.
 
     Raises
     ------

@@ -283,3 +283,19 @@ def test_impact_rows_handed_chunk_by_chunk_equal_the_whole(plane_site):
     one = impact_table3d(whole.impact_rows, ["rock"]).frame
     parts = [impact_table3d(c, ["rock"]).frame for c in chunks]
     assert list(one["point"]) == [p for f in parts for p in f["point"]]
+
+
+def test_a_3d_table_with_an_impossible_y_refused_in_one_line(cli, fails, plane_site):
+    """A 3-D table read back with y_m beyond any plan coordinate: one line naming
+    the file, the row and the column; nothing written."""
+    model = write_model3d(plane_site, {"height_m": 2.0})
+    out = plane_site / "out"
+    assert cli("simulate", model, "--rocks", "2", "--seed", "1",
+               "--impacts", out / "i.csv").exit_code == 0  # fmt: skip
+    table = ImpactTable.read(out / "i.csv").frame
+    table.loc[1, "y_m"] = 3e7
+    table.to_csv(plane_site / "bad.csv", index=False)
+    fails(cli("fit", plane_site / "bad.csv", "--model",
+              write_profile_model(plane_site), "-o", out / "cal.json"),
+          "bad.csv", "row 2", "column y_m", "a plan coordinate")  # fmt: skip
+    assert not (out / "cal.json").exists()
