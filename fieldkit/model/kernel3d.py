@@ -131,12 +131,14 @@ Path = namedtuple(
 )
 PATH_FIELDS = Path._fields
 #: Columns of a recorded impact row (``R_*`` name each column's index): the rock,
-#: the contact (DEM coordinates), the material index, the local-axes speeds, spin
-#: before and after, the unit normal N the impact used (tilted by roughness) and
-#: the unit tangent T (in the plane of incidence, along the incoming tangential
-#: velocity), all in DEM axes, and the body at the impact (after mass loss).
+#: the time since its release, the contact (DEM coordinates), the material index,
+#: the local-axes speeds, spin before and after, the unit normal N the impact used
+#: (tilted by roughness) and the unit tangent T (in the plane of incidence, along
+#: the incoming tangential velocity), all in DEM axes, and the body at the impact
+#: (after mass loss).
 IMPACT_COLUMNS = (
     "rock",
+    "t_s",
     "x_m",
     "y_m",
     "z_m",
@@ -159,6 +161,7 @@ IMPACT_COLUMNS = (
 )
 N_IMPACT = len(IMPACT_COLUMNS)
 R_ROCK = IMPACT_COLUMNS.index("rock")
+R_T = IMPACT_COLUMNS.index("t_s")
 R_X = IMPACT_COLUMNS.index("x_m")
 R_Y = IMPACT_COLUMNS.index("y_m")
 R_Z = IMPACT_COLUMNS.index("z_m")
@@ -402,6 +405,7 @@ def run_rock(
     n = 0
     k = path_start
     state = -1
+    t = 0.0  # time since the release [s]
     h, gx, gy = surface_at(gr, x, y)
     if h != h:
         k = _emit(path, k, path_on, x, y, z, 0.0, m, 0.0, math.nan)
@@ -427,6 +431,7 @@ def run_rock(
             y = y + vy * tc
             z = z + vz * tc - 0.5 * G * tc * tc
             vz = vz - G * tc
+            t += tc
             if not hit:
                 state = EXITED
                 break
@@ -454,6 +459,7 @@ def run_rock(
             if rec_on:
                 row = rec_start + n - 1
                 rec[row, R_ROCK] = rock
+                rec[row, R_T] = t
                 rec[row, R_X] = x
                 rec[row, R_Y] = y
                 rec[row, R_Z] = z
@@ -484,9 +490,9 @@ def run_rock(
             else:
                 vx, vy, vz = vfx, vfy, vfz
         else:
-            state, x, y, z, vx, vy, vz, w, k = _slide(
+            state, x, y, z, vx, vy, vz, w, k, t = _slide(
                 gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st,
-                path, k, path_on,
+                path, k, path_on, t,
             )  # fmt: skip
             if state < 0:
                 flying = True
@@ -551,11 +557,12 @@ def _line_direction(gx, gy, groove):
 
 
 @njit(cache=True)
-def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
+def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on, t):
     """Slide/roll on the surface until the rock stops, leaves the DEM or launches.
 
-    Returns ``(state, x, y, z, vx, vy, vz, w, samples)``; ``state`` -1 = launched
-    (flying from the returned point, above the surface).
+    Returns ``(state, x, y, z, vx, vy, vz, w, samples, t)``; ``state`` -1 =
+    launched (flying from the returned point, above the surface); ``t`` the time
+    [s] at the returned point (``t`` at the start plus the steps taken).
     """
     mi, cell_id = _cell_material(gr, x, y)
     entry = 0
@@ -598,7 +605,7 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
         restart = False
         if sp < st.stop_v or sp == 0.0:
             if gt <= fric:
-                return STOPPED, x, y, z, 0.0, 0.0, 0.0, 0.0, k
+                return STOPPED, x, y, z, 0.0, 0.0, 0.0, 0.0, k, t
             vx = vy = vz = 0.0
             sp = 0.0
             s = 1.0 - fric / gt
@@ -639,10 +646,10 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
         bz = z + vz * dt - 0.5 * G * dt * dt
         hb = surface_at(gr, bx, by)[0]
         if hb != hb:
-            return EXITED, x, y, z, vx, vy, vz, w, k
+            return EXITED, x, y, z, vx, vy, vz, w, k, t
         if bz > hb + LAUNCH_GAP_M:
             k = _emit(path, k, on, x, y, z, sp, m, 0.5 * m * kr * w * w, 0.0)
-            return -1, bx, by, bz, vx, vy, vz - G * dt, w, k
+            return -1, bx, by, bz, vx, vy, vz - G * dt, w, k, t + dt
         x1 = x + vx * dt + 0.5 * ax * dt * dt
         y1 = y + vy * dt + 0.5 * ay * dt * dt
         if edge == 1:  # just past the edge, in the patch ahead
@@ -651,11 +658,11 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
             y1 = y + (edge_at + math.copysign(EDGE_NUDGE, edge_at)) * gr.cell
         h1, gx1, gy1 = surface_at(gr, x1, y1)
         if h1 != h1:
-            return EXITED, x, y, z, vx, vy, vz, w, k
+            return EXITED, x, y, z, vx, vy, vz, w, k, t
         if restart and (x1 - x) * gx1 + (y1 - y) * gy1 > 0.0:
             # a step from rest ends where the ground rises along it: the fall lines
             # meet within one step (a notch), where the rock stays
-            return STOPPED, x, y, z, 0.0, 0.0, 0.0, 0.0, k
+            return STOPPED, x, y, z, 0.0, 0.0, 0.0, 0.0, k, t
         walked += math.sqrt((x1 - x) ** 2 + (y1 - y) ** 2 + (h1 - z) ** 2)
         if rest:
             vx = vy = vz = 0.0
@@ -675,7 +682,7 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
                 # a convex edge: the rock leaves the surface (the 2-D convex break)
                 # when its free flight would rise above LAUNCH_GAP_M off the plane
                 k = _emit(path, k, on, x, y, z, sp, m, 0.5 * m * kr * w * w, 0.0)
-                return -1, x1, y1, h1, vx, vy, vz, w, k
+                return -1, x1, y1, h1, vx, vy, vz, w, k, t + dt
             if groove == 0:
                 vx -= vn * n1x
                 vy -= vn * n1y
@@ -698,6 +705,7 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
                 u = vx * dx + vy * dy + vz * dz
                 vx, vy, vz = u * dx, u * dy, u * dz
         x, y, z = x1, y1, h1
+        t += dt
         if groove != 0 and not _is_groove(gr, x, y, groove):
             groove = 0  # the groove opens: back on the surface
         sp = math.sqrt(vx * vx + vy * vy + vz * vz)
@@ -710,7 +718,7 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
             cell_id = cell1
             entry += 1
             tanphi = _friction_tan(mat, mi1, key, n, entry)
-    return MAX_IMPACTS, x, y, z, vx, vy, vz, w, k
+    return MAX_IMPACTS, x, y, z, vx, vy, vz, w, k, t
 
 
 @njit(cache=True, parallel=True)

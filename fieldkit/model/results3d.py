@@ -111,7 +111,6 @@ def deposits_frame(result) -> pd.DataFrame:
 
 #: ImpactTable columns a 3-D impact row leaves empty -> why (said with the table).
 IMPACT3D_EMPTY = {
-    "t_s": "the 3-D kernel keeps no clock",
     "theta0_deg, theta0_source": "no restitution angle is assumed: the rebound is "
     "simulated",
     "flight_time_s, flight_length_m, hmax_vertical_m, hmax_normal_m": "the 3-D "
@@ -159,8 +158,9 @@ def impact_table3d(rows: dict[str, np.ndarray], material_names) -> ImpactTable:
     -------
     ImpactTable
         ``path_id`` the rock's index in the run, ``point`` its impact number from
-        1; ``material``, body, spins; ``tree_strike`` False (the 3-D simulator has
-        no trees); :data:`IMPACT3D_EMPTY` columns NaN; extension columns ``y_m``,
+        1; ``t_s`` the time since its release; ``material``, body, spins;
+        ``tree_strike`` False (the 3-D simulator has no trees);
+        :data:`IMPACT3D_EMPTY` columns NaN; extension columns ``y_m``,
         ``normal_x/y/z``, ``tangent_x/y/z``, ``dip_deg``.
 
     Examples
@@ -170,7 +170,8 @@ def impact_table3d(rows: dict[str, np.ndarray], material_names) -> ImpactTable:
 
     >>> vi, b = math.sqrt(2 * 9.81 * 5), math.radians(30)
     >>> one = lambda v: np.array([float(v)])
-    >>> rows = {"rock": np.array([0]), "x_m": one(0), "y_m": one(0), "z_m": one(0),
+    >>> rows = {"rock": np.array([0]), "t_s": one(1.0), "x_m": one(0),
+    ...     "y_m": one(0), "z_m": one(0),
     ...     "material_index": np.array([0]), "vin_mps": one(-vi * math.cos(b)),
     ...     "vit_mps": one(vi * math.sin(b)), "vfn_mps": one(0.3 * vi * math.cos(b)),
     ...     "vft_mps": one(0.8 * vi * math.sin(b)), "omega_i_radps": one(0),
@@ -199,6 +200,7 @@ def impact_table3d(rows: dict[str, np.ndarray], material_names) -> ImpactTable:
         {
             "path_id": rock.astype(str),
             "point": number.astype(str),
+            "t_s": r["t_s"],
             "x_m": r["x_m"],
             "y_m": r["y_m"],
             "z_m": r["z_m"],

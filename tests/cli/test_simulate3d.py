@@ -80,7 +80,8 @@ def fake_impact_rows(result: FakeResult3D) -> dict[str, np.ndarray]:
     s = np.sqrt(1.25)
     full = lambda v: np.full(n, float(v))  # noqa: E731
     return {
-        "rock": np.repeat(np.arange(result.rocks), 3), "x_m": result.path["x_m"][at],
+        "rock": np.repeat(np.arange(result.rocks), 3), "t_s": np.tile([1.0, 2, 3],
+        result.rocks), "x_m": result.path["x_m"][at],
         "y_m": result.path["y_m"][at], "z_m": result.path["z_m"][at] - 1.0,
         "material_index": np.zeros(n, np.int64), "vin_mps": full(-5),
         "vit_mps": full(3), "vfn_mps": full(2.5), "vft_mps": full(2.4),

@@ -83,7 +83,7 @@ def test_first_impact_of_a_drop_on_an_inclined_plane(cli, plane_site):
     assert "note: --impacts: 3-D impact rows: x_m, y_m, z_m the contact" in (
         result.stderr
     )
-    assert "columns left empty in 3-D rows: t_s" in result.stderr
+    assert "columns left empty in 3-D rows: theta0_deg" in result.stderr
     table = ImpactTable.read(out / "impacts.csv")
     assert table.paths() == ["0", "1", "2"]
     row = first_rows(table).iloc[0]
@@ -112,7 +112,8 @@ def test_first_impact_of_a_drop_on_an_inclined_plane(cli, plane_site):
     for name, value in expected.items():
         assert row[name] == pytest.approx(value, rel=1e-9, abs=1e-9), name
     assert row["material"] == "rock" and not row["tree_strike"]
-    for empty in ("t_s", "theta0_deg", "flight_time_s", "hmax_normal_m"):
+    assert row["t_s"] == pytest.approx(math.sqrt(2 * h / G), rel=1e-12)
+    for empty in ("theta0_deg", "flight_time_s", "hmax_normal_m"):
         assert math.isnan(row[empty]), empty
     # every rock starts alike (no seeder spread): the three first impacts agree
     np.testing.assert_allclose(first_rows(table)["vin_mps"], expected["vin_mps"])
@@ -152,7 +153,8 @@ def test_a_throw_across_the_slope_in_its_plane_of_incidence(cli, plane_site):
     psi = math.degrees(math.atan2(-tt[2], n[2]))
     assert psi < BETA_DEG - 5.0  # a cross-slope impact: not the dip
     expected = {
-        "x_m": x0 + vx * t, "y_m": y0 + vy * t, "z_m": float(ground(x0, y0)),
+        "t_s": t, "x_m": x0 + vx * t, "y_m": y0 + vy * t,
+        "z_m": float(ground(x0, y0)),
         "vin_mps": vin, "vit_mps": vit, "slope_deg": psi, "dip_deg": BETA_DEG,
         "vi_x_mps": float(v @ x_h), "vi_z_mps": float(v @ z_up),
         "vi_mps": float(np.linalg.norm(v)), "vfn_mps": -E_N * vin,
@@ -299,3 +301,72 @@ def test_a_3d_table_with_an_impossible_y_refused_in_one_line(cli, fails, plane_s
               write_profile_model(plane_site), "-o", out / "cal.json"),
           "bad.csv", "row 2", "column y_m", "a plan coordinate")  # fmt: skip
     assert not (out / "cal.json").exists()
+
+
+def test_impact_times_are_those_of_the_flights_between(cli, plane_site):
+    """t_s (time since the release): between two impacts of a rock that flew
+    (vfn above core.slide_vn_mps, 0.5 m/s), the contacts are joined by the
+    parabola leaving the first with its 3-D rebound velocity vfn N + vft T over
+    exactly t_s(next) - t_s."""
+    model = write_model3d(plane_site, {"height_m": 2.0, "vx_sd_mps": 3.0,
+                                       "vy_sd_mps": 3.0})  # fmt: skip
+    out = plane_site / "out"
+    result = cli("simulate", model, "--rocks", "10", "--seed", "8",
+                 "--impacts", out / "impacts.csv")  # fmt: skip
+    assert result.exit_code == 0, result.stderr
+    f = ImpactTable.read(out / "impacts.csv").frame
+    same = (f["path_id"].to_numpy()[1:] == f["path_id"].to_numpy()[:-1])
+    flew = same & (f["vfn_mps"].to_numpy()[:-1] > 0.5)
+    assert flew.sum() >= 10
+    assert (np.diff(f["t_s"].to_numpy())[same] > 0).all()
+    dt = np.diff(f["t_s"].to_numpy())[flew]
+    assert (dt > 0).all()
+    vf = (f["vfn_mps"].to_numpy()[:, None] * f[["normal_x", "normal_y", "normal_z"]]
+          .to_numpy() + f["vft_mps"].to_numpy()[:, None]
+          * f[["tangent_x", "tangent_y", "tangent_z"]].to_numpy())[:-1][flew]
+    start = f[["x_m", "y_m", "z_m"]].to_numpy()[:-1][flew]
+    end = f[["x_m", "y_m", "z_m"]].to_numpy()[1:][flew]
+    expected = start + vf * dt[:, None]
+    expected[:, 2] -= 0.5 * G * dt**2
+    np.testing.assert_allclose(end, expected, rtol=0, atol=1e-8)
+
+
+def test_impact_time_after_a_slide_and_a_launch(cli, tmp_path):
+    """A rock released at rest on a 20 deg slope (friction 10 deg) slides 15 m
+    (plan) to a convex break onto 45 deg, launches there and lands: its first
+    impact comes at t1 + t2 -- the slide, L = a t1^2 / 2 with a = g (sin 20 - tan
+    10 cos 20), then the flight from the break at v1 = a t1 along the upper
+    slope, t2 = 2 v1 (tan 45 cos 20 - sin 20) / g -- where that flight meets the
+    lower slope."""
+    b1, b2, phi = (math.radians(d) for d in (20.0, 45.0, 10.0))
+    xb, x0, y0 = 20.5, 5.5, 4.5
+    xc = np.arange(60) + 0.5
+    z = np.where(xc <= xb, 100.0 - math.tan(b1) * xc,
+                 100.0 - math.tan(b1) * xb - math.tan(b2) * (xc - xb))  # fmt: skip
+    rows = "\n".join(" ".join(f"{v:.12f}" for v in z) for _ in range(10))
+    (tmp_path / "break.asc").write_text(
+        "ncols 60\nnrows 10\nxllcorner 0\nyllcorner 0\ncellsize 1\n"
+        f"NODATA_value -9999\n{rows}\n"
+    )
+    (tmp_path / "m.json").write_text(json.dumps({
+        "terrain": {"dem": "break.asc", "materials": "rock", "releases": [[x0, y0]]},
+        "materials": {"rock": {"e_n": E_N, "e_t": E_T,
+                               "friction_deg": math.degrees(phi)}},
+        "body": {"mass_kg": MASS_KG, "radius_m": RADIUS_M, "gyration_m": 0.126},
+    }))  # fmt: skip
+    out = tmp_path / "out"
+    result = cli("simulate", tmp_path / "m.json", "--rocks", "1", "--seed", "1",
+                 "--impacts", out / "impacts.csv")  # fmt: skip
+    assert result.exit_code == 0, result.stderr
+    row = ImpactTable.read(out / "impacts.csv").frame.iloc[0]
+    a = G * (math.sin(b1) - math.tan(phi) * math.cos(b1))
+    t1 = math.sqrt(2 * (xb - x0) / math.cos(b1) / a)
+    v1 = a * t1
+    t2 = 2 * v1 * (math.tan(b2) * math.cos(b1) - math.sin(b1)) / G
+    assert row["point"] == "1"
+    assert row["t_s"] == pytest.approx(t1 + t2, rel=1e-7)
+    assert row["x_m"] == pytest.approx(xb + v1 * math.cos(b1) * t2, rel=1e-7)
+    assert row["dip_deg"] == pytest.approx(45.0, rel=1e-12)
+    assert row["vi_mps"] == pytest.approx(
+        math.hypot(v1 * math.cos(b1), v1 * math.sin(b1) + G * t2), rel=1e-7
+    )
