@@ -1003,9 +1003,15 @@ def _check_xlsx_text(frame: pd.DataFrame, path: Path) -> None:
             "str",
         ):
             continue
-        bad = column.map(lambda v: isinstance(v, str) and bool(_XLSX_ILLEGAL.search(v)))
+        # a plain bool array: Series.map keeps a string dtype on an empty column,
+        # which has no any() (a run without impacts wrote no XLSX)
+        bad = np.fromiter(
+            (isinstance(v, str) and bool(_XLSX_ILLEGAL.search(v)) for v in column),
+            dtype=bool,
+            count=len(column),
+        )
         if bad.any():
-            i = int(np.flatnonzero(bad.to_numpy(bool))[0])
+            i = int(np.flatnonzero(bad)[0])
             raise InputFileError(
                 f"column {name}: {column.iloc[i]!r} holds a control character that "
                 "XLSX cannot store; write CSV or Parquet, or remove it",

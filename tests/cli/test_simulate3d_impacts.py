@@ -370,3 +370,27 @@ def test_impact_time_after_a_slide_and_a_launch(cli, tmp_path):
     assert row["vi_mps"] == pytest.approx(
         math.hypot(v1 * math.cos(b1), v1 * math.sin(b1) + G * t2), rel=1e-7
     )
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet", ".xlsx"])
+def test_a_run_without_impacts_writes_the_header(cli, plane_site, suffix):
+    """Rocks released on the ground of a 30 deg plane with a 40 deg friction
+    angle never move, so never impact: the table is written with its columns and
+    no row in every format (XLSX used to end in a traceback here)."""
+    model = write_model3d(plane_site, {})
+    data = json.loads(model.read_text())
+    data["materials"]["rock"]["friction_deg"] = 40.0  # above the 30 deg dip
+    model.write_text(json.dumps(data))
+    target = plane_site / "out" / f"impacts{suffix}"
+    result = cli("simulate", model, "--rocks", "2", "--seed", "1",
+                 "--impacts", target)  # fmt: skip
+    assert result.exit_code == 0, result.stderr
+    assert "2 rocks, 0 impacts" in result.stdout
+    assert f"wrote {target}" in result.stdout
+    import pandas as pd
+
+    read = {".csv": pd.read_csv, ".parquet": pd.read_parquet,
+            ".xlsx": pd.read_excel}[suffix]  # fmt: skip
+    frame = read(target)
+    assert len(frame) == 0
+    assert {"path_id", "vin_mps", "y_m", "normal_z", "t_s"} <= set(frame.columns)
