@@ -1,7 +1,8 @@
 """`fieldkit simulate MODEL_3D --impacts`: the 3-D kernel's impacts as an
 ImpactTable, checked against closed forms on an inclined plane (a drop, a throw
-across the slope) and read back by `fieldkit fit`, which must recover the
-model's e_n and e_t (an independent check of the table's N/T decomposition)."""
+across the slope, a slide to a convex break) and read back by `fieldkit fit`,
+which must recover the model's e_n and e_t (an independent check of the table's
+N/T decomposition), and by `fieldkit diagnose`."""
 
 from __future__ import annotations
 
@@ -209,6 +210,12 @@ def test_fit_on_the_3d_impacts_recovers_e_n_and_e_t(cli, plane_site):
     rock = json.loads((out / "calibrated.json").read_text())["materials"]["rock"]
     assert rock["e_n"] == pytest.approx(E_N, abs=1e-6)
     assert rock["e_t"] == pytest.approx(E_T, abs=1e-6)
+    # diagnose reads it too: constant e_n, e_t explain every held-out rebound
+    diagnosed = cli("diagnose", out / "impacts.csv", "--model",
+                    plane_site / "model2d.json", "--json", out / "d.json")  # fmt: skip
+    assert diagnosed.exit_code == 0, diagnosed.stderr
+    report = json.loads((out / "d.json").read_text())
+    assert report["baseline"]["cv_rmse_mps"] < 1e-9
 
 
 def test_impacts_target_refused_before_the_run(cli, fails, plane_site):
