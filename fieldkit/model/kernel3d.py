@@ -52,6 +52,12 @@ ever shorter steps. On an inclined plane and along a groove the scheme is exact;
 a profile extruded along y it follows the 2-D kernel's exact slide
 (tests/model/test_kernel3d.py).
 
+Impact rows (:data:`IMPACT_COLUMNS`, written when recording): the contact, the
+local-axes speeds, N and T in DEM axes, the body, and the time since the release
+(each flight's contact time is exact; a slide adds the duration of its steps, exact
+on a plane). :func:`fieldkit.model.results3d.impact_table3d` makes them an
+ImpactTable.
+
 Randomness: every draw is ``f(key, impact number, slot)``
 (:mod:`fieldkit.model.random_streams`, the 2-D slots; the tilt across the plane of
 incidence uses :data:`SLOT_ROUGHNESS_LATERAL`), so threads and chunks do not change
