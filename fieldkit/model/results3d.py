@@ -159,7 +159,8 @@ def impact_table3d(rows: dict[str, np.ndarray], material_names) -> ImpactTable:
     ImpactTable
         ``path_id`` the rock's index in the run, ``point`` its impact number from
         1; ``t_s`` the time since its release; ``material``, body, spins;
-        ``tree_strike`` False (the 3-D simulator has no trees);
+        ``tree_strike`` whether the rock struck a tree since its previous impact
+        (``tree_impacts``);
         :data:`IMPACT3D_EMPTY` columns NaN; extension columns ``y_m``,
         ``normal_x/y/z``, ``tangent_x/y/z``, ``dip_deg``.
 
@@ -178,7 +179,7 @@ def impact_table3d(rows: dict[str, np.ndarray], material_names) -> ImpactTable:
     ...     "omega_f_radps": one(0), "normal_x": one(math.sin(b)), "normal_y": one(0),
     ...     "normal_z": one(math.cos(b)), "tangent_x": one(math.cos(b)),
     ...     "tangent_y": one(0), "tangent_z": one(-math.sin(b)), "mass_kg": one(100),
-    ...     "radius_m": one(0.2), "gyration_m": one(0.126)}
+    ...     "radius_m": one(0.2), "gyration_m": one(0.126), "tree_strike": one(0)}
     >>> f = impact_table3d(rows, ["rock"]).frame
     >>> [round(float(f.loc[0, c]), 6) for c in ("slope_deg", "vi_x_mps", "e_n", "e_t")]
     [30.0, 0.0, 0.3, 0.8]
@@ -215,7 +216,7 @@ def impact_table3d(rows: dict[str, np.ndarray], material_names) -> ImpactTable:
             "vf_z_mps": vfn * cos_psi - vft * sin_psi,
             "omega_i_radps": r["omega_i_radps"],
             "omega_f_radps": r["omega_f_radps"],
-            "tree_strike": np.zeros(rock.size, bool),
+            "tree_strike": np.asarray(r["tree_strike"], float) > 0.5,
             **{k: r[k] for k in ("normal_x", "normal_y", "normal_z", "tangent_x",
                                  "tangent_y", "tangent_z")},  # fmt: skip
             "dip_deg": np.degrees(np.arccos(np.clip(nz, -1.0, 1.0))),
@@ -416,8 +417,9 @@ def line_summary(result, xy_m: np.ndarray, name: str) -> dict:
 
 def summary3d(result, model, lines: list) -> dict:
     """summary.json of a 3-D run: rocks, impacts, wall_s, seed, final states, the
-    stopped fraction, release-to-deposit distance in plan, and the analysis lines
-    (``lines``: :class:`~fieldkit.model.terrain_file.AnalysisLine`)."""
+    stopped fraction, release-to-deposit distance in plan, the analysis lines
+    (``lines``: :class:`~fieldkit.model.terrain_file.AnalysisLine`) and, with
+    ``tree_impacts`` on, ``tree_strikes`` (total, rocks that struck one, stems)."""
     state = np.asarray(result.state)
     names = state_names(state)
     final = {k: names.count(k) for k in ("stopped", "left_dem", "capped")}
@@ -427,7 +429,7 @@ def summary3d(result, model, lines: list) -> dict:
     releases = np.asarray(model.releases, float)[np.asarray(result.release_index)]
     xyz = np.asarray(result.deposit_xyz, float)
     distance = np.hypot(xyz[:, 0] - releases[:, 0], xyz[:, 1] - releases[:, 1])
-    return {
+    out = {
         "dimension": 3,
         "rocks": rocks,
         "impacts": int(result.impacts),
@@ -444,3 +446,13 @@ def summary3d(result, model, lines: list) -> dict:
             line_summary(result, ln.xy_m, ln.label(i)) for i, ln in enumerate(lines)
         ],  # fmt: skip
     }
+    if "tree_impacts" in (model.effects or {}):
+        strikes = np.asarray(result.tree_strikes_per_rock)
+        out["tree_strikes"] = {
+            "total": int(strikes.sum()),
+            "rocks_struck": int((strikes > 0).sum()),
+            "stems": int(len(model.trees.x_m)),
+            "over": "every rock; a strike: the centre within d/2 + r of a stem, "
+            "below its top",
+        }
+    return out

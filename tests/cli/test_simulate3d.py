@@ -89,6 +89,7 @@ def fake_impact_rows(result: FakeResult3D) -> dict[str, np.ndarray]:
         "normal_y": full(-0.5 / s), "normal_z": full(1 / s), "tangent_x": full(0),
         "tangent_y": full(-1 / s), "tangent_z": full(-0.5 / s),
         "mass_kg": full(MASS_KG), "radius_m": full(0.2), "gyration_m": full(0.126),
+        "tree_strike": full(0),
     }  # fmt: skip
 
 
