@@ -401,3 +401,46 @@ def test_a_run_without_impacts_writes_the_header(cli, plane_site, suffix):
     frame = read(target)
     assert len(frame) == 0
     assert {"path_id", "vin_mps", "y_m", "normal_z", "t_s"} <= set(frame.columns)
+
+
+def test_impact_after_a_tree_strike_in_flight(cli, tmp_path):
+    """A rock thrown at 5 m/s from 3 m above a plane (dip atan 0.6 towards +x)
+    strikes a 30 cm stem 2 m ahead where its centre is d/2 + r from the stem's
+    axis (t = 0.33 s); the trunk takes E = c (100 d)^p (c 0.5, p 2.31), the
+    direction is kept; its next impact -- flagged tree_strike -- comes where the
+    slower parabola from the strike meets the plane, at t = 0.33 s + its flight."""
+    xc = np.arange(40) + 0.5
+    rows = "\n".join(" ".join(f"{v:.12f}" for v in 60.0 - 0.6 * xc)
+                     for _ in range(20))  # fmt: skip
+    (tmp_path / "t.asc").write_text(
+        "ncols 40\nnrows 20\nxllcorner 0\nyllcorner 0\ncellsize 1\n"
+        f"NODATA_value -9999\n{rows}\n"
+    )
+    (tmp_path / "m.json").write_text(json.dumps({
+        "terrain": {"dem": "t.asc", "materials": "rock", "releases": [[10.0, 10.0]]},
+        "materials": {"rock": {"e_n": E_N, "e_t": E_T, "friction_deg": 30.0}},
+        "body": {"mass_kg": MASS_KG, "radius_m": RADIUS_M, "gyration_m": 0.126},
+        "seeder": {"height_m": 3.0, "vx_mps": 5.0},
+        "effects": {"tree_impacts": {"energy_factor": 0.5}},
+        "trees": {"x_m": [12.0], "y_m": [10.0], "diameter_m": [0.3],
+                  "height_m": [20.0]},
+    }))  # fmt: skip
+    out = tmp_path / "out"
+    result = cli("simulate", tmp_path / "m.json", "--rocks", "1", "--seed", "1",
+                 "--impacts", out / "impacts.csv")  # fmt: skip
+    assert result.exit_code == 0, result.stderr
+    row = ImpactTable.read(out / "impacts.csv").frame.iloc[0]
+    ts = (12.0 - 0.15 - RADIUS_M - 10.0) / 5.0
+    xs, zs = 10.0 + 5.0 * ts, 60.0 - 0.6 * 10.0 + 3.0 - 0.5 * G * ts**2
+    v = np.array([5.0, -G * ts])
+    energy = 0.5 * (100 * 0.3) ** 2.31
+    v_after = v * math.sqrt(1.0 - 2.0 * energy / MASS_KG / (v @ v))
+    # zs + vz tau - g tau^2 / 2 = 60 - 0.6 (xs + vx tau)
+    qa, qb, qc = -0.5 * G, v_after[1] + 0.6 * v_after[0], zs - (60.0 - 0.6 * xs)
+    tau = (-qb - math.sqrt(qb * qb - 4 * qa * qc)) / (2 * qa)
+    assert bool(row["tree_strike"])
+    assert row["t_s"] == pytest.approx(ts + tau, rel=1e-9)
+    assert row["x_m"] == pytest.approx(xs + v_after[0] * tau, rel=1e-9)
+    assert row["vi_mps"] == pytest.approx(
+        math.hypot(v_after[0], v_after[1] - G * tau), rel=1e-9
+    )
