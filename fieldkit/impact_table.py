@@ -169,6 +169,29 @@ EXTENSION_COLUMNS: tuple[Column, ...] = (
         "standard uncertainty of a tree-strike height the reduction used [m]",
     ),
     Column(
+        "y_m",
+        "float",
+        False,
+        "3-D rows: contact y in the DEM's coordinates [m] (x_m, z_m: its x and "
+        "elevation)",
+    ),
+    *(
+        Column(f"normal_{a}", "float", False, f"3-D rows: unit normal N, DEM {a} [-]")
+        for a in "xyz"
+    ),
+    *(
+        Column(
+            f"tangent_{a}",
+            "float",
+            False,
+            f"3-D rows: unit tangent T (plane of incidence), DEM {a} [-]",
+        )
+        for a in "xyz"
+    ),
+    Column(
+        "dip_deg", "float", False, "3-D rows: dip of the surface N is normal to [deg]"
+    ),
+    Column(
         "vin_vfn_corr",
         "float",
         False,
@@ -297,6 +320,7 @@ MAX_PLAUSIBLE_FLIGHT_HEIGHT_M = 10.0
 #: the error model's standard uncertainties not negative.
 READ_BOUNDS: dict[str, tuple[float, float, str, str]] = {
     "x_m": (-1.0e7, 1.0e7, "m", "a distance along a fall path"),
+    "y_m": (-1.0e7, 1.0e7, "m", "a plan coordinate (3-D rows)"),
     "z_m": (-11_000.0, 11_000.0, "m", "an elevation on Earth"),
     "mass_kg": (MIN_MASS_KG, MAX_MASS_KG, "kg", "a rock's mass (1 g to 10,000 t)"),
     "radius_m": (MIN_LENGTH_M, MAX_LENGTH_M, "m", "a rock's contact radius"),
@@ -979,9 +1003,15 @@ def _check_xlsx_text(frame: pd.DataFrame, path: Path) -> None:
             "str",
         ):
             continue
-        bad = column.map(lambda v: isinstance(v, str) and bool(_XLSX_ILLEGAL.search(v)))
+        # a plain bool array: Series.map keeps a string dtype on an empty column,
+        # which has no any() (a run without impacts wrote no XLSX)
+        bad = np.fromiter(
+            (isinstance(v, str) and bool(_XLSX_ILLEGAL.search(v)) for v in column),
+            dtype=bool,
+            count=len(column),
+        )
         if bad.any():
-            i = int(np.flatnonzero(bad.to_numpy(bool))[0])
+            i = int(np.flatnonzero(bad)[0])
             raise InputFileError(
                 f"column {name}: {column.iloc[i]!r} holds a control character that "
                 "XLSX cannot store; write CSV or Parquet, or remove it",

@@ -14,9 +14,6 @@ from fieldkit.cli.design import parse_measured
 from fieldkit.errors import ArgumentError
 from fieldkit.outputs import OutputSet, write_json
 
-#: Rows an XLSX sheet holds (the header takes one).
-XLSX_MAX_ROWS = 1_048_576 - 1
-
 FLAGS = {
     "rocks": "--rocks",
     "seed": "--seed",
@@ -81,7 +78,9 @@ def simulate(
         typer.Option(
             "--impacts",
             help="Write every impact as an ImpactTable (.csv, .parquet; .xlsx up "
-            "to 1,048,575 rows), path_id = rock, streamed to disk in chunks.",
+            "to 1,048,575 rows), path_id = rock, streamed to disk in chunks. 3-D: "
+            "x_m, y_m, z_m the contact in the DEM's coordinates, each row's section "
+            "plane its plane of incidence (docs/terrain-model.md).",
         ),
     ] = None,
     summary: Annotated[
@@ -195,9 +194,12 @@ def simulate(
     distance and, at each analysis line (--line, else the model file's
     analysis_lines), the passing fraction and p50/p95/p99 of speed, kinetic energy
     and bounce height with their Monte Carlo SEs; --deposits, --rasters (GeoTIFF in
-    the DEM's CRS), --figures (map.png) and --rrd write the rest. --impacts, --at,
-    --measured and --envelope-dx are for profile models; --deposits, --rasters,
-    --line and --observed for terrain models.
+    the DEM's CRS), --figures (map.png) and --rrd write the rest; --impacts writes
+    every impact as an ImpactTable row, in the plane of incidence of the impact
+    (N the surface normal, T along the incoming tangential velocity; what each
+    column means in 3-D and which stay empty is printed). --at, --measured and
+    --envelope-dx are for profile models; --deposits, --rasters, --line and
+    --observed for terrain models.
 
     Example (from the repository root; thesis §7.5.4, Tornado Mountain with
     the RocFall inputs of Table 7-1):
@@ -213,7 +215,8 @@ def simulate(
           --line 0,180,120,180 \\
           --observed tests/data/tschamut2014/observed_deposition.csv \\
           --summary out3d/summary.json --deposits out3d/deposits.csv \\
-          --rasters out3d/rasters --figures out3d/figures --rrd out3d/sim.rrd
+          --impacts out3d/impacts.csv --rasters out3d/rasters \\
+          --figures out3d/figures --rrd out3d/sim.rrd
     """
     import fieldkit.model.kernel as kernel
     from fieldkit.cli.progress import report_written, step
@@ -223,10 +226,7 @@ def simulate(
         refuse_options,
         simulate_terrain,
     )
-    from fieldkit.io.impact_stream import (
-        ImpactStreamWriter,
-        stream_format,
-    )
+    from fieldkit.io.impact_stream import ImpactTableOutput, check_impacts_target
     from fieldkit.model.model3d import Model3D
     from fieldkit.model.model_file import read_model
     from fieldkit.model.simulate import (
@@ -241,9 +241,8 @@ def simulate(
             f"seed must be from 0 to 2**64 - 1 (got {seed})", source="seed"
         )
     points = [parse_measured(text) for text in (measured or [])]
-    to_xlsx = impacts is not None and impacts.suffix.lower() == ".xlsx"
-    if impacts is not None and not to_xlsx:
-        stream_format(impacts, "impacts_path")
+    if impacts is not None:
+        check_impacts_target(impacts, "impacts_path")
     if rrd is not None and rrd.suffix.lower() != ".rrd":
         raise ArgumentError(f"must be a .rrd file, got {rrd.name!r}", source="--rrd")
 
@@ -263,7 +262,7 @@ def simulate(
             simulate_terrain(
                 model, outputs, rocks=rocks, seed=seed, summary=summary,
                 deposits=deposits, rasters=rasters, lines=line, observed=observed,
-                figures=figures, rrd=rrd, trajectories=trajectories,
+                figures=figures, rrd=rrd, trajectories=trajectories, impacts=impacts,
             )  # fmt: skip
             return
         refuse_options(given, TERRAIN_ONLY, "is for a terrain (3-D) model; "
@@ -310,17 +309,13 @@ def simulate(
             warm_kernel()  # load from the cache (< 1 s), off the clock
 
         kept: list = []  # impacts of the trajectory rocks, for the recording
-        whole: list = []  # every impact, for an XLSX table
         writer = None
-        if impacts is not None and not to_xlsx:
-            tmp = outputs.stream(impacts, argument="--impacts")
-            writer = ImpactStreamWriter(tmp, stream_format(impacts))
+        if impacts is not None:
+            writer = ImpactTableOutput(impacts, outputs, argument="--impacts")
 
         def on_chunk(table) -> None:  # chunks arrive derived (model.simulate)
             if writer is not None:
                 writer.write(table)
-            elif to_xlsx:
-                whole.append(table.frame)
             if rrd is not None and trajectories:
                 ids = table.frame["path_id"].astype(int)
                 if (ids < trajectories).any():
@@ -347,21 +342,8 @@ def simulate(
                 writer.close()
         result.seed = seed
         result.compile_s = compile_s
-        if to_xlsx:
-            import pandas as pd
-
-            from fieldkit.impact_table import ImpactTable
-
-            rows = sum(len(frame) for frame in whole)
-            if rows > XLSX_MAX_ROWS:
-                raise ArgumentError(
-                    f"{rows:,} impacts do not fit an XLSX sheet "
-                    f"({XLSX_MAX_ROWS:,} rows); write .csv or .parquet",
-                    source="--impacts",
-                )
-            ImpactTable(pd.concat(whole, ignore_index=True), source="simulation").write(
-                impacts, outputs=outputs
-            )
+        if writer is not None:
+            writer.finish()  # an XLSX table is written whole here
         stats = result.summary()
         stats["measured"] = _measured_percentiles(result, points)
         if summary is not None:
@@ -381,6 +363,7 @@ def simulate(
 
             some = ImpactTable(pd.concat(kept, ignore_index=True)) if kept else None
             write_simulation_recording(rrd, result, some, outputs=outputs)
+        to_xlsx = impacts is not None and impacts.suffix.lower() == ".xlsx"
         with step("writing the outputs", announce=rrd is not None or to_xlsx):
             written = outputs.commit()
     _print_summary(stats, model)

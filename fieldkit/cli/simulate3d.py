@@ -16,7 +16,6 @@ from fieldkit.outputs import OutputSet, write_file, write_json
 
 #: Options of `fieldkit simulate` that read a profile (2-D) model only.
 PROFILE_ONLY = {
-    "impacts": "--impacts",
     "at": "--at",
     "measured": "--measured",
     "envelope_dx": "--envelope-dx",
@@ -71,14 +70,24 @@ def simulate_terrain(
     figures: Path | None,
     rrd: Path | None,
     trajectories: int,
+    impacts: Path | None = None,
 ) -> None:
-    """Run a 3-D model and write what was asked (:mod:`fieldkit.model.results3d`)."""
+    """Run a 3-D model and write what was asked (:mod:`fieldkit.model.results3d`).
+
+    ``impacts``: every impact as an ImpactTable row
+    (:func:`fieldkit.model.results3d.impact_table3d`), streamed chunk by chunk; the
+    3-D meaning of its columns and the columns left empty are stated on stderr.
+    """
     from fieldkit.cli.progress import report_written, step
+    from fieldkit.io.impact_stream import ImpactTableOutput
     from fieldkit.io.releases import read_releases
     from fieldkit.model.results import STOPPED
     from fieldkit.model.results3d import (
+        IMPACT3D_EMPTY,
+        IMPACT3D_FRAME,
         RASTERS,
         deposits_frame,
+        impact_table3d,
         simulator3d,
         summary3d,
         write_geotiff,
@@ -132,8 +141,30 @@ def simulate_terrain(
         note(f"`seed` not given: used {seed}; pass --seed {seed} to reproduce")
     rng = np.random.default_rng(seed)
     run = simulator3d()
-    with step(f"simulating {rocks:,} rocks on the DEM"):
-        result = run(model, rocks, rng)
+    doing = f"simulating {rocks:,} rocks on the DEM"
+    recording = {}
+    writer = None
+    if impacts is not None:
+        writer = ImpactTableOutput(impacts, outputs, argument="--impacts")
+        names = list(model.materials)
+        recording = {
+            "record_impacts": True,
+            "on_impact_rows": lambda rows: writer.write(impact_table3d(rows, names)),
+        }
+        doing += f", recording their impacts for {impacts}"
+    try:
+        with step(doing):
+            result = run(model, rocks, rng, **recording)
+    finally:
+        if writer is not None:
+            writer.close()
+    if writer is not None:
+        writer.finish()  # an XLSX table is written whole here
+        note(f"--impacts: {IMPACT3D_FRAME}")
+        note(
+            "--impacts: columns left empty in 3-D rows: "
+            + "; ".join(f"{cols} ({why})" for cols, why in IMPACT3D_EMPTY.items())
+        )
     result.seed = seed
     for text in getattr(result, "notes", None) or []:
         note(text)  # what the simulator assumed (a default that changes a result)
@@ -173,7 +204,8 @@ def simulate_terrain(
 
         write_terrain_recording(rrd, model.terrain, result, observed=observed_xy,
                                 paths=trajectories, outputs=outputs)  # fmt: skip
-    with step("writing the outputs", announce=rrd is not None):
+    to_xlsx = impacts is not None and impacts.suffix.lower() == ".xlsx"
+    with step("writing the outputs", announce=rrd is not None or to_xlsx):
         written = outputs.commit()
     print_summary3d(stats, model)
     report_written(written)

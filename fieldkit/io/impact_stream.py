@@ -159,3 +159,98 @@ class ImpactStreamWriter:
                 self._schema,
                 write_options=pa_csv.WriteOptions(quoting_style="needed"),
             )
+
+
+#: Rows an XLSX sheet holds (the header takes one).
+XLSX_MAX_ROWS = 1_048_576 - 1
+
+
+def check_impacts_target(path: str | os.PathLike[str], argument: str) -> None:
+    """Refuse, before any work, a target :class:`ImpactTableOutput` cannot write
+    (an extension other than .csv, .parquet, .xlsx; naming ``argument``)."""
+    if Path(path).suffix.lower() != ".xlsx":
+        stream_format(path, argument)
+
+
+class ImpactTableOutput:
+    """A simulation's ImpactTable file, written chunk by chunk as the run makes it.
+
+    CSV and Parquet are streamed (:class:`ImpactStreamWriter` into the temporary
+    file of :meth:`fieldkit.outputs.OutputSet.stream`: memory bounded by a chunk);
+    XLSX cannot be, so its chunks are kept and written whole by :meth:`finish`, at
+    most :data:`XLSX_MAX_ROWS` rows. The 2-D and 3-D simulations write through it.
+
+    Parameters
+    ----------
+    path
+        The target (.csv, .parquet or .xlsx; a FIFO or device streams CSV).
+    outputs
+        The command's output set (the file appears at its commit).
+    argument
+        The option naming the target, in errors.
+
+    Examples
+    --------
+    >>> import tempfile, pandas as pd
+    >>> from fieldkit.outputs import OutputSet
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> chunk = ImpactTable(pd.DataFrame({"path_id": ["0"], "point": ["1"],
+    ...     "x_m": [1.0], "z_m": [0.0], "slope_deg": [30.0], "vi_x_mps": [3.0],
+    ...     "vi_z_mps": [-4.0], "vf_x_mps": [3.0], "vf_z_mps": [2.0]}))
+    >>> with OutputSet() as outputs:
+    ...     out = ImpactTableOutput(folder / "i.xlsx", outputs, argument="--impacts")
+    ...     out.write(chunk)
+    ...     out.finish()
+    ...     written = outputs.commit()
+    >>> len(ImpactTable.read(folder / "i.xlsx"))
+    1
+    """
+
+    def __init__(
+        self, path: str | os.PathLike[str], outputs, *, argument: str
+    ) -> None:
+        self.path = Path(path)
+        self.outputs = outputs
+        self.argument = argument
+        self.rows = 0
+        self._frames: list = []
+        self._writer: ImpactStreamWriter | None = None
+        check_impacts_target(self.path, argument)
+        if self.path.suffix.lower() != ".xlsx":
+            tmp = outputs.stream(self.path, argument=argument)
+            self._writer = ImpactStreamWriter(tmp, stream_format(self.path, argument))
+
+    def write(self, table: ImpactTable) -> None:
+        """Append the rows of ``table`` (a chunk of whole rocks, in order)."""
+        self.rows += len(table)
+        if self._writer is not None:
+            self._writer.write(table)
+        else:
+            self._frames.append(table.frame)
+
+    def close(self) -> None:
+        """Close the stream (safe to call again; call it on failure too)."""
+        if self._writer is not None:
+            self._writer.close()
+
+    def finish(self) -> None:
+        """Close the stream, or write the XLSX table into the output set.
+
+        Raises
+        ------
+        ArgumentError
+            An XLSX target and more than :data:`XLSX_MAX_ROWS` rows.
+        """
+        self.close()
+        if self._writer is not None:
+            return
+        if self.rows > XLSX_MAX_ROWS:
+            raise ArgumentError(
+                f"{self.rows:,} impacts do not fit an XLSX sheet "
+                f"({XLSX_MAX_ROWS:,} rows); write .csv or .parquet",
+                source=self.argument,
+            )
+        import pandas as pd
+
+        frame = pd.concat(self._frames, ignore_index=True)
+        ImpactTable(frame, source="simulation").write(self.path, outputs=self.outputs)

@@ -72,6 +72,13 @@ binned into the DEM's cells (:func:`stems_of`) and only the cells within
 trees pays for the empty cells around it, not for the number of trees. The next
 impact row is flagged ``tree_strike``.
 
+Impact rows (:data:`IMPACT_COLUMNS`, written when recording): the contact, the
+local-axes speeds, N and T in DEM axes, the body, the tree-strike flag, and the time
+since the release (each flight's contact and strike times are exact; a slide adds
+the duration of its steps, exact on a plane, and a strike within a step the time to
+it with the speed linear in time along the chord).
+:func:`fieldkit.model.results3d.impact_table3d` makes them an ImpactTable.
+
 Randomness: every draw is ``f(key, impact number, slot)``
 (:mod:`fieldkit.model.random_streams`, the 2-D slots; the tilt across the plane of
 incidence uses :data:`SLOT_ROUGHNESS_LATERAL`), so threads and chunks do not change
@@ -158,9 +165,15 @@ Path = namedtuple(
     "Path", ("x_m", "y_m", "z_m", "speed_mps", "ke_j", "re_j", "height_m")
 )
 PATH_FIELDS = Path._fields
-#: Columns of a recorded impact row.
+#: Columns of a recorded impact row (``R_*`` name each column's index): the rock,
+#: the time since its release, the contact (DEM coordinates), the material index,
+#: the local-axes speeds, spin before and after, the unit normal N the impact used
+#: (tilted by roughness) and the unit tangent T (in the plane of incidence, along
+#: the incoming tangential velocity), all in DEM axes, the body at the impact (after
+#: mass loss) and whether a tree was struck since the previous impact (1.0).
 IMPACT_COLUMNS = (
     "rock",
+    "t_s",
     "x_m",
     "y_m",
     "z_m",
@@ -174,9 +187,37 @@ IMPACT_COLUMNS = (
     "normal_x",
     "normal_y",
     "normal_z",
+    "tangent_x",
+    "tangent_y",
+    "tangent_z",
+    "mass_kg",
+    "radius_m",
+    "gyration_m",
     "tree_strike",
 )
 N_IMPACT = len(IMPACT_COLUMNS)
+R_ROCK = IMPACT_COLUMNS.index("rock")
+R_T = IMPACT_COLUMNS.index("t_s")
+R_X = IMPACT_COLUMNS.index("x_m")
+R_Y = IMPACT_COLUMNS.index("y_m")
+R_Z = IMPACT_COLUMNS.index("z_m")
+R_MATERIAL = IMPACT_COLUMNS.index("material_index")
+R_VIN = IMPACT_COLUMNS.index("vin_mps")
+R_VIT = IMPACT_COLUMNS.index("vit_mps")
+R_VFN = IMPACT_COLUMNS.index("vfn_mps")
+R_VFT = IMPACT_COLUMNS.index("vft_mps")
+R_OMEGA_I = IMPACT_COLUMNS.index("omega_i_radps")
+R_OMEGA_F = IMPACT_COLUMNS.index("omega_f_radps")
+R_NX = IMPACT_COLUMNS.index("normal_x")
+R_NY = IMPACT_COLUMNS.index("normal_y")
+R_NZ = IMPACT_COLUMNS.index("normal_z")
+R_TX = IMPACT_COLUMNS.index("tangent_x")
+R_TY = IMPACT_COLUMNS.index("tangent_y")
+R_TZ = IMPACT_COLUMNS.index("tangent_z")
+R_MASS = IMPACT_COLUMNS.index("mass_kg")
+R_RADIUS = IMPACT_COLUMNS.index("radius_m")
+R_GYRATION = IMPACT_COLUMNS.index("gyration_m")
+R_TREE = IMPACT_COLUMNS.index("tree_strike")
 
 
 @njit(cache=True)
@@ -420,9 +461,9 @@ def _local_axes(vx, vy, vz, nx, ny, nz):
 def impact(gr, mat, flags, par, key, n, x, y, vx, vy, vz, w, r, kg):
     """One impact at ``(x, y)`` on the surface; returns the rebound and its axes.
 
-    Returns ``(vfx, vfy, vfz, w_f, vin, vit, vfn, vft, nx, ny, nz, mi)``: rebound
-    velocity and spin, the local-axes speeds, the normal used (tilted by roughness)
-    and the material index.
+    Returns ``(vfx, vfy, vfz, w_f, vin, vit, vfn, vft, nx, ny, nz, tx, ty, tz,
+    mi)``: rebound velocity and spin, the local-axes speeds, the normal used
+    (tilted by roughness), the unit tangent T and the material index.
     """
     h, gx, gy = surface_at(gr, x, y)
     nx, ny, nz = _unit_normal(gx, gy)
@@ -469,7 +510,7 @@ def impact(gr, mat, flags, par, key, n, x, y, vx, vy, vz, w, r, kg):
     vfx = vft * tx + vfn * nx
     vfy = vft * ty + vfn * ny
     vfz = vft * tz + vfn * nz
-    return vfx, vfy, vfz, w_f, vin, vit, vfn, vft, nx, ny, nz, mi
+    return vfx, vfy, vfz, w_f, vin, vit, vfn, vft, nx, ny, nz, tx, ty, tz, mi
 
 
 @njit(cache=True)
@@ -512,6 +553,7 @@ def run_rock(
     strikes = 0
     struck = 0.0  # a tree struck since the last impact
     skip = -1  # the stem just struck
+    t = 0.0  # time since the release [s]
     n = 0
     k = path_start
     state = -1
@@ -547,6 +589,7 @@ def run_rock(
                     y = y + vy * ts
                     z = z + vz * ts - 0.5 * G * ts * ts
                     vz = vz - G * ts
+                    t += ts
                     k, vx, vy, vz = _strike(
                         gr, stems, ks, par, path, k, path_on, x, y, z, vx, vy, vz, m,
                         re,
@@ -563,6 +606,7 @@ def run_rock(
             y = y + vy * tc
             z = z + vz * tc - 0.5 * G * tc * tc
             vz = vz - G * tc
+            t += tc
             if not hit:
                 state = EXITED
                 break
@@ -584,26 +628,33 @@ def run_rock(
                 m, r, kg = m0 * ratio, r0 * cube, k0 * cube
                 kr = kg * kg
             w_i = w
-            vfx, vfy, vfz, w, vin, vit, vfn, vft, nnx, nny, nnz, mi = impact(
-                gr, mat, flags, par, key, n, x, y, vx, vy, vz, w, r, kg
+            vfx, vfy, vfz, w, vin, vit, vfn, vft, nnx, nny, nnz, tx, ty, tz, mi = (
+                impact(gr, mat, flags, par, key, n, x, y, vx, vy, vz, w, r, kg)
             )
             if rec_on:
                 row = rec_start + n - 1
-                rec[row, 0] = rock
-                rec[row, 1] = x
-                rec[row, 2] = y
-                rec[row, 3] = z
-                rec[row, 4] = mi
-                rec[row, 5] = vin
-                rec[row, 6] = vit
-                rec[row, 7] = vfn
-                rec[row, 8] = vft
-                rec[row, 9] = w_i
-                rec[row, 10] = w
-                rec[row, 11] = nnx
-                rec[row, 12] = nny
-                rec[row, 13] = nnz
-                rec[row, 14] = struck
+                rec[row, R_ROCK] = rock
+                rec[row, R_T] = t
+                rec[row, R_X] = x
+                rec[row, R_Y] = y
+                rec[row, R_Z] = z
+                rec[row, R_MATERIAL] = mi
+                rec[row, R_VIN] = vin
+                rec[row, R_VIT] = vit
+                rec[row, R_VFN] = vfn
+                rec[row, R_VFT] = vft
+                rec[row, R_OMEGA_I] = w_i
+                rec[row, R_OMEGA_F] = w
+                rec[row, R_NX] = nnx
+                rec[row, R_NY] = nny
+                rec[row, R_NZ] = nnz
+                rec[row, R_TX] = tx
+                rec[row, R_TY] = ty
+                rec[row, R_TZ] = tz
+                rec[row, R_MASS] = m
+                rec[row, R_RADIUS] = r
+                rec[row, R_GYRATION] = kg
+                rec[row, R_TREE] = struck
             struck = 0.0
             h, gx, gy = surface_at(gr, x, y)
             nx, ny, nz = _unit_normal(gx, gy)
@@ -616,9 +667,9 @@ def run_rock(
             else:
                 vx, vy, vz = vfx, vfy, vfz
         else:
-            state, x, y, z, vx, vy, vz, w, k, hits, skip = _slide(
+            state, x, y, z, vx, vy, vz, w, k, hits, skip, t = _slide(
                 gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st,
-                path, k, path_on, stems, par, trees, skip,
+                path, k, path_on, stems, par, trees, skip, t,
             )  # fmt: skip
             if hits > 0:
                 strikes += hits
@@ -687,14 +738,17 @@ def _line_direction(gx, gy, groove):
 
 @njit(cache=True)
 def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on,
-           stems, par, trees, skip):  # fmt: skip
+           stems, par, trees, skip, t):  # fmt: skip
     """Slide/roll on the surface until the rock stops, leaves the DEM or launches.
 
-    Returns ``(state, x, y, z, vx, vy, vz, w, samples, strikes, skip)``; ``state``
-    -1 = launched (flying from the returned point, above the surface). With
-    ``trees``, a step whose chord enters a stem's cylinder ends there with a
+    Returns ``(state, x, y, z, vx, vy, vz, w, samples, strikes, skip, t)``;
+    ``state`` -1 = launched (flying from the returned point, above the surface).
+    With ``trees``, a step whose chord enters a stem's cylinder ends there with a
     strike (the speed there from ``v^2`` linear along the step, exact on a plane);
-    ``skip`` is the stem just struck (:func:`_left_stem`).
+    ``skip`` is the stem just struck (:func:`_left_stem`). ``t``: the time [s] at
+    the returned point (``t`` at the start plus the steps taken; to a strike within
+    a step, ``2 d / (v_0 + v_s)`` over the chord's distance ``d`` to it, exact for
+    constant acceleration along a line).
     """
     hits = 0
     mi, cell_id = _cell_material(gr, x, y)
@@ -738,7 +792,7 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on,
         restart = False
         if sp < st.stop_v or sp == 0.0:
             if gt <= fric:
-                return STOPPED, x, y, z, 0.0, 0.0, 0.0, 0.0, k, hits, skip
+                return STOPPED, x, y, z, 0.0, 0.0, 0.0, 0.0, k, hits, skip, t
             vx = vy = vz = 0.0
             sp = 0.0
             s = 1.0 - fric / gt
@@ -779,10 +833,10 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on,
         bz = z + vz * dt - 0.5 * G * dt * dt
         hb = surface_at(gr, bx, by)[0]
         if hb != hb:
-            return EXITED, x, y, z, vx, vy, vz, w, k, hits, skip
+            return EXITED, x, y, z, vx, vy, vz, w, k, hits, skip, t
         if bz > hb + LAUNCH_GAP_M:
             k = _emit(path, k, on, x, y, z, sp, m, 0.5 * m * kr * w * w, 0.0)
-            return -1, bx, by, bz, vx, vy, vz - G * dt, w, k, hits, skip
+            return -1, bx, by, bz, vx, vy, vz - G * dt, w, k, hits, skip, t + dt
         x1 = x + vx * dt + 0.5 * ax * dt * dt
         y1 = y + vy * dt + 0.5 * ay * dt * dt
         if edge == 1:  # just past the edge, in the patch ahead
@@ -791,11 +845,11 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on,
             y1 = y + (edge_at + math.copysign(EDGE_NUDGE, edge_at)) * gr.cell
         h1, gx1, gy1 = surface_at(gr, x1, y1)
         if h1 != h1:
-            return EXITED, x, y, z, vx, vy, vz, w, k, hits, skip
+            return EXITED, x, y, z, vx, vy, vz, w, k, hits, skip, t
         if restart and (x1 - x) * gx1 + (y1 - y) * gy1 > 0.0:
             # a step from rest ends where the ground rises along it: the fall lines
             # meet within one step (a notch), where the rock stays
-            return STOPPED, x, y, z, 0.0, 0.0, 0.0, 0.0, k, hits, skip
+            return STOPPED, x, y, z, 0.0, 0.0, 0.0, 0.0, k, hits, skip, t
         if trees:
             skip = _left_stem(stems, skip, x, y, r)
             ks, s1 = stem_struck(
@@ -811,6 +865,10 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on,
                 xs = x + s1 * (x1 - x)
                 ys = y + s1 * (y1 - y)
                 hs, gxs, gys = surface_at(gr, xs, ys)
+                # the time to the strike: speed linear in time along the chord
+                d_s = s1 * math.sqrt((x1 - x) ** 2 + (y1 - y) ** 2 + (h1 - z) ** 2)
+                v_s = math.sqrt(v2) if v2 > 0.0 else 0.0
+                t += 2.0 * d_s / (sp + v_s) if sp + v_s > 0.0 else 0.0
                 if groove == 0:  # along the tangent plane there
                     n1x, n1y, n1z = _unit_normal(gxs, gys)
                     en = ex * n1x + ey * n1y + ez * n1z
@@ -854,7 +912,7 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on,
                 # a convex edge: the rock leaves the surface (the 2-D convex break)
                 # when its free flight would rise above LAUNCH_GAP_M off the plane
                 k = _emit(path, k, on, x, y, z, sp, m, 0.5 * m * kr * w * w, 0.0)
-                return -1, x1, y1, h1, vx, vy, vz, w, k, hits, skip
+                return -1, x1, y1, h1, vx, vy, vz, w, k, hits, skip, t + dt
             if groove == 0:
                 vx -= vn * n1x
                 vy -= vn * n1y
@@ -877,6 +935,7 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on,
                 u = vx * dx + vy * dy + vz * dz
                 vx, vy, vz = u * dx, u * dy, u * dz
         x, y, z = x1, y1, h1
+        t += dt
         if groove != 0 and not _is_groove(gr, x, y, groove):
             groove = 0  # the groove opens: back on the surface
         sp = math.sqrt(vx * vx + vy * vy + vz * vz)
@@ -889,7 +948,7 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on,
             cell_id = cell1
             entry += 1
             tanphi = _friction_tan(mat, mi1, key, n, entry)
-    return MAX_IMPACTS, x, y, z, vx, vy, vz, w, k, hits, skip
+    return MAX_IMPACTS, x, y, z, vx, vy, vz, w, k, hits, skip, t
 
 
 @njit(cache=True, parallel=True)

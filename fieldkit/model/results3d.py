@@ -14,6 +14,8 @@ so it is deterministic and independent of how the kernel was threaded.
   fraction). A path is followed between its samples as straight pieces cut at most
   a quarter cell long (values interpolated linearly), so a rock crossing a cell's
   corner between two samples is still counted.
+* **Impacts** (:func:`impact_table3d`): one ImpactTable row per impact, the 2-D
+  rows' conventions in each impact's plane of incidence (below).
 * **Analysis lines** (barrier polylines in plan): a rock passes a line when a
   piece of its path crosses it; it is counted once, at its first crossing, with its
   speed, translational kinetic energy and bounce height interpolated there. The
@@ -29,6 +31,7 @@ import numpy as np
 import pandas as pd
 
 from fieldkit.errors import ArgumentError
+from fieldkit.impact_table import ImpactTable
 from fieldkit.model.results import (
     EXITED_DOWNSLOPE,
     EXITED_UPSLOPE,
@@ -69,7 +72,7 @@ def simulator3d():
     -------
     callable
         :func:`fieldkit.model.simulate3d.simulate3d` -- ``(model, rocks, rng, *,
-        sample_m=None, record_impacts=False) -> Result3D``.
+        sample_m=None, record_impacts=False, on_impact_rows=None) -> Result3D``.
 
     Raises
     ------
@@ -104,6 +107,122 @@ def deposits_frame(result) -> pd.DataFrame:
             "state": state_names(result.state),
         }
     )
+
+
+#: ImpactTable columns a 3-D impact row leaves empty -> why (said with the table).
+IMPACT3D_EMPTY = {
+    "theta0_deg, theta0_source": "no restitution angle is assumed: the rebound is "
+    "simulated",
+    "flight_time_s, flight_length_m, hmax_vertical_m, hmax_normal_m": "the 3-D "
+    "kernel does not measure the flight leaving an impact",
+}
+#: What a 3-D impact row's section-frame columns mean, in one sentence.
+IMPACT3D_FRAME = (
+    "3-D impact rows: x_m, y_m, z_m the contact in the DEM's coordinates; N (normal_x,"
+    " normal_y, normal_z) the surface normal the impact used (tilted by "
+    "slope_roughness), T (tangent_*) in the plane of incidence along the incoming "
+    "tangential velocity; each row's section plane is its plane of incidence: "
+    "vi_x/vf_x along the plane's horizontal line in the direction of travel, "
+    "vi_z/vf_z along its steepest upward direction (vertical when the plane is), "
+    "slope_deg the angle of N from that direction (the dip when the rock travels "
+    "down the fall line), dip_deg the surface's own dip; vin, vit, vfn, vft, "
+    "theta_i/f, e_n, e_t and the energies as in 2-D"
+)
+
+
+def impact_table3d(rows: dict[str, np.ndarray], material_names) -> ImpactTable:
+    """The ImpactTable (derived) of 3-D impact rows of consecutive rocks.
+
+    Each impact is planar: the incoming velocity ``vin N + vit T`` and the rebound
+    ``vfn N + vft T`` lie in the plane of incidence spanned by ``N`` and ``T``
+    (:mod:`fieldkit.model.kernel3d`). That plane is the row's section plane, with
+    ``X`` its horizontal line along the travel and ``Z`` its steepest upward
+    direction (the projection of the vertical: ``Z ∝ n_z N + t_z T``,
+    ``X ∝ n_z T - t_z N``), so ``slope_deg = atan2(-t_z, n_z)`` and the
+    section-frame velocities ``vi_x = vit cos(psi) + vin sin(psi)``, ``vi_z = vin
+    cos(psi) - vit sin(psi)`` (and ``vf_*`` alike) give back, through
+    :meth:`ImpactTable.derive`, the kernel's ``vin, vit, vfn, vft`` -- hence its
+    ``e_n, e_t`` and angles -- to rounding. Speeds and energies are the 3-D ones
+    (the whole velocity lies in the plane); ``z_m`` is the contact's elevation, so
+    the energy heads are the 3-D ones too.
+
+    Parameters
+    ----------
+    rows
+        :attr:`fieldkit.model.simulate3d.Result3D.impact_rows` (or one chunk of
+        them): whole rocks, each rock's impacts in order.
+    material_names
+        The model's material names, in the order ``material_index`` counts them.
+
+    Returns
+    -------
+    ImpactTable
+        ``path_id`` the rock's index in the run, ``point`` its impact number from
+        1; ``t_s`` the time since its release; ``material``, body, spins;
+        ``tree_strike`` whether the rock struck a tree since its previous impact
+        (``tree_impacts``);
+        :data:`IMPACT3D_EMPTY` columns NaN; extension columns ``y_m``,
+        ``normal_x/y/z``, ``tangent_x/y/z``, ``dip_deg``.
+
+    Examples
+    --------
+    A drop of 5 m on a plane dipping 30 deg towards +x: ``vi = sqrt(2 g 5)``,
+    ``vin = -vi cos 30``, ``vit = vi sin 30``.
+
+    >>> vi, b = math.sqrt(2 * 9.81 * 5), math.radians(30)
+    >>> one = lambda v: np.array([float(v)])
+    >>> rows = {"rock": np.array([0]), "t_s": one(1.0), "x_m": one(0),
+    ...     "y_m": one(0), "z_m": one(0),
+    ...     "material_index": np.array([0]), "vin_mps": one(-vi * math.cos(b)),
+    ...     "vit_mps": one(vi * math.sin(b)), "vfn_mps": one(0.3 * vi * math.cos(b)),
+    ...     "vft_mps": one(0.8 * vi * math.sin(b)), "omega_i_radps": one(0),
+    ...     "omega_f_radps": one(0), "normal_x": one(math.sin(b)), "normal_y": one(0),
+    ...     "normal_z": one(math.cos(b)), "tangent_x": one(math.cos(b)),
+    ...     "tangent_y": one(0), "tangent_z": one(-math.sin(b)), "mass_kg": one(100),
+    ...     "radius_m": one(0.2), "gyration_m": one(0.126), "tree_strike": one(0)}
+    >>> f = impact_table3d(rows, ["rock"]).frame
+    >>> [round(float(f.loc[0, c]), 6) for c in ("slope_deg", "vi_x_mps", "e_n", "e_t")]
+    [30.0, 0.0, 0.3, 0.8]
+    """
+    r = {k: np.asarray(v) for k, v in rows.items()}
+    rock = r["rock"].astype(np.int64)
+    first = np.ones(rock.size, bool)
+    first[1:] = rock[1:] != rock[:-1]
+    start = np.maximum.accumulate(np.where(first, np.arange(rock.size), 0))
+    number = np.arange(rock.size) - start + 1
+    nz, tz = r["normal_z"].astype(float), r["tangent_z"].astype(float)
+    norm = np.hypot(nz, tz)
+    cos_psi, sin_psi = nz / norm, -tz / norm
+    vin, vit, vfn, vft = (
+        r[k].astype(float) for k in ("vin_mps", "vit_mps", "vfn_mps", "vft_mps")
+    )
+    names = np.asarray(list(material_names), dtype=object)
+    frame = pd.DataFrame(
+        {
+            "path_id": rock.astype(str),
+            "point": number.astype(str),
+            "t_s": r["t_s"],
+            "x_m": r["x_m"],
+            "y_m": r["y_m"],
+            "z_m": r["z_m"],
+            "slope_deg": np.degrees(np.arctan2(sin_psi, cos_psi)),
+            "material": names[r["material_index"].astype(np.int64)],
+            "mass_kg": r["mass_kg"],
+            "radius_m": r["radius_m"],
+            "gyration_m": r["gyration_m"],
+            "vi_x_mps": vit * cos_psi + vin * sin_psi,
+            "vi_z_mps": vin * cos_psi - vit * sin_psi,
+            "vf_x_mps": vft * cos_psi + vfn * sin_psi,
+            "vf_z_mps": vfn * cos_psi - vft * sin_psi,
+            "omega_i_radps": r["omega_i_radps"],
+            "omega_f_radps": r["omega_f_radps"],
+            "tree_strike": np.asarray(r["tree_strike"], float) > 0.5,
+            **{k: r[k] for k in ("normal_x", "normal_y", "normal_z", "tangent_x",
+                                 "tangent_y", "tangent_z")},  # fmt: skip
+            "dip_deg": np.degrees(np.arccos(np.clip(nz, -1.0, 1.0))),
+        }
+    )
+    return ImpactTable(frame, source="simulation").derive()
 
 
 def _path_fields(result) -> dict[str, np.ndarray]:

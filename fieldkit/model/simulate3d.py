@@ -13,6 +13,7 @@ count or chunk size.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -46,7 +47,10 @@ class Result3D:
     at the final position (and just before and after every tree strike, at the
     same point). ``tree_strikes_per_rock``: the trees each rock struck
     (``tree_impacts``; zeros without). ``impact_rows`` (with
-    ``record_impacts``): one array per :data:`fieldkit.model.kernel3d.IMPACT_COLUMNS`.
+    ``record_impacts``): one array per :data:`fieldkit.model.kernel3d.IMPACT_COLUMNS`
+    (``rock`` and ``material_index`` as int64), rocks in order and each rock's
+    impacts in order; None when impacts were not recorded or were handed to
+    ``on_impact_rows`` chunk by chunk.
     """
 
     rocks: int
@@ -232,6 +236,14 @@ def warm_kernel3d() -> float:
     return time.perf_counter() - tic
 
 
+def _impact_rows(rec: np.ndarray) -> dict[str, np.ndarray]:
+    """Kernel impact rows as named arrays (``rock``, ``material_index`` int64)."""
+    rows = dict(zip(kernel3d.IMPACT_COLUMNS, rec.T.copy(), strict=True))
+    rows["rock"] = rows["rock"].astype(np.int64)
+    rows["material_index"] = rows["material_index"].astype(np.int64)
+    return rows
+
+
 def simulate3d(
     model: Model3D,
     rocks: int,
@@ -241,6 +253,7 @@ def simulate3d(
     record_impacts: bool = False,
     chunk_rocks: int = CHUNK_ROCKS,
     keep_paths: bool = True,
+    on_impact_rows: Callable[[dict[str, np.ndarray]], None] | None = None,
 ) -> Result3D:
     """Simulate ``rocks`` rocks of ``model`` with the random numbers of ``rng``.
 
@@ -264,6 +277,11 @@ def simulate3d(
         without ``record_impacts``, one kernel pass instead of two -- for fits and
         benchmarks that need only deposits. Deposits, states and impacts are the
         same either way.
+    on_impact_rows
+        With ``record_impacts``: called with each chunk's impact rows (as
+        :attr:`Result3D.impact_rows`, consecutive rocks in order) as soon as the
+        chunk has run, instead of keeping them (``impact_rows`` is then None):
+        memory bounded by one chunk's impacts.
 
     Returns
     -------
@@ -372,7 +390,9 @@ def simulate3d(
         run(path, poff, keep_paths, rec, roff, record_impacts)
         wall += time.perf_counter() - tic
         path_parts.append(path)
-        if record_impacts:
+        if record_impacts and on_impact_rows is not None:
+            on_impact_rows(_impact_rows(rec))
+        elif record_impacts:
             rec_parts.append(rec)
     offsets = np.zeros(rocks + 1, np.int64)
     if keep_paths:
@@ -382,11 +402,8 @@ def simulate3d(
         for name in kernel3d.PATH_FIELDS
     }
     rows = None
-    if record_impacts:
-        allrec = np.concatenate(rec_parts) if rec_parts else no_rec
-        rows = dict(zip(kernel3d.IMPACT_COLUMNS, allrec.T.copy(), strict=True))
-        rows["rock"] = rows["rock"].astype(np.int64)
-        rows["material_index"] = rows["material_index"].astype(np.int64)
+    if record_impacts and on_impact_rows is None:
+        rows = _impact_rows(np.concatenate(rec_parts) if rec_parts else no_rec)
     return Result3D(
         rocks=rocks,
         seed=None,

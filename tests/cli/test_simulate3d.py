@@ -70,6 +70,29 @@ def fake_result(paths: list[np.ndarray], releases: list[int]) -> FakeResult3D:
     )
 
 
+def fake_impact_rows(result: FakeResult3D) -> dict[str, np.ndarray]:
+    """Three impacts per rock at its first three samples, on the test plane (dip
+    atan 0.5 to the south), travelling south: vin -5, vit 3, vfn 2.5, vft 2.4."""
+    a = np.asarray(result.path_offsets)[:-1]
+    at = np.concatenate([a + k for k in range(3)])
+    at.sort()
+    n = at.size
+    s = np.sqrt(1.25)
+    full = lambda v: np.full(n, float(v))  # noqa: E731
+    return {
+        "rock": np.repeat(np.arange(result.rocks), 3), "t_s": np.tile([1.0, 2, 3],
+        result.rocks), "x_m": result.path["x_m"][at],
+        "y_m": result.path["y_m"][at], "z_m": result.path["z_m"][at] - 1.0,
+        "material_index": np.zeros(n, np.int64), "vin_mps": full(-5),
+        "vit_mps": full(3), "vfn_mps": full(2.5), "vft_mps": full(2.4),
+        "omega_i_radps": full(0), "omega_f_radps": full(-12), "normal_x": full(0),
+        "normal_y": full(-0.5 / s), "normal_z": full(1 / s), "tangent_x": full(0),
+        "tangent_y": full(-1 / s), "tangent_z": full(-0.5 / s),
+        "mass_kg": full(MASS_KG), "radius_m": full(0.2), "gyration_m": full(0.126),
+        "tree_strike": full(0),
+    }  # fmt: skip
+
+
 def plane_z(x, y):
     """The test DEM: a plane rising 0.5 m per metre northwards."""
     return 0.5 * (np.asarray(y) - Y0) + 0.0 * np.asarray(x)
@@ -138,17 +161,21 @@ def kernel(monkeypatch):
         nan_height_at: int | None = None  # a path sample whose height is NaN
         calls: list = []
 
-        def __call__(self, model, rocks, rng, *, sample_m=None):
+        def __call__(self, model, rocks, rng, *, sample_m=None,
+                     record_impacts=False, on_impact_rows=None):  # fmt: skip
             self.calls.append((model, rocks))
             if self.paths is not None:
                 result = fake_result(self.paths, self.releases or [0] * len(self.paths))
                 if self.nan_height_at is not None:
                     result.path["height_m"][self.nan_height_at] = np.nan
-                return result
-            starts = model.releases
-            which = [i % len(starts) for i in range(rocks)]
-            paths = [straight(x, y, y - 50) for x, y, _z in starts[which]]
-            return fake_result(paths, which)
+            else:
+                starts = model.releases
+                which = [i % len(starts) for i in range(rocks)]
+                paths = [straight(x, y, y - 50) for x, y, _z in starts[which]]
+                result = fake_result(paths, which)
+            if record_impacts:
+                on_impact_rows(fake_impact_rows(result))
+            return result
 
     fake = Fake()
     monkeypatch.setattr(results3d, "simulator3d", lambda: fake)
@@ -403,11 +430,16 @@ def test_help_example_3d_runs(cli, kernel, repo_copy, shell_commands, run_shell)
     assert len(lines) == 1
     code, output = run_shell(lines[0], repo_copy)
     assert code == 0, output
-    for name in ("summary.json", "deposits.csv", "rasters/max_ke_j.tif",
-                 "figures/map.png", "sim.rrd"):  # fmt: skip
+    for name in ("summary.json", "deposits.csv", "impacts.csv",
+                 "rasters/max_ke_j.tif", "figures/map.png", "sim.rrd"):  # fmt: skip
         assert (repo_copy / "out3d" / name).stat().st_size > 0
     s = json.loads((repo_copy / "out3d/summary.json").read_text())
     assert s["rocks"] == 800 and len(s["lines"]) == 1
+    from fieldkit.impact_table import ImpactTable
+
+    table = ImpactTable.read(repo_copy / "out3d/impacts.csv")
+    assert len(table) == 3 * 800 and table.paths()[:2] == ["0", "1"]
+    assert set(table.frame["material"]) == {"meadow"}
 
 
 def test_rasters_independent_of_chunking(cli, site, kernel, tmp_path, monkeypatch):
