@@ -382,6 +382,11 @@ def sensitivity(settings: dict, main: dict) -> list[dict]:
     return out
 
 
+#: r.stone's own default lateral spread of the launch angle [deg] (main.c), run
+#: beside the exported 0 to show what the spread no one calibrated does.
+RSTONE_DEFAULT_ANGLE = 10
+
+
 def rstone_comparison(settings: dict, fits: list) -> dict:
     """r.stone with the exported parameters of each seed's 3-D calibrated model on
     the held-out runs, beside fieldkit's 3-D calibrated model read the same way.
@@ -392,7 +397,9 @@ def rstone_comparison(settings: dict, fits: list) -> dict:
     with the held-out ensemble's size, both censored at the tracked extent: fieldkit
     runs on the clipped DEM; r.stone on the whole DEM (on the clipped one a release
     cell at the extent's edge would have nodata among the 8 neighbours its launch
-    direction reads), its counter set to 0 outside the extent."""
+    direction reads), its counter set to 0 outside the extent. r.stone runs twice:
+    as exported (launch angle range 0) and with its own default range
+    (:data:`RSTONE_DEFAULT_ANGLE`)."""
     from fieldkit.export.rstone3d import (
         rstone_inputs3d,
         rstone_missing,
@@ -413,39 +420,53 @@ def rstone_comparison(settings: dict, fits: list) -> dict:
     _, censor = _model3d(tracked_extent(), DROP_M)
     rocks = settings["holdout_rocks"]
     keys = ("reach_m", "passage_mean_m", "miss_m", "observed_m", "deposit_passed")
-    per = {n: {k: [] for k in keys} for n in ("r.stone", "3-D calibrated")}
-    tic, notes, short = time.perf_counter(), [], 0
+    spread = f"r.stone, ang {RSTONE_DEFAULT_ANGLE}"
+    names = ("r.stone", spread, "3-D calibrated")
+    per = {n: {k: [] for k in keys} for n in names}
+    tic, notes, short = time.perf_counter(), {}, 0
+
+    def outside(x, y):
+        mx, my = np.meshgrid(x, y)
+        return ~censor.contains(np.column_stack([mx.ravel(), my.ravel()]))
+
     for seed, model in zip(SEEDS, fits, strict=True):
         exported = replace(model, terrain=whole.terrain,
                            material_index=whole.material_index)  # fmt: skip
         inputs = rstone_inputs3d(exported)
-        notes = inputs.notes
+        notes[seed] = inputs.notes
         g = inputs.grid
-        gx, gy = np.meshgrid(g.x_m, g.y_m)
-        outside = ~censor.contains(np.column_stack([gx.ravel(), gy.ravel()]))
         cells = {r.run_id: source_cell(inputs, *r.release_xy) for r in hold}
-        counters = run_rstone_batch(inputs, cells, rocks)
+        counters = {
+            "r.stone": run_rstone_batch(inputs, cells, rocks),
+            spread: run_rstone_batch(
+                replace(inputs, options=inputs.options
+                        | {"ang_stoch_range": RSTONE_DEFAULT_ANGLE}),
+                cells, rocks,
+            ),
+        }  # fmt: skip
+        short += sum(int(c[cells[r.run_id]] < rocks)
+                     for grids in counters.values()
+                     for r, c in ((r, grids[r.run_id]) for r in hold))  # fmt: skip
         t = model.terrain
         tx = t.x0_m + t.cell_m * (np.arange(t.shape[1]) + 0.5)
         ty = t.y0_m + t.cell_m * (np.arange(t.shape[0]) + 0.5)
-        mx, my = np.meshgrid(tx, ty)
-        beyond = ~censor.contains(np.column_stack([mx.ravel(), my.ravel()]))
-        short += sum(int(counters[r.run_id][cells[r.run_id]] < rocks) for r in hold)
-        rows = {n: [] for n in per}
+        off_r, off_f = outside(g.x_m, g.y_m), outside(tx, ty)
+        rows = {n: [] for n in names}
         with one_kernel_thread():
             for i, run in enumerate(hold):
-                counter = counters[run.run_id].copy()
-                counter.ravel()[outside] = 0.0
-                rows["r.stone"].append(
-                    footprint(counter, g.x_m, g.y_m, run.release_xy, run.deposit_xy)
-                )
+                for name, grids in counters.items():
+                    counter = grids[run.run_id].copy()
+                    counter.ravel()[off_r] = 0.0
+                    rows[name].append(
+                        footprint(counter, g.x_m, g.y_m, run.release_xy, run.deposit_xy)
+                    )
                 res = simulate3d(
                     plan_fit.run_model(model, run),
                     rocks,
                     np.random.default_rng([seed, plan_fit.HOLDOUT_STREAM, i]),
                 )
                 count = rasters(res, t)["passing_count"].astype(float)
-                count.ravel()[beyond] = 0.0
+                count.ravel()[off_f] = 0.0
                 rows["3-D calibrated"].append(
                     footprint(count, tx, ty, run.release_xy, run.deposit_xy)
                 )
@@ -453,17 +474,28 @@ def rstone_comparison(settings: dict, fits: list) -> dict:
             for k in keys:
                 per[name][k].append([float(getattr(f, k)) for f in fps])
     arrays = {n: {k: np.array(v) for k, v in d.items()} for n, d in per.items()}
+    n_runs = len(SEEDS) * len(hold) * 2
     print(
         f"r.stone (GRASS) with the exported parameters on the {len(hold)} held-out "
-        f"runs, seeds 1-3 (each seed's calibrated model; {rocks} stones per run, "
+        f"runs, seeds 1-3 (each seed's calibrated model; {rocks} stones per run from "
         f"its release cell; {time.perf_counter() - tic:.0f} s with fieldkit's "
         "paths), beside fieldkit's 3-D calibrated model read the same way"
     )
-    for line in notes:
-        print(f"  {line}")
+    first = notes[SEEDS[0]]
+    for line in first:
+        if all(line in notes[s] for s in SEEDS):
+            print(f"  {line}")
+    for seed in SEEDS:
+        for line in notes[seed]:
+            if not all(line in notes[s] for s in SEEDS):
+                print(f"  seed {seed}: {line}")
     print(
-        f"  stones traced: {len(SEEDS) * len(hold) - short} of {len(SEEDS) * len(hold)}"
-        f" runs count all {rocks} in their release cell (r.stone's counter there)"
+        f"  '{spread}': the same files with r.stone's default launch-angle range "
+        f"{RSTONE_DEFAULT_ANGLE} (a lateral spread nobody calibrated)"
+    )
+    print(
+        f"  stones traced: {n_runs - short} of {n_runs} r.stone runs count all "
+        f"{rocks} in their release cell (r.stone's counter there)"
     )
     print(
         "  compared: each run's footprint in plan, censored at the tracked extent -- "
@@ -479,8 +511,13 @@ def rstone_comparison(settings: dict, fits: list) -> dict:
         f"{'forecast':<18}{'reach':>8}{'reach-obs':>11}{'obs<=reach':>12}"
         f"{'passage':>9}{'dep passed':>12}{'miss':>7}"
     )
-    out: dict = {"stones_per_run": rocks, "notes": list(notes), "forecasts": {},
-                 "runs_short_of_stones": short, "comparisons": []}  # fmt: skip
+    out: dict = {
+        "stones_per_run": rocks,
+        "notes": {str(k): list(v) for k, v in notes.items()},
+        "runs_short_of_stones": short,
+        "forecasts": {},
+        "comparisons": [],
+    }
     observed = arrays["r.stone"]["observed_m"]
     for name, a in arrays.items():
         reach = a["reach_m"]
@@ -499,13 +536,20 @@ def rstone_comparison(settings: dict, fits: list) -> dict:
             f"{row['passage_mean_m']:8.1f}m{100 * row['deposit_cell_passed']:11.0f}%"
             f"{row['miss_m']:6.1f}m"
         )
-    print(f"(observed mean distance {observed.mean():.1f} m over the held-out runs)")
-    print("r.stone - 3-D calibrated, paired over runs (SE over runs, seeds 1-3):")
-    for k in ("reach_m", "passage_mean_m", "miss_m"):
-        c = paired_comparison(arrays["r.stone"][k], arrays["3-D calibrated"][k], k,
-                              "r.stone", "3-D calibrated", seeds=SEEDS)  # fmt: skip
-        print(f"  {k}: {c.mean_difference:+.2f} +- {c.se:.2f} m")
-        out["comparisons"].append(c.to_dict())
+    print(
+        f"(observed mean distance {observed.mean():.1f} m over the held-out runs; "
+        "the 3-D calibrated model's reach is often the tracked extent's edge)"
+    )
+    print("paired over runs, A - 3-D calibrated (SE over runs, seeds 1-3):")
+    for name in names[:2]:
+        parts = []
+        for k in ("reach_m", "passage_mean_m", "miss_m"):
+            c = paired_comparison(arrays[name][k], arrays["3-D calibrated"][k], k,
+                                  name, "3-D calibrated", seeds=SEEDS)  # fmt: skip
+            parts.append(f"{k.removesuffix('_m')} {c.mean_difference:+.1f} +- "
+                         f"{c.se:.1f} m")  # fmt: skip
+            out["comparisons"].append(c.to_dict())
+        print(f"  {name:<16}" + ", ".join(parts))
     return out
 
 

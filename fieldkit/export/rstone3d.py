@@ -242,8 +242,8 @@ def _notes(model: Model3D, present: list[str], offset: float,
             + "; ".join(
                 [
                     *(
-                        f"{n}'s roughness ({model.materials[n].roughness_deg_sd:g} deg"
-                        f" SD of the normal; r.stone's ground is the DEM's triangles)"
+                        f"{n}'s roughness ({model.materials[n].roughness_deg_sd:.3g} "
+                        "deg SD of the normal; r.stone's ground is the DEM's triangles)"
                         for n in rough
                     ),
                     *(f"effect {e}" for e in dropped),
