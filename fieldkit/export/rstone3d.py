@@ -77,6 +77,14 @@ RNG_NOTE = (
     "each run's N stones are one fixed sample, the same every time"
 )
 
+#: How r.stone's counter is marked, and what that does to a footprint read from it.
+COUNTER_NOTE = (
+    "r.stone marks its counter at path points at least 5 m apart, the last one "
+    "always (stone.c Filter with OUTPUT_TAB 5 m, MarkPath): the stop's cell is "
+    "marked, but a trajectory can skip a cell on the way, so a footprint read from "
+    "it is sparser than fieldkit's passing_count (paths cut every quarter cell)"
+)
+
 
 @dataclass(frozen=True)
 class Rstone3DInputs:
@@ -232,6 +240,7 @@ def _notes(model: Model3D, present: list[str], offset: float,
         "cell's centre on the ground, horizontally towards the steepest neighbour); "
         f"stop_vel {options['stop_vel']:g} m/s",
         RNG_NOTE,
+        COUNTER_NOTE,
     ]
     rough = [n for n in present if model.materials[n].roughness_deg_sd > 0
              or model.materials[n].roughness_m > 0]  # fmt: skip
