@@ -33,12 +33,21 @@ Two assumptions, each shown moved in a last table:
   provenance says why); at rest, a block on a cell flatter than its friction
   angle never moves (run v086's release, 12 degrees).
 
+Where GRASS GIS and r.stone are present (``tools/r.stone/install.sh``; else one
+line says why it was skipped), r.stone runs with the exported parameters of each
+seed's calibrated model on the held-out runs, one source cell and 200 stones per
+run (:mod:`fieldkit.export.rstone3d`; its random numbers are seeded with the
+constant 1). r.stone writes no deposits, so only footprints in plan are compared
+(:mod:`fieldkit.fit.footprint`: reach, passage distance, the observed deposit's
+cell passed or missed), beside fieldkit's 3-D calibrated model read the same way.
+
 With ``--full``, also repeated 5-fold cross-validation over the 79 distinct runs
 (2 repeats, stratified by block, seed 1): 3-D calibrated against the climatology.
 
 Sizes (default / ``--full``): 3-D fit 60 / 100 rocks per run and 80 / 160
 evaluations (Sobol screen 0 / 16 points); held-out 200 / 500 rocks per run; about
-80 s / 12 min measured (the five fixed-split cases; the k-fold's ten fits).
+90 s / 12 min measured (the five fixed-split cases, the r.stone section about 40 s
+of it; the k-fold's ten fits).
 
 Run:  python examples/calibrate_tschamut_3d.py [OUT_DIR] [--full]
 """
