@@ -35,11 +35,12 @@ Two assumptions, each shown moved in a last table:
 
 Where GRASS GIS and r.stone are present (``tools/r.stone/install.sh``; else one
 line says why it was skipped), r.stone runs with the exported parameters of each
-seed's calibrated model on the held-out runs, one source cell and 200 stones per
-run (:mod:`fieldkit.export.rstone3d`; its random numbers are seeded with the
-constant 1). r.stone writes no deposits, so only footprints in plan are compared
-(:mod:`fieldkit.fit.footprint`: reach, passage distance, the observed deposit's
-cell passed or missed), beside fieldkit's 3-D calibrated model read the same way.
+seed's calibrated model on the held-out runs, one source cell and as many stones
+as held-out rocks per run (:mod:`fieldkit.export.rstone3d`; its random numbers are
+seeded with the constant 1). r.stone writes no deposits, so only footprints in
+plan are compared (:mod:`fieldkit.fit.footprint`: reach, passage distance, the
+observed deposit's cell passed or missed), beside fieldkit's 3-D calibrated model
+read the same way.
 
 With ``--full``, also repeated 5-fold cross-validation over the 79 distinct runs
 (2 repeats, stratified by block, seed 1): 3-D calibrated against the climatology.
