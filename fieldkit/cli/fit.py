@@ -453,9 +453,11 @@ def fit(
     --screen, --free, default e_n, e_t, friction_deg of every material,
     --bound); held-out runs are scored (fair energy score, fair distance CRPS)
     for the calibrated model, the start and the climatology with paired
-    differences +- SE over runs (one seed). The calibrated file is the base
-    file with the fitted values and provenance.fit; its terrain block's file
-    names are made absolute.
+    differences +- SE over runs, over --holdout-seeds fits (default 3);
+    --tracked-extent censors every forecast at the surveyed area's edge. The
+    calibrated file is the base file with the fitted values and provenance.fit;
+    its terrain block's file names are made relative to the calibrated file's
+    folder.
     With --paths alone, the file is an ImpactTable from reduce and each path is
     fitted on the model's own profile: its runout, flight heights, impact spacing
     and speeds at the impacts.

@@ -4,14 +4,16 @@ against the start and the climatology, the calibrated 3-D model file.
 
 The calibrated model file is the base model file as written, with the fitted
 values in place, ``provenance.fit`` added, and every file name of its ``terrain``
-block made absolute (resolved against the base model file's folder), so the file
-reads from wherever it is written.
+block rewritten relative to the folder the calibrated file is written to (resolved
+against the base model file's folder first), so the calibrated file reads the same
+DEM and releases where it is written, and the pair can be moved together.
 """
 
 from __future__ import annotations
 
 import json
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -68,9 +70,9 @@ def check_releases_on_dem(runs, terrain, path: Path) -> None:
 
 
 def calibrated_model_dict(model_file: Path, values: dict[str, float],
-                          fit_record: dict) -> dict:  # fmt: skip
+                          fit_record: dict, output: Path) -> dict:  # fmt: skip
     """The base model file's JSON with ``values`` in place, ``provenance.fit``
-    added and the ``terrain`` block's file names absolute.
+    added and the ``terrain`` block's file names relative to ``output``'s folder.
 
     ``values`` are names of :func:`fieldkit.fit.plan_fit.parameters3d`
     (``materials.<m>.<field>``, ``<effect>.<param>``, ``core.<setting>``).
@@ -79,12 +81,14 @@ def calibrated_model_dict(model_file: Path, values: dict[str, float],
 
     data = parse_json(model_file.read_text(encoding="utf-8-sig"), str(model_file))
     base = model_file.resolve().parent
+    target = Path(output).resolve().parent
     block = data["terrain"]
     for key in ("dem", "materials", "releases"):
         value = block.get(key)
         if isinstance(value, str) and (key == "dem" or value not in data["materials"]):
             path = Path(value)
-            block[key] = str(path if path.is_absolute() else (base / path).resolve())
+            path = path if path.is_absolute() else (base / path).resolve()
+            block[key] = Path(os.path.relpath(path, target)).as_posix()
     for key, value in values.items():
         parts = key.split(".")
         if parts[0] == "materials":
@@ -277,7 +281,7 @@ def fit_plan_command(
             }
         data = calibrated_model_dict(
             model_file, dict(zip(result.names, result.values, strict=True)),
-            fit_record,
+            fit_record, output,
         )  # fmt: skip
         write_json(output, data, outputs)
         if json_file is not None:
@@ -288,8 +292,8 @@ def fit_plan_command(
     for line in held_lines:
         typer.echo(line)
     typer.echo(
-        "note: the calibrated model file keeps the base file's terrain block with "
-        "its file names made absolute"
+        "note: the calibrated model file keeps the base file's terrain block, its "
+        "file names relative to the calibrated file's folder"
     )
     report_written(written)
 

@@ -215,6 +215,12 @@ def print_summary3d(s: dict, model) -> None:
             "core.max_impacts): they are neither stopped nor left the DEM; raise "
             '"core": {"max_impacts": ...} in the model file to follow them'
         )
+    if "tree_strikes" in s:
+        t = s["tree_strikes"]
+        echo(
+            f"tree strikes: {t['total']} (by {t['rocks_struck']} of {s['rocks']} "
+            f"rocks; {t['stems']} stems in the model)"
+        )
     d = s["deposits"]["distance_m"]
     echo(
         "release -> deposit distance in plan (m, stopped rocks): "

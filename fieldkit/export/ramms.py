@@ -415,33 +415,10 @@ def _unmapped(model: Model) -> list[tuple[str, str]]:
         out.append(
             (
                 f"effect {spec.name} ({state})",
-                not_a_law(spec.name, "RAMMS")
-                or EFFECT_REASONS.get(
-                    spec.name,
-                    "a lumped-mass effect: RAMMS's rigid-body contact has no such "
-                    "parameter",
-                ),
+                not_a_law(spec.name, "RAMMS") or spec.export("RAMMS").how,
             )
         )
     return out
-
-
-#: Why each effect of the registry has no RAMMS input (a statistical alternative
-#: is said so by :func:`~fieldkit.export.lumped.not_a_law`).
-EFFECT_REASONS = {
-    "angle_dependent_restitution": "RAMMS has no restitution coefficient: the "
-    "rebound at any angle comes from the rigid rock's shape, rotation and the "
-    "slip-dependent ground friction",
-    "velocity_scaled_restitution": "RAMMS has no restitution coefficient to scale; "
-    "its impacts are plastic (epsilon = 0) whatever the speed",
-    "rotation_friction": "RAMMS computes rotation from the rigid rock's contact "
-    "(its own friction law, mu_min to mu_max); no lumped coupling parameter",
-    "slope_roughness": "RAMMS's roughness comes from the DEM and the rock's shape; "
-    "no random dip input",
-    "mass_loss": "RAMMS's rock keeps its shape and mass during a run",
-    "tree_impacts": "forest is set in RAMMS by polygons (not written)",
-    "air_drag": "RAMMS's flight has no drag input",
-}
 
 
 def _mismatches(

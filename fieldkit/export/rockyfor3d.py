@@ -62,6 +62,7 @@ import numpy as np
 from fieldkit.errors import ArgumentError
 from fieldkit.export.ascii_grid import ascii_grid_text
 from fieldkit.export.fitted import with_error
+from fieldkit.export.lumped import not_a_law
 from fieldkit.export.result import Export, Mapped
 from fieldkit.export.site import ExportSite, checked_site, ground_cells, pad_site
 from fieldkit.export.translation import (
@@ -636,30 +637,6 @@ def _mapped(
     return out
 
 
-#: Why each effect of the registry is, or is not, carried into Rockyfor3D.
-EFFECT_REASONS = {
-    "angle_dependent_restitution": "Rockyfor3D draws Rn within the soil type's range "
-    "whatever the impact angle; the realised e_n it produces is compared with the "
-    "class (mismatch below), the soil type itself follows the ground description",
-    "velocity_scaled_restitution": "Rockyfor3D draws Rn within the soil type's range; "
-    "the realised e_n the scaling produces is compared with the class (mismatch "
-    "below), the soil type itself follows the ground description",
-    "rotation_friction": "Rockyfor3D computes Rt from the obstacle heights; the "
-    "tangential rebound this coupling realises is in the realised e_t that "
-    "rg70/rg20/rg10 are inverted from",
-    "slope_roughness": "Rockyfor3D's roughness inputs (rg70/rg20/rg10) carry its Rt "
-    "(written from the realised e_t); fieldkit's random local dip has no input of its "
-    "own -- Rockyfor3D's rebound geometry on the DEM applies",
-    "mass_loss": "Rockyfor3D's block keeps its volume during a run (its volume "
-    "variation is a setting of the run, §2.5, not fragmentation)",
-    "tree_impacts": "Rockyfor3D's forest inputs (tree file or nrtrees/dbh grids, "
-    "§2.2) are not written: the run is without forest",
-    "air_drag": "Rockyfor3D's flight is a parabola; it has no drag input",
-    "affine_rebound": "a statistical alternative of the diagnosis, not a law: "
-    "Rockyfor3D has no such law",
-}
-
-
 def _unmapped(
     model: Model, site: ExportSite, present: list[str]
 ) -> list[tuple[str, str]]:
@@ -725,11 +702,7 @@ def _unmapped(
         out.append(
             (
                 f"effect {spec.name} ({state})",
-                EFFECT_REASONS.get(
-                    spec.name,
-                    "Rockyfor3D has its own rebound and energy-loss rules (§3.3); "
-                    "none of its inputs takes this effect",
-                ),
+                not_a_law(spec.name, "Rockyfor3D") or spec.export("Rockyfor3D").how,
             )
         )
     if model.trees is not None:

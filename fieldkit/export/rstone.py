@@ -89,6 +89,9 @@ from fieldkit.model.materials import Material
 from fieldkit.model.model_file import Model
 
 TARGET = "rstone"
+#: The program's name in the effects' export metadata (:data:`~fieldkit.model.
+#: effects.spec.EXPORT_TARGETS`).
+PROGRAM = "r.stone"
 TITLE = "r.stone (GRASS GIS)"
 
 #: Trajectories in all, as ``fieldkit simulate``'s default ensemble.
@@ -1166,17 +1169,6 @@ def _unmapped(model: Model, present: list[str]) -> list[tuple[str, str]]:
     return out
 
 
-#: Why r.stone has no place for each effect that does not change the rebound pair.
-NO_PROCESS = {
-    "slope_roughness": "r.stone has no roughness input: its ground is the DEM's "
-    "triangles (stone.c NewPlane)",
-    "mass_loss": "r.stone's block is a point whose mass never enters its kinematics: "
-    "no fragmentation or mass loss",
-    "tree_impacts": "r.stone has no forest or tree input",
-    "air_drag": "r.stone's flight is a drag-free parabola (Parab, points.c)",
-}
-
-
 def effect_lines(model: Model) -> list[tuple[str, str]]:
     """Every registered effect (:data:`fieldkit.model.effects.registry.EFFECTS`),
     active in ``model`` or not, and what r.stone does with it."""
@@ -1186,24 +1178,18 @@ def effect_lines(model: Model) -> list[tuple[str, str]]:
     for spec in registry.EFFECTS:
         active = spec.name in model.effects
         state = "active in the model" if active else "not in the model"
-        if spec.changes_rebound or spec.name == "slope_roughness":
-            why = (
-                "r.stone's only impact law is a constant pair per cell (Bounce, "
-                "points.c): "
-                + (
-                    "its rebounds are folded into the in-range constant pair fitted "
-                    "to the calibrated model's own impacts, which no longer varies "
-                    "as the effect makes it"
-                    if active
-                    else "an active one would be folded into the fitted constant pair"
-                )
-            )
-            if spec.name == "slope_roughness":
-                why = NO_PROCESS[spec.name] + "; " + why
-            reason = not_a_law(spec.name, TARGET)
-            why += f"; {reason}" if reason and active else ""
+        reason = not_a_law(spec.name, PROGRAM)
+        if reason:
+            why = reason
         else:
-            why = NO_PROCESS.get(spec.name, "r.stone has no such process or parameter")
+            why = spec.export(PROGRAM).how
+            if spec.name == "slope_roughness":
+                # the random dip is not an input, but it is in the impacts the
+                # constant pair is fitted to
+                why += (
+                    "; its rebounds are folded into the in-range constant pair "
+                    "fitted to the calibrated model's own impacts"
+                )
         out.append((f"effect {spec.name} ({state})", why))
     return out
 

@@ -52,12 +52,32 @@ ever shorter steps. On an inclined plane and along a groove the scheme is exact;
 a profile extruded along y it follows the 2-D kernel's exact slide
 (tests/model/test_kernel3d.py).
 
+Trees (``tree_impacts``, thesis §6.6): a stem stands at ``(x, y)`` with trunk
+diameter ``d`` and a top ``height`` above the ground at the stem. The rock strikes
+it where its centre enters the vertical cylinder of radius ``d/2 + r`` about the
+stem below the top -- through the side, or through the top while over the disc
+(:func:`stem_struck`). In flight the plan projection is a straight line (no drag)
+and the height a parabola in time, so the entry is a root of two quadratics, exact
+like the contact; a slide step is short and is taken along its chord, the speed at
+the strike from ``v^2`` linear along the step (exact on a plane). At the strike the
+trunk takes the 2-D law's energy
+(:func:`fieldkit.model.effects.tree_impacts.speed_after_strike`, capped at the
+kinetic energy), the direction of travel and the spin are kept, and the rock flies
+or slides on from there; the stem just struck is passed through (as 2-D passes
+the tree), and can be struck again only after the rock has left its disc. The
+strike is geometric and certain: ``hit_probability`` must be 1 in 3-D
+(:func:`fieldkit.model.simulate3d.tree_hit_probability` says why). Stems are
+binned into the DEM's cells (:func:`stems_of`) and only the cells within
+``max(d)/2 + r`` of a piece's plan segment are searched, so a rock far from the
+trees pays for the empty cells around it, not for the number of trees. The next
+impact row is flagged ``tree_strike``.
+
 Randomness: every draw is ``f(key, impact number, slot)``
 (:mod:`fieldkit.model.random_streams`, the 2-D slots; the tilt across the plane of
 incidence uses :data:`SLOT_ROUGHNESS_LATERAL`), so threads and chunks do not change
-results. ``mass_loss`` uses the plan distance from the release point (2-D: the
-horizontal distance). Not yet in 3-D: ``tree_impacts``, ``air_drag``
-(:data:`NOT_IN_3D`; :func:`fieldkit.model.simulate3d.simulate3d` refuses them).
+results; tree strikes draw nothing. ``mass_loss`` uses the plan distance from the
+release point (2-D: the horizontal distance). Not yet in 3-D: ``air_drag``
+(:data:`NOT_IN_3D`; :func:`fieldkit.model.simulate3d.simulate3d` refuses it).
 """
 
 from __future__ import annotations
@@ -68,7 +88,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit, prange
 
-from fieldkit.model.effects import mass_loss, slope_roughness
+from fieldkit.model.effects import mass_loss, slope_roughness, tree_impacts
 from fieldkit.model.effects.registry import EFFECTS, LAYOUT
 from fieldkit.model.kernel import (
     MATERIAL_COLUMNS,
@@ -91,7 +111,7 @@ INF = math.inf
 #: A rock that left the DEM (or reached nodata): the 2-D "exited" code.
 EXITED = EXITED_DOWNSLOPE
 #: Effects the 3-D kernel does not apply yet (a model enabling one is refused).
-NOT_IN_3D = ("tree_impacts", "air_drag")
+NOT_IN_3D = ("air_drag",)
 #: Normal draw slot of the roughness tilt across the plane of incidence (uniforms
 #: 6 and 7 of an impact; the 2-D slots use 0-5, 200+ and 2000+).
 SLOT_ROUGHNESS_LATERAL = 3
@@ -108,6 +128,9 @@ _NAMES = [spec.name for spec in EFFECTS]
 F_ROUGH = _NAMES.index("slope_roughness")
 F_ROT = _NAMES.index("rotation_friction")
 F_MASS = _NAMES.index("mass_loss")
+F_TREE = _NAMES.index("tree_impacts")
+P_TREE_C = LAYOUT["tree_impacts.energy_factor"]
+P_TREE_EXP = LAYOUT["tree_impacts.energy_exponent"]
 P_MASS_RATE = LAYOUT["mass_loss.rate_per_m"]
 P_MASS_EXP = LAYOUT["mass_loss.impact_exponent"]
 P_ROUGH = LAYOUT["slope_roughness.scale"]
@@ -125,6 +148,11 @@ Ground = namedtuple("Ground", ("z", "xc0", "yc0", "cell", "mat_index"))
 Settings = namedtuple(
     "Settings", ("slide_vn", "stop_v", "max_impacts", "sample_m", "step_m")
 )
+#: Tree stems binned into the DEM's cells (:func:`stems_of`): stem ``x``, ``y``
+#: [m], trunk ``diameter`` [m], ``top_z`` (the ground at the stem plus the tree's
+#: height) [m], sorted by cell; the stems of cell ``row * nx + col`` are
+#: ``cell_start[cell] .. cell_start[cell + 1]``; ``max_half`` the largest d/2 [m].
+Stems = namedtuple("Stems", ("x", "y", "diameter", "top_z", "cell_start", "max_half"))
 #: Sampled path buffers (flat, one entry per sample).
 Path = namedtuple(
     "Path", ("x_m", "y_m", "z_m", "speed_mps", "ke_j", "re_j", "height_m")
@@ -146,6 +174,7 @@ IMPACT_COLUMNS = (
     "normal_x",
     "normal_y",
     "normal_z",
+    "tree_strike",
 )
 N_IMPACT = len(IMPACT_COLUMNS)
 
@@ -282,6 +311,96 @@ def _sample_flight(gr, path, k, on, x, y, z, vx, vy, vz, t1, sample_m, m, re):
     return k
 
 
+@njit(cache=True)
+def _stem_entry(stems, k, x, y, z, ux, uy, bz, az, s_end, r):
+    """When the piece ``p(s) = (x + ux s, y + uy s, z + bz s + az s^2)``,
+    ``0 <= s <= s_end``, enters stem ``k``'s cylinder (radius ``d/2 + r`` about
+    the stem, up to its top); inf if it does not. Entering through the side needs
+    the centre below the top there, through the top a descent inside the disc; a
+    piece that starts inside the cylinder does not enter it."""
+    big_r = 0.5 * stems.diameter[k] + r
+    dx = x - stems.x[k]
+    dy = y - stems.y[k]
+    a = ux * ux + uy * uy
+    b = 2.0 * (dx * ux + dy * uy)
+    c = dx * dx + dy * dy - big_r * big_r
+    disc = b * b - 4.0 * a * c
+    if not (a > 0.0 and disc > 0.0):
+        return INF  # no plan motion, or passing by (a graze is no strike)
+    sq = math.sqrt(disc)
+    q = -0.5 * (b + sq) if b >= 0.0 else -0.5 * (b - sq)
+    ta = min(q / a, c / q)
+    tb = max(q / a, c / q)
+    if tb < 0.0 or ta > s_end:
+        return INF
+    top = stems.top_z[k]
+    t0 = max(ta, 0.0)
+    if z + (bz + az * t0) * t0 < top:
+        # below the top where the piece is first inside the disc: the side, unless
+        # it starts inside (then it is in the cylinder already)
+        return ta if ta >= 0.0 else INF
+    td = descending_root(az, bz, z - top)  # through the top, inside the disc
+    return td if t0 <= td <= min(tb, s_end) else INF
+
+
+@njit(cache=True)
+def stem_struck(gr, stems, skip, x, y, z, ux, uy, bz, az, s_end, r):
+    """The first stem the piece of :func:`_stem_entry` enters, ``(index, s)``
+    (index -1: none), ``skip`` (a stem just struck, or -1) aside.
+
+    Only the DEM cells within ``max_half + r`` of the piece's plan segment are
+    searched (stems are binned by cell), so the cost does not grow with the stems
+    far from the rock.
+    """
+    ny, nx = gr.z.shape
+    cell = gr.cell
+    x0 = gr.xc0 - 0.5 * cell
+    y0 = gr.yc0 - 0.5 * cell
+    margin = stems.max_half + r
+    xe = x + ux * s_end
+    ye = y + uy * s_end
+    j0 = max(int(math.floor((min(y, ye) - margin - y0) / cell)), 0)
+    j1 = min(int(math.floor((max(y, ye) + margin - y0) / cell)), ny - 1)
+    best = INF
+    found = -1
+    for j in range(j0, j1 + 1):
+        lo = y0 + j * cell - margin  # the row's band, widened by the margin
+        hi = lo + cell + 2.0 * margin
+        if uy != 0.0:
+            sa = (lo - y) / uy
+            sb = (hi - y) / uy
+            sa, sb = max(min(sa, sb), 0.0), min(max(sa, sb), s_end)
+            if sa > sb:
+                continue
+            xa = x + ux * sa
+            xb = x + ux * sb
+        else:
+            xa, xb = x, xe
+        i0 = max(int(math.floor((min(xa, xb) - margin - x0) / cell)), 0)
+        i1 = min(int(math.floor((max(xa, xb) + margin - x0) / cell)), nx - 1)
+        for i in range(i0, i1 + 1):
+            c = j * nx + i
+            for k in range(stems.cell_start[c], stems.cell_start[c + 1]):
+                if k == skip:
+                    continue
+                s = _stem_entry(stems, k, x, y, z, ux, uy, bz, az, s_end, r)
+                if s < best:
+                    best, found = s, k
+    return found, best
+
+
+@njit(cache=True)
+def _left_stem(stems, skip, x, y, r):
+    """``skip``, or -1 once the rock is clear of that stem's disc (so a stem just
+    struck is not struck again on the way through, but can be on a later pass)."""
+    if skip < 0:
+        return skip
+    big_r = (0.5 * stems.diameter[skip] + r) * (1.0 + 1e-6)
+    dx = x - stems.x[skip]
+    dy = y - stems.y[skip]
+    return skip if dx * dx + dy * dy <= big_r * big_r else -1
+
+
 @njit(cache=True, inline="always")
 def _local_axes(vx, vy, vz, nx, ny, nz):
     """``(vin, vit, tx, ty, tz)``: the velocity's normal component on the unit
@@ -354,14 +473,34 @@ def impact(gr, mat, flags, par, key, n, x, y, vx, vy, vz, w, r, kg):
 
 
 @njit(cache=True)
+def _strike(gr, stems, ks, par, path, k, on, x, y, z, vx, vy, vz, m, re):
+    """A strike on stem ``ks`` at ``(x, y, z)``: the trunk takes its energy
+    (:func:`fieldkit.model.effects.tree_impacts.speed_after_strike`, capped at the
+    kinetic energy), the direction is kept. Emits the samples just before and just
+    after; returns ``(k, vx, vy, vz)``."""
+    sp = math.sqrt(vx * vx + vy * vy + vz * vz)
+    hgt = z - surface_at(gr, x, y)[0]
+    k = _emit(path, k, on, x, y, z, sp, m, re, hgt)
+    v_new = tree_impacts.speed_after_strike(
+        sp, m, stems.diameter[ks], par[P_TREE_C], par[P_TREE_EXP]
+    )
+    scale = v_new / sp if sp > 0.0 else 0.0
+    vx, vy, vz = vx * scale, vy * scale, vz * scale
+    k = _emit(path, k, on, x, y, z, v_new, m, re, hgt)
+    return k, vx, vy, vz
+
+
+@njit(cache=True)
 def run_rock(
-    key, x, y, z, vx, vy, vz, w, m, r, kg, gr, mat, flags, par, st,
+    key, x, y, z, vx, vy, vz, w, m, r, kg, gr, mat, flags, par, st, stems,
     path, path_start, path_on, rec, rec_start, rec_on, rock,
 ):  # fmt: skip
-    """Follow one rock; returns ``(impacts, state, x, y, z, samples)``.
+    """Follow one rock; returns ``(impacts, state, x, y, z, samples, strikes)``.
 
     ``gr`` is a :data:`Ground`, ``mat`` the material table (columns ``M_*``),
-    ``flags`` / ``par`` the effects (registry layout), ``st`` the :data:`Settings`.
+    ``flags`` / ``par`` the effects (registry layout), ``st`` the :data:`Settings`,
+    ``stems`` the trees (:data:`Stems`; struck with ``tree_impacts`` on);
+    ``strikes`` counts the tree strikes.
     Path samples are written from ``path_start`` when ``path_on`` (else only
     counted), impact rows into ``rec[rec_start + i]`` when ``rec_on``.
     """
@@ -369,13 +508,17 @@ def run_rock(
     kr = kg * kg
     m0, r0, k0, x_rel, y_rel = m, r, kg, x, y
     losing = flags[F_MASS] == 1
+    trees = flags[F_TREE] == 1 and stems.x.size > 0
+    strikes = 0
+    struck = 0.0  # a tree struck since the last impact
+    skip = -1  # the stem just struck
     n = 0
     k = path_start
     state = -1
     h, gx, gy = surface_at(gr, x, y)
     if h != h:
         k = _emit(path, k, path_on, x, y, z, 0.0, m, 0.0, math.nan)
-        return 0, EXITED, x, y, z, k - path_start
+        return 0, EXITED, x, y, z, k - path_start, 0
     nx, ny, nz = _unit_normal(gx, gy)
     flying = z > h or vx * nx + vy * ny + vz * nz > 0.0
     if not flying:
@@ -389,6 +532,29 @@ def run_rock(
     while state < 0:
         if flying:
             tc, hit = flight_contact(gr, x, y, z, vx, vy, vz)
+            if trees:
+                skip = _left_stem(stems, skip, x, y, r)
+                ks, ts = stem_struck(
+                    gr, stems, skip, x, y, z, vx, vy, vz, -0.5 * G, tc, r
+                )
+                if ks >= 0:
+                    re = 0.5 * m * kr * w * w
+                    k = _sample_flight(
+                        gr, path, k, path_on, x, y, z, vx, vy, vz, ts, st.sample_m,
+                        m, re,
+                    )  # fmt: skip
+                    x = x + vx * ts
+                    y = y + vy * ts
+                    z = z + vz * ts - 0.5 * G * ts * ts
+                    vz = vz - G * ts
+                    k, vx, vy, vz = _strike(
+                        gr, stems, ks, par, path, k, path_on, x, y, z, vx, vy, vz, m,
+                        re,
+                    )  # fmt: skip
+                    strikes += 1
+                    struck = 1.0
+                    skip = ks
+                    continue
             k = _sample_flight(
                 gr, path, k, path_on, x, y, z, vx, vy, vz, tc, st.sample_m, m,
                 0.5 * m * kr * w * w,
@@ -437,6 +603,8 @@ def run_rock(
                 rec[row, 11] = nnx
                 rec[row, 12] = nny
                 rec[row, 13] = nnz
+                rec[row, 14] = struck
+            struck = 0.0
             h, gx, gy = surface_at(gr, x, y)
             nx, ny, nz = _unit_normal(gx, gy)
             vn_real = vfx * nx + vfy * ny + vfz * nz
@@ -448,16 +616,19 @@ def run_rock(
             else:
                 vx, vy, vz = vfx, vfy, vfz
         else:
-            state, x, y, z, vx, vy, vz, w, k = _slide(
+            state, x, y, z, vx, vy, vz, w, k, hits, skip = _slide(
                 gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st,
-                path, k, path_on,
+                path, k, path_on, stems, par, trees, skip,
             )  # fmt: skip
+            if hits > 0:
+                strikes += hits
+                struck = 1.0
             if state < 0:
                 flying = True
     sp = math.sqrt(vx * vx + vy * vy + vz * vz) if state != STOPPED else 0.0
     hh = surface_at(gr, x, y)[0]
     k = _emit(path, k, path_on, x, y, z, sp, m, 0.5 * m * kr * w * w, z - hh)
-    return n, state, x, y, z, k - path_start
+    return n, state, x, y, z, k - path_start, strikes
 
 
 @njit(cache=True)
@@ -515,12 +686,17 @@ def _line_direction(gx, gy, groove):
 
 
 @njit(cache=True)
-def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
+def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on,
+           stems, par, trees, skip):  # fmt: skip
     """Slide/roll on the surface until the rock stops, leaves the DEM or launches.
 
-    Returns ``(state, x, y, z, vx, vy, vz, w, samples)``; ``state`` -1 = launched
-    (flying from the returned point, above the surface).
+    Returns ``(state, x, y, z, vx, vy, vz, w, samples, strikes, skip)``; ``state``
+    -1 = launched (flying from the returned point, above the surface). With
+    ``trees``, a step whose chord enters a stem's cylinder ends there with a
+    strike (the speed there from ``v^2`` linear along the step, exact on a plane);
+    ``skip`` is the stem just struck (:func:`_left_stem`).
     """
+    hits = 0
     mi, cell_id = _cell_material(gr, x, y)
     entry = 0
     tanphi = _friction_tan(mat, mi, key, n, entry)
@@ -562,7 +738,7 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
         restart = False
         if sp < st.stop_v or sp == 0.0:
             if gt <= fric:
-                return STOPPED, x, y, z, 0.0, 0.0, 0.0, 0.0, k
+                return STOPPED, x, y, z, 0.0, 0.0, 0.0, 0.0, k, hits, skip
             vx = vy = vz = 0.0
             sp = 0.0
             s = 1.0 - fric / gt
@@ -603,10 +779,10 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
         bz = z + vz * dt - 0.5 * G * dt * dt
         hb = surface_at(gr, bx, by)[0]
         if hb != hb:
-            return EXITED, x, y, z, vx, vy, vz, w, k
+            return EXITED, x, y, z, vx, vy, vz, w, k, hits, skip
         if bz > hb + LAUNCH_GAP_M:
             k = _emit(path, k, on, x, y, z, sp, m, 0.5 * m * kr * w * w, 0.0)
-            return -1, bx, by, bz, vx, vy, vz - G * dt, w, k
+            return -1, bx, by, bz, vx, vy, vz - G * dt, w, k, hits, skip
         x1 = x + vx * dt + 0.5 * ax * dt * dt
         y1 = y + vy * dt + 0.5 * ay * dt * dt
         if edge == 1:  # just past the edge, in the patch ahead
@@ -615,11 +791,50 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
             y1 = y + (edge_at + math.copysign(EDGE_NUDGE, edge_at)) * gr.cell
         h1, gx1, gy1 = surface_at(gr, x1, y1)
         if h1 != h1:
-            return EXITED, x, y, z, vx, vy, vz, w, k
+            return EXITED, x, y, z, vx, vy, vz, w, k, hits, skip
         if restart and (x1 - x) * gx1 + (y1 - y) * gy1 > 0.0:
             # a step from rest ends where the ground rises along it: the fall lines
             # meet within one step (a notch), where the rock stays
-            return STOPPED, x, y, z, 0.0, 0.0, 0.0, 0.0, k
+            return STOPPED, x, y, z, 0.0, 0.0, 0.0, 0.0, k, hits, skip
+        if trees:
+            skip = _left_stem(stems, skip, x, y, r)
+            ks, s1 = stem_struck(
+                gr, stems, skip, x, y, z, x1 - x, y1 - y, h1 - z, 0.0, 1.0, r
+            )
+            if ks >= 0:
+                ex, ey, ez = vx + ax * dt, vy + ay * dt, vz + az * dt
+                if rest:
+                    ex, ey, ez = x1 - x, y1 - y, h1 - z  # (only the direction)
+                    v2 = (1.0 - s1) * sp * sp
+                else:
+                    v2 = sp * sp + s1 * (ex * ex + ey * ey + ez * ez - sp * sp)
+                xs = x + s1 * (x1 - x)
+                ys = y + s1 * (y1 - y)
+                hs, gxs, gys = surface_at(gr, xs, ys)
+                if groove == 0:  # along the tangent plane there
+                    n1x, n1y, n1z = _unit_normal(gxs, gys)
+                    en = ex * n1x + ey * n1y + ez * n1z
+                    ex, ey, ez = ex - en * n1x, ey - en * n1y, ez - en * n1z
+                norm = math.sqrt(ex * ex + ey * ey + ez * ez)
+                vs = math.sqrt(v2) if v2 > 0.0 else 0.0
+                scale = vs / norm if norm > 0.0 else 0.0
+                re = 0.5 * m * kr * w * w
+                k, vx, vy, vz = _strike(
+                    gr, stems, ks, par, path, k, on, xs, ys, hs, ex * scale,
+                    ey * scale, ez * scale, m, re,
+                )  # fmt: skip
+                hits += 1
+                skip = ks
+                x, y, z = xs, ys, hs
+                sp = math.sqrt(vx * vx + vy * vy + vz * vz)
+                w = -sp / r
+                walked = 0.0
+                mi1, cell1 = _cell_material(gr, x, y)
+                if cell1 != cell_id:
+                    cell_id = cell1
+                    entry += 1
+                    tanphi = _friction_tan(mat, mi1, key, n, entry)
+                continue
         walked += math.sqrt((x1 - x) ** 2 + (y1 - y) ** 2 + (h1 - z) ** 2)
         if rest:
             vx = vy = vz = 0.0
@@ -639,7 +854,7 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
                 # a convex edge: the rock leaves the surface (the 2-D convex break)
                 # when its free flight would rise above LAUNCH_GAP_M off the plane
                 k = _emit(path, k, on, x, y, z, sp, m, 0.5 * m * kr * w * w, 0.0)
-                return -1, x1, y1, h1, vx, vy, vz, w, k
+                return -1, x1, y1, h1, vx, vy, vz, w, k, hits, skip
             if groove == 0:
                 vx -= vn * n1x
                 vy -= vn * n1y
@@ -674,28 +889,77 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on):
             cell_id = cell1
             entry += 1
             tanphi = _friction_tan(mat, mi1, key, n, entry)
-    return MAX_IMPACTS, x, y, z, vx, vy, vz, w, k
+    return MAX_IMPACTS, x, y, z, vx, vy, vz, w, k, hits, skip
 
 
 @njit(cache=True, parallel=True)
 def run_rocks(
-    keys, x, y, z, vx, vy, vz, w, m, r, kg, gr, mat, flags, par, st,
+    keys, x, y, z, vx, vy, vz, w, m, r, kg, gr, mat, flags, par, st, stems,
     path, path_offsets, path_on, rec, rec_offsets, rec_on, first_rock,
-    impacts, states, deposit, samples,
+    impacts, states, deposit, samples, strikes,
 ):  # fmt: skip
     """:func:`run_rock` over all rocks in parallel; outputs written in place."""
     for i in prange(keys.size):
-        n, s, xf, yf, zf, ns = run_rock(
+        n, s, xf, yf, zf, ns, nt = run_rock(
             keys[i], x[i], y[i], z[i], vx[i], vy[i], vz[i], w[i], m[i], r[i], kg[i],
-            gr, mat, flags, par, st, path, path_offsets[i], path_on,
+            gr, mat, flags, par, st, stems, path, path_offsets[i], path_on,
             rec, rec_offsets[i], rec_on, first_rock + i,
         )  # fmt: skip
+        strikes[i] = nt
         impacts[i] = n
         states[i] = s
         deposit[i, 0] = xf
         deposit[i, 1] = yf
         deposit[i, 2] = zf
         samples[i] = ns
+
+
+def stems_of(x_m, y_m, diameter_m, height_m, terrain) -> Stems:
+    """The trees as the kernel takes them (:data:`Stems`), binned into the DEM's
+    cells; a stem off the DEM's surface (outside the cell centres or beside nodata)
+    is left out: no rock can reach it.
+
+    Parameters
+    ----------
+    x_m, y_m, diameter_m, height_m
+        Stem positions, trunk diameters and tree heights [m] (equal lengths).
+    terrain
+        The :class:`fieldkit.model.terrain.Terrain` the rocks run on.
+
+    Examples
+    --------
+    >>> from fieldkit.model.terrain import Terrain
+    >>> t = Terrain(0.0, 0.0, 1.0, np.zeros((3, 3)))
+    >>> s = stems_of([1.2, 0.7, 9.0], [1.5, 0.6, 1.0], [0.3, 0.2, 0.3],
+    ...              [20.0, 15.0, 20.0], t)
+    >>> s.x.tolist(), s.cell_start.tolist(), s.max_half
+    ([0.7, 1.2], [0, 1, 1, 1, 1, 2, 2, 2, 2, 2], 0.15)
+    """
+    x = np.asarray(x_m, float)
+    y = np.asarray(y_m, float)
+    d = np.asarray(diameter_m, float)
+    ground = terrain.heights(x, y)
+    keep = np.isfinite(ground)
+    x, y, d = x[keep], y[keep], d[keep]
+    top = ground[keep] + np.asarray(height_m, float)[keep]
+    ny, nx = terrain.shape
+    row, col = terrain.cell_index(x, y)
+    cell = row * nx + col
+    order = np.argsort(cell, kind="stable")
+    start = np.searchsorted(cell[order], np.arange(ny * nx + 1)).astype(np.int64)
+    return Stems(
+        np.ascontiguousarray(x[order]),
+        np.ascontiguousarray(y[order]),
+        np.ascontiguousarray(d[order]),
+        np.ascontiguousarray(top[order]),
+        start,
+        float(0.5 * d.max()) if d.size else 0.0,
+    )
+
+
+def no_stems(terrain) -> Stems:
+    """No trees (a model without any)."""
+    return stems_of([], [], [], [], terrain)
 
 
 def empty_path() -> Path:

@@ -19,11 +19,15 @@ above), velocity ``(vx, vy, vz)`` and spin with their SDs, mass with its SD (at 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from fieldkit.model.model_blocks import Body, Trees
+from fieldkit.model.model_blocks import Body
 from fieldkit.model.terrain import Terrain
+
+if TYPE_CHECKING:
+    from fieldkit.model.terrain_file import Trees3D
 
 
 @dataclass(frozen=True)
@@ -68,7 +72,9 @@ class Model3D:
     core
         Core settings (as in 2-D: slide_vn_mps, stop_speed_mps, max_impacts, ...).
     trees
-        Tree positions and sizes (not yet used in 3-D: refused when active).
+        Tree stems in plan with their trunk diameters and heights
+        (:class:`fieldkit.model.terrain_file.Trees3D`), struck with
+        ``tree_impacts`` on; or None.
     crs
         The DEM's coordinate reference system (WKT) or None.
     analysis_lines
@@ -89,7 +95,7 @@ class Model3D:
     release_weights: np.ndarray
     seeder: Seeder3D = field(default_factory=Seeder3D)
     core: dict[str, float] = field(default_factory=dict)
-    trees: Trees | None = None
+    trees: Trees3D | None = None
     crs: str | None = None
     provenance: dict = field(default_factory=dict)
     source: str = ""

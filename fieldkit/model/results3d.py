@@ -298,8 +298,9 @@ def line_summary(result, xy_m: np.ndarray, name: str) -> dict:
 
 def summary3d(result, model, lines: list) -> dict:
     """summary.json of a 3-D run: rocks, impacts, wall_s, seed, final states, the
-    stopped fraction, release-to-deposit distance in plan, and the analysis lines
-    (``lines``: :class:`~fieldkit.model.terrain_file.AnalysisLine`)."""
+    stopped fraction, release-to-deposit distance in plan, the analysis lines
+    (``lines``: :class:`~fieldkit.model.terrain_file.AnalysisLine`) and, with
+    ``tree_impacts`` on, ``tree_strikes`` (total, rocks that struck one, stems)."""
     state = np.asarray(result.state)
     names = state_names(state)
     final = {k: names.count(k) for k in ("stopped", "left_dem", "capped")}
@@ -309,7 +310,7 @@ def summary3d(result, model, lines: list) -> dict:
     releases = np.asarray(model.releases, float)[np.asarray(result.release_index)]
     xyz = np.asarray(result.deposit_xyz, float)
     distance = np.hypot(xyz[:, 0] - releases[:, 0], xyz[:, 1] - releases[:, 1])
-    return {
+    out = {
         "dimension": 3,
         "rocks": rocks,
         "impacts": int(result.impacts),
@@ -326,3 +327,13 @@ def summary3d(result, model, lines: list) -> dict:
             line_summary(result, ln.xy_m, ln.label(i)) for i, ln in enumerate(lines)
         ],  # fmt: skip
     }
+    if "tree_impacts" in (model.effects or {}):
+        strikes = np.asarray(result.tree_strikes_per_rock)
+        out["tree_strikes"] = {
+            "total": int(strikes.sum()),
+            "rocks_struck": int((strikes > 0).sum()),
+            "stems": int(len(model.trees.x_m)),
+            "over": "every rock; a strike: the centre within d/2 + r of a stem, "
+            "below its top",
+        }
+    return out

@@ -43,8 +43,10 @@ class Result3D:
     ``i``'s from ``path_offsets[i]`` to ``path_offsets[i + 1]``: fields ``x_m, y_m,
     z_m, speed_mps, ke_j, re_j, height_m`` (centre height above the ground,
     vertical), a sample at least every ``sample_m`` travelled, at every impact and
-    at the final position. ``impact_rows`` (with ``record_impacts``): one array per
-    :data:`fieldkit.model.kernel3d.IMPACT_COLUMNS`.
+    at the final position (and just before and after every tree strike, at the
+    same point). ``tree_strikes_per_rock``: the trees each rock struck
+    (``tree_impacts``; zeros without). ``impact_rows`` (with
+    ``record_impacts``): one array per :data:`fieldkit.model.kernel3d.IMPACT_COLUMNS`.
     """
 
     rocks: int
@@ -60,6 +62,7 @@ class Result3D:
     sample_m: float
     impact_rows: dict[str, np.ndarray] | None = None
     notes: list[str] = field(default_factory=list)
+    tree_strikes_per_rock: np.ndarray | None = None
 
     def rock_path(self, i: int) -> dict[str, np.ndarray]:
         """The samples of rock ``i`` (views into :attr:`path`)."""
@@ -86,6 +89,8 @@ def check_model3d(model: Model3D) -> None:
     ------
     ArgumentError
         An effect not yet in 3-D (:data:`fieldkit.model.kernel3d.NOT_IN_3D`) is on;
+        ``tree_impacts`` is on without ``trees`` or with a ``hit_probability``
+        other than 1 (:func:`tree_hit_probability`);
         ``material_index`` is not the DEM's shape or indexes past ``materials``;
         ``releases`` is not (n, 3) finite, has a point off the DEM's surface, or
         its weights are not >= 0 with a positive sum.
@@ -97,6 +102,11 @@ def check_model3d(model: Model3D) -> None:
             "switch them off for a 3-D model",
             source="model",
         )
+    if "tree_impacts" in model.effects:
+        if model.trees is None:
+            raise ArgumentError("tree_impacts is on but the model has no trees",
+                                source="trees")  # fmt: skip
+        tree_hit_probability(model.effects["tree_impacts"], source="model")
     mi = np.asarray(model.material_index)
     if mi.shape != model.terrain.shape:
         raise ArgumentError(
@@ -131,6 +141,37 @@ def check_model3d(model: Model3D) -> None:
         raise ArgumentError(
             "release_weights must be one weight >= 0 per release point, not all 0",
             source="release_weights",
+        )
+
+
+#: Why a 3-D model's ``tree_impacts.hit_probability`` must be 1.
+WHY_HIT_PROBABILITY_1 = (
+    "in 3-D the stems are placed and a strike is geometric (the rock centre within "
+    "d/2 + r of a stem, below its top), so it must be 1"
+)
+
+
+def tree_hit_probability(params: dict, *, source: str = "model") -> None:
+    """Refuse a 3-D ``tree_impacts.hit_probability`` other than 1.
+
+    In 2-D ``hit_probability`` is the chance that a trunk standing at a chainage
+    lies in the rock's lane, which a section cannot know. A 3-D model places
+    every stem, so whether the rock passes within ``d/2 + r`` of it below its top
+    is geometry, and a strike is certain when it does: a probability below 1 would
+    thin a mapped stand at random a second time (the map already says where the
+    stems are), and a fit could use it as a free knob with no field meaning. A
+    stand known only as a density is given as stems drawn from it.
+
+    Raises
+    ------
+    ArgumentError
+        ``hit_probability`` is not 1, naming ``source``.
+    """
+    p = float(params.get("hit_probability", 1.0))
+    if p != 1.0:
+        raise ArgumentError(
+            f"tree_impacts.hit_probability is {p:g}; {WHY_HIT_PROBABILITY_1}",
+            source=source,
         )
 
 
@@ -272,11 +313,23 @@ def simulate3d(
     )
     mat = _material_table(model.materials)
     flags, par = registry.kernel_arrays(model.effects)
+    stems = kernel3d.no_stems(terrain)
+    if "tree_impacts" in model.effects:
+        tr = model.trees
+        stems = kernel3d.stems_of(tr.x_m, tr.y_m, tr.diameter_m, tr.height_m, terrain)
+        off = len(tr.x_m) - stems.x.size
+        notes.append(
+            f"tree_impacts: {stems.x.size} stems on the DEM, each struck where a "
+            "rock's centre passes within d/2 + r of it below its top "
+            "(hit_probability 1: 3-D strikes are geometric)"
+            + (f"; {off} stem(s) off the DEM's surface never reached" if off else "")
+        )
     d = draw_rocks3d(model, rocks, rng)
     impacts = np.zeros(rocks, np.int64)
     states = np.zeros(rocks, np.int64)
     deposit = np.zeros((rocks, 3))
     samples = np.zeros(rocks, np.int64)
+    strikes = np.zeros(rocks, np.int64)
     no_rec = np.zeros((0, kernel3d.N_IMPACT))
     path_parts: list[kernel3d.Path] = []
     rec_parts: list[np.ndarray] = []
@@ -291,9 +344,9 @@ def simulate3d(
             path, poff, pon, rec, roff, ron, a=a, sel=sel, starts=starts, body=body
         ):
             kernel3d.run_rocks(
-                *starts, *body, ground, mat, flags, par, settings,
+                *starts, *body, ground, mat, flags, par, settings, stems,
                 path, poff, pon, rec, roff, ron, a,
-                impacts[sel], states[sel], deposit[sel], samples[sel],
+                impacts[sel], states[sel], deposit[sel], samples[sel], strikes[sel],
             )  # fmt: skip
 
         zeros = np.zeros(b - a, np.int64)
@@ -354,4 +407,5 @@ def simulate3d(
         sample_m=float(sample_m),
         impact_rows=rows,
         notes=notes,
+        tree_strikes_per_rock=strikes,
     )

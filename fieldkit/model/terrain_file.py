@@ -35,9 +35,12 @@ Optional top-level fields beside ``materials``, ``body``, ``effects`` and ``core
 (read as in 2-D): ``seeder`` (``height_m`` above the ground, ``vx_mps, vy_mps,
 vz_mps, omega_radps``, their ``*_sd_*`` spreads and ``mass_sd_kg``; all 0 when
 absent, i.e. rocks start at rest on the ground), ``trees`` (lists
-``x_m, y_m, diameter_m``), ``analysis_lines`` (barrier polylines ``{"name":
-..., "xy_m": [[x, y], ...]}``) and ``provenance``. Every problem is one line
-naming the model file (or the file it reads) and the field.
+``x_m, y_m, diameter_m, height_m``: stems in plan, trunk diameter and tree height;
+struck with ``tree_impacts`` on, whose ``hit_probability`` is 1 in 3-D --
+:func:`fieldkit.model.simulate3d.tree_hit_probability`), ``analysis_lines``
+(barrier polylines ``{"name": ..., "xy_m": [[x, y], ...]}``) and ``provenance``.
+Every problem is one line naming the model file (or the file it reads) and the
+field.
 """
 
 from __future__ import annotations
@@ -90,11 +93,12 @@ MAX_LINE_VERTICES = 10_000
 
 @dataclass(frozen=True)
 class Trees3D:
-    """Trees in plan: stem position [m] and trunk diameter [m]."""
+    """Trees in plan: stem position [m], trunk diameter [m] and tree height [m]."""
 
     x_m: np.ndarray
     y_m: np.ndarray
     diameter_m: np.ndarray
+    height_m: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -206,6 +210,8 @@ def model3d_from_dict(
             "tree_impacts is on but the model has no trees", source=source,
             where="trees",
         )  # fmt: skip
+    if "tree_impacts" in effects:
+        effects["tree_impacts"] = _tree_effect3d(data, effects["tree_impacts"], source)
     lines = tuple(
         analysis_lines_from(data.get("analysis_lines", []), source, "analysis_lines")
     )
@@ -449,11 +455,31 @@ def _seeder3d(data: dict, source: str) -> Seeder3D:
     return Seeder3D(**values)
 
 
+def _tree_effect3d(data: dict, params: dict, source: str) -> dict:
+    """``tree_impacts`` of a 3-D model: ``hit_probability`` 1 (the strike is
+    geometric; :func:`fieldkit.model.simulate3d.tree_hit_probability`), given as 1
+    or left out (2-D's default, 0.5, is not taken)."""
+    from fieldkit.model.simulate3d import WHY_HIT_PROBABILITY_1
+
+    given = data["effects"]["tree_impacts"]
+    params = dict(params)
+    if "hit_probability" not in given:
+        params["hit_probability"] = 1.0
+    elif params["hit_probability"] != 1.0:
+        raise InputFileError(
+            f"is {params['hit_probability']:g}; {WHY_HIT_PROBABILITY_1} (or left out)",
+            source=source,
+            where="effects.tree_impacts.hit_probability",
+        )
+    return params
+
+
 def _trees3d(data: dict, source: str) -> Trees3D:
-    """Tree stems in plan: lists ``x_m, y_m, diameter_m`` of one length."""
-    _unknown(data, {"x_m", "y_m", "diameter_m"}, "trees", source)
-    arrays = number_lists(data, ("x_m", "y_m", "diameter_m"), "trees", source)
-    for key in ("y_m", "diameter_m"):
+    """Tree stems in plan: lists ``x_m, y_m, diameter_m, height_m`` of one length."""
+    keys = ("x_m", "y_m", "diameter_m", "height_m")
+    _unknown(data, set(keys), "trees", source)
+    arrays = number_lists(data, keys, "trees", source)
+    for key in keys[1:]:
         if arrays[key].size != arrays["x_m"].size:
             raise InputFileError(
                 f"has {arrays[key].size} values, trees.x_m has {arrays['x_m'].size}",
@@ -465,6 +491,12 @@ def _trees3d(data: dict, source: str) -> Trees3D:
         raise InputFileError(
             f"must be in (0, {TREE_BOUNDS['diameter_m']:g}] m", source=source,
             where="trees.diameter_m",
+        )  # fmt: skip
+    h = arrays["height_m"]
+    if np.any(h <= 0) or np.any(h > TREE_BOUNDS["height_m"]):
+        raise InputFileError(
+            f"must be in (0, {TREE_BOUNDS['height_m']:g}] m", source=source,
+            where="trees.height_m",
         )  # fmt: skip
     return Trees3D(**arrays)
 

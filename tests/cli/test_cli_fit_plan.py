@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -120,10 +121,14 @@ def test_fit_of_a_terrain_model_recovers_friction_and_writes_a_model_simulate_ru
     assert comp[("start", "energy_fair_m")]["mean_difference"] < 0
     scores = ("energy_fair_m", "distance_crps_fair_m")
     assert set(comp) == {(b, s) for b in ("start", "climatology") for s in scores}
-    # the calibrated file: fitted value in place, terrain files absolute, readable
+    # the calibrated file: fitted value in place, terrain files relative to its
+    # folder, readable there and after the folder is moved
     calibrated = json.loads((out / "calibrated_3d.json").read_text())
     assert calibrated["materials"]["ground"]["friction_deg"] == friction["value"]
-    assert Path(calibrated["terrain"]["dem"]) == (site / "dem" / "plane.asc").resolve()
+    assert calibrated["terrain"]["dem"] == "../dem/plane.asc"
+    assert (out / calibrated["terrain"]["dem"]).resolve() == (
+        site / "dem" / "plane.asc"
+    ).resolve()
     assert calibrated["terrain"]["materials"] == "ground"
     assert calibrated["provenance"]["fit"]["objective_m"] == fit["objective_m"]
     assert (site / "model3d.json").read_text() == base_text  # input untouched
@@ -131,6 +136,14 @@ def test_fit_of_a_terrain_model_recovers_friction_and_writes_a_model_simulate_ru
               "--summary", out / "sim" / "summary.json")  # fmt: skip
     assert sim.exit_code == 0, sim.stderr + sim.stdout
     assert (out / "sim" / "summary.json").is_file()
+    moved = tmp_path.parent / (tmp_path.name + "_moved")
+    shutil.copytree(tmp_path, moved)
+    again = cli("simulate", moved / "out" / "calibrated_3d.json", "--rocks", "4",
+                "--seed", "2", "--summary", moved / "sim2.json")  # fmt: skip
+    assert again.exit_code == 0, again.stderr + again.stdout
+    first = json.loads((out / "sim" / "summary.json").read_text())
+    second = json.loads((moved / "sim2.json").read_text())
+    assert second["deposits"] == first["deposits"]  # the same DEM read, moved
 
 
 def test_fit_of_a_terrain_model_refuses_a_dem_option_in_one_line(

@@ -78,6 +78,24 @@ def test_metadata_answers_what_consumers_ask(name):
         assert f"held by an impact fit: {why}" in text
 
 
+def test_3d_targets_read_the_metadata():
+    """RAMMS, Rockyfor3D and r.stone keep no list of effects of their own: r.stone's
+    effect lines are the metadata's words (the random dip adds that its rebounds are
+    in the fitted pair)."""
+    from fieldkit.export import ramms, rockyfor3d, rstone
+
+    for module in (ramms, rockyfor3d, rstone):
+        assert not hasattr(module, "EFFECT_REASONS")
+        assert not hasattr(module, "NO_PROCESS")
+    lines = dict(rstone.effect_lines(build()))
+    for spec in EFFECTS:
+        why = lines[f"effect {spec.name} (not in the model)"]
+        if spec.is_law:
+            assert why.startswith(spec.export("r.stone").how), spec.name
+        else:
+            assert "statistical alternative" in why
+
+
 def test_consumers_read_the_metadata():
     from fieldkit.diagnose.candidates import IMPACT_CANDIDATES
     from fieldkit.export import crsp, lumped, rocfall

@@ -390,7 +390,7 @@ def test_mass_loss_follows_eqs_6_15_16_with_the_plan_distance():
         assert np.isclose(mass, BODY.mass_kg * ratio, rtol=1e-9).any(), i
 
 
-@pytest.mark.parametrize("effect", ["tree_impacts", "air_drag"])
+@pytest.mark.parametrize("effect", ["air_drag"])
 def test_an_effect_not_yet_in_3d_is_refused(effect):
     t = grid_of(plane(30.0, 0.0), 10, 10)
     model = model_on(t, [(5.0, 5.0)], effects={effect: {}})

@@ -50,6 +50,18 @@ SPEC = EffectSpec(
             False,
             "RocFall's lumped mass ignores air resistance",
         ),
+        "RAMMS": Export(
+            False,
+            "RAMMS's flight has no drag input",
+        ),
+        "Rockyfor3D": Export(
+            False,
+            "Rockyfor3D's flight is a parabola; it has no drag input",
+        ),
+        "r.stone": Export(
+            False,
+            "r.stone's flight is a drag-free parabola (Parab, points.c)",
+        ),
     },
 )
 

@@ -67,6 +67,24 @@ SPEC = EffectSpec(
             "impact-angle law for Rn was found in its documentation: Rn, Rt are "
             "fitted in range to the rebounds the law realises",
         ),
+        "RAMMS": Export(
+            False,
+            "RAMMS has no restitution coefficient: the rebound at any angle comes from"
+            " the rigid rock's shape, rotation and the slip-dependent ground friction",
+        ),
+        "Rockyfor3D": Export(
+            False,
+            "Rockyfor3D draws Rn within the soil type's range whatever the impact "
+            "angle; the realised e_n it produces is compared with the class (mismatch "
+            "below), the soil type itself follows the ground description",
+        ),
+        "r.stone": Export(
+            True,
+            "r.stone's only impact law is a constant nrest/trest pair per cell "
+            "(Bounce, points.c): the rebounds this law makes are folded into the "
+            "in-range pair fitted to the calibrated model's own impacts, which no "
+            "longer varies as the law makes it",
+        ),
     },
 )
 

@@ -46,6 +46,20 @@ SPEC = EffectSpec(
             False,
             "RocFall's lumped-mass rock keeps its mass (no breakage or abrasion)",
         ),
+        "RAMMS": Export(
+            False,
+            "RAMMS's rock keeps its shape and mass during a run",
+        ),
+        "Rockyfor3D": Export(
+            False,
+            "Rockyfor3D's block keeps its volume during a run (its volume variation is"
+            " a setting of the run, §2.5, not fragmentation)",
+        ),
+        "r.stone": Export(
+            False,
+            "r.stone's block is a point whose mass never enters its kinematics: no "
+            "fragmentation or mass loss",
+        ),
     },
 )
 

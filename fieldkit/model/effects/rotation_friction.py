@@ -59,6 +59,24 @@ SPEC = EffectSpec(
             "'consider rotational velocity' (on/off only: RocFall's own rotation, its "
             "friction and coupling are not written)",
         ),
+        "RAMMS": Export(
+            False,
+            "RAMMS computes rotation from the rigid rock's contact (its own friction "
+            "law, mu_min to mu_max); no lumped coupling parameter",
+        ),
+        "Rockyfor3D": Export(
+            False,
+            "Rockyfor3D computes Rt from the obstacle heights; the tangential rebound "
+            "this coupling realises is in the realised e_t that rg70/rg20/rg10 are "
+            "inverted from",
+        ),
+        "r.stone": Export(
+            True,
+            "r.stone's only impact law is a constant nrest/trest pair per cell "
+            "(Bounce, points.c): the rebounds this law makes are folded into the "
+            "in-range pair fitted to the calibrated model's own impacts, which no "
+            "longer varies as the law makes it",
+        ),
     },
 )
 

@@ -51,6 +51,22 @@ SPEC = EffectSpec(
             True,
             "each material's slope roughness (SD of the dip)",
         ),
+        "RAMMS": Export(
+            False,
+            "RAMMS's roughness comes from the DEM and the rock's shape; no random dip "
+            "input",
+        ),
+        "Rockyfor3D": Export(
+            False,
+            "Rockyfor3D's roughness inputs (rg70/rg20/rg10) carry its Rt (written from"
+            " the realised e_t); fieldkit's random local dip has no input of its own "
+            "-- Rockyfor3D's rebound geometry on the DEM applies",
+        ),
+        "r.stone": Export(
+            False,
+            "r.stone has no roughness input: its ground is the DEM's triangles "
+            "(stone.c NewPlane)",
+        ),
     },
 )
 

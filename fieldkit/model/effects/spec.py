@@ -25,7 +25,7 @@ class Parameter:
 
 #: Export targets whose handling of every law an effect declares
 #: (:attr:`EffectSpec.exports`): the lumped-mass programs fieldkit writes files for.
-EXPORT_TARGETS = ("CRSP", "RocFall")
+EXPORT_TARGETS = ("CRSP", "RocFall", "RAMMS", "Rockyfor3D", "r.stone")
 #: Impact quantities (:attr:`EffectSpec.writes`) that make up the rebound: normal
 #: (``e_n``, ``vfn_mps``), tangential and spin.
 NORMAL_REBOUND = ("e_n", "vfn_mps")

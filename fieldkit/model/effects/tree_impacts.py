@@ -10,6 +10,10 @@ A strike dissipates the energy the trunk can take,
 38.7 and 2.31 for beech), capped at the kinetic energy; the speed falls accordingly,
 direction kept. The next impact row is flagged ``tree_strike``.
 ``hit_probability = 0`` is the base model.
+
+In 3-D (:mod:`fieldkit.model.kernel3d`) the stems are placed in plan, so whether a
+rock passes within ``d/2 + r`` of one below its top is geometry: every such pass is
+a strike, the same law applies there, and ``hit_probability`` must be 1.
 """
 
 from __future__ import annotations
@@ -32,7 +36,7 @@ SPEC = EffectSpec(
             0.0,
             1.0,
             "-",
-            "chance a passing tree is struck",
+            "chance a passing tree is struck (2-D; 1 in 3-D: strikes are geometric)",
             0.0,
         ),
         Parameter(
@@ -62,6 +66,19 @@ SPEC = EffectSpec(
             False,
             "RocFall's lumped mass has no trees (barriers only); the trees are not "
             "exported",
+        ),
+        "RAMMS": Export(
+            False,
+            "forest is set in RAMMS by polygons (not written)",
+        ),
+        "Rockyfor3D": Export(
+            False,
+            "Rockyfor3D's forest inputs (tree file or nrtrees/dbh grids, §2.2) are not"
+            " written: the run is without forest",
+        ),
+        "r.stone": Export(
+            False,
+            "r.stone has no forest or tree input",
         ),
     },
 )

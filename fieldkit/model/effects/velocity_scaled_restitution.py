@@ -41,6 +41,24 @@ SPEC = EffectSpec(
             "'scale Rn by velocity' at RocFall's K = 9.144 m/s; another K or an Rn "
             "above 1 is fitted in range under that law",
         ),
+        "RAMMS": Export(
+            False,
+            "RAMMS has no restitution coefficient to scale; its impacts are plastic "
+            "(epsilon = 0) whatever the speed",
+        ),
+        "Rockyfor3D": Export(
+            False,
+            "Rockyfor3D draws Rn within the soil type's range; the realised e_n the "
+            "scaling produces is compared with the class (mismatch below), the soil "
+            "type itself follows the ground description",
+        ),
+        "r.stone": Export(
+            True,
+            "r.stone's only impact law is a constant nrest/trest pair per cell "
+            "(Bounce, points.c): the rebounds this law makes are folded into the "
+            "in-range pair fitted to the calibrated model's own impacts, which no "
+            "longer varies as the law makes it",
+        ),
     },
 )
 
