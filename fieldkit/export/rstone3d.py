@@ -27,7 +27,9 @@ with :mod:`fieldkit.export.rstone`'s conversions:
 
 What r.stone cannot take is said (:attr:`Rstone3DInputs.notes`): roughness (the
 slope-roughness effect's random tilt of the normal: r.stone's ground is the DEM's
-triangles), every other active effect, the block's mass and size, the lateral
+triangles), each active effect as its own export metadata for r.stone says
+(:meth:`~fieldkit.model.effects.spec.EffectSpec.export`), the block's mass and
+size, the lateral
 spread of the launch (``ang_stoch_range`` written 0: fieldkit's seeder here has
 no launch direction), and r.stone's random numbers, seeded with the constant 1
 (``random2.c`` ``Init_RNG``): the same files give the same run.
@@ -53,12 +55,14 @@ import numpy as np
 
 from fieldkit.errors import ArgumentError, FieldkitError
 from fieldkit.export.ascii_grid import ascii_grid_text
+from fieldkit.export.lumped import not_a_law
 from fieldkit.export.rstone import (
     DEFAULT_ANGLE_RANGE,
     DEFAULT_START_VEL_MPS,
     EDGE_CELLS,
     G_MPS2,
     MAX_ELEVATION_M,
+    PROGRAM,
     _check,
     dem_offset_m,
     friction_sd_tan,
@@ -66,6 +70,7 @@ from fieldkit.export.rstone import (
     stoch_range,
 )
 from fieldkit.io.dem import DemGrid, read_dem
+from fieldkit.model.effects import registry
 from fieldkit.model.model3d import Model3D
 
 #: The input rasters written once per model (the sources are written per run).
@@ -241,25 +246,28 @@ def _notes(model: Model3D, present: list[str], offset: float,
         f"stop_vel {options['stop_vel']:g} m/s",
         RNG_NOTE,
         COUNTER_NOTE,
+        f"body not written ({model.body.mass_kg:g} kg, radius "
+        f"{model.body.radius_m:g} m; each run's own block likewise): r.stone's block "
+        "is a point whose mass never enters its kinematics",
     ]
     rough = [n for n in present if model.materials[n].roughness_deg_sd > 0
              or model.materials[n].roughness_m > 0]  # fmt: skip
-    dropped = [e for e in model.effects if e != "slope_roughness" or not rough]
-    if rough or model.effects:
+    if rough:
         out.append(
-            "not in r.stone: "
-            + "; ".join(
-                [
-                    *(
-                        f"{n}'s roughness ({model.materials[n].roughness_deg_sd:.3g} "
-                        "deg SD of the normal; r.stone's ground is the DEM's triangles)"
-                        for n in rough
-                    ),
-                    *(f"effect {e}" for e in dropped),
-                ]
+            "roughness not written: "
+            + ", ".join(
+                f"{n} {model.materials[n].roughness_deg_sd:.3g} deg SD of the normal"
+                for n in rough
             )
-            + ": e_n, e_t written as calibrated with them, not refitted"
+            + " (r.stone's ground is the DEM's triangles); e_n, e_t are written as "
+            "calibrated with it, not refitted to a law without it"
         )
+    for name in model.effects:  # how r.stone takes each: the effect's own metadata
+        export = registry.effect(name).export(PROGRAM)
+        why = not_a_law(name, PROGRAM) or (
+            export.how if export else "r.stone's export of it is not declared"
+        )
+        out.append(f"effect {name}: {why}")
     if offset:
         out.append(f"DEM raised by {offset:g} m (r.stone takes z <= 0 as no ground)")
     return out

@@ -113,8 +113,15 @@ def test_what_rstone_cannot_take_is_refused(change, words):
 def test_roughness_and_effects_are_said_not_written():
     m = _model(roughness_deg_sd=8.0)
     m = replace(m, effects={"slope_roughness": {}})
-    notes = " ".join(rstone_inputs3d(m).notes)
-    assert "roughness (8 deg SD" in notes and "not refitted" in notes
+    notes = rstone_inputs3d(m).notes
+    text = " ".join(notes)
+    assert "rock 8 deg SD of the normal" in text and "not refitted" in text
+    # the effect as its own export metadata for r.stone says
+    assert "effect slope_roughness: r.stone has no roughness input" in text
+    m = replace(m, effects={"air_drag": {"cd": 0.5}})
+    assert "effect air_drag: r.stone's flight is a drag-free parabola" in " ".join(
+        rstone_inputs3d(m).notes
+    )
 
 
 def test_footprint_reads_reach_passage_and_miss():
