@@ -548,7 +548,7 @@ def rstone_comparison(settings: dict, fits: list) -> dict:
         )
     print(
         f"(observed mean distance {observed.mean():.1f} m over the held-out runs; "
-        "the 3-D calibrated model's reach is often the tracked extent's edge)"
+        "reach-obs and obs<=reach over runs and seeds)"
     )
     print("paired over runs, A - 3-D calibrated (SE over runs, seeds 1-3):")
     for name in names[:2]:
