@@ -33,12 +33,22 @@ Two assumptions, each shown moved in a last table:
   provenance says why); at rest, a block on a cell flatter than its friction
   angle never moves (run v086's release, 12 degrees).
 
+Where GRASS GIS and r.stone are present (``tools/r.stone/install.sh``; else one
+line says why it was skipped), r.stone runs with the exported parameters of each
+seed's calibrated model on the held-out runs, one source cell and as many stones
+as held-out rocks per run (:mod:`fieldkit.export.rstone3d`; its random numbers are
+seeded with the constant 1). r.stone writes no deposits, so only footprints in
+plan are compared (:mod:`fieldkit.fit.footprint`: reach, passage distance, the
+observed deposit's cell passed or missed), beside fieldkit's 3-D calibrated model
+read the same way.
+
 With ``--full``, also repeated 5-fold cross-validation over the 79 distinct runs
 (2 repeats, stratified by block, seed 1): 3-D calibrated against the climatology.
 
 Sizes (default / ``--full``): 3-D fit 60 / 100 rocks per run and 80 / 160
 evaluations (Sobol screen 0 / 16 points); held-out 200 / 500 rocks per run; about
-80 s / 12 min measured (the five fixed-split cases; the k-fold's ten fits).
+90 s / 12 min measured (the five fixed-split cases, the r.stone section about 40 s
+of it; the k-fold's ten fits).
 
 Run:  python examples/calibrate_tschamut_3d.py [OUT_DIR] [--full]
 """
@@ -190,10 +200,11 @@ def _model3d(extent, height):
 
 
 def fixed_split(settings: dict, extent: Extent | None, height: float,
-                verbose: bool = True) -> dict:  # fmt: skip
+                verbose: bool = True, fits: list | None = None) -> dict:  # fmt: skip
     """The fixed split over seeds 1-3: fits, held-out scores, paired comparisons.
     ``extent``: censor every forecast at the tracked extent (None: not);
-    ``height``: the release drop [m]."""
+    ``height``: the release drop [m]; ``fits``: a list the 3-D calibrated model of
+    each seed is appended to."""
     say = print if verbose else (lambda *a, **k: None)
     base3d, censor = _model3d(extent, height)
     base2d = read_model(MODEL_2D)
@@ -247,6 +258,8 @@ def fixed_split(settings: dict, extent: Extent | None, height: float,
             max_evaluations=settings["evaluations"],
             screen=settings["screen"],
         )
+        if fits is not None:
+            fits.append(fit.model)
         say(f"seed {seed}: 3-D fit in {time.perf_counter() - tic:.1f} s")
         for line in fit.lines():
             say("  " + line)
@@ -379,6 +392,177 @@ def sensitivity(settings: dict, main: dict) -> list[dict]:
     return out
 
 
+#: r.stone's own default lateral spread of the launch angle [deg] (main.c), run
+#: beside the exported 0 to show what the spread no one calibrated does.
+RSTONE_DEFAULT_ANGLE = 10
+
+
+def rstone_comparison(settings: dict, fits: list) -> dict:
+    """r.stone with the exported parameters of each seed's 3-D calibrated model on
+    the held-out runs, beside fieldkit's 3-D calibrated model read the same way.
+
+    r.stone writes no deposits, only rasters: each run's footprint in plan
+    (:mod:`fieldkit.fit.footprint`) is read from r.stone's ``counter`` and from
+    fieldkit's ``passing_count`` (the held-out streams' rocks, with paths), both
+    with the held-out ensemble's size, both censored at the tracked extent: fieldkit
+    runs on the clipped DEM; r.stone on the whole DEM (on the clipped one a release
+    cell at the extent's edge would have nodata among the 8 neighbours its launch
+    direction reads), its counter set to 0 outside the extent. r.stone runs twice:
+    as exported (launch angle range 0) and with its own default range
+    (:data:`RSTONE_DEFAULT_ANGLE`)."""
+    from fieldkit.export.rstone3d import (
+        rstone_inputs3d,
+        rstone_missing,
+        run_rstone_batch,
+        source_cell,
+    )
+    from fieldkit.fit.footprint import footprint
+    from fieldkit.model.results3d import rasters
+    from fieldkit.model.simulate3d import simulate3d
+
+    print()
+    missing = rstone_missing()
+    if missing:
+        print(f"r.stone comparison skipped: {missing}")
+        return {"skipped": missing}
+    _, hold = _runs()
+    whole, _ = _model3d(None, DROP_M)
+    _, censor = _model3d(tracked_extent(), DROP_M)
+    rocks = settings["holdout_rocks"]
+    keys = ("reach_m", "passage_mean_m", "miss_m", "observed_m", "deposit_passed")
+    spread = f"r.stone, ang {RSTONE_DEFAULT_ANGLE}"
+    names = ("r.stone", spread, "3-D calibrated")
+    per = {n: {k: [] for k in keys} for n in names}
+    tic, notes, short = time.perf_counter(), {}, 0
+
+    def outside(x, y):
+        mx, my = np.meshgrid(x, y)
+        return ~censor.contains(np.column_stack([mx.ravel(), my.ravel()]))
+
+    for seed, model in zip(SEEDS, fits, strict=True):
+        exported = replace(model, terrain=whole.terrain,
+                           material_index=whole.material_index)  # fmt: skip
+        inputs = rstone_inputs3d(exported)
+        notes[seed] = inputs.notes
+        g = inputs.grid
+        cells = {r.run_id: source_cell(inputs, *r.release_xy) for r in hold}
+        counters = {
+            "r.stone": run_rstone_batch(inputs, cells, rocks),
+            spread: run_rstone_batch(
+                replace(inputs, options=inputs.options
+                        | {"ang_stoch_range": RSTONE_DEFAULT_ANGLE}),
+                cells, rocks,
+            ),
+        }  # fmt: skip
+        short += sum(int(c[cells[r.run_id]] < rocks)
+                     for grids in counters.values()
+                     for r, c in ((r, grids[r.run_id]) for r in hold))  # fmt: skip
+        t = model.terrain
+        tx = t.x0_m + t.cell_m * (np.arange(t.shape[1]) + 0.5)
+        ty = t.y0_m + t.cell_m * (np.arange(t.shape[0]) + 0.5)
+        off_r, off_f = outside(g.x_m, g.y_m), outside(tx, ty)
+        rows = {n: [] for n in names}
+        with one_kernel_thread():
+            for i, run in enumerate(hold):
+                for name, grids in counters.items():
+                    counter = grids[run.run_id].copy()
+                    counter.ravel()[off_r] = 0.0
+                    rows[name].append(
+                        footprint(counter, g.x_m, g.y_m, run.release_xy, run.deposit_xy)
+                    )
+                res = simulate3d(
+                    plan_fit.run_model(model, run),
+                    rocks,
+                    np.random.default_rng([seed, plan_fit.HOLDOUT_STREAM, i]),
+                )
+                count = rasters(res, t)["passing_count"].astype(float)
+                count.ravel()[off_f] = 0.0
+                rows["3-D calibrated"].append(
+                    footprint(count, tx, ty, run.release_xy, run.deposit_xy)
+                )
+        for name, fps in rows.items():
+            for k in keys:
+                per[name][k].append([float(getattr(f, k)) for f in fps])
+    arrays = {n: {k: np.array(v) for k, v in d.items()} for n, d in per.items()}
+    n_runs = len(SEEDS) * len(hold) * 2
+    print(
+        f"r.stone (GRASS) with the exported parameters on the {len(hold)} held-out "
+        f"runs, seeds 1-3 (each seed's calibrated model; {rocks} stones per run from "
+        f"its release cell; {time.perf_counter() - tic:.0f} s with fieldkit's "
+        "paths), beside fieldkit's 3-D calibrated model read the same way"
+    )
+    first = notes[SEEDS[0]]
+    for line in first:
+        if all(line in notes[s] for s in SEEDS):
+            print(f"  {line}")
+    for seed in SEEDS:
+        for line in notes[seed]:
+            if not all(line in notes[s] for s in SEEDS):
+                print(f"  seed {seed}: {line}")
+    print(
+        f"  '{spread}': the same files with r.stone's default launch-angle range "
+        f"{RSTONE_DEFAULT_ANGLE} (a lateral spread nobody calibrated)"
+    )
+    print(
+        f"  stones traced: {n_runs - short} of {n_runs} r.stone runs count all "
+        f"{rocks} in their release cell (r.stone's counter there)"
+    )
+    print(
+        "  compared: each run's footprint in plan, censored at the tracked extent -- "
+        "reach (farthest passed cell from the release), passage (count-weighted "
+        "mean distance of the passed cells), whether the observed deposit's cell "
+        "was passed and else its distance to the nearest passed cell (miss)"
+    )
+    print(
+        "  not compared: deposit energy score, distance CRPS, 90 % coverage -- "
+        "r.stone writes no deposits, only counter, maxvel and maxdz rasters"
+    )
+    print(
+        f"{'forecast':<18}{'reach':>8}{'reach-obs':>11}{'obs<=reach':>12}"
+        f"{'passage':>9}{'dep passed':>12}{'miss':>7}"
+    )
+    out: dict = {
+        "stones_per_run": rocks,
+        "notes": {str(k): list(v) for k, v in notes.items()},
+        "runs_short_of_stones": short,
+        "forecasts": {},
+        "comparisons": [],
+    }
+    observed = arrays["r.stone"]["observed_m"]
+    for name, a in arrays.items():
+        reach = a["reach_m"]
+        row = {
+            "reach_m": float(reach.mean()),
+            "reach_minus_observed_m": float((reach - observed).mean()),
+            "observed_within_reach": float((observed <= reach).mean()),
+            "passage_mean_m": float(a["passage_mean_m"].mean()),
+            "deposit_cell_passed": float(a["deposit_passed"].mean()),
+            "miss_m": float(a["miss_m"].mean()),
+        }
+        out["forecasts"][name] = row
+        print(
+            f"{name:<18}{row['reach_m']:7.1f}m{row['reach_minus_observed_m']:+10.1f}m"
+            f"{100 * row['observed_within_reach']:11.0f}%"
+            f"{row['passage_mean_m']:8.1f}m{100 * row['deposit_cell_passed']:11.0f}%"
+            f"{row['miss_m']:6.1f}m"
+        )
+    print(
+        f"(observed mean distance {observed.mean():.1f} m over the held-out runs; "
+        "reach-obs and obs<=reach over runs and seeds)"
+    )
+    print("paired over runs, A - 3-D calibrated (SE over runs, seeds 1-3):")
+    for name in names[:2]:
+        parts = []
+        for k in ("reach_m", "passage_mean_m", "miss_m"):
+            c = paired_comparison(arrays[name][k], arrays["3-D calibrated"][k], k,
+                                  name, "3-D calibrated", seeds=SEEDS)  # fmt: skip
+            parts.append(f"{k.removesuffix('_m')} {c.mean_difference:+.1f} +- "
+                         f"{c.se:.1f} m")  # fmt: skip
+            out["comparisons"].append(c.to_dict())
+        print(f"  {name:<16}" + ", ".join(parts))
+    return out
+
+
 def kfold(settings: dict, repeats: int = 2, k: int = 5, seed: int = 1) -> dict:
     base3d, censor = _model3d(tracked_extent(), DROP_M)
     runs = _dedupe(
@@ -444,11 +628,13 @@ def main(argv: list[str]) -> None:
     args = [a for a in argv if a != "--full"]
     out = Path(args[0]) if args else Path("out") / "calibrate_tschamut_3d"
     settings = FULL if full else SMALL
-    main_split = fixed_split(settings, tracked_extent(), DROP_M)
+    fits: list = []
+    main_split = fixed_split(settings, tracked_extent(), DROP_M, fits=fits)
     summary = {
         "settings": settings,
         "fixed_split": main_split,
         "sensitivity": sensitivity(settings, main_split),
+        "rstone": rstone_comparison(settings, fits),
     }
     if full:
         summary["kfold"] = kfold(settings)

@@ -137,6 +137,12 @@ EXPECTED = {
         r"3 seed\(s\)\)",
         r"3-D calibrated - 2-D calibrated = -\d+\.\d+ \+- \d+\.\d+",
         r"^off +0\.0m +1\d\.\d\d +11\.82",
+        # r.stone with the exported parameters, where GRASS and r.stone are present
+        # (else one line saying why not): footprints only, no deposits
+        r"^(r\.stone +\d+\.\dm +[+-]\d+\.\dm +\d+% +\d+\.\dm +\d+% +\d+\.\dm$"
+        r"|r\.stone comparison skipped: .+)",
+        r"^(  not compared: deposit energy score, distance CRPS.*no deposits"
+        r"|r\.stone comparison skipped: .+)",
         r"wrote .*calibrate_tschamut_3d\.json",
     ],
     # Issue 18: a virtual campaign with eq. 7.1 hidden, surveyed, reduced with the

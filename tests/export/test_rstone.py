@@ -482,8 +482,10 @@ def test_doctests():
     import doctest
 
     import fieldkit.export.rstone as export_module
+    import fieldkit.export.rstone3d as export3d_module
+    import fieldkit.fit.footprint as footprint_module
     import fieldkit.io.rstone_results as results_module
 
-    for module in (export_module, results_module):
+    for module in (export_module, results_module, export3d_module, footprint_module):
         result = doctest.testmod(module)
         assert result.attempted > 0 and result.failed == 0, module.__name__

@@ -205,3 +205,95 @@ def test_tschamut_area_runout_agrees_with_the_emulation(tschamut_run):
     runouts, left = emulated_runouts(model, record, read_dem(dem))
     print(f"emulation: {np.mean(left):.1%} leave the grid")
     assert not _agreement(summary, runouts, record["grid"]["cellsize_m"])
+
+
+# ---------------------------------------------------------------------------
+# A 3-D model's own DEM (fieldkit.export.rstone3d): an inclined plane onto a flat
+# floor, one source cell, the real r.stone.
+
+#: r.stone's gravity (stone.h G) [m/s²].
+RSTONE_G = 9.805
+
+
+def _plane_model(friction_tan: float, *, slope_deg: float = 30.0):
+    """A 30 deg plane falling east for 60 m onto a flat floor (5 m cells, 40 x 9),
+    one material, no spread, released at rest in the middle row's second cell."""
+    from fieldkit.model.materials import Material
+    from fieldkit.model.model3d import Model3D, Seeder3D
+    from fieldkit.model.model_blocks import Body
+    from fieldkit.model.terrain import Terrain
+
+    cell, nx, ny, toe = 5.0, 40, 9, 60.0
+    x = (np.arange(nx) + 0.5) * cell
+    z = np.tile(np.where(x < toe, math.tan(math.radians(slope_deg)) * (toe - x),
+                         0.0), (ny, 1))  # fmt: skip
+    phi = math.degrees(math.atan(friction_tan))
+    rock = Material.from_dict("rock", {"e_n": 0.3, "e_t": 0.9, "friction_deg": phi})
+    return Model3D(
+        Terrain(0.0, 0.0, cell, z), {"rock": rock}, np.zeros((ny, nx), int), {},
+        Body(100.0, 0.2, 0.13), np.array([[7.5, 22.5, z[4, 1]]]), np.ones(1),
+        Seeder3D(height_m=0.0), core={"stop_speed_mps": 0.05},
+    )  # fmt: skip
+
+
+def _rolling_stop_m(x_m, z_m, friction_tan, v0_mps, *, break_loss: bool) -> float:
+    """Independent expectation: the plan distance from x_m[0] where a block rolling
+    down the section (x_m, z_m) stops under r.stone's rolling law, deceleration
+    g sin(beta) against the motion in the plane plus gravity's component along it
+    (points.c Roll), by energy balance segment by segment. ``break_loss``: at each
+    slope break the velocity is projected onto the new plane (speed x cos of the
+    angle between them: a lower bound); else the speed is kept (an upper bound)."""
+    f = RSTONE_G * math.sin(math.atan(friction_tan))
+    v2, plan, previous = v0_mps**2, 0.0, None
+    for x0, x1, z0, z1 in zip(x_m[:-1], x_m[1:], z_m[:-1], z_m[1:], strict=True):
+        theta = math.atan2(z0 - z1, x1 - x0)  # downhill positive
+        if break_loss and previous is not None:
+            v2 *= math.cos(theta - previous) ** 2
+        previous = theta
+        along = math.hypot(x1 - x0, z1 - z0)
+        a = RSTONE_G * math.sin(theta) - f
+        if a < 0 and v2 + 2 * a * along <= 0:
+            return plan + v2 / (-2 * a) * math.cos(theta)
+        v2 += 2 * a * along
+        plan += x1 - x0
+    return plan
+
+
+def test_plane_onto_floor_in_the_real_rstone(tmp_path):
+    from fieldkit.export.rstone3d import rstone_inputs3d, run_rstone_batch, source_cell
+    from fieldkit.fit.footprint import footprint
+
+    reach = {}
+    for friction in (0.2, 0.4):
+        inputs = rstone_inputs3d(_plane_model(friction))
+        # no spread written: every stone is the same (launch angle range 0)
+        assert inputs.options["vrest_stoch_range"] == 0
+        assert inputs.options["ang_stoch_range"] == 0
+        start = source_cell(inputs, 7.5, 22.5)
+        assert start == (4, 1)
+        counter = run_rstone_batch(inputs, {"plane": start}, 10,
+                                   tmp_path / f"f{friction}")["plane"]  # fmt: skip
+        g = inputs.grid
+        # every stone traced, and every passed cell lies down the fall line: the
+        # source's row (the plane has no slope across it)
+        assert counter[start] == 10
+        rows = np.flatnonzero(np.nansum(counter, axis=1))
+        assert rows.tolist() == [4]
+        f = footprint(counter, g.x_m, g.y_m, (7.5, 22.5), (100.0, 22.5))
+        reach[friction] = f.reach_m
+        section = g.values[4] - inputs.offset_m
+        x = g.x_m[1:]
+        v0 = inputs.options["start_vel"]
+        lo = _rolling_stop_m(x, section[1:], friction, v0, break_loss=True)
+        hi = _rolling_stop_m(x, section[1:], friction, v0, break_loss=False)
+        print(
+            f"friction tan {friction}: r.stone reach {f.reach_m:.1f} m (farthest "
+            f"passed cell's centre); energy balance {lo:.1f}..{hi:.1f} m"
+        )
+        # the farthest passed cell holds the stop, good to one cell (its centre)
+        # and one 5 m path step (the counter marks path points 5 m apart)
+        cell = g.cellsize_m
+        assert lo - cell - 5.0 <= f.reach_m <= hi + cell / 2, (f.reach_m, lo, hi)
+    # measured on GRASS 8.2.1: 145 m and 75 m; the energy balance 135..147 m and
+    # 71..74 m
+    assert reach[0.2] > reach[0.4] + 50
