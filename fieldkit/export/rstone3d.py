@@ -382,11 +382,15 @@ def rstone_missing() -> str:
     if grass is None:
         return "GRASS GIS is not installed (no `grass` on PATH)"
     try:
-        base = subprocess.run(
+        done = subprocess.run(
             [grass, "--config", "path"], capture_output=True, text=True, timeout=60
-        ).stdout.strip()
+        )
     except (OSError, subprocess.SubprocessError) as exc:
         return f"`grass --config path` failed: {exc}"
+    base = done.stdout.strip()
+    if done.returncode != 0 or not base:
+        last = (done.stderr.strip().splitlines() or ["no output"])[-1]
+        return f"`grass --config path` failed (exit {done.returncode}: {last})"
     if not (Path(base) / "bin" / "r.stone").is_file():
         return (
             f"r.stone is not built into GRASS ({base}/bin/r.stone; "
