@@ -139,6 +139,26 @@ SCRIPT = "run_rstone.sh"
 OUTPUT_GRIDS = ("counter", "maxvel", "maxdz")
 
 
+def material_grids(per_material, grid: DemGrid) -> dict[str, str]:
+    """r.stone's three material rasters as ESRI ASCII text: ``nrest.asc`` and
+    ``trest.asc`` (whole percent) and ``friction.asc`` (tan of the friction angle,
+    3 decimals); ``per_material(f)`` maps ``f(material)`` onto the grid (NaN where
+    no ground)."""
+    return {
+        "nrest.asc": ascii_grid_text(
+            per_material(lambda m: percent(m.e_n)), grid, integer=True
+        ),
+        "trest.asc": ascii_grid_text(
+            per_material(lambda m: percent(m.e_t)), grid, integer=True
+        ),
+        "friction.asc": ascii_grid_text(
+            per_material(lambda m: math.tan(math.radians(m.friction_deg))),
+            grid,
+            decimals=3,
+        ),
+    }
+
+
 def percent(value: float) -> int:
     """A coefficient as whole percent, rounded half up.
 
@@ -808,17 +828,7 @@ def export_rstone(
         "sources.asc": ascii_grid_text(
             np.where(ground, np.where(source, per_cell, 0), np.nan), grid, integer=True
         ),
-        "nrest.asc": ascii_grid_text(
-            per_material(lambda m: percent(m.e_n)), grid, integer=True
-        ),
-        "trest.asc": ascii_grid_text(
-            per_material(lambda m: percent(m.e_t)), grid, integer=True
-        ),
-        "friction.asc": ascii_grid_text(
-            per_material(lambda m: math.tan(math.radians(m.friction_deg))),
-            grid,
-            decimals=3,
-        ),
+        **material_grids(per_material, grid),
         SCRIPT: run_script(options),
     }
     files[RECORD] = record_text(

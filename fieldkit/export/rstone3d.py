@@ -66,6 +66,7 @@ from fieldkit.export.rstone import (
     _check,
     dem_offset_m,
     friction_sd_tan,
+    material_grids,
     percent,
     stoch_range,
 )
@@ -196,17 +197,7 @@ def rstone_inputs3d(model: Model3D) -> Rstone3DInputs:
 
     files = {
         "dem.asc": ascii_grid_text(dem, grid, decimals=3),
-        "nrest.asc": ascii_grid_text(
-            per_material(lambda m: percent(m.e_n)), grid, integer=True
-        ),
-        "trest.asc": ascii_grid_text(
-            per_material(lambda m: percent(m.e_t)), grid, integer=True
-        ),
-        "friction.asc": ascii_grid_text(
-            per_material(lambda m: math.tan(math.radians(m.friction_deg))),
-            grid,
-            decimals=3,
-        ),
+        **material_grids(per_material, grid),
     }
     materials = [model.materials[n] for n in present]
     speed = _start_speed_mps(model)

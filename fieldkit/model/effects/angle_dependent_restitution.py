@@ -19,7 +19,7 @@ import math
 
 from numba import njit
 
-from fieldkit.model.effects.spec import EffectSpec, Export, Parameter
+from fieldkit.model.effects.spec import RSTONE_FOLDED, EffectSpec, Export, Parameter
 
 SPEC = EffectSpec(
     name="angle_dependent_restitution",
@@ -78,13 +78,7 @@ SPEC = EffectSpec(
             "angle; the realised e_n it produces is compared with the class (mismatch "
             "below), the soil type itself follows the ground description",
         ),
-        "r.stone": Export(
-            True,
-            "r.stone's only impact law is a constant nrest/trest pair per cell "
-            "(Bounce, points.c): the rebounds this law makes are folded into the "
-            "in-range pair fitted to the calibrated model's own impacts, which no "
-            "longer varies as the law makes it",
-        ),
+        "r.stone": RSTONE_FOLDED,
     },
 )
 

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from fieldkit.model.effects.spec import EffectSpec, Export, Parameter
+from fieldkit.model.effects.spec import RSTONE_FOLDED, EffectSpec, Export, Parameter
 
 SPEC = EffectSpec(
     name="rotation_friction",
@@ -70,13 +70,7 @@ SPEC = EffectSpec(
             "this coupling realises is in the realised e_t that rg70/rg20/rg10 are "
             "inverted from",
         ),
-        "r.stone": Export(
-            True,
-            "r.stone's only impact law is a constant nrest/trest pair per cell "
-            "(Bounce, points.c): the rebounds this law makes are folded into the "
-            "in-range pair fitted to the calibrated model's own impacts, which no "
-            "longer varies as the law makes it",
-        ),
+        "r.stone": RSTONE_FOLDED,
     },
 )
 

@@ -47,6 +47,17 @@ class Export:
 KINDS = ("law", "alternative")
 
 
+#: How r.stone takes a law that changes the rebound pair: its only impact law is a
+#: constant pair per cell, so the pair is fitted to the model's own impacts.
+RSTONE_FOLDED = Export(
+    True,
+    "r.stone's only impact law is a constant nrest/trest pair per cell "
+    "(Bounce, points.c): the rebounds this law makes are folded into the "
+    "in-range pair fitted to the calibrated model's own impacts, which no "
+    "longer varies as the law makes it",
+)
+
+
 @dataclass(frozen=True)
 class EffectSpec:
     """Declared metadata of one effect.
