@@ -337,6 +337,20 @@ def _friction_tan(mat, mi, key, n, entry):
 
 
 @njit(cache=True)
+def _fly(gr, path, k, on, x, y, z, vx, vy, vz, t1, sample_m, m, re):
+    """The flight over ``[0, t1]``: its samples, then ``(k, x, y, z, vz)`` at ``t1``
+    (the parabola; ``vx, vy`` do not change)."""
+    k = _sample_flight(gr, path, k, on, x, y, z, vx, vy, vz, t1, sample_m, m, re)
+    return (
+        k,
+        x + vx * t1,
+        y + vy * t1,
+        z + vz * t1 - 0.5 * G * t1 * t1,
+        vz - G * t1,
+    )
+
+
+@njit(cache=True)
 def _sample_flight(gr, path, k, on, x, y, z, vx, vy, vz, t1, sample_m, m, re):
     """Samples of the flight over ``[0, t1)``: at most ``sample_m`` travelled apart."""
     q = math.sqrt(2.0 * G * sample_m)
@@ -581,14 +595,10 @@ def run_rock(
                 )
                 if ks >= 0:
                     re = 0.5 * m * kr * w * w
-                    k = _sample_flight(
+                    k, x, y, z, vz = _fly(
                         gr, path, k, path_on, x, y, z, vx, vy, vz, ts, st.sample_m,
                         m, re,
                     )  # fmt: skip
-                    x = x + vx * ts
-                    y = y + vy * ts
-                    z = z + vz * ts - 0.5 * G * ts * ts
-                    vz = vz - G * ts
                     t += ts
                     k, vx, vy, vz = _strike(
                         gr, stems, ks, par, path, k, path_on, x, y, z, vx, vy, vz, m,
@@ -598,14 +608,10 @@ def run_rock(
                     struck = 1.0
                     skip = ks
                     continue
-            k = _sample_flight(
+            k, x, y, z, vz = _fly(
                 gr, path, k, path_on, x, y, z, vx, vy, vz, tc, st.sample_m, m,
                 0.5 * m * kr * w * w,
             )  # fmt: skip
-            x = x + vx * tc
-            y = y + vy * tc
-            z = z + vz * tc - 0.5 * G * tc * tc
-            vz = vz - G * tc
             t += tc
             if not hit:
                 state = EXITED
