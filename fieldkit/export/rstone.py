@@ -903,24 +903,31 @@ def emulation_text(release_x_m: float, cellsize_m: float) -> str:
     )
 
 
-def run_script(options: dict[str, float]) -> str:
-    """The bash script run inside a GRASS session (:func:`_how_to_use`): import
-    the five grids, set the region to the DEM, run r.stone with ``options``, write
-    its three result grids as ESRI ASCII beside the inputs."""
+def rstone_arguments(options: dict[str, float], angle_range: int) -> str:
+    """r.stone's scalar arguments from ``options`` (:func:`_options`): the uniform
+    stochastic functions, ``angle_range`` as ``ang_stoch_range``, the three
+    spread ranges, ``start_vel`` and ``stop_vel``."""
     o = options
-    args = " ".join(
+    return " ".join(
         f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
         for k, v in (
             ("stoch_funct", 0),
             ("stoch_funct_ang", 0),
-            ("ang_stoch_range", DEFAULT_ANGLE_RANGE),
-            ("vrest_stoch_range", o["vrest_stoch_range"]),
-            ("hrest_stoch_range", o["hrest_stoch_range"]),
-            ("frict_stoch_range", o["frict_stoch_range"]),
+            ("ang_stoch_range", int(angle_range)),
+            ("vrest_stoch_range", int(o["vrest_stoch_range"])),
+            ("hrest_stoch_range", int(o["hrest_stoch_range"])),
+            ("frict_stoch_range", int(o["frict_stoch_range"])),
             ("start_vel", round(float(o["start_vel"]), 3)),
             ("stop_vel", float(o["stop_vel"])),
         )
     )
+
+
+def run_script(options: dict[str, float]) -> str:
+    """The bash script run inside a GRASS session (:func:`_how_to_use`): import
+    the five grids, set the region to the DEM, run r.stone with ``options``, write
+    its three result grids as ESRI ASCII beside the inputs."""
+    args = rstone_arguments(options, DEFAULT_ANGLE_RANGE)
     rasters = " ".join(f"{n}={n}" for n in ("dem", "sources", "nrest", "trest",
                                             "friction"))  # fmt: skip
     outputs = " ".join(f"{n}={n}" for n in OUTPUT_GRIDS)

@@ -68,6 +68,7 @@ from fieldkit.export.rstone import (
     friction_sd_tan,
     material_grids,
     percent,
+    rstone_arguments,
     stoch_range,
 )
 from fieldkit.io.dem import DemGrid, read_dem
@@ -334,20 +335,7 @@ def batch_script(options: dict[str, float], names: list[str]) -> str:
     """Bash for a GRASS session (:func:`run_rstone_batch`): import the DEM and
     the material rasters once, then for each name run r.stone on
     ``sources_<name>.asc`` and write ``counter_<name>.asc`` (nodata -1)."""
-    o = options
-    args = " ".join(
-        f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
-        for k, v in (
-            ("stoch_funct", 0),
-            ("stoch_funct_ang", 0),
-            ("ang_stoch_range", int(o["ang_stoch_range"])),
-            ("vrest_stoch_range", int(o["vrest_stoch_range"])),
-            ("hrest_stoch_range", int(o["hrest_stoch_range"])),
-            ("frict_stoch_range", int(o["frict_stoch_range"])),
-            ("start_vel", round(float(o["start_vel"]), 3)),
-            ("stop_vel", float(o["stop_vel"])),
-        )
-    )
+    args = rstone_arguments(options, int(options["ang_stoch_range"]))
     runs = " ".join(shlex.quote(n) for n in names)
     return f"""#!/usr/bin/env bash
 # r.stone once per source file beside this script (written by fieldkit).
