@@ -328,6 +328,16 @@ def _emit(path, k, on, x, y, z, speed, m, re, hgt):
 
 
 @njit(cache=True)
+def _enter_cell(gr, mat, key, n, x, y, cell_id, entry, tanphi):
+    """``(cell_id, entry, tanphi)`` after a slide step ends at ``(x, y)``: a new
+    DEM cell draws a new friction (:func:`_friction_tan`, entry number + 1)."""
+    mi1, cell1 = _cell_material(gr, x, y)
+    if cell1 != cell_id:
+        return cell1, entry + 1, _friction_tan(mat, mi1, key, n, entry + 1)
+    return cell_id, entry, tanphi
+
+
+@njit(cache=True)
 def _friction_tan(mat, mi, key, n, entry):
     phi = mat[mi, M_PHI]
     if mat[mi, M_PHI_SD] > 0.0:
@@ -893,11 +903,9 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on,
                 sp = math.sqrt(vx * vx + vy * vy + vz * vz)
                 w = -sp / r
                 walked = 0.0
-                mi1, cell1 = _cell_material(gr, x, y)
-                if cell1 != cell_id:
-                    cell_id = cell1
-                    entry += 1
-                    tanphi = _friction_tan(mat, mi1, key, n, entry)
+                cell_id, entry, tanphi = _enter_cell(
+                    gr, mat, key, n, x, y, cell_id, entry, tanphi
+                )
                 continue
         walked += math.sqrt((x1 - x) ** 2 + (y1 - y) ** 2 + (h1 - z) ** 2)
         if rest:
@@ -949,11 +957,9 @@ def _slide(gr, mat, key, n, x, y, z, vx, vy, vz, w, m, r, kr, st, path, k, on,
         if walked >= half:
             k = _emit(path, k, on, x, y, z, sp, m, 0.5 * m * kr * w * w, 0.0)
             walked = 0.0
-        mi1, cell1 = _cell_material(gr, x, y)
-        if cell1 != cell_id:
-            cell_id = cell1
-            entry += 1
-            tanphi = _friction_tan(mat, mi1, key, n, entry)
+        cell_id, entry, tanphi = _enter_cell(
+            gr, mat, key, n, x, y, cell_id, entry, tanphi
+        )
     return MAX_IMPACTS, x, y, z, vx, vy, vz, w, k, hits, skip, t
 
 
