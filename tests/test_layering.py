@@ -64,6 +64,9 @@ STAGE_EDGES: frozenset[tuple[str, str]] = frozenset(
         ("campaign", "model"),
         ("export", "model"),
         ("export", "fit"),
+        # the flight segmentation tells mid-air misfits from contacts with the
+        # simulator's own drag law (model.drag_flight, model.effects.air_drag)
+        ("tracking", "model"),
     }
 )
 

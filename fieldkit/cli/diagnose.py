@@ -426,11 +426,14 @@ def diagnose(
                     "assumed launch angles or materials)",
                     source="sensitivity",
                 )
-            if radius is None:
-                raise ArgumentError("a track needs --radius (the body's radius, m)")
-            from fieldkit.cli.diagnose_track import diagnose_track_file
+            from fieldkit.cli.diagnose_track import diagnose_track_file, track_body
             from fieldkit.diagnose.flights import check_body
 
+            radius, mass, body_notes = track_body(
+                input_file, radius_m=radius, mass_kg=mass
+            )
+            for line in body_notes:
+                note(line)
             check_body(radius, mass)
 
             with _step_once_checked(

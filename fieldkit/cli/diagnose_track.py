@@ -9,6 +9,7 @@ written by `fieldkit track`), else from
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from pathlib import Path
 
@@ -16,6 +17,7 @@ import numpy as np
 
 from fieldkit.diagnose.diagnosis import Diagnosis
 from fieldkit.diagnose.flights import FlightSamples, check_body, diagnose_flights
+from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.io.track_files import read_track
 from fieldkit.track import Track
 from fieldkit.tracking.flights.pipeline import analyse_track
@@ -54,6 +56,63 @@ def track_flights(track: Track, *, radius_m: float) -> list[FlightSamples]:
         )
     track.meta["flights_from"] = origin
     return flights
+
+
+#: Track file columns holding the body `fieldkit track` was given (one value).
+BODY_COLUMNS = {"radius_m": "body_radius_m", "mass_kg": "body_mass_kg"}
+
+
+def track_body(
+    path: Path, *, radius_m: float | None, mass_kg: float | None
+) -> tuple[float, float | None, list[str]]:
+    """The body of a track file: ``(radius_m, mass_kg, notes)``.
+
+    A value given explicitly must agree with the file's ``body_radius_m`` /
+    ``body_mass_kg`` (written by `fieldkit track`); a value not given is read from
+    the file (and said so in the notes).
+
+    Raises
+    ------
+    ArgumentError
+        No radius given and none in the file, or a given value that disagrees with
+        the file's (naming both).
+    InputFileError
+        A body column that does not hold one positive number.
+    """
+    import pandas as pd
+
+    header = pd.read_csv(path, nrows=0).columns
+    given = {"radius_m": radius_m, "mass_kg": mass_kg}
+    notes = []
+    for name, column in BODY_COLUMNS.items():
+        if column not in header:
+            continue
+        values = pd.to_numeric(
+            pd.read_csv(path, usecols=[column])[column], errors="coerce"
+        ).dropna().unique()
+        if len(values) != 1 or not values[0] > 0:
+            raise InputFileError(
+                f"column {column} must hold one positive number (the body "
+                f"`fieldkit track` was given), got {list(values)[:3]}",
+                source=str(path),
+            )
+        value = float(values[0])
+        if given[name] is None:
+            given[name] = value
+            notes.append(f"{name} = {value:g} from the track file's {column}")
+        elif not math.isclose(given[name], value, rel_tol=1e-6):
+            raise ArgumentError(
+                f"{given[name]:g} disagrees with the track file's {column} = "
+                f"{value:g} (the body it was tracked with)",
+                source=name,
+            )
+    if given["radius_m"] is None:
+        raise ArgumentError(
+            "a track needs the body's radius (m): the file has no body_radius_m "
+            "column (a track not written by `fieldkit track`)",
+            source="radius_m",
+        )
+    return given["radius_m"], given["mass_kg"], notes
 
 
 def diagnose_track_file(

@@ -265,11 +265,52 @@ def build_impact_table(
     ]
     for column, values in contact_sds(pairs, slope, sx).items():
         f[column] = values
+    extended = f["extended"].to_numpy(bool)
     f = f.drop(columns=["x_end_m", "z_end_m", "extended", "sag_rms_m"])
     table = ImpactTable(f, source=path_id).derive()
+    refused = refused_impacts(table.frame, extended)
+    if refused:
+        for i, reason in refused.items():
+            row = table.frame.iloc[i]
+            warnings.append(
+                f"contact at t = {float(row['t_s']):.4f} s refused as an impact: "
+                f"{reason}"
+            )
+        keep = np.setdiff1d(np.arange(len(f)), list(refused))
+        if keep.size == 0:
+            return None, warnings
+        f = f.iloc[keep].reset_index(drop=True)
+        f["point"] = [str(i + 1) for i in range(len(f))]
+        table = ImpactTable(f, source=path_id).derive()
     table.frame["theta0_deg"] = table.frame["theta_f_deg"]
     table.frame["theta0_source"] = pd.array(["video"] * len(f), dtype="string")
     return table, warnings
+
+
+def refused_impacts(f: pd.DataFrame, extended: np.ndarray) -> dict[int, str]:
+    """Rows of a derived impact table that cannot be impacts, with the reason.
+
+    An instantaneous impact (not an extended contact: a net may overhang) on a
+    surface turned past vertical to face the body (the body would have met the
+    ground from below), or with ``e_n < 0`` (the body does not leave the surface it
+    struck), is not an impact: the surface or the contact is wrong.
+    """
+    out = {}
+    for i in range(len(f)):
+        if extended[i]:
+            continue
+        psi, e_n = float(f["slope_deg"].iloc[i]), float(f["e_n"].iloc[i])
+        if np.isfinite(psi) and abs(psi) > 90.0:
+            out[i] = (
+                f"the surface would face the body from below (slope_deg {psi:.1f}, "
+                "past vertical): the body cannot strike the ground from underneath"
+            )
+        elif np.isfinite(e_n) and e_n < 0:
+            out[i] = (
+                f"e_n = {e_n:.3f} < 0 (the body does not leave the surface it "
+                "struck)"
+            )
+    return out
 
 
 def _flight_geometry(f: pd.DataFrame) -> None:

@@ -237,7 +237,11 @@ def analyse_track(
     warnings: list[str] = []
     if not flights:
         warnings.append("no ballistic flight found in the track")
+    misfit = {m.flight: m for m in seg.misfits}
     for f in flights:
+        if f.index in misfit:  # its g is off because drag bends it, not the scale
+            warnings.append(misfit[f.index].message())
+            continue
         message = f.gravity_warning()
         if message:
             warnings.append(message)
@@ -249,6 +253,16 @@ def analyse_track(
         residual[f.rows] = f.residual_m
     track.frame["flight"] = label
     track.frame["residual_m"] = residual
+    # the track file's provenance: which flights only a dragged flight explains
+    model = np.full(len(track), "", dtype=object)
+    for f in flights:
+        model[f.rows] = "air_drag" if f.index in misfit else "ballistic"
+    track.frame["flight_model"] = model
+    # the track file carries the body, so a diagnosis of it needs no radius again
+    track.frame["body_radius_m"] = radius_m
+    if mass_kg is not None:
+        track.frame["body_mass_kg"] = mass_kg
+    track.meta["misfits"] = [m.message() for m in seg.misfits]
     track.meta.update(
         noise_m=seg.noise_m,
         g_common_mps2=seg.g_common_mps2,

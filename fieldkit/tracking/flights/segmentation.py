@@ -33,7 +33,7 @@ Everything between two consecutive flights is a :class:`ContactSpan`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -44,7 +44,15 @@ from fieldkit.tracking.flights.end_trimming import (
     trim_ends,
     trim_kinked_ends,
 )
-from fieldkit.tracking.flights.segment_growth import grow_segment
+from fieldkit.tracking.flights.free_flight import (
+    JoinTest,
+    classify_join,
+    drag_fit,
+    extend_flight,
+    flight_residuals,
+    needs_drag,
+)
+from fieldkit.tracking.flights.segment_growth import CHI2_JOIN, grow_segment
 
 #: A contact with at least this many samples off both flights is extended (a net, a
 #: rolling phase) rather than an impact.
@@ -78,6 +86,40 @@ class ContactSpan:
         return self.t_first_after_s - self.t_last_before_s
 
 
+@dataclass(frozen=True)
+class FlightMisfit:
+    """A flight the parabola split in mid-air and one dragged flight explains.
+
+    Attributes
+    ----------
+    flight
+        Index of the flight in the segmentation.
+    t_start_s, t_end_s
+        Its first and last sample times [s].
+    split_at_s
+        Where the parabolas had split it [s] (joins that are not contacts).
+    k_per_m
+        Drag factor ``k`` of ``a = g - k |v| v`` fitted to the flight [1/m].
+    """
+
+    flight: int
+    t_start_s: float
+    t_end_s: float
+    split_at_s: tuple[float, ...]
+    k_per_m: float
+
+    def message(self, label: str | None = None) -> str:
+        """``flight 3 is not ballistic: try air_drag`` with the evidence."""
+        where = ", ".join(f"{t:.4f}" for t in self.split_at_s)
+        return (
+            f"{label or f'flight {self.flight}'} (t = {self.t_start_s:.4f}-"
+            f"{self.t_end_s:.4f} s) is not ballistic: try air_drag. A parabola "
+            f"stopped fitting it in mid-air at t = {where} s, where one flight with "
+            f"quadratic drag (k = {self.k_per_m:.4g} 1/m) explains the samples better "
+            "(BIC); no impact is reported there"
+        )
+
+
 @dataclass
 class Segmentation:
     """Flights found in a track.
@@ -94,6 +136,8 @@ class Segmentation:
         The track's apparent gravity (weighted median of the flights) [m/s^2].
     frame_interval_s
         Median time between samples [s].
+    misfits
+        Flights that only a dragged flight explains (:func:`merge_free_flights`).
     """
 
     flights: list[np.ndarray]
@@ -101,6 +145,7 @@ class Segmentation:
     noise_m: float
     g_common_mps2: float
     frame_interval_s: float
+    misfits: list[FlightMisfit] = field(default_factory=list)
 
 
 def estimate_noise(
@@ -241,6 +286,7 @@ def find_flights(
             flights.append(rows)
 
     g_fix = g_common if np.isfinite(g_common) else 9.81
+    flights, misfits = merge_free_flights(t, x, z, flights, g_fix, sigma)
     for k in range(len(flights) - 1):
         if flights[k + 1][0] - flights[k][-1] - 1 >= EXTENDED_CONTACT_SAMPLES:
             flights[k] = stable_end(t, x, z, flights[k], sigma, g_fix, at_start=False)
@@ -264,7 +310,82 @@ def find_flights(
         noise_m=sigma,
         g_common_mps2=g_common,
         frame_interval_s=dt,
+        misfits=misfits,
     )
+
+
+def merge_free_flights(
+    t: np.ndarray,
+    x: np.ndarray,
+    z: np.ndarray,
+    flights: list[np.ndarray],
+    g_mps2: float,
+    sigma: float,
+) -> tuple[list[np.ndarray], list[FlightMisfit]]:
+    """Join consecutive flights that one free flight explains (no contact between).
+
+    Each join is tested by :func:`fieldkit.tracking.flights.free_flight.classify_join`
+    (two parabolas against one parabola or one dragged flight, by BIC). When a free
+    flight wins, the two become one flight, with the samples between them that lie
+    on it (chi-square of :data:`~.segment_growth.CHI2_JOIN`), and the test is
+    repeated with the next flight. A flight that needed drag is returned as a
+    :class:`FlightMisfit` (indices into the returned flights).
+    """
+    flights = [np.asarray(r) for r in flights]
+    joined: list[list[tuple[float, JoinTest | float]]] = [[] for _ in flights]
+    for i, rows in enumerate(flights):
+        k = needs_drag(t[rows], x[rows], z[rows], g_mps2=g_mps2, sigma_m=sigma)
+        if k > 0:  # the parabola stopped growing where drag bent the flight
+            lo = flights[i - 1][-1] + 1 if i > 0 else 0
+            hi = flights[i + 1][0] - 1 if i + 1 < len(flights) else len(t) - 1
+            grown = extend_flight(
+                t, x, z, rows, lo, hi, k, g_mps2=g_mps2, sigma_m=sigma,
+                chi2_join=CHI2_JOIN,
+            )  # fmt: skip
+            ends = [rows[0]] if grown[0] < rows[0] else []
+            ends += [rows[-1]] if grown[-1] > rows[-1] else []
+            joined[i] = [(float(t[e]), k) for e in ends]
+            flights[i] = grown
+    i = 0
+    while i < len(flights) - 1:
+        a, b = flights[i], flights[i + 1]
+        test = classify_join(
+            (t[a], x[a], z[a]), (t[b], x[b], z[b]), g_mps2=g_mps2, sigma_m=sigma
+        )
+        if test.model == "contact":
+            i += 1
+            continue
+        rows = np.concatenate([a, b])
+        gap = np.arange(a[-1] + 1, b[0])
+        if gap.size:
+            k = test.k_per_m if test.model == "air_drag" else 0.0
+            res = flight_residuals(
+                t[rows], x[rows], z[rows], k, g_mps2,
+                np.column_stack([t[gap], x[gap], z[gap]]),
+            )  # fmt: skip
+            fits = (res**2).sum(axis=1) <= CHI2_JOIN * sigma**2
+            rows = np.concatenate([rows, gap[fits]])
+        flights[i] = np.sort(rows)
+        t_join = 0.5 * (float(t[a[-1]]) + float(t[b[0]]))
+        joined[i] = joined[i] + [(t_join, test)] + joined[i + 1]
+        del flights[i + 1], joined[i + 1]
+    misfits = []
+    for i, joins in enumerate(joined):
+        # a float is the k of a flight grown past where its parabola stopped
+        drag = [j if isinstance(j, float) else j.k_per_m for _, j in joins
+                if isinstance(j, float) or j.model == "air_drag"]  # fmt: skip
+        if drag:
+            r = flights[i]
+            misfits.append(
+                FlightMisfit(
+                    flight=i,
+                    t_start_s=float(t[r[0]]),
+                    t_end_s=float(t[r[-1]]),
+                    split_at_s=tuple(sorted(tj for tj, _ in joins)),
+                    k_per_m=drag_fit(t[r], x[r], z[r], g_mps2)[0],
+                )
+            )
+    return flights, misfits
 
 
 def _common_gravity(fits) -> float:

@@ -23,6 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from fieldkit.model import drag_flight
+from fieldkit.model.effects import air_drag
 from fieldkit.physics.constants import G
 from fieldkit.physics.local_axes import to_local, to_section
 from fieldkit.track import Track
@@ -53,8 +55,16 @@ def bouncing_ball(
     angle_noise_rad: float = 0.0,
     max_impacts: int = 20,
     rng: np.random.Generator | None = None,
+    cd: float = 0.0,
+    mass_kg: float = 0.14,
+    air_density_kg_m3: float = 1.225,
 ) -> SyntheticTrack:
     """A sphere bouncing down the plane ``z = -x tan(psi)`` sampled at ``fps``.
+
+    With ``cd > 0`` the flights carry quadratic air drag ``a = g - k |v| v``,
+    ``k = rho cd pi r^2 / (2 m)`` (:mod:`fieldkit.model.effects.air_drag`),
+    integrated by :func:`fieldkit.model.drag_flight.flight_path` (RK4, exact to
+    rounding for the parabola); each landing is found by bisection to 1e-12 s.
 
     Parameters
     ----------
@@ -77,6 +87,9 @@ def bouncing_ball(
         Standard deviation of Gaussian noise added to x, z and to the marker angle.
     rng
         Random generator for the noise (required when noise is non-zero).
+    cd, mass_kg, air_density_kg_m3
+        Drag coefficient (0: exact parabolas), body mass [kg] and air density
+        [kg/m^3] of the drag factor ``k``.
 
     Returns
     -------
@@ -87,22 +100,19 @@ def bouncing_ball(
     k = gyration_m if gyration_m is not None else np.sqrt(0.4) * radius_m
     psi = surface_angle_deg
     n_hat = np.array([np.sin(np.radians(psi)), np.cos(np.radians(psi))])
-    g_n = G * n_hat[1]  # gravity component along -N
     p = np.array(start_xz_m, float)
     v = np.array(start_velocity_mps, float)
     omega, angle, t = float(omega0_radps), 0.0, 0.0
     pieces = []  # (t_start, p, v, angle, omega)
     truth = []
+    k_drag = float(air_drag.drag_factor(cd, air_density_kg_m3, radius_m, mass_kg))
     while t < duration_s and len(truth) < max_impacts:
         pieces.append((t, p.copy(), v.copy(), angle, omega))
-        d0 = p @ n_hat - radius_m
-        vn = v @ n_hat
-        dt_hit = (vn + np.sqrt(vn * vn + 2.0 * g_n * d0)) / g_n
-        if dt_hit < 1e-9 or t + dt_hit >= duration_s:
+        dt_hit = _time_to_plane(p, v, n_hat, radius_m, k_drag, duration_s - t)
+        if dt_hit is None or dt_hit < 1e-9 or t + dt_hit >= duration_s:
             break
         t += dt_hit
-        p = p + v * dt_hit + np.array([0.0, -0.5 * G * dt_hit**2])
-        v = v + np.array([0.0, -G * dt_hit])
+        p, v = _flight_state(p, v, dt_hit, k_drag)
         angle += omega * dt_hit
         vit, vin = to_local(v[0], v[1], psi)
         vft, vfn = e_t * vit, -e_n * vin
@@ -135,8 +145,15 @@ def bouncing_ball(
     for j, (t0, p0, v0, a0, w0) in enumerate(pieces):
         sel = which == j
         tau = times[sel] - t0
-        x[sel] = p0[0] + v0[0] * tau
-        z[sel] = p0[1] + v0[1] * tau - 0.5 * G * tau**2
+        if k_drag > 0 and sel.any():
+            tt = np.concatenate([[0.0], tau])
+            xs, zs, _, _ = drag_flight.flight_path(
+                tt, p0[0], p0[1], v0[0], v0[1], k_drag, G, drag_flight.MAX_STEP_S
+            )
+            x[sel], z[sel] = xs[1:], zs[1:]
+        else:
+            x[sel] = p0[0] + v0[0] * tau
+            z[sel] = p0[1] + v0[1] * tau - 0.5 * G * tau**2
         ang[sel] = a0 + w0 * tau
     if noise_m or angle_noise_rad:
         if rng is None:
@@ -160,10 +177,54 @@ def bouncing_ball(
             frame,
             source="synthetic bouncing ball",
             fps=fps_reported or fps,
-            meta={"truth_fps": fps, "radius_m": radius_m, "gyration_m": k},
+            meta={
+                "truth_fps": fps,
+                "radius_m": radius_m,
+                "gyration_m": k,
+                "mass_kg": mass_kg,
+                "cd": cd,
+                "k_per_m": k_drag,
+            },
         ),
         pd.DataFrame(truth),
     )
+
+
+def _flight_state(p, v, dt, k_drag):
+    """Centre and velocity after ``dt`` seconds of free flight (drag factor ``k``)."""
+    if k_drag <= 0:
+        return p + v * dt + np.array([0.0, -0.5 * G * dt**2]), v + np.array(
+            [0.0, -G * dt]
+        )
+    xs, zs, _, vel = drag_flight.flight_path(
+        np.array([0.0, dt]), p[0], p[1], v[0], v[1], k_drag, G, drag_flight.MAX_STEP_S
+    )
+    return np.array([xs[1], zs[1]]), vel[1].copy()
+
+
+def _time_to_plane(p, v, n_hat, radius_m, k_drag, horizon_s):
+    """Time until the centre is ``radius_m`` above the plane through the origin
+    with normal ``n_hat`` (None when not within ``horizon_s``)."""
+    g_n = G * n_hat[1]
+    d0 = p @ n_hat - radius_m
+    vn = v @ n_hat
+    if k_drag <= 0:
+        return float((vn + np.sqrt(vn * vn + 2.0 * g_n * d0)) / g_n)
+
+    def gap(dt):
+        q, _ = _flight_state(p, v, dt, k_drag)
+        return float(q @ n_hat - radius_m)
+
+    step, t = 1e-3, 0.0
+    while t < horizon_s + step:
+        if gap(t + step) < 0.0:
+            lo, hi = t, t + step
+            while hi - lo > 1e-12:
+                mid = 0.5 * (lo + hi)
+                lo, hi = (lo, mid) if gap(mid) < 0.0 else (mid, hi)
+            return hi
+        t += step
+    return None
 
 
 def net_capture(

@@ -1,0 +1,226 @@
+"""Is a join between two flights a contact, or one free flight the parabola missed?
+
+The segmentation grows flights with a parabola
+(:mod:`fieldkit.tracking.flights.segment_growth`): on a flight bent by air drag the
+growth stops in mid-air and the next piece starts there, and every such join would
+become a "contact". A contact must be an event no free flight explains, so each join
+between consecutive flights ``a`` and ``b`` is tested on the samples of ``a`` and
+``b`` (the same data for every model) with three models:
+
+* **contact** -- ``a`` and ``b`` each a parabola with the track's ``g``
+  (8 parameters: position and velocity of each);
+* **ballistic** -- one parabola through both (4 parameters);
+* **air_drag** -- one flight with quadratic drag ``a = g - k |v| v``, the law of
+  :mod:`fieldkit.model.effects.air_drag`, integrated by
+  :mod:`fieldkit.model.drag_flight`, ``k >= 0`` fitted (5 parameters).
+
+The data choose by the Bayesian information criterion of Gaussian errors,
+``BIC = n ln(SSE / n) + p ln n`` with ``n`` the number of coordinates (two per
+sample) and ``SSE / n`` floored at ``(sigma / 10)^2`` (noise-free tracks). The join
+is a contact only when the contact model has the lowest BIC; otherwise the two flights
+are one free flight, and when that flight needs drag the track reports it as a model
+misfit of the parabola ("flight 3 is not ballistic: try air_drag"), never as an
+impact.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from fieldkit.model import drag_flight
+
+#: Newton iterations on the drag factor of one flight.
+_NEWTON = 12
+#: Gauss-Newton iterations on a flight's initial state per drag factor.
+_INNER = 8
+#: Largest drag factor tried [1/m]: a ping-pong ball (2.7 g, r 20 mm, cd 0.5) has
+#: 0.28 / m; ten times that is drag no tracked body has.
+MAX_K_PER_M = 3.0
+
+
+@dataclass(frozen=True)
+class JoinTest:
+    """The models of one join, by BIC (lower is better).
+
+    Attributes
+    ----------
+    bic_contact, bic_ballistic, bic_drag
+        BIC of two parabolas, one parabola and one dragged flight.
+    k_per_m
+        The drag factor of the dragged flight [1/m].
+    rms_drag_m
+        RMS residual per coordinate of the dragged flight [m].
+    """
+
+    bic_contact: float
+    bic_ballistic: float
+    bic_drag: float
+    k_per_m: float
+    rms_drag_m: float
+
+    @property
+    def model(self) -> str:
+        """``contact``, ``ballistic`` or ``air_drag``: the model the data choose."""
+        best = min(self.bic_contact, self.bic_ballistic, self.bic_drag)
+        if best == self.bic_contact:
+            return "contact"
+        return "ballistic" if best == self.bic_ballistic else "air_drag"
+
+
+def _bic(sse: float, n: int, p: int, floor: float) -> float:
+    return n * math.log(max(sse / n, floor)) + p * math.log(n)
+
+
+def _flight_sse(t, x, z, k: float, g: float) -> tuple[float, float, float]:
+    return _flight_fit(t, x, z, k, g)[:3]
+
+
+def _flight_fit(t, x, z, k: float, g: float):
+    """``(sse, r.j_k, |j_k perp|^2, state)`` of one flight at drag factor ``k``;
+    ``state`` is ``(x0, z0, vx0, vz0)`` at ``t[0]``."""
+    params = np.full((1, 4), np.nan)
+    start = np.array([0, t.size], dtype=np.int64)
+    sse, grad, info = drag_flight.fit_flights(
+        t, x, z, start, k, g, drag_flight.MAX_STEP_S, params, _INNER
+    )
+    return float(sse[0]), float(grad[0]), float(info[0]), params[0]
+
+
+def flight_residuals(t, x, z, k: float, g: float, t_eval) -> np.ndarray:
+    """Residuals ``(m, 2)`` at the samples ``t_eval`` (inside the span of ``t``) of
+    the flight with drag factor ``k`` fitted to ``(t, x, z)``; ``t_eval`` come with
+    their positions as ``(t, x, z)`` columns of a ``(m, 3)`` array."""
+    state = _flight_fit(t, x, z, k, g)[3]
+    te = np.asarray(t_eval, float)
+    order = np.argsort(te[:, 0])
+    times = np.concatenate([[t[0]], te[order, 0]])
+    xs, zs, _, _ = drag_flight.flight_path(
+        times, state[0], state[1], state[2], state[3], k, g, drag_flight.MAX_STEP_S
+    )
+    out = np.empty((te.shape[0], 2))
+    out[order, 0] = te[order, 1] - xs[1:]
+    out[order, 1] = te[order, 2] - zs[1:]
+    return out
+
+
+def drag_fit(t, x, z, g: float) -> tuple[float, float]:
+    """Quadratic-drag flight fitted to samples: ``(k [1/m], sse [m^2])``.
+
+    ``k`` in ``[0, MAX_K_PER_M]`` by projected Newton on the sum of squares profiled
+    over the initial position and velocity (as
+    :func:`fieldkit.diagnose.flights.diagnose_flights` does over many flights).
+    """
+    k = 0.0
+    sse, grad, info = _flight_sse(t, x, z, k, g)
+    for _ in range(_NEWTON):
+        step = grad / info if info > 0 else 0.0
+        trial_k = min(max(k + step, 0.0), MAX_K_PER_M)
+        if trial_k == k:
+            break
+        trial = _flight_sse(t, x, z, trial_k, g)
+        while trial[0] > sse and abs(trial_k - k) > 1e-12:
+            trial_k = 0.5 * (trial_k + k)
+            trial = _flight_sse(t, x, z, trial_k, g)
+        if trial[0] > sse:
+            break
+        done = abs(trial_k - k) <= 1e-6 * max(trial_k, 1e-9)
+        k, (sse, grad, info) = trial_k, trial
+        if done:
+            break
+    return k, sse
+
+
+def needs_drag(t, x, z, *, g_mps2: float, sigma_m: float) -> float:
+    """Drag factor ``k`` [1/m] when one flight's own samples choose quadratic drag
+    over the parabola (BIC, as in :func:`classify_join`), else 0."""
+    n = 2 * t.size
+    floor = (0.1 * sigma_m) ** 2
+    sse_one = _flight_sse(t, x, z, 0.0, g_mps2)[0]
+    k, sse_drag = drag_fit(t, x, z, g_mps2)
+    better = _bic(sse_drag, n, 5, floor) < _bic(sse_one, n, 4, floor)
+    return k if better and k > 0 else 0.0
+
+
+def extend_flight(
+    t, x, z, rows: np.ndarray, lo: int, hi: int, k: float, *, g_mps2: float,
+    sigma_m: float, chi2_join: float, block: int = 8,
+) -> np.ndarray:  # fmt: skip
+    """Grow a dragged flight's rows over the positions ``lo..hi`` next to its ends.
+
+    The flight (drag factor ``k`` fixed) is refitted after each block of samples;
+    the next samples join while their residual's chi-square (2 d.o.f., noise
+    ``sigma_m``) stays within ``chi2_join``; the first that does not ends the growth
+    on that side.
+    """
+    rows = np.asarray(rows)
+    for forward in (True, False):
+        while True:
+            edge = rows[-1] if forward else rows[0]
+            cand = (
+                np.arange(edge + 1, min(edge + block, hi) + 1)
+                if forward
+                else np.arange(edge - 1, max(edge - block, lo) - 1, -1)
+            )
+            if cand.size == 0:
+                break
+            res = flight_residuals(
+                t[rows], x[rows], z[rows], k, g_mps2,
+                np.column_stack([t[cand], x[cand], z[cand]]),
+            )  # fmt: skip
+            ok = (res**2).sum(axis=1) <= chi2_join * sigma_m**2
+            run = int(np.argmin(ok)) if not ok.all() else cand.size
+            if run == 0:
+                break
+            rows = np.sort(np.concatenate([rows, cand[:run]]))
+            if run < cand.size:
+                break
+    return rows
+
+
+def classify_join(
+    a: tuple[np.ndarray, np.ndarray, np.ndarray],
+    b: tuple[np.ndarray, np.ndarray, np.ndarray],
+    *,
+    g_mps2: float,
+    sigma_m: float,
+) -> JoinTest:
+    """Contact, one parabola or one dragged flight for the samples ``a`` then ``b``.
+
+    Parameters
+    ----------
+    a, b
+        ``(t_s, x_m, z_m)`` of the flight before and after the join (times
+        increasing, all of ``a`` before ``b``).
+    g_mps2
+        The track's gravity [m/s^2].
+    sigma_m
+        Position noise per coordinate [m] (the BIC's variance floor is a hundredth
+        of its square).
+
+    Examples
+    --------
+    >>> t = np.arange(0, 0.4, 0.002)
+    >>> x, z = 3.0 * t, 2.0 * t - 4.905 * t**2
+    >>> j = classify_join((t[:100], x[:100], z[:100]), (t[100:], x[100:], z[100:]),
+    ...                   g_mps2=9.81, sigma_m=1e-4)
+    >>> j.model
+    'ballistic'
+    """
+    t = np.concatenate([a[0], b[0]])
+    x = np.concatenate([a[1], b[1]])
+    z = np.concatenate([a[2], b[2]])
+    n = 2 * t.size
+    floor = (0.1 * sigma_m) ** 2
+    sse_two = _flight_sse(*a, 0.0, g_mps2)[0] + _flight_sse(*b, 0.0, g_mps2)[0]
+    sse_one = _flight_sse(t, x, z, 0.0, g_mps2)[0]
+    k, sse_drag = drag_fit(t, x, z, g_mps2)
+    return JoinTest(
+        bic_contact=_bic(sse_two, n, 8, floor),
+        bic_ballistic=_bic(sse_one, n, 4, floor),
+        bic_drag=_bic(sse_drag, n, 5, floor),
+        k_per_m=k,
+        rms_drag_m=math.sqrt(sse_drag / n),
+    )
