@@ -99,6 +99,8 @@ class BounceScene:
     e_n: tuple = (0.7, 0.65, 0.6, 0.55, 0.5)  # prescribed, impact by impact
     friction: float = 0.3  # Coulomb coefficient at the contact
     duration_s: float = 0.95
+    drag_cd: float = 0.0  # quadratic air drag a = -k |v| v, k = rho cd pi r^2 / (2 m)
+    air_density_kg_m3: float = 1.225
 
 
 @dataclass
@@ -142,8 +144,114 @@ def _impact(v, omega, surface_deg, e_n, mu, ball: Ball):
     )
 
 
+def drag_factor(scene: BounceScene, ball: Ball) -> float:
+    """``k = rho cd pi r^2 / (2 m)`` [1/m] of the scene's air drag."""
+    return (
+        scene.air_density_kg_m3 * scene.drag_cd * math.pi * ball.radius_m**2
+        / (2.0 * ball.mass_kg)
+    )  # fmt: skip
+
+
+def _drag_rk4(state, h, k):
+    """One RK4 step of ``(x, z, vx, vz, angle, omega)`` under g and quadratic drag."""
+
+    def deriv(s):
+        speed = math.hypot(s[2], s[3])
+        return np.array(
+            [s[2], s[3], -k * speed * s[2], -G - k * speed * s[3], s[5], 0.0]
+        )
+
+    k1 = deriv(state)
+    k2 = deriv(state + 0.5 * h * k1)
+    k3 = deriv(state + 0.5 * h * k2)
+    k4 = deriv(state + h * k3)
+    return state + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+
+
+def drag_bounce_motion(
+    scene: BounceScene, ball: Ball, times: np.ndarray, substeps: int = 40
+):
+    """State at ``times`` of the bounce scene with quadratic air drag in flight.
+
+    RK4 with ``substeps`` steps per frame; an impact inside a step is located by
+    bisection to 1e-13 s and applied there (the same instantaneous rough-sphere
+    impact as :func:`bounce_motion`). Returns (states, impacts).
+    """
+    _, normal = _plate_axes(scene.surface_deg)
+    p0 = np.array(scene.plate_point_m)
+    k = drag_factor(scene, ball)
+    state = np.array(
+        [*scene.start_m, *scene.start_velocity_mps, scene.start_angle_rad,
+         scene.start_omega_radps], float,
+    )  # fmt: skip
+
+    def gap(s):
+        return float((s[:2] - p0) @ normal) - ball.radius_m
+
+    def on_plate(s):
+        return (s[:2] - ball.radius_m * normal)[0] <= scene.plate_end_x_m
+
+    states = np.zeros((len(times), 6))
+    impacts = []
+    h = (times[1] - times[0]) / substeps
+    for i, t_frame in enumerate(times):
+        states[i] = state
+        for step in range(substeps):
+            new = _drag_rk4(state, h, k)
+            if gap(new) < 0.0 and gap(state) >= 0.0 and on_plate(new):
+                if len(impacts) == len(scene.e_n):
+                    raise ValueError("bounce scene: more impacts than e_n values")
+                lo, hi = 0.0, h
+                while hi - lo > 1e-13:
+                    mid = 0.5 * (lo + hi)
+                    below = gap(_drag_rk4(state, mid, k)) < 0
+                    lo, hi = (lo, mid) if below else (mid, hi)
+                hit = _drag_rk4(state, lo, k)
+                vel_i, omega = hit[2:4].copy(), hit[5]
+                e_n = scene.e_n[len(impacts)]
+                vel, omega_f, local = _impact(
+                    vel_i, omega, scene.surface_deg, e_n, scene.friction, ball
+                )
+                pos = hit[:2]
+                impacts.append(
+                    dict(
+                        index=len(impacts) + 1,
+                        t_s=t_frame + step * h + lo,
+                        x_m=pos[0],
+                        z_m=pos[1],
+                        contact_x_m=float((pos - ball.radius_m * normal)[0]),
+                        contact_z_m=float((pos - ball.radius_m * normal)[1]),
+                        vi_x_mps=vel_i[0],
+                        vi_z_mps=vel_i[1],
+                        vf_x_mps=vel[0],
+                        vf_z_mps=vel[1],
+                        vin_mps=local["vin"],
+                        vit_mps=local["vit"],
+                        vfn_mps=local["vfn"],
+                        vft_mps=local["vft"],
+                        e_n=-local["vfn"] / local["vin"],
+                        e_t=local["vft"] / local["vit"],
+                        omega_i_radps=omega,
+                        omega_f_radps=omega_f,
+                        ends_rolling=local["rolling"],
+                        vi_mps=float(np.hypot(*vel_i)),
+                        vf_mps=float(np.hypot(*vel)),
+                    )
+                )
+                hit[2:4], hit[5] = vel, omega_f
+                new = _drag_rk4(hit, h - lo, k)
+            state = new
+    return states, [{k_: _plain(v) for k_, v in imp.items()} for imp in impacts]
+
+
 def bounce_motion(scene: BounceScene, ball: Ball, times: np.ndarray):
-    """Exact piecewise-ballistic state at ``times``; returns (states, impacts)."""
+    """Exact piecewise-ballistic state at ``times``; returns (states, impacts).
+
+    A scene with air drag (``drag_cd > 0``) is integrated by
+    :func:`drag_bounce_motion`.
+    """
+    if scene.drag_cd > 0:
+        return drag_bounce_motion(scene, ball, times)
     tangent, normal = _plate_axes(scene.surface_deg)
     p0 = np.array(scene.plate_point_m)
     pos = np.array(scene.start_m, float)
@@ -570,12 +678,42 @@ def _short_bounce_scene() -> BounceScene:
     )
 
 
+def _drag_bounce_scene() -> BounceScene:
+    return BounceScene(
+        surface_deg=18.0,
+        plate_point_m=(0.0, 0.40),
+        plate_end_x_m=1.15,
+        start_m=(-0.07, 0.55),
+        start_velocity_mps=(2.0, 0.0),
+        start_omega_radps=0.0,
+        e_n=(0.7, 0.65, 0.6),
+        duration_s=0.8,
+        drag_cd=2.5,
+    )
+
+
+def _short_drag_bounce_scene() -> BounceScene:
+    return BounceScene(
+        surface_deg=18.0,
+        plate_point_m=(0.0, 0.30),
+        plate_end_x_m=0.66,
+        start_m=(-0.06, 0.40),
+        start_velocity_mps=(1.6, 0.0),
+        start_omega_radps=0.0,
+        e_n=(0.7, 0.65, 0.6),
+        duration_s=0.55,
+        drag_cd=2.5,
+    )
+
+
 #: clip name -> (camera factory, scene factory). ``bounce_short`` (480x320, 542
 #: frames, 3 impacts) is the reduced clip the fast tests render.
 PRESETS = {
     "bounce": (Camera, BounceScene),
     "net": (Camera, NetScene),
     "bounce_short": (_short_bounce_camera, _short_bounce_scene),
+    "bounce_drag": (Camera, _drag_bounce_scene),
+    "bounce_drag_short": (_short_bounce_camera, _short_drag_bounce_scene),
 }
 
 

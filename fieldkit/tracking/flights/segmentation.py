@@ -27,6 +27,11 @@ Method (region growing from the cleanest seeds):
 4. **Extension and trimming.** Accepted flights grow again into samples freed by
    rejected segments; end samples off the fit are trimmed; next to an extended
    contact, samples are dropped while the contact-side velocity still drifts.
+5. **No contact without an event.** A flight bent by air drag stops the parabola
+   in mid-air; :func:`merge_free_flights` grows it on as a dragged flight and joins
+   consecutive flights that one free flight (parabola or quadratic drag, chosen by
+   BIC, :mod:`fieldkit.tracking.flights.free_flight`) explains. Such flights are
+   reported as misfits ("flight 3 is not ballistic: try air_drag"), not impacts.
 
 Everything between two consecutive flights is a :class:`ContactSpan`.
 """
@@ -50,7 +55,6 @@ from fieldkit.tracking.flights.free_flight import (
     drag_fit,
     extend_flight,
     flight_residuals,
-    needs_drag,
 )
 from fieldkit.tracking.flights.segment_growth import CHI2_JOIN, grow_segment
 
@@ -324,28 +328,38 @@ def merge_free_flights(
 ) -> tuple[list[np.ndarray], list[FlightMisfit]]:
     """Join consecutive flights that one free flight explains (no contact between).
 
-    Each join is tested by :func:`fieldkit.tracking.flights.free_flight.classify_join`
+    First each flight is grown on as a dragged flight
+    (:func:`fieldkit.tracking.flights.free_flight.extend_flight`) over the samples
+    beside it, kept when that adds at least :data:`EXTENDED_CONTACT_SAMPLES`. Each
+    join is tested by :func:`fieldkit.tracking.flights.free_flight.classify_join`
     (two parabolas against one parabola or one dragged flight, by BIC). When a free
     flight wins, the two become one flight, with the samples between them that lie
     on it (chi-square of :data:`~.segment_growth.CHI2_JOIN`), and the test is
-    repeated with the next flight. A flight that needed drag is returned as a
-    :class:`FlightMisfit` (indices into the returned flights).
+    repeated with the next flight. A flight grown or joined as a dragged flight is
+    returned as a :class:`FlightMisfit` (indices into the returned flights).
     """
     flights = [np.asarray(r) for r in flights]
     joined: list[list[tuple[float, JoinTest | float]]] = [[] for _ in flights]
     for i, rows in enumerate(flights):
-        k = needs_drag(t[rows], x[rows], z[rows], g_mps2=g_mps2, sigma_m=sigma)
-        if k > 0:  # the parabola stopped growing where drag bent the flight
-            lo = flights[i - 1][-1] + 1 if i > 0 else 0
-            hi = flights[i + 1][0] - 1 if i + 1 < len(flights) else len(t) - 1
-            grown = extend_flight(
-                t, x, z, rows, lo, hi, k, g_mps2=g_mps2, sigma_m=sigma,
-                chi2_join=CHI2_JOIN,
-            )  # fmt: skip
-            ends = [rows[0]] if grown[0] < rows[0] else []
-            ends += [rows[-1]] if grown[-1] > rows[-1] else []
-            joined[i] = [(float(t[e]), k) for e in ends]
-            flights[i] = grown
+        # where drag bent a flight, the parabola stopped growing in mid-air: the
+        # dragged flight grows on; it is kept when it explains at least
+        # EXTENDED_CONTACT_SAMPLES more samples (a parabola's own end, trimmed
+        # at an impact, is left alone)
+        k = drag_fit(t[rows], x[rows], z[rows], g_mps2)[0]
+        if k <= 0:
+            continue
+        lo = flights[i - 1][-1] + 1 if i > 0 else 0
+        hi = flights[i + 1][0] - 1 if i + 1 < len(flights) else len(t) - 1
+        grown = extend_flight(
+            t, x, z, rows, lo, hi, k, g_mps2=g_mps2, sigma_m=sigma,
+            chi2_join=CHI2_JOIN,
+        )  # fmt: skip
+        if grown.size - rows.size < EXTENDED_CONTACT_SAMPLES:
+            continue
+        ends = [rows[0]] if grown[0] < rows[0] else []
+        ends += [rows[-1]] if grown[-1] > rows[-1] else []
+        joined[i] = [(float(t[e]), k) for e in ends]
+        flights[i] = grown
     i = 0
     while i < len(flights) - 1:
         a, b = flights[i], flights[i + 1]
@@ -371,18 +385,18 @@ def merge_free_flights(
         del flights[i + 1], joined[i + 1]
     misfits = []
     for i, joins in enumerate(joined):
-        # a float is the k of a flight grown past where its parabola stopped
-        drag = [j if isinstance(j, float) else j.k_per_m for _, j in joins
-                if isinstance(j, float) or j.model == "air_drag"]  # fmt: skip
-        if drag:
-            r = flights[i]
+        r = flights[i]
+        # a float is the k of a flight the dragged flight grew past its parabola
+        dragged = any(isinstance(j, float) or j.model == "air_drag" for _, j in joins)
+        k = drag_fit(t[r], x[r], z[r], g_mps2)[0] if dragged else 0.0
+        if k > 0:
             misfits.append(
                 FlightMisfit(
                     flight=i,
                     t_start_s=float(t[r[0]]),
                     t_end_s=float(t[r[-1]]),
                     split_at_s=tuple(sorted(tj for tj, _ in joins)),
-                    k_per_m=drag_fit(t[r], x[r], z[r], g_mps2)[0],
+                    k_per_m=k,
                 )
             )
     return flights, misfits
