@@ -267,14 +267,18 @@ def diagnose(
     ] = None,
     radius: Annotated[
         float | None,
-        typer.Option("--radius", help="Track only: body radius (m)."),
+        typer.Option(
+            "--radius",
+            help="Track only: body radius (m); default: the track file's "
+            "body_radius_m (written by `fieldkit track`).",
+        ),
     ] = None,
     mass: Annotated[
         float | None,
         typer.Option(
             "--mass",
-            help="Track only: body mass (kg); default: a 2650 "
-            "kg/m3 sphere of --radius.",
+            help="Track only: body mass (kg); default: the track file's "
+            "body_mass_kg, else a 2650 kg/m3 sphere of --radius.",
         ),
     ] = None,  # fmt: skip
     material: MaterialOpt = None,
@@ -339,8 +343,9 @@ def diagnose(
     error by more than 1 % and 1 standard error, are reported as confounded and
     neither is added. Accepted effects are added stepwise. A track CSV is
     diagnosed at flight level, on the positions of its flights: air_drag is
-    recommended when it lowers the held-out error by more than 2 standard
-    errors of that gain. Its x and z residuals are tested against the time from
+    recommended when it lowers the held-out error by more than 1 % and by more
+    than 2 standard errors of that gain; the body (--radius, --mass) is read
+    from the track file when `fieldkit track` wrote it. Its x and z residuals are tested against the time from
     mid-flight and the speed (4 tests; a residual depends on a feature when its
     Holm-adjusted p <= 0.05). The dependence tests only describe the
     residuals: no recommendation rests on them. With -o (a calibration), the

@@ -20,7 +20,8 @@ both models thus get the same freedom per held-out flight, and the gain is the
 improvement of the held-out RMS of the position residuals (``cv_rmse_m``, per
 coordinate), with its jackknife standard error over flights
 (:mod:`fieldkit.diagnose.scoring`). ``air_drag`` is recommended when the gain
-exceeds :data:`~fieldkit.diagnose.scoring.DEFAULT_Z` standard errors, the rule of the
+exceeds :data:`~fieldkit.diagnose.scoring.MIN_GAIN` and
+:data:`~fieldkit.diagnose.scoring.DEFAULT_Z` standard errors, the rule of the
 impact-level diagnosis.
 """
 
@@ -44,6 +45,7 @@ from fieldkit.diagnose.groups import make_groups
 from fieldkit.diagnose.residual_tests import describe, mark_holm
 from fieldkit.diagnose.scoring import (
     DEFAULT_Z,
+    MIN_GAIN,
     held_out,
     improvement,
     meaningful,
@@ -397,9 +399,11 @@ def diagnose_flights(
         _held_out_drag(data, groups.fold, k_max), 1.0, groups.group, n_groups
     )
     gain, se = improvement(base_ho, drag_ho)
-    # cd = 0 reproduces the ballistic baseline exactly (nested, no optimiser
-    # round-off), so no minimum gain: the SE rule alone decides.
-    ok = meaningful(gain, se, z=z, min_gain=0.0)
+    # the impact-level rule, 1 % floor included: detection errors correlated over
+    # frames let a tiny cd absorb them with a small jackknife SE (the plain
+    # bounce_short clip, no drag: +0.2 % +/- 0.1 %), and such a gain is not worth
+    # a parameter
+    ok = meaningful(gain, se, z=z, min_gain=MIN_GAIN)
 
     full = _fit(data, k_max)
     n_obs = 2 * data.t.size
@@ -438,7 +442,8 @@ def diagnose_flights(
         after, steps, final = baseline, [], base
         stopped = (
             f"air_drag does not improve the held-out error meaningfully "
-            f"(gain {gain:+.1%} ± {se:.1%}; needs more than {z:g} standard errors)"
+            f"(gain {gain:+.1%} ± {se:.1%}; needs more than {MIN_GAIN:.0%} and "
+            f"{z:g} standard errors)"
         )
     before = _dependence(data, base)
     after_dep = _dependence(data, final)
@@ -463,9 +468,8 @@ def diagnose_flights(
         confounded=[],
         after=after,
         rule=(
-            f"air_drag is recommended when {recommendation_rule(z, 0.0)} (jackknife "
-            "over flights); no minimum gain, since cd = 0 is the ballistic baseline "
-            "exactly"
+            f"air_drag is recommended when {recommendation_rule(z, MIN_GAIN)} "
+            "(jackknife over flights)"
         ),
         groups=(
             f"{data.n_flights} flights (whole flights held out); "

@@ -129,7 +129,7 @@ def test_help_report_and_summary_state_the_same_rule(two_effects, cli):
     )
     help_text = " ".join(cli("diagnose", "--help").stdout.split())
     assert f"one is recommended only when {rule} (jackknife" in help_text
-    flights = recommendation_rule(min_gain=0.0)
+    flights = recommendation_rule()
     assert f"air_drag is recommended when {flights}." in help_text
     text = (out / "rep" / "report.md").read_text()
     assert f"A candidate is recommended when {rule};" in text
@@ -238,7 +238,7 @@ def test_track_report_names_flights_once_and_says_what_is_fixed(
                      flags=re.M)  # fmt: skip
     assert "| gravity g | 9.81 m/s² (fixed, not fitted) |" in text
     assert "air_density_kg_m3, air density (sea level) | 1.225 kg/m^3 (fixed" in text
-    assert f"air_drag is recommended when {recommendation_rule(min_gain=0.0)}" in text
+    assert f"air_drag is recommended when {recommendation_rule()}" in text
     assert "*p* is a test's own p-value (Spearman)" in text
     assert "horizontal position x, vertical position z, all in m" in text
     assert re.search(r"^diagnosing the flights of .*track.csv", r.stderr, re.M)
