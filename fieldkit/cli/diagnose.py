@@ -344,7 +344,7 @@ def diagnose(
     neither is added. Accepted effects are added stepwise. A track CSV is
     diagnosed at flight level, on the positions of its flights: air_drag is
     recommended when it lowers the held-out error by more than 1 % and by more
-    than 2 standard errors of that gain; the body (--radius, --mass) is read
+    than 2 standard errors of that gain. The body (--radius, --mass) is read
     from the track file when `fieldkit track` wrote it. Its x and z residuals are tested against the time from
     mid-flight and the speed (4 tests; a residual depends on a feature when its
     Holm-adjusted p <= 0.05). The dependence tests only describe the
