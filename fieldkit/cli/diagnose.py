@@ -347,8 +347,9 @@ def diagnose(
     than 2 standard errors of that gain. The body (--radius, --mass) is read
     from the track file when `fieldkit track` wrote it. Its x and z residuals
     are tested against the time from mid-flight and the speed (4 tests; a
-    residual depends on a feature when its Holm-adjusted p <= 0.05). The dependence tests only describe the
-    residuals: no recommendation rests on them. With -o (a calibration), the
+    residual depends on a feature when its Holm-adjusted p <= 0.05). The
+    dependence tests only describe the residuals: no recommendation rests on
+    them. With -o (a calibration), the
     base and the written model are first set side by side at the analysis points
     (--at, else the model file's analysis_points) beside the values measured
     there (--measured, the preset's), as fit does.
