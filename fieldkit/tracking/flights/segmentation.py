@@ -42,6 +42,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from fieldkit.physics.constants import G
 from fieldkit.tracking.flights.ballistic_fit import fit_flight
 from fieldkit.tracking.flights.end_trimming import (
     stable_end,
@@ -290,7 +291,8 @@ def find_flights(
             flights.append(rows)
 
     g_fix = g_common if np.isfinite(g_common) else 9.81
-    flights, misfits = merge_free_flights(t, x, z, flights, g_fix, sigma)
+    # the free-flight tests use the true g: the pieces' own g is biased by drag
+    flights, misfits = merge_free_flights(t, x, z, flights, G, sigma)
     for k in range(len(flights) - 1):
         if flights[k + 1][0] - flights[k][-1] - 1 >= EXTENDED_CONTACT_SAMPLES:
             flights[k] = stable_end(t, x, z, flights[k], sigma, g_fix, at_start=False)
