@@ -268,7 +268,7 @@ def build_impact_table(
     extended = f["extended"].to_numpy(bool)
     f = f.drop(columns=["x_end_m", "z_end_m", "extended", "sag_rms_m"])
     table = ImpactTable(f, source=path_id).derive()
-    refused = refused_impacts(table.frame, extended)
+    refused = refused_impacts(table.frame, extended, radius_m=radius_m)
     if refused:
         for i, reason in refused.items():
             row = table.frame.iloc[i]
@@ -287,19 +287,44 @@ def build_impact_table(
     return table, warnings
 
 
-def refused_impacts(f: pd.DataFrame, extended: np.ndarray) -> dict[int, str]:
+#: How far beyond one radius from a given surface a contact's centre may lie, as a
+#: share of the radius (a given angle fixes the surface's dip; its height is that of
+#: the lowest contact).
+SURFACE_TOLERANCE_FRACTION = 0.5
+
+
+def refused_impacts(
+    f: pd.DataFrame, extended: np.ndarray, *, radius_m: float
+) -> dict[int, str]:
     """Rows of a derived impact table that cannot be impacts, with the reason.
 
-    An instantaneous impact (not an extended contact: a net may overhang) on a
-    surface turned past vertical to face the body (the body would have met the
-    ground from below), or with ``e_n < 0`` (the body does not leave the surface it
-    struck), is not an impact: the surface or the contact is wrong.
+    Only instantaneous impacts are judged (an extended contact may overhang: a net).
+    Refused are an impact on a surface turned past vertical to face the body (the
+    body would have struck the ground from below), one with ``e_n < 0`` (the body
+    does not leave the surface it struck), and, on a given surface
+    (``slope_source == "given"``), one whose centre lies more than
+    ``(1 + SURFACE_TOLERANCE_FRACTION) r`` from the surface line of that dip through
+    the lowest such contact: a contact needs the ground.
     """
     out = {}
+    short = ~np.asarray(extended, bool)
+    psi_all = f["slope_deg"].to_numpy(float)
+    given = short & (f["slope_source"].astype(str).to_numpy() == "given")
+    given &= np.isfinite(psi_all) & (np.abs(psi_all) <= 90.0)
+    height = np.full(len(f), np.nan)
+    if given.any():
+        rad = np.radians(psi_all)
+        # the centre's distance along N = (sin psi, cos psi) from a line of dip psi
+        height = f["x_m"].to_numpy(float) * np.sin(rad) + f["z_m"].to_numpy(
+            float
+        ) * np.cos(rad)
+        height = np.where(given, height - np.nanmin(np.where(given, height, np.nan)),
+                          np.nan)  # fmt: skip
+    tolerance = SURFACE_TOLERANCE_FRACTION * radius_m
     for i in range(len(f)):
-        if extended[i]:
+        if not short[i]:
             continue
-        psi, e_n = float(f["slope_deg"].iloc[i]), float(f["e_n"].iloc[i])
+        psi, e_n = float(psi_all[i]), float(f["e_n"].iloc[i])
         if np.isfinite(psi) and abs(psi) > 90.0:
             out[i] = (
                 f"the surface would face the body from below (slope_deg {psi:.1f}, "
@@ -309,6 +334,13 @@ def refused_impacts(f: pd.DataFrame, extended: np.ndarray) -> dict[int, str]:
             out[i] = (
                 f"e_n = {e_n:.3f} < 0 (the body does not leave the surface it "
                 "struck)"
+            )
+        elif np.isfinite(height[i]) and height[i] > tolerance:
+            out[i] = (
+                f"the centre is {height[i] * 1e3:.1f} mm above the surface at the "
+                f"lowest contact (a line of the given dip {psi:.1f} deg), beyond "
+                f"the tolerance of {tolerance * 1e3:.1f} mm "
+                f"({SURFACE_TOLERANCE_FRACTION:g} radius): the body is in mid-air"
             )
     return out
 

@@ -33,8 +33,10 @@ Before the joins are tested, every flight is also grown on with its own dragged
 flight (:func:`extend_flight`, ``k`` from :func:`drag_fit`) over the samples the
 parabola left beside it: a flight whose samples were partly taken by rejected
 pieces gets them back. The segmentation keeps the growth only when it adds at least
-``EXTENDED_CONTACT_SAMPLES`` samples (the parabola's own ends, trimmed at an impact,
-stay as they were).
+``EXTENDED_CONTACT_SAMPLES`` samples and the grown flight prefers drag to the
+parabola (:func:`prefers_drag`): a ballistic flight's ends, trimmed at an impact,
+stay as they were (on 1 mm noise, growing them let a small impact's samples into
+the flight).
 """
 
 from __future__ import annotations
@@ -129,22 +131,36 @@ def drag_fit(t, x, z, g: float) -> tuple[float, float]:
     """
     k = 0.0
     sse, grad, info = _flight_sse(t, x, z, k, g)
+    if not np.isfinite(sse):
+        return 0.0, sse
     for _ in range(_NEWTON):
         step = grad / info if info > 0 else 0.0
         trial_k = min(max(k + step, 0.0), MAX_K_PER_M)
         if trial_k == k:
             break
         trial = _flight_sse(t, x, z, trial_k, g)
-        while trial[0] > sse and abs(trial_k - k) > 1e-12:
+        while not trial[0] <= sse and abs(trial_k - k) > 1e-12:
             trial_k = 0.5 * (trial_k + k)
             trial = _flight_sse(t, x, z, trial_k, g)
-        if trial[0] > sse:
+        if not trial[0] <= sse:
             break
         done = abs(trial_k - k) <= 1e-6 * max(trial_k, 1e-9)
         k, (sse, grad, info) = trial_k, trial
         if done:
             break
     return k, sse
+
+
+def prefers_drag(t, x, z, *, g_mps2: float, sigma_m: float) -> float:
+    """Drag factor ``k`` [1/m] when one flight's samples choose quadratic drag over
+    the parabola (BIC, variance floored at ``sigma_m^2`` as in
+    :func:`classify_join`), else 0."""
+    n = 2 * t.size
+    floor = sigma_m**2
+    sse_one = _flight_sse(t, x, z, 0.0, g_mps2)[0]
+    k, sse_drag = drag_fit(t, x, z, g_mps2)
+    better = _bic(sse_drag, n, 5, floor) < _bic(sse_one, n, 4, floor)
+    return k if better and k > 0 else 0.0
 
 
 def extend_flight(

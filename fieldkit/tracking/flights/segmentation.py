@@ -56,9 +56,13 @@ from fieldkit.tracking.flights.free_flight import (
     drag_fit,
     extend_flight,
     flight_residuals,
+    prefers_drag,
 )
 from fieldkit.tracking.flights.segment_growth import CHI2_JOIN, grow_segment
 
+#: Largest relative distance of the track's apparent g from 9.81 for the
+#: free-flight tests to use 9.81 (beyond it the capture rate or scale is off).
+G_TRUSTED_FRACTION = 0.2
 #: A contact with at least this many samples off both flights is extended (a net, a
 #: rolling phase) rather than an impact.
 EXTENDED_CONTACT_SAMPLES = 5
@@ -292,7 +296,10 @@ def find_flights(
 
     g_fix = g_common if np.isfinite(g_common) else 9.81
     # the free-flight tests use the true g: the pieces' own g is biased by drag
-    flights, misfits = merge_free_flights(t, x, z, flights, G, sigma)
+    # (a few %); far from it the capture rate or scale is wrong, and the track's g
+    # stands in (the gravity check warns)
+    g_free = G if abs(g_fix / G - 1.0) < G_TRUSTED_FRACTION else g_fix
+    flights, misfits = merge_free_flights(t, x, z, flights, g_free, sigma)
     for k in range(len(flights) - 1):
         if flights[k + 1][0] - flights[k][-1] - 1 >= EXTENDED_CONTACT_SAMPLES:
             flights[k] = stable_end(t, x, z, flights[k], sigma, g_fix, at_start=False)
@@ -332,7 +339,8 @@ def merge_free_flights(
 
     First each flight is grown on as a dragged flight
     (:func:`fieldkit.tracking.flights.free_flight.extend_flight`) over the samples
-    beside it, kept when that adds at least :data:`EXTENDED_CONTACT_SAMPLES`. Each
+    beside it, kept when that adds at least :data:`EXTENDED_CONTACT_SAMPLES` and
+    the grown flight prefers drag (BIC). Each
     join is tested by :func:`fieldkit.tracking.flights.free_flight.classify_join`
     (two parabolas against one parabola or one dragged flight, by BIC). When a free
     flight wins, the two become one flight, with the samples between them that lie
@@ -357,6 +365,9 @@ def merge_free_flights(
             chi2_join=CHI2_JOIN,
         )  # fmt: skip
         if grown.size - rows.size < EXTENDED_CONTACT_SAMPLES:
+            continue
+        k = prefers_drag(t[grown], x[grown], z[grown], g_mps2=g_mps2, sigma_m=sigma)
+        if k <= 0:
             continue
         ends = [rows[0]] if grown[0] < rows[0] else []
         ends += [rows[-1]] if grown[-1] > rows[-1] else []
