@@ -34,7 +34,7 @@ flight (:func:`extend_flight`, ``k`` from :func:`drag_fit`) over the samples the
 parabola left beside it: a flight whose samples were partly taken by rejected
 pieces gets them back. The segmentation keeps the growth only when it adds at least
 ``EXTENDED_CONTACT_SAMPLES`` samples and the grown flight prefers drag to the
-parabola (:func:`prefers_drag`): a ballistic flight's ends, trimmed at an impact,
+parabola (:func:`prefers_drag`, BIC): a ballistic flight's ends, trimmed at an impact,
 stay as they were (on 1 mm noise, growing them let a small impact's samples into
 the flight).
 """
@@ -153,10 +153,17 @@ def drag_fit(t, x, z, g: float) -> tuple[float, float]:
 
 def prefers_drag(t, x, z, *, g_mps2: float, sigma_m: float) -> float:
     """Drag factor ``k`` [1/m] when one flight's samples choose quadratic drag over
-    the parabola (BIC, variance floored at ``sigma_m^2`` as in
-    :func:`classify_join`), else 0."""
+    the parabola (BIC), else 0.
+
+    The variance floor is ``(sigma_m / 10)^2``, not the ``sigma_m^2`` of
+    :func:`classify_join`: a flight only just long enough to show drag bends from
+    its parabola by less than the noise (``bounce_drag_short``'s second flight),
+    and this test is only asked about a flight a dragged flight has already grown
+    by :data:`~.segmentation.EXTENDED_CONTACT_SAMPLES` samples past where its
+    parabola stopped.
+    """
     n = 2 * t.size
-    floor = sigma_m**2
+    floor = (0.1 * sigma_m) ** 2
     sse_one = _flight_sse(t, x, z, 0.0, g_mps2)[0]
     k, sse_drag = drag_fit(t, x, z, g_mps2)
     better = _bic(sse_drag, n, 5, floor) < _bic(sse_one, n, 4, floor)
