@@ -105,7 +105,7 @@ def track(
             "-o",
             "--out",
             help="Track CSV (t_s, x_m, z_m, angle_rad, omega_radps, flight, "
-            "residual_m, pixels).",
+            "residual_m, flight_model, body_radius_m, body_mass_kg, pixels).",
         ),
     ] = None,
     impacts: Annotated[
