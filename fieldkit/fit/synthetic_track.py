@@ -149,7 +149,8 @@ def synthetic_track(
     Returns
     -------
     Track
-        Columns of a track file plus ``x_m_true``, ``z_m_true``, ``flight_true``;
+        Columns of a track file plus ``x_m_true``, ``z_m_true``, ``flight_true``
+        and the body (``body_radius_m``, ``body_mass_kg``);
         ``meta`` holds the truth (``cd``, ``k_per_m``, flight times; without drag
         a flight lasts ``2 v sin(angle) / (g cos psi)``, 0.609 s below).
 
@@ -236,6 +237,9 @@ def synthetic_track(
             "x_m_true": x_true,
             "z_m_true": z_true,
             "flight_true": flight,
+            # the body, so `fieldkit diagnose` reads it (as from `fieldkit track`)
+            "body_radius_m": radius_m,
+            "body_mass_kg": mass_kg,
         }
     )
     meta = {

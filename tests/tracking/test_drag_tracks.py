@@ -162,3 +162,18 @@ def test_synthetic_dragged_track_diagnosed_from_its_samples(cli, tmp_path):
     assert d["candidates"][0]["improvement"] >= 0.25
     assert abs(d["candidates"][0]["params"]["air_drag.cd"] - 2.0) < 0.2
     assert "3 flights from segmentation" in " ".join(d["notes"])
+
+
+def test_synth_track_carries_the_body_for_diagnose(cli, repo, tmp_path):
+    """`synth --track` writes the model's body; `diagnose` needs no --radius."""
+    track = tmp_path / "track.csv"
+    r = cli("synth", repo / "surveys/tornado_mountain/model_rocfall_table_7_1.json",
+            "--track", "--fps", "200", "--noise-m", "0.005", "--flights", "4",
+            "--seed", "1", "-o", track)  # fmt: skip
+    assert r.exit_code == 0, r.output
+    f = pd.read_csv(track)
+    assert set(f["body_radius_m"]) == {0.725} and set(f["body_mass_kg"]) == {3750}
+    d = cli("diagnose", track, "--seed", "1")
+    assert d.exit_code == 0, d.output
+    assert "radius_m = 0.725 from the track file's body_radius_m" in d.stderr
+    assert "mass_kg = 3750 from the track file's body_mass_kg" in d.stderr
