@@ -4,7 +4,7 @@ Synthetic tracks: a rock of radius 0.2 m (rock sphere, 88.8 kg) bouncing down a
 35 deg plane, flights launched at 15 m/s (+-20 %) 10-20 deg above the plane, 200
 frames/s, 5 mm noise. Rates over 20 seeds were measured with
 benchmarks/bench_diagnose_flights.py (50 seeds: cd 0 -> 0/50 recommended, cd 0.1
--> 49/50 at 15 m/s).
+-> 26/50 at 15 m/s with the 1 % floor of the rule, 31/50 without it).
 """
 
 from __future__ import annotations
@@ -116,8 +116,9 @@ def test_no_drag_recommends_nothing_and_leaves_the_baseline():
 
 @pytest.mark.slow
 def test_false_and_detection_rates_over_20_seeds():
-    # the 2-SE rule; measured: 0/20 false (cd 0), 18/20 found at cd 0.3, 15 m/s
-    # (k v^2 = 0.06 m/s^2); at cd 0.1 only about 60 % (bench_diagnose_flights)
+    # the rule (> 1 % and > 2 SE); measured: 0/20 false (cd 0), 18/20 found at cd
+    # 0.3, 15 m/s (k v^2 = 0.06 m/s^2); at cd 0.1 only about 50 %
+    # (bench_diagnose_flights)
     false = sum(diagnose(make(s, 0.0), s).recommended is not None for s in range(20))
     found = sum(diagnose(make(s, 0.3), s).recommended == "air_drag" for s in range(20))
     assert false <= 1
