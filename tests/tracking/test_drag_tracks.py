@@ -177,3 +177,76 @@ def test_synth_track_carries_the_body_for_diagnose(cli, repo, tmp_path):
     assert d.exit_code == 0, d.output
     assert "radius_m = 0.725 from the track file's body_radius_m" in d.stderr
     assert "mass_kg = 3750 from the track file's body_mass_kg" in d.stderr
+
+
+def _kicked_poses(times, r=0.0375, e_n=0.7):
+    """A ball bouncing on level ground (z = 0) whose flight is kicked upward
+    (+1.3 m/s) in mid-air as it falls, 220 ms after its first impact (112 mm
+    above the ground); impact times returned."""
+    g = 9.81
+    pos, vel, t0 = np.array([0.02, 0.30]), np.array([1.0, 0.0]), 0.0
+    pieces, impacts = [], []
+    t_first = np.sqrt(2 * (pos[1] - r) / g)
+    events = [("impact", t_first), ("kick", t_first + 0.22)]
+    while True:
+        pieces.append((t0, pos.copy(), vel.copy()))
+        if events:
+            kind, te = events.pop(0)
+        else:  # the next landing on the ground
+            kind = "impact"
+            te = t0 + (vel[1] + np.sqrt(vel[1] ** 2 + 2 * g * (pos[1] - r))) / g
+        if te > times[-1]:
+            break
+        dt = te - t0
+        pos = pos + vel * dt + np.array([0.0, -0.5 * g * dt * dt])
+        vel = vel + np.array([0.0, -g * dt])
+        vel[1] = -e_n * vel[1] if kind == "impact" else vel[1] + 1.3
+        if kind == "impact":
+            impacts.append(te)
+        t0 = te
+    starts = np.array([p[0] for p in pieces])
+    which = np.searchsorted(starts, times, side="right") - 1
+    poses = np.zeros((len(times), 3))
+    for j, (ts, p, v) in enumerate(pieces):
+        sel, dt = which == j, times[which == j] - ts
+        poses[sel, 0] = p[0] + v[0] * dt
+        poses[sel, 1] = p[1] + v[1] * dt - 0.5 * g * dt * dt
+    return poses, impacts
+
+
+def test_a_contact_in_mid_air_is_refused_on_a_given_surface(cli, repo, tmp_path):
+    """A kick in mid-air is a velocity jump no free flight explains, and it even
+    looks like a bounce (e_n 1.6 on level ground), but the body is 112 mm above
+    the given ground: not an impact."""
+    name = "fieldkit_video_render_for_kick"
+    spec = importlib.util.spec_from_file_location(name, repo / "video" / "render.py")
+    render = importlib.util.module_from_spec(spec)
+    sys.modules[name] = render
+    spec.loader.exec_module(render)
+    camera = render.Camera(width=480, height=320, origin_u_px=30.0, origin_v_px=300.0)
+    rng = np.random.default_rng(7)
+    scene = render.BounceScene(surface_deg=0.0, plate_point_m=(0.0, 0.0))
+    bg = np.clip(render.background(camera, rng, scene) + 0.5, 0, 255).astype(np.uint8)
+    times = np.arange(900) / 1205.0
+    poses, true_impacts = _kicked_poses(times)
+    clip = render.write_clip(tmp_path / "kick.avi", camera, render.Ball(), bg, poses,
+                             rng)  # fmt: skip
+    homography = tmp_path / "kick.homography.json"
+    marks = [(40, 280), (440, 280), (440, 40), (40, 40), (240, 160)]
+    homography.write_text(json.dumps({"points": [
+        dict(u_px=u, v_px=v, x_m=(u - 30.0) * 0.002, z_m=(300.0 - v) * 0.002)
+        for u, v in marks
+    ]}))  # fmt: skip
+    impacts = tmp_path / "impacts.csv"
+    r = cli("track", clip, "--fps", FPS, "--homography", homography,
+            "--radius", "0.0375", "--surface-angle", "0", "-q",
+            "--impacts", impacts)  # fmt: skip
+    assert r.exit_code == 0, r.output
+    assert len(true_impacts) == 2
+    found = pd.read_csv(impacts)
+    assert len(found) == 2, r.output
+    assert np.abs(found["t_s"].to_numpy() - true_impacts).max() < 1 / 1205
+    assert found["e_n"].to_numpy() == pytest.approx([0.7, 0.7], abs=0.05)
+    refused = [ln for ln in r.stderr.splitlines() if "refused as an impact" in ln]
+    assert len(refused) == 1 and "above the surface at the lowest contact" in refused[0]
+    assert "the body is in mid-air" in refused[0]
