@@ -247,6 +247,9 @@ def test_a_contact_in_mid_air_is_refused_on_a_given_surface(cli, repo, tmp_path)
     assert len(found) == 2, r.output
     assert np.abs(found["t_s"].to_numpy() - true_impacts).max() < 1 / 1205
     assert found["e_n"].to_numpy() == pytest.approx([0.7, 0.7], abs=0.05)
+    # the flight from the first impact runs to the next kept one, not to the kick
+    flight = float(found["flight_time_s"].iloc[0])
+    assert flight == pytest.approx(true_impacts[1] - true_impacts[0], abs=2 / 1205)
     refused = [ln for ln in r.stderr.splitlines() if "refused as an impact" in ln]
     assert len(refused) == 1 and "above the surface at the lowest contact" in refused[0]
     assert "the body is in mid-air" in refused[0]

@@ -266,8 +266,8 @@ def build_impact_table(
     for column, values in contact_sds(pairs, slope, sx).items():
         f[column] = values
     extended = f["extended"].to_numpy(bool)
-    f = f.drop(columns=["x_end_m", "z_end_m", "extended", "sag_rms_m"])
-    table = ImpactTable(f, source=path_id).derive()
+    internal = ["x_end_m", "z_end_m", "extended", "sag_rms_m"]
+    table = ImpactTable(f.drop(columns=internal), source=path_id).derive()
     refused = refused_impacts(table.frame, extended, radius_m=radius_m)
     if refused:
         for i, reason in refused.items():
@@ -281,7 +281,8 @@ def build_impact_table(
             return None, warnings
         f = f.iloc[keep].reset_index(drop=True)
         f["point"] = [str(i + 1) for i in range(len(f))]
-        table = ImpactTable(f, source=path_id).derive()
+        _flight_geometry(f)  # the flight to the next kept impact
+        table = ImpactTable(f.drop(columns=internal), source=path_id).derive()
     table.frame["theta0_deg"] = table.frame["theta_f_deg"]
     table.frame["theta0_source"] = pd.array(["video"] * len(f), dtype="string")
     return table, warnings
