@@ -438,8 +438,6 @@ def diagnose(
             radius, mass, body_notes = track_body(
                 input_file, radius_m=radius, mass_kg=mass
             )
-            for line in body_notes:
-                note(line)
             check_body(radius, mass)
 
             with _step_once_checked(
@@ -450,6 +448,10 @@ def diagnose(
                     input_file, radius_m=radius, mass_kg=mass, rng=rng, folds=folds,
                     progress=progress,
                 )  # fmt: skip
+            # stated once the track has passed every check (an error stays alone)
+            for line in body_notes:
+                note(line)
+            diagnosis.notes[0:0] = body_notes
         else:
             if radius is not None or mass is not None:
                 raise ArgumentError(

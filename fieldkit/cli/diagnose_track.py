@@ -108,9 +108,8 @@ def track_body(
             )
     if given["radius_m"] is None:
         raise ArgumentError(
-            "a track needs the body's radius (m): the file has no body_radius_m "
-            "column (a track not written by `fieldkit track`)",
-            source="radius_m",
+            "a track needs --radius (the body's radius, m): the file has no "
+            "body_radius_m column (`fieldkit track` and `synth --track` write it)"
         )
     return given["radius_m"], given["mass_kg"], notes
 
