@@ -67,33 +67,34 @@ def track_body(
 ) -> tuple[float, float | None, list[str]]:
     """The body of a track file: ``(radius_m, mass_kg, notes)``.
 
-    A value given explicitly must agree with the file's ``body_radius_m`` /
-    ``body_mass_kg`` (written by `fieldkit track`); a value not given is read from
-    the file (and said so in the notes).
+    The file is read and checked first (:func:`fieldkit.io.track_files.read_track`:
+    its own errors come before any about the body). A value given explicitly must
+    agree with the file's ``body_radius_m`` / ``body_mass_kg`` (written by
+    `fieldkit track` and `synth --track`); a value not given is read from the file
+    (and said so in the notes).
 
     Raises
     ------
     ArgumentError
         No radius given and none in the file, or a given value that disagrees with
-        the file's (naming both).
+        the file's (naming both and the file).
     InputFileError
-        A body column that does not hold one positive number.
+        An unreadable track, or a body column that does not hold one positive
+        number.
     """
     import pandas as pd
 
-    header = pd.read_csv(path, nrows=0).columns
+    frame = read_track(path, "track").frame
     given = {"radius_m": radius_m, "mass_kg": mass_kg}
     notes = []
     for name, column in BODY_COLUMNS.items():
-        if column not in header:
+        if column not in frame.columns:
             continue
-        values = pd.to_numeric(
-            pd.read_csv(path, usecols=[column])[column], errors="coerce"
-        ).dropna().unique()
+        values = pd.to_numeric(frame[column], errors="coerce").dropna().unique()
         if len(values) != 1 or not values[0] > 0:
             raise InputFileError(
-                f"column {column} must hold one positive number (the body "
-                f"`fieldkit track` was given), got {list(values)[:3]}",
+                f"column {column} must hold one positive number (the body the track "
+                f"was made with), got {[float(v) for v in values[:3]]}",
                 source=str(path),
             )
         value = float(values[0])
@@ -102,8 +103,8 @@ def track_body(
             notes.append(f"{name} = {value:g} from the track file's {column}")
         elif not math.isclose(given[name], value, rel_tol=1e-6):
             raise ArgumentError(
-                f"{given[name]:g} disagrees with the track file's {column} = "
-                f"{value:g} (the body it was tracked with)",
+                f"{given[name]:g} disagrees with {path}'s {column} = {value:g} "
+                "(the body the track was made with)",
                 source=name,
             )
     if given["radius_m"] is None:

@@ -93,8 +93,7 @@ def test_every_track_reader_refuses_bad_times_and_coordinates(
 def test_the_unedited_track_still_diagnoses_four_flights(four_flights, tmp_path, cli):
     """The check refuses only the edited rows: the audit's own track diagnoses."""
     out = tmp_path / "d.json"
-    r = cli("diagnose", four_flights, "--radius", "0.725", "--seed", "1",
-            "--json", out)  # fmt: skip
+    r = cli("diagnose", four_flights, "--seed", "1", "--json", out)
     assert r.exit_code == 0, r.output
     assert "4 flights from" in out.read_text()
 

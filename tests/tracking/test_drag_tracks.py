@@ -108,7 +108,7 @@ def test_diagnose_on_the_dragged_track_finds_drag_without_radius(
 def test_a_radius_that_disagrees_with_the_track_file_is_an_error(dragged, cli, fails):
     _, track_csv, _, _ = dragged
     r = cli("diagnose", track_csv, "--radius", "0.05", "--seed", "1")
-    fails(r, "--radius", "0.05", "body_radius_m = 0.0375")
+    fails(r, "--radius", "0.05", str(track_csv), "body_radius_m = 0.0375")
 
 
 def test_plain_clip_has_no_misfit_and_no_drag(clips, cli, tmp_path):
