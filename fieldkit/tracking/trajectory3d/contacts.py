@@ -1,0 +1,241 @@
+"""Where two consecutive flights meet: an impact on the ground, or a misfit.
+
+With g fixed the difference of two fitted flights is linear in time (the gravity
+terms cancel), so the time they come closest is closed form (:func:`meet_time`);
+there the incoming and outgoing velocities are the two fits' velocities, and the
+contact point the mean of their positions.
+
+**No contact without the ground.** A join is an impact only when
+
+* the flights meet: closest approach within ``tolerance_m``, between the last
+  sample of the first and the first sample of the second (one sampling interval
+  either side);
+* the centre there is within ``radius_m + tolerance_m`` of the local ground plane
+  (:mod:`.surface`) and not more than ``tolerance_m`` below it;
+* it arrives into the ground and leaves out of it (``vin < 0``, ``vfn > 0``:
+  ``e_n < 0`` is never an impact).
+
+Otherwise the join is a :class:`Contact` of kind ``misfit`` with the reason in
+words (a flight split in mid-air is not ballistic there: air drag, a spin-induced
+lift, or a wrong time base). Two flights that do not meet but end and start on the
+ground with at least :data:`RESOLVED_GAP_SAMPLES` samples between them are a
+*resolved* contact (the block was on the ground for several samples): its
+duration is the time between the two flights' end and start samples, the impact
+velocity the first flight's at its end, the rebound the second's at its start.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import chi2
+
+from fieldkit.model.terrain import Terrain
+from fieldkit.physics.constants import G
+from fieldkit.tracking.trajectory3d.flights import (
+    FALSE_ALARM,
+    MIN_FLIGHT_SAMPLES,
+    MIN_NOISE_SD_M,
+    Flight3D,
+    fit_flight,
+)
+from fieldkit.tracking.trajectory3d.surface import LocalPlane, local_plane
+
+#: Samples at each end of a flight left out of the fit that places the join.
+BOUNDARY_SAMPLES = 3
+#: Passes of the boundary re-assignment at each join.
+REFINE_PASSES = 3
+#: Samples between two flights from which a contact's duration counts as resolved.
+RESOLVED_GAP_SAMPLES = 2
+#: Samples at each side of a contact whose median spin is the spin before / after.
+SPIN_SAMPLES = 3
+
+
+@dataclass(frozen=True)
+class Contact:
+    """A join between flight ``flight`` and ``flight + 1`` (numbered from 1).
+
+    ``kind`` is ``impact`` or ``misfit`` (then ``reason`` says why, and the
+    velocities may be NaN).
+    """
+
+    flight: int
+    kind: str
+    reason: str
+    t_s: float
+    point_m: np.ndarray
+    vi_mps: np.ndarray
+    vf_mps: np.ndarray
+    plane: LocalPlane | None
+    height_m: float
+    miss_m: float
+    duration_s: float
+    omega_i_radps: float
+    omega_f_radps: float
+
+
+def meet_time(a: Flight3D, b: Flight3D) -> float:
+    """Time at which two fitted flights come closest (g cancels: linear difference)."""
+    # p(t) = p0 + v0 (t - tr) - g (t - tr)^2/2 z = c + lin t - g t^2/2 z: the
+    # difference of two flights is c_a - c_b + (lin_a - lin_b) t
+    c_a = a.p0_m - a.v0_mps * a.t_ref_s - 0.5 * G * a.t_ref_s**2 * _Z
+    c_b = b.p0_m - b.v0_mps * b.t_ref_s - 0.5 * G * b.t_ref_s**2 * _Z
+    lin_a = a.v0_mps + G * a.t_ref_s * _Z
+    lin_b = b.v0_mps + G * b.t_ref_s * _Z
+    d0 = c_a - c_b
+    dv = lin_a - lin_b
+    den = float(dv @ dv)
+    return float(-(d0 @ dv) / den) if den > 0 else float("nan")
+
+
+_Z = np.array([0.0, 0.0, 1.0])
+
+
+def _fits(t, p, idx, fl, sigma, bound) -> bool:
+    e = p[idx] - fl.position(t[idx])
+    return float(e @ e) / (sigma * sigma) <= bound
+
+
+def refine_joins(
+    t_s: np.ndarray, xyz_m: np.ndarray, ranges: list[tuple[int, int]], sigma_m: float
+) -> list[tuple[int, int]]:
+    """Move the samples around each join to the flight on their side of the time
+    the two flights meet (fitted without :data:`BOUNDARY_SAMPLES` at the join),
+    keeping only samples that fit it; the others lie between the flights."""
+    t = np.asarray(t_s, float)
+    p = np.asarray(xyz_m, float)
+    sigma = max(float(sigma_m), MIN_NOISE_SD_M)
+    bound = chi2.isf(FALSE_ALARM, 3)
+    m, k = MIN_FLIGHT_SAMPLES, BOUNDARY_SAMPLES
+    out = list(ranges)
+    for j in range(len(out) - 1):
+        for _ in range(REFINE_PASSES):
+            (a0, a1), (b0, b1) = out[j], out[j + 1]
+            fa = fit_flight(t, p, a0, max(a0 + m, a1 - k) if a1 - a0 > m else a1)
+            fb = fit_flight(t, p, min(b1 - m, b0 + k) if b1 - b0 > m else b0, b1)
+            ts = meet_time(fa, fb)
+            if not np.isfinite(ts):
+                break
+            ea = fa.end
+            while ea < b1 and t[ea] < ts and _fits(t, p, ea, fa, sigma, bound):
+                ea += 1
+            while ea > a0 + m and t[ea - 1] > ts:
+                ea -= 1
+            sb = fb.start
+            while sb - 1 >= ea and t[sb - 1] > ts and _fits(t, p, sb - 1, fb, sigma,
+                                                             bound):  # fmt: skip
+                sb -= 1
+            while sb < b1 - m and t[sb] < ts:
+                sb += 1
+            new = [(a0, ea), (sb, b1)]
+            if new == out[j : j + 2]:
+                break
+            out[j : j + 2] = new
+    return out
+
+
+def _spin(omega, idx) -> float:
+    if omega is None:
+        return float("nan")
+    v = omega[idx]
+    v = v[np.isfinite(v)]
+    return float(np.median(v)) if v.size else float("nan")
+
+
+def classify_join(
+    j: int,
+    t_s: np.ndarray,
+    a: Flight3D,
+    b: Flight3D,
+    terrain: Terrain,
+    *,
+    radius_m: float,
+    tolerance_m: float,
+    footprint_m: float,
+    omega: np.ndarray | None,
+) -> Contact:
+    """The join of flights ``a`` and ``b`` (flight numbers ``j``, ``j + 1``)."""
+    t = np.asarray(t_s, float)
+    dt = float(np.median(np.diff(t)))
+    nan3 = np.full(3, np.nan)
+    ts = meet_time(a, b)
+    t_end, t_start = t[a.end - 1], t[b.start]
+    spin_i = _spin(omega, np.arange(max(a.start, a.end - SPIN_SAMPLES), a.end))
+    spin_f = _spin(omega, np.arange(b.start, min(b.end, b.start + SPIN_SAMPLES)))
+    meets = np.isfinite(ts) and t_end - dt <= ts <= t_start + dt
+    miss = float(np.linalg.norm(a.position(ts) - b.position(ts))) if meets else np.inf
+    meets = meets and miss <= tolerance_m
+    gap = b.start - a.end
+    if meets:
+        t_c = ts
+        point = 0.5 * (a.position(ts) + b.position(ts))
+        vi, vf = a.velocity(ts), b.velocity(ts)
+        duration = float("nan")
+    else:
+        t_c = t_end
+        point = a.position(t_end)
+        vi, vf = a.velocity(t_end), b.velocity(t_start)
+        duration = float(t_start - t_end)
+
+    def done(kind, reason, plane=None, height=float("nan")):
+        return Contact(j, kind, reason, float(t_c), point, vi, vf, plane, height,
+                       miss, duration if kind == "impact" else float("nan"),
+                       spin_i, spin_f)  # fmt: skip
+
+    plane = local_plane(terrain, point[0], point[1], footprint_m)
+    if plane is None:
+        return done("misfit", f"flights {j} and {j + 1} join off the DEM's surface")
+    height = plane.distance(point, point[0], point[1])
+    reach = radius_m + tolerance_m
+    if not meets:
+        end_h = height
+        start_p = b.position(t_start)
+        start_plane = local_plane(terrain, start_p[0], start_p[1], footprint_m)
+        start_h = (
+            start_plane.distance(start_p, start_p[0], start_p[1])
+            if start_plane is not None
+            else np.inf
+        )
+        if gap >= RESOLVED_GAP_SAMPLES and end_h <= reach and start_h <= reach:
+            pass  # a contact resolved by the sampling: checked as an impact below
+        else:
+            why = (
+                f"flights {j} and {j + 1} do not meet (closest {miss:.3f} m apart"
+                f" at t = {ts:.3f} s)"
+                if np.isfinite(miss)
+                else f"flights {j} and {j + 1} do not meet between their samples"
+            )
+            return done("misfit", f"{why}: a flight is not ballistic there "
+                        "(try air_drag) or a contact was not sampled", plane,
+                        height)  # fmt: skip
+    if height > reach:
+        return done(
+            "misfit",
+            f"flights {j} and {j + 1} meet {height:.2f} m above the ground at t = "
+            f"{t_c:.3f} s (more than radius + tolerance {reach:.2f} m): a mid-air "
+            "split, not an impact -- the flight is not ballistic there (try "
+            "air_drag)",
+            plane,
+            height,
+        )
+    if height < -tolerance_m:
+        return done(
+            "misfit",
+            f"flights {j} and {j + 1} meet {-height:.2f} m below the DEM's surface "
+            f"at t = {t_c:.3f} s (more than the tolerance {tolerance_m:.2f} m): the "
+            "DEM or the trajectory's coordinates are off there",
+            plane,
+            height,
+        )
+    n = plane.normal
+    vin, vfn = float(vi @ n), float(vf @ n)
+    if not vin < 0:
+        return done("misfit", f"at t = {t_c:.3f} s the block arrives out of the "
+                    f"ground (vin {vin:+.2f} m/s): not an impact", plane,
+                    height)  # fmt: skip
+    if not vfn > 0:
+        return done("misfit", f"at t = {t_c:.3f} s the rebound points into the "
+                    f"ground (vfn {vfn:+.2f} m/s, e_n < 0): not an impact", plane,
+                    height)  # fmt: skip
+    return done("impact", "", plane, height)

@@ -1,0 +1,194 @@
+"""Ballistic flights in 3-D samples: the sampling noise, segmentation and fits.
+
+In free flight without drag the centre follows ``p(t) = p0 + v0 tau - (0, 0, g
+tau^2 / 2)`` (``tau = t - t_ref``, g = 9.81 m/s^2 fixed): with the known gravity
+term added back, every coordinate is a straight line in time, fitted by least
+squares. Air drag is not modelled (the flights are ballistic; a flight that is not
+shows as a mid-air split, :mod:`.contacts`).
+
+**Noise.** The sampling noise SD is estimated from the data (:func:`noise_sd`): the
+second divided difference of three consecutive samples of a ballistic flight is
+``(0, 0, -g)`` exactly, whatever the velocity, so its scatter is the noise's
+(``6 sigma^2 / dt^4`` for equal intervals); the median absolute deviation keeps the
+few triples that straddle a contact from counting.
+
+**Segmentation** (:func:`segment_flights`): a flight starts at the first window of
+:data:`MIN_FLIGHT_SAMPLES` samples that is ballistic (chi-square of its residuals
+within :data:`FALSE_ALARM`), and grows sample by sample while each new sample lies
+within the prediction's chi-square (3 dof) bound; two samples in a row beyond it end
+the flight (one is an outlier, skipped). The boundary samples are then re-assigned
+at each join by the time the two fitted flights meet (:mod:`.contacts`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import chi2
+
+from fieldkit.physics.constants import G
+
+#: Fewest samples a flight is fitted to.
+MIN_FLIGHT_SAMPLES = 6
+#: Probability that a ballistic sample (or window) is taken for a break.
+FALSE_ALARM = 1e-4
+#: Smallest noise SD used [m] (exact samples would make every bound zero).
+MIN_NOISE_SD_M = 1e-4
+_UP = np.array([0.0, 0.0, 1.0])
+
+
+@dataclass(frozen=True)
+class Flight3D:
+    """A ballistic flight fitted to samples ``start .. end - 1``.
+
+    Attributes
+    ----------
+    start, end
+        Sample index range (end exclusive).
+    t_ref_s
+        Reference time of the fit [s] (its first sample).
+    p0_m, v0_mps
+        Fitted position and velocity at ``t_ref_s`` (3-vectors).
+    rms_m
+        Root-mean-square 3-D residual of the fit [m].
+    """
+
+    start: int
+    end: int
+    t_ref_s: float
+    p0_m: np.ndarray
+    v0_mps: np.ndarray
+    rms_m: float
+
+    @property
+    def samples(self) -> int:
+        return self.end - self.start
+
+    def position(self, t_s: float) -> np.ndarray:
+        """Fitted centre position at ``t_s`` [m]."""
+        tau = t_s - self.t_ref_s
+        return self.p0_m + self.v0_mps * tau - 0.5 * G * tau * tau * _UP
+
+    def velocity(self, t_s: float) -> np.ndarray:
+        """Fitted velocity at ``t_s`` [m/s]."""
+        return self.v0_mps - G * (t_s - self.t_ref_s) * _UP
+
+
+def noise_sd(t_s: np.ndarray, xyz_m: np.ndarray) -> float:
+    """Sampling noise SD per coordinate [m], from second divided differences.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> t = np.arange(400) / 200.0
+    >>> p = np.c_[3 * t, -t, 5 + 4 * t - 4.905 * t**2] + rng.normal(0, 0.02, (400, 3))
+    >>> round(noise_sd(t, p), 3)
+    0.02
+    """
+    t = np.asarray(t_s, float)
+    p = np.asarray(xyz_m, float)
+    d1 = np.diff(p, axis=0) / np.diff(t)[:, None]
+    acc = 2.0 * np.diff(d1, axis=0) / (t[2:] - t[:-2])[:, None]
+    acc[:, 2] += G
+    dt = np.median(np.diff(t))
+    mad = np.median(np.abs(acc - np.median(acc, axis=0)))
+    return float(1.4826 * mad * dt * dt / np.sqrt(6.0))
+
+
+def fit_flight(t_s: np.ndarray, xyz_m: np.ndarray, start: int, end: int) -> Flight3D:
+    """Least-squares ballistic fit (g fixed) to samples ``start .. end - 1``."""
+    t = t_s[start:end]
+    tau = t - t[0]
+    q = xyz_m[start:end].copy()
+    q[:, 2] += 0.5 * G * tau * tau
+    a = np.c_[np.ones_like(tau), tau]
+    coef, *_ = np.linalg.lstsq(a, q, rcond=None)
+    res = q - a @ coef
+    return Flight3D(
+        start,
+        end,
+        float(t[0]),
+        coef[0].copy(),
+        coef[1].copy(),
+        float(np.sqrt(np.mean(np.sum(res * res, axis=1)))),
+    )
+
+
+class _Growing:
+    """Running sums of a straight-line fit of q = p + g tau^2/2 z against tau."""
+
+    def __init__(self, t_ref: float) -> None:
+        self.t_ref = t_ref
+        self.n = 0
+        self.st = self.stt = 0.0
+        self.sq = np.zeros(3)
+        self.stq = np.zeros(3)
+
+    def add(self, t: float, p: np.ndarray) -> None:
+        tau = t - self.t_ref
+        q = p + 0.5 * G * tau * tau * _UP
+        self.n += 1
+        self.st += tau
+        self.stt += tau * tau
+        self.sq += q
+        self.stq += tau * q
+
+    def chi2(self, t: float, p: np.ndarray, sigma: float) -> float:
+        """Squared prediction residual of a new sample over its variance."""
+        n = self.n
+        tbar = self.st / n
+        stt = self.stt - n * tbar * tbar
+        slope = (self.stq - tbar * self.sq) / stt
+        qbar = self.sq / n
+        tau = t - self.t_ref
+        pred = qbar + slope * (tau - tbar)
+        q = p + 0.5 * G * tau * tau * _UP
+        var = sigma * sigma * (1.0 + 1.0 / n + (tau - tbar) ** 2 / stt)
+        e = q - pred
+        return float(e @ e / var)
+
+
+def _window_ballistic(t, p, i, m, sigma) -> bool:
+    f = fit_flight(t, p, i, i + m)
+    ss = f.rms_m**2 * m / (sigma * sigma)
+    return ss <= chi2.isf(FALSE_ALARM, 3 * (m - 2))
+
+
+def segment_flights(
+    t_s: np.ndarray, xyz_m: np.ndarray, sigma_m: float
+) -> list[tuple[int, int]]:
+    """Sample ranges ``(start, end)`` of the ballistic flights, in time order.
+
+    Samples in no range lie between flights (at a contact, or outliers).
+    """
+    t = np.asarray(t_s, float)
+    p = np.asarray(xyz_m, float)
+    n = len(t)
+    m = MIN_FLIGHT_SAMPLES
+    sigma = max(float(sigma_m), MIN_NOISE_SD_M)
+    bound = chi2.isf(FALSE_ALARM, 3)
+    out: list[tuple[int, int]] = []
+    i = 0
+    while i + m <= n:
+        if not _window_ballistic(t, p, i, m, sigma):
+            i += 1
+            continue
+        grow = _Growing(t[i])
+        for k in range(i, i + m):
+            grow.add(t[k], p[k])
+        j = i + m
+        end = j
+        while j < n:
+            if grow.chi2(t[j], p[j], sigma) <= bound:
+                grow.add(t[j], p[j])
+                j += 1
+                end = j
+                continue
+            if j + 1 < n and grow.chi2(t[j + 1], p[j + 1], sigma) <= bound:
+                j += 1  # one outlier: skipped, the flight goes on
+                continue
+            break
+        out.append((i, end))
+        i = end
+    return out

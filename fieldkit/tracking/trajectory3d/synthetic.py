@@ -1,0 +1,140 @@
+"""3-D trajectories sampled from the 3-D simulator, with exact truth.
+
+The simulator's impact rows (:func:`fieldkit.model.simulate3d.simulate3d` with
+``record_impacts``) give every contact's time, point and the velocities in and out
+(``vin N + vit T``, ``vfn N + vft T``); between two contacts a flight is an exact
+parabola (no drag in 3-D). :func:`sampled_runs` rebuilds each rock's flights from
+them, keeps the rock only while each flight ends exactly where the next impact row
+says (a slide or a tree strike between two impacts ends the kept part there), ends
+the kept part before the first flight shorter than ``min_flight_s`` (a sampling at
+100-200 Hz cannot fit it), samples the flights at ``fps`` from a random phase, and
+adds Gaussian noise of SD ``noise_sd_m`` to every coordinate. The truth is the
+impact rows of the kept part that have a kept flight on both sides, with the
+lateral deflection of their velocities.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from fieldkit.physics.constants import G
+
+#: Largest mismatch of a rebuilt flight with the next impact row [m].
+CHAIN_TOLERANCE_M = 1e-6
+
+
+@dataclass(frozen=True)
+class SampledRun:
+    """One rock's sampled trajectory and its truth.
+
+    Attributes
+    ----------
+    samples
+        ``path_id, t_s, x_m, y_m, z_m, omega_radps`` (noisy positions, spin exact).
+    truth
+        The simulator's impact rows kept (``t_s, x_m, y_m, z_m, e_n, e_t,
+        lateral_deg, ...``) as a frame.
+    """
+
+    samples: pd.DataFrame
+    truth: pd.DataFrame
+
+
+def _vectors(rows, i):
+    n = np.array([rows["normal_x"][i], rows["normal_y"][i], rows["normal_z"][i]])
+    t = np.array([rows["tangent_x"][i], rows["tangent_y"][i], rows["tangent_z"][i]])
+    vi = rows["vin_mps"][i] * n + rows["vit_mps"][i] * t
+    vf = rows["vfn_mps"][i] * n + rows["vft_mps"][i] * t
+    p = np.array([rows["x_m"][i], rows["y_m"][i], rows["z_m"][i]])
+    return p, vi, vf
+
+
+def sampled_runs(
+    result,
+    *,
+    fps: float,
+    noise_sd_m: float,
+    rng: np.random.Generator,
+    min_flight_s: float = 0.1,
+    min_impacts: int = 2,
+    material_names=("ground",),
+) -> list[SampledRun]:
+    """Sampled, noisy trajectories of every rock of a 3-D result with truth.
+
+    Parameters
+    ----------
+    result
+        A :class:`fieldkit.model.simulate3d.Result3D` run with ``record_impacts``
+        and ``keep_paths`` (the release point is the path's first sample).
+    fps
+        Sampling rate [Hz].
+    noise_sd_m
+        SD of the Gaussian noise added to each coordinate [m].
+    rng
+        Random numbers (sampling phase, noise).
+    min_flight_s
+        A rock's kept part ends before its first flight shorter than this.
+    min_impacts
+        Rocks with fewer truth impacts are left out.
+    material_names
+        The model's material names (in the order of its material index).
+    """
+    from fieldkit.model.results3d import impact_table3d
+
+    rows = result.impact_rows
+    rock = rows["rock"]
+    out = []
+    for k in range(result.rocks):
+        idx = np.flatnonzero(rock == k)
+        if idx.size == 0:
+            continue
+        start = result.rock_path(k)
+        p0 = np.array([start["x_m"][0], start["y_m"][0], start["z_m"][0]])
+        t1 = rows["t_s"][idx[0]]
+        p1, vi1, _ = _vectors(rows, idx[0])
+        v0 = vi1 + np.array([0.0, 0.0, G * t1])
+        # flights: (t_start, p_start, v_start, t_end); the first from the release
+        flights = [(0.0, p0, v0, t1)]
+        if np.linalg.norm(p0 + v0 * t1 - [0, 0, 0.5 * G * t1 * t1] - p1) > 1e-6:
+            continue  # the rock did not fly straight to its first impact
+        for a, b in zip(idx[:-1], idx[1:], strict=True):
+            pa, _, vfa = _vectors(rows, a)
+            pb, vib, _ = _vectors(rows, b)
+            dt = rows["t_s"][b] - rows["t_s"][a]
+            end = pa + vfa * dt - np.array([0.0, 0.0, 0.5 * G * dt * dt])
+            if np.linalg.norm(end - pb) > CHAIN_TOLERANCE_M or dt < min_flight_s:
+                break
+            flights.append((rows["t_s"][a], pa, vfa, rows["t_s"][b]))
+        if flights[0][3] < min_flight_s:
+            continue
+        kept = idx[: len(flights) - 1]  # impacts with a kept flight on each side
+        if kept.size < min_impacts:
+            continue
+        t_end = flights[-1][3]
+        t = np.arange(rng.uniform(0.0, 1.0 / fps), t_end, 1.0 / fps)
+        which = np.searchsorted([f[0] for f in flights], t, side="right") - 1
+        xyz = np.empty((t.size, 3))
+        omega = np.empty(t.size)
+        for j, (ts, ps, vs, _) in enumerate(flights):
+            sel = which == j
+            tau = (t[sel] - ts)[:, None]
+            xyz[sel] = ps + vs * tau - np.array([0.0, 0.0, 0.5 * G]) * tau * tau
+            omega[sel] = 0.0 if j == 0 else rows["omega_f_radps"][idx[j - 1]]
+        xyz += rng.normal(0.0, noise_sd_m, xyz.shape)
+        samples = pd.DataFrame({"path_id": f"run{k}", "t_s": t, "x_m": xyz[:, 0],
+                                "y_m": xyz[:, 1], "z_m": xyz[:, 2],
+                                "omega_radps": omega})  # fmt: skip
+        sub = {name: values[kept] for name, values in rows.items()}
+        truth = impact_table3d(sub, list(material_names)).frame
+        lat = []
+        for i in kept:
+            _, vi, vf = _vectors(rows, i)
+            cross = vi[0] * vf[1] - vi[1] * vf[0]
+            lat.append(np.degrees(np.arctan2(cross, vi[0] * vf[0] + vi[1] * vf[1])))
+        truth["lateral_deg"] = lat
+        truth["path_id"] = f"run{k}"
+        out.append(SampledRun(samples, truth))
+    return out
