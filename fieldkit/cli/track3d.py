@@ -76,6 +76,14 @@ def track3d(
             "from each trajectory (stated).",
         ),
     ] = None,
+    material: Annotated[
+        str | None,
+        typer.Option(
+            "--material",
+            help="Slope material label of every impact (fit and diagnose group "
+            "impacts by it; default: empty, stated).",
+        ),
+    ] = None,
     out: Annotated[
         Path | None,
         typer.Option("-o", "--out", help="ImpactTable: .csv, .parquet or .xlsx."),
@@ -129,10 +137,15 @@ def track3d(
     terrain = terrain_from_dem(read_dem(dem))
     print_body_notes(body)
     nan = float("nan")
+    gyration_m = body.gyration_m
+    if gyration_m is None:
+        gyration_m = math.sqrt(0.4) * body.radius_m
+        note(f"no --gyration, --shape or --dimensions: gyration_m {gyration_m:.4g} m, "
+             "a solid sphere's (k = sqrt(2/5) r), as a model file's default")
     b3 = Body3D(
         body.radius_m,
         body.mass_kg if body.mass_kg is not None else nan,
-        body.gyration_m if body.gyration_m is not None else nan,
+        gyration_m,
     )
     foot = body.radius_m if footprint is None else footprint
     note("flights: ballistic fits with g = 9.81 m/s^2 fixed, no air drag")
@@ -151,8 +164,11 @@ def track3d(
                                   footprint_m=foot, noise_sd_m=noise_sd),
                 run,
             ))  # fmt: skip
-    table = impact_rows(reductions, b3, foot)
-    for red, run in reductions:
+    table = impact_rows(reductions, b3, foot, material)
+    if material is None:
+        note("no --material: the material column is empty (give --material NAME "
+             "to fit or diagnose the table)")
+    for red, _ in reductions:
         noise = (f"noise SD {1e3 * red.noise_sd_m:.1f} mm "
                  f"({'estimated' if red.noise_estimated else 'given'})")  # fmt: skip
         typer.echo(

@@ -3,7 +3,8 @@
 Full-scale test sites publish the block's centre sampled at 100-200 Hz in the DEM's
 coordinates, sometimes with its spin. One concept per module:
 
-* :mod:`.samples` -- the trajectory CSV read strictly into :class:`.samples.Trajectory3D`;
+* :mod:`.samples` -- the trajectory CSV read strictly
+  (:class:`.samples.Trajectory3D`);
 * :mod:`.flights` -- the sampling noise and the ballistic flights (g fixed, no drag);
 * :mod:`.surface` -- the local ground plane fitted over the block's footprint;
 * :mod:`.contacts` -- where two consecutive flights meet: an impact on the ground, or

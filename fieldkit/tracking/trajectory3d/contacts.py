@@ -158,7 +158,6 @@ def classify_join(
     """The join of flights ``a`` and ``b`` (flight numbers ``j``, ``j + 1``)."""
     t = np.asarray(t_s, float)
     dt = float(np.median(np.diff(t)))
-    nan3 = np.full(3, np.nan)
     ts = meet_time(a, b)
     t_end, t_start = t[a.end - 1], t[b.start]
     spin_i = _spin(omega, np.arange(max(a.start, a.end - SPIN_SAMPLES), a.end))

@@ -137,8 +137,10 @@ def impact_rows(
     reductions: list[tuple[Reduction3D, Trajectory3D]],
     body: Body3D,
     footprint_m: float,
+    material: str | None = None,
 ) -> ImpactTable:
-    """The impacts of every reduced trajectory as one derived ImpactTable."""
+    """The impacts of every reduced trajectory as one derived ImpactTable
+    (``material`` the slope material label of every row; None leaves it empty)."""
     recs: list[dict] = []
     for k, (red, traj) in enumerate(reductions):
         chain = _chainage(red, traj)
@@ -173,7 +175,7 @@ def impact_rows(
     rows = {c: np.array([r[c] for r in recs], float) for c in cols}
     frame = impact_table3d(rows, [""]).frame
     frame["path_id"] = [r["_path"] for r in recs]
-    frame["material"] = np.nan
+    frame["material"] = np.nan if material is None else material
     frame = frame.drop(columns=["tree_strike"])  # trees are not seen in a trajectory
     frame["chainage_m"] = [r["_chainage"] for r in recs]
     frame["lateral_deg"] = [r["_lateral"] for r in recs]
