@@ -21,15 +21,9 @@ import numpy as np
 import pandas as pd
 
 from fieldkit.impact_table import ImpactTable
-from fieldkit.model.materials import Material
-from fieldkit.model.model3d import Model3D, Seeder3D
-from fieldkit.model.model_file import Body
-from fieldkit.model.simulate3d import simulate3d
-from fieldkit.model.terrain import Terrain
-from fieldkit.tracking.trajectory3d.synthetic import sampled_runs
+from fieldkit.tracking.trajectory3d.synthetic import valley_runs, write_site
 
 OUT = Path(sys.argv[1] if len(sys.argv) > 1 else "out/track3d")
-NX, NY, CELL = 120, 60, 1.0
 FPS, NOISE_SD_M = 200.0, 0.02
 
 
@@ -43,30 +37,9 @@ def fieldkit(*args) -> str:
 
 def main() -> None:
     OUT.mkdir(parents=True, exist_ok=True)
-    xc, yc = (np.arange(NX) + 0.5) * CELL, (np.arange(NY) + 0.5) * CELL
-    x, y = np.meshgrid(xc, yc)
-    z = 100.0 - 0.7 * x + 0.02 * (y - 30.0) ** 2 + 0.3 * np.sin(x / 7.0)
-    model = Model3D(
-        terrain=Terrain(0.0, 0.0, CELL, z),
-        materials={"ground": Material("ground", 0.6, 0.85, 30.0)},
-        material_index=np.zeros((NY, NX), np.int64),
-        effects={},
-        body=Body(100.0, 0.2, 0.126),
-        releases=np.array([[5.5, 25.0, 0.0], [5.5, 35.0, 0.0]]),
-        release_weights=np.ones(2),
-        seeder=Seeder3D(height_m=1.0, vx_mps=6.0, vz_mps=2.0, vx_sd_mps=1.0,
-                        vy_sd_mps=2.0),  # fmt: skip
-    )
-    result = simulate3d(model, 8, np.random.default_rng(1), record_impacts=True)
-    runs = sampled_runs(result, fps=FPS, noise_sd_m=NOISE_SD_M,
-                        rng=np.random.default_rng(2), min_flight_s=0.25)  # fmt: skip
+    terrain, runs = valley_runs(fps=FPS, noise_sd_m=NOISE_SD_M)
+    write_site(OUT, terrain, runs)
     samples = pd.concat([r.samples for r in runs])
-    samples.to_csv(OUT / "trajectories.csv", index=False)
-    rows = "\n".join(" ".join(f"{v:.9f}" for v in row) for row in z[::-1])
-    (OUT / "valley.asc").write_text(
-        f"ncols {NX}\nnrows {NY}\nxllcorner 0\nyllcorner 0\ncellsize {CELL}\n"
-        f"NODATA_value -9999\n{rows}\n"
-    )
     print(
         f"raw trajectories: {len(runs)} runs, {len(samples)} samples at "
         f"{FPS:.0f} Hz, noise SD {100 * NOISE_SD_M:.0f} cm per coordinate"

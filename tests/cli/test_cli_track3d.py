@@ -11,55 +11,24 @@ import pandas as pd
 import pytest
 
 from fieldkit.impact_table import ImpactTable
+from fieldkit.tracking.trajectory3d.synthetic import (
+    VALLEY_MASS_KG as MASS_KG,
+)
+from fieldkit.tracking.trajectory3d.synthetic import (
+    VALLEY_RADIUS_M as RADIUS_M,
+)
+from fieldkit.tracking.trajectory3d.synthetic import (
+    valley_runs,
+    write_site,
+)
 
 NOISE_SD_M = 0.02
-NX, NY, CELL = 120, 60, 1.0
-E_N, E_T = 0.6, 0.85
-RADIUS_M, MASS_KG = 0.2, 100.0
-
-
-def ground(x, y):
-    """A valley dipping ~35 deg toward +x, curved across (lateral deflections) and
-    rippled along (varying dips)."""
-    return 100.0 - 0.7 * x + 0.02 * (y - 30.0) ** 2 + 0.3 * np.sin(x / 7.0)
 
 
 def simulated_runs(fps: float, seed: int = 2, rocks: int = 8):
-    """Runs of the 3-D simulator on the valley, sampled at ``fps`` with noise."""
-    from fieldkit.model.materials import Material
-    from fieldkit.model.model3d import Model3D, Seeder3D
-    from fieldkit.model.model_file import Body
-    from fieldkit.model.simulate3d import simulate3d
-    from fieldkit.model.terrain import Terrain
-    from fieldkit.tracking.trajectory3d.synthetic import sampled_runs
-
-    xc, yc = (np.arange(NX) + 0.5) * CELL, (np.arange(NY) + 0.5) * CELL
-    z = ground(*np.meshgrid(xc, yc))
-    model = Model3D(
-        terrain=Terrain(0.0, 0.0, CELL, z),
-        materials={"ground": Material("ground", E_N, E_T, 30.0)},
-        material_index=np.zeros((NY, NX), np.int64),
-        effects={},
-        body=Body(MASS_KG, RADIUS_M, 0.126),
-        releases=np.array([[5.5, 25.0, 0.0], [5.5, 35.0, 0.0]]),
-        release_weights=np.ones(2),
-        seeder=Seeder3D(height_m=1.0, vx_mps=6.0, vz_mps=2.0, vx_sd_mps=1.0,
-                        vy_sd_mps=2.0),  # fmt: skip
-    )
-    result = simulate3d(model, rocks, np.random.default_rng(1), record_impacts=True)
-    runs = sampled_runs(result, fps=fps, noise_sd_m=NOISE_SD_M,
-                        rng=np.random.default_rng(seed), min_flight_s=0.25)  # fmt: skip
-    return z, runs
-
-
-def write_site(folder, z, runs):
-    rows = "\n".join(" ".join(f"{v:.9f}" for v in row) for row in z[::-1])
-    (folder / "valley.asc").write_text(
-        f"ncols {NX}\nnrows {NY}\nxllcorner 0\nyllcorner 0\ncellsize {CELL}\n"
-        f"NODATA_value -9999\n{rows}\n"
-    )
-    pd.concat([r.samples for r in runs]).to_csv(folder / "runs.csv", index=False)
-    return folder / "runs.csv", folder / "valley.asc"
+    """Runs of the 3-D simulator on the analytic valley (e_n 0.6, e_t 0.85),
+    sampled at ``fps`` with 2 cm noise."""
+    return valley_runs(fps=fps, noise_sd_m=NOISE_SD_M, rocks=rocks, seed=seed)
 
 
 def match(found: pd.DataFrame, truth: pd.DataFrame, window_s: float = 0.02):
@@ -80,9 +49,9 @@ def match(found: pd.DataFrame, truth: pd.DataFrame, window_s: float = 0.02):
 
 @pytest.mark.parametrize("fps", [100.0, 200.0])
 def test_every_impact_found_with_en_et_lateral_recovered(cli, tmp_path, fps):
-    z, runs = simulated_runs(fps)
+    terrain, runs = simulated_runs(fps)
     assert len(runs) >= 6
-    samples, dem = write_site(tmp_path, z, runs)
+    samples, dem = write_site(tmp_path, terrain, runs)
     out = tmp_path / "out" / "impacts.csv"
     result = cli("track3d", samples, "--dem", dem, "--radius", RADIUS_M,
                  "--mass", MASS_KG, "-o", out)  # fmt: skip
@@ -130,7 +99,7 @@ def test_a_flight_bent_in_mid_air_is_a_misfit_not_an_impact(cli, tmp_path):
     """A sideways push of 2 m/s halfway through a run's second flight (no flight is
     ballistic across it) splits the flight in mid-air: reported as a misfit, with
     its height; the run's true impacts are still found and nothing is added."""
-    z, runs = simulated_runs(200.0)
+    terrain, runs = simulated_runs(200.0)
     run = runs[0]
     tr = run.truth
     s = run.samples.copy()
@@ -139,7 +108,7 @@ def test_a_flight_bent_in_mid_air_is_a_misfit_not_an_impact(cli, tmp_path):
     s.loc[late, "y_m"] += 2.0 * np.minimum(s.loc[late, "t_s"] - t_kick,
                                            tr["t_s"].iloc[1] - t_kick)  # fmt: skip
     run = type(run)(s, tr.iloc[:1])  # impacts after the push moved: keep the first
-    samples, dem = write_site(tmp_path, z, [run])
+    samples, dem = write_site(tmp_path, terrain, [run])
     result = cli("track3d", samples, "--dem", dem, "--radius", RADIUS_M,
                  "-o", tmp_path / "i.csv")  # fmt: skip
     assert result.exit_code == 0, result.stderr
@@ -154,16 +123,16 @@ def test_a_flight_bent_in_mid_air_is_a_misfit_not_an_impact(cli, tmp_path):
     ("edit", "words"),
     [
         (lambda s: s.replace(s.splitlines()[5].split(",")[4], "abc", 1),
-         ["runs.csv", "row 6", "z_m", "abc"]),
+         ["trajectories.csv", "row 6", "z_m", "abc"]),
         (lambda s: "\n".join(s.splitlines()[:1] + s.splitlines()[1:][::-1]),
-         ["runs.csv", "row 3", "t_s", "increase"]),
-        (lambda s: s.replace("y_m", "north", 1), ["runs.csv", "y_m"]),
+         ["trajectories.csv", "row 3", "t_s", "increase"]),
+        (lambda s: s.replace("y_m", "north", 1), ["trajectories.csv", "y_m"]),
     ],
 )  # fmt: skip
 def test_bad_samples_are_one_line_and_write_nothing(cli, fails, tmp_path, digest,
                                                     edit, words):  # fmt: skip
-    z, runs = simulated_runs(100.0, rocks=2)
-    samples, dem = write_site(tmp_path, z, runs[:1])
+    terrain, runs = simulated_runs(100.0, rocks=2)
+    samples, dem = write_site(tmp_path, terrain, runs[:1])
     samples.write_text(edit(samples.read_text()))
     before = digest(samples)
     out = tmp_path / "out" / "impacts.csv"
@@ -174,7 +143,7 @@ def test_bad_samples_are_one_line_and_write_nothing(cli, fails, tmp_path, digest
 
 
 def test_no_dem_no_radius(cli, fails, tmp_path):
-    z, runs = simulated_runs(100.0, rocks=2)
-    samples, dem = write_site(tmp_path, z, runs[:1])
+    terrain, runs = simulated_runs(100.0, rocks=2)
+    samples, dem = write_site(tmp_path, terrain, runs[:1])
     fails(cli("track3d", samples, "--radius", RADIUS_M), "--dem")
     fails(cli("track3d", samples, "--dem", dem), "--radius")
