@@ -147,3 +147,57 @@ def test_no_dem_no_radius(cli, fails, tmp_path):
     samples, dem = write_site(tmp_path, terrain, runs[:1])
     fails(cli("track3d", samples, "--radius", RADIUS_M), "--dem")
     fails(cli("track3d", samples, "--dem", dem), "--radius")
+
+
+def test_a_contact_the_sampling_resolves_has_its_duration(cli, tmp_path):
+    """The block rests 60 ms at its first impact point (12 samples at 200 Hz)
+    before leaving as the simulator says: the contact's duration is measured
+    (within one sampling interval), its e_n and e_t are still the truth's; the
+    instantaneous contacts keep an empty duration."""
+    terrain, runs = simulated_runs(200.0)
+    run = runs[0]
+    tr = run.truth.reset_index(drop=True)
+    s = run.samples.copy()
+    t1, rest = float(tr["t_s"].iloc[0]), 0.06
+    s.loc[s["t_s"] > t1, "t_s"] += rest
+    still = np.arange(t1 + 0.0025, t1 + rest, 1 / 200.0)
+    rng = np.random.default_rng(5)
+    xyz = tr[["x_m", "y_m", "z_m"]].iloc[0].to_numpy() + rng.normal(
+        0.0, NOISE_SD_M, (still.size, 3)
+    )
+    pad = pd.DataFrame({"path_id": s["path_id"].iloc[0], "t_s": still,
+                        "x_m": xyz[:, 0], "y_m": xyz[:, 1], "z_m": xyz[:, 2],
+                        "omega_radps": 0.0})  # fmt: skip
+    s = pd.concat([s, pad]).sort_values("t_s")
+    truth = tr.copy()
+    truth.loc[1:, "t_s"] += rest
+    samples, dem = write_site(tmp_path, terrain, [type(run)(s, truth)])
+    out = tmp_path / "i.csv"
+    result = cli("track3d", samples, "--dem", dem, "--radius", RADIUS_M, "-o", out)
+    assert result.exit_code == 0, result.stderr
+    assert "contact_duration_s: 1 of 3 impacts resolved" in result.stderr
+    found = ImpactTable.read(out).frame
+    pairs, missed, extra = match(found, truth)
+    assert not missed and not extra
+    first = found.iloc[0]
+    assert first["contact_duration_s"] == pytest.approx(rest, abs=1 / 200.0)
+    assert first["t_s"] == pytest.approx(t1, abs=1 / 200.0)
+    assert first["e_n"] == pytest.approx(truth["e_n"].iloc[0], abs=0.05)
+    assert first["e_t"] == pytest.approx(truth["e_t"].iloc[0], abs=0.05)
+    assert found["contact_duration_s"].iloc[1:].isna().all()
+
+
+def test_a_non_spherical_block_gives_its_gyration(cli, tmp_path):
+    """Block dimensions (--shape ellipsoid --dimensions) set the rows' radius of
+    gyration (and so the rotational energies), as for `track` and `reduce`."""
+    terrain, runs = simulated_runs(100.0, rocks=2)
+    samples, dem = write_site(tmp_path, terrain, runs[:1])
+    out = tmp_path / "i.csv"
+    result = cli("track3d", samples, "--dem", dem, "--shape", "ellipsoid",
+                 "--dimensions", "0.6,0.4,0.4", "--radius", RADIUS_M,
+                 "--mass", MASS_KG, "-o", out)  # fmt: skip
+    assert result.exit_code == 0, result.stderr
+    f = ImpactTable.read(out).frame
+    # ellipsoid rotating about c: k^2 = (a^2 + b^2) / 5 with a = 0.3, b = 0.2 m
+    assert f["gyration_m"].iloc[0] == pytest.approx(np.sqrt((0.09 + 0.04) / 5))
+    assert "solid sphere" not in result.stderr

@@ -48,6 +48,9 @@ BOUNDARY_SAMPLES = 3
 REFINE_PASSES = 3
 #: Samples between two flights from which a contact's duration counts as resolved.
 RESOLVED_GAP_SAMPLES = 2
+#: A segment whose ballistic arc (g T^2 / 8) rises more than this many noise SDs
+#: is a flight, never a ground phase (:func:`on_the_ground`).
+GROUND_ARC_SDS = 2.0
 #: Samples at each side of a contact whose median spin is the spin before / after.
 SPIN_SAMPLES = 3
 
@@ -73,6 +76,41 @@ class Contact:
     duration_s: float
     omega_i_radps: float
     omega_f_radps: float
+
+
+def on_the_ground(
+    t_s: np.ndarray,
+    xyz_m: np.ndarray,
+    f: Flight3D,
+    terrain: Terrain,
+    *,
+    radius_m: float,
+    tolerance_m: float,
+    footprint_m: float,
+    sigma_m: float,
+) -> bool:
+    """Whether the samples of ``f`` never leave the ground: their centre stays
+    within ``radius_m + tolerance_m`` of the ground plane under them at a height
+    above it that is constant within the noise (chi-square at
+    :data:`~.flights.FALSE_ALARM`), and a ballistic arc of their duration would
+    rise no more than :data:`GROUND_ARC_SDS` noise SDs (``g T^2 / 8``), so the
+    two cannot be told apart. A block resting, sliding or rolling for a few
+    samples can also pass for a slow ballistic flight (g t^2/2 is 1.5 cm in 55 ms);
+    it is a contact, not a flight between two impacts."""
+    sigma = max(float(sigma_m), MIN_NOISE_SD_M)
+    duration = float(t_s[f.end - 1] - t_s[f.start])
+    if G * duration**2 / 8.0 > GROUND_ARC_SDS * sigma:
+        return False  # a ballistic arc this long rises measurably: a flight
+    q = np.asarray(xyz_m)[f.start : f.end]
+    mid = np.median(q, axis=0)
+    plane = local_plane(terrain, mid[0], mid[1], footprint_m)
+    if plane is None:
+        return False
+    h = np.array([plane.distance(p, mid[0], mid[1]) for p in q])
+    if h.max() > radius_m + tolerance_m:
+        return False
+    ss = float(np.sum((h - h.mean()) ** 2)) / (sigma * sigma)
+    return ss <= chi2.isf(FALSE_ALARM, len(h) - 1)
 
 
 def meet_time(a: Flight3D, b: Flight3D) -> float:
@@ -135,6 +173,24 @@ def refine_joins(
     return out
 
 
+def _reach(f: Flight3D, plane: LocalPlane, at: np.ndarray, h_m: float,
+           near_s: float) -> float:  # fmt: skip
+    """The time nearest ``near_s`` at which flight ``f`` is ``h_m`` above ``plane``
+    (the plane's point under ``at``); NaN if never."""
+    n = plane.normal
+    ground = np.array([at[0], at[1], plane.z_m])
+    tr = f.t_ref_s
+    # (p0 + v0 tau - g tau^2/2 z - ground) . n = h
+    qa = -0.5 * G * n[2]
+    qb = float(f.v0_mps @ n)
+    qc = float((f.p0_m - ground) @ n) - h_m
+    roots = np.roots([qa, qb, qc]) if qa != 0 else np.array([-qc / qb])
+    roots = roots[np.isreal(roots)].real + tr
+    if roots.size == 0:
+        return float("nan")
+    return float(roots[np.argmin(np.abs(roots - near_s))])
+
+
 def _spin(omega, idx) -> float:
     if omega is None:
         return float("nan")
@@ -154,6 +210,7 @@ def classify_join(
     tolerance_m: float,
     footprint_m: float,
     omega: np.ndarray | None,
+    xyz_m: np.ndarray | None = None,
 ) -> Contact:
     """The join of flights ``a`` and ``b`` (flight numbers ``j``, ``j + 1``)."""
     t = np.asarray(t_s, float)
@@ -187,6 +244,25 @@ def classify_join(
         return done("misfit", f"flights {j} and {j + 1} join off the DEM's surface")
     height = plane.distance(point, point[0], point[1])
     reach = radius_m + tolerance_m
+    if not meets and gap >= RESOLVED_GAP_SAMPLES and xyz_m is not None:
+        # on the ground for several samples: where the flights reach the height the
+        # block kept between them, against the plane under those samples
+        mid = np.median(np.asarray(xyz_m)[a.end : b.start], axis=0)
+        under = local_plane(terrain, mid[0], mid[1], footprint_m)
+        if under is not None:
+            h_c = float(np.median([under.distance(q, mid[0], mid[1])
+                                   for q in np.asarray(xyz_m)[a.end : b.start]]))
+            t_in = _reach(a, under, mid, h_c, t_end)
+            t_out = _reach(b, under, mid, h_c, t_start)
+            if np.isfinite(t_in) and np.isfinite(t_out) and t_out > t_in:
+                t_c, duration = t_in, float(t_out - t_in)
+                point = a.position(t_in)
+                vi, vf = a.velocity(t_in), b.velocity(t_out)
+                plane = local_plane(terrain, point[0], point[1], footprint_m)
+                if plane is None:
+                    return done("misfit", f"flights {j} and {j + 1} join off the "
+                                "DEM's surface")  # fmt: skip
+                height = plane.distance(point, point[0], point[1])
     if not meets:
         end_h = height
         start_p = b.position(t_start)

@@ -28,6 +28,7 @@ from fieldkit.model.terrain import Terrain
 from fieldkit.tracking.trajectory3d.contacts import (
     Contact,
     classify_join,
+    on_the_ground,
     refine_joins,
 )
 from fieldkit.tracking.trajectory3d.flights import (
@@ -85,6 +86,13 @@ def reduce_trajectory(
     ranges = segment_flights(t, p, sigma)
     ranges = refine_joins(t, p, ranges, sigma)
     flights = [fit_flight(t, p, a, b) for a, b in ranges]
+    ground = [
+        on_the_ground(t, p, f, terrain, radius_m=body.radius_m,
+                      tolerance_m=tolerance_m, footprint_m=footprint_m,
+                      sigma_m=sigma)  # fmt: skip
+        for f in flights
+    ]
+    flights = [f for f, g in zip(flights, ground, strict=True) if not g]
     out = Reduction3D(
         trajectory.path_id,
         len(t),
@@ -98,7 +106,7 @@ def reduce_trajectory(
             classify_join(
                 j + 1, t, flights[j], flights[j + 1], terrain,
                 radius_m=body.radius_m, tolerance_m=tolerance_m,
-                footprint_m=footprint_m, omega=trajectory.omega_radps,
+                footprint_m=footprint_m, omega=trajectory.omega_radps, xyz_m=p,
             )  # fmt: skip
         )
     return out
