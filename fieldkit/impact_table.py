@@ -208,6 +208,12 @@ EXTENSION_COLUMNS: tuple[Column, ...] = (
         "positive seen from above, in (-180, 180] [deg]",
     ),
     Column(
+        "lateral_sd_deg",
+        "float",
+        False,
+        "standard uncertainty of lateral_deg from the sampling noise [deg]",
+    ),
+    Column(
         "contact_height_m",
         "float",
         False,

@@ -70,6 +70,12 @@ def test_every_impact_found_with_en_et_lateral_recovered(cli, tmp_path, fps):
     assert np.abs(f["e_t"] - t["e_t"]).max() <= 0.05
     assert np.abs(f["lateral_deg"] - t["lateral_deg"]).max() <= 2.0
     assert np.ptp(t["lateral_deg"]) > 20.0  # the deflections are real, both ways
+    # the stated uncertainties (from the noise through the flights' fits) match
+    # the errors: median |error| / SD near a normal's 0.67
+    for name, sd in (("e_n", "e_n_sd"), ("e_t", "e_t_sd"),
+                     ("lateral_deg", "lateral_sd_deg")):  # fmt: skip
+        z = np.abs(f[name] - t[name]) / f[sd]
+        assert 0.3 < np.median(z) < 1.2, (name, np.median(z))
     # the same convention as the simulator's rows: N, T and the dip agree (to
     # 1e-9 inside a DEM patch; where the footprint disc straddles a patch edge the
     # plane averages the two patches' slopes, the simulator takes one side's)

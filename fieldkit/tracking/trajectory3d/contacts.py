@@ -76,6 +76,8 @@ class Contact:
     duration_s: float
     omega_i_radps: float
     omega_f_radps: float
+    vi_sd_mps: float = float("nan")
+    vf_sd_mps: float = float("nan")
 
 
 def on_the_ground(
@@ -237,7 +239,7 @@ def classify_join(
     def done(kind, reason, plane=None, height=float("nan")):
         return Contact(j, kind, reason, float(t_c), point, vi, vf, plane, height,
                        miss, duration if kind == "impact" else float("nan"),
-                       spin_i, spin_f)  # fmt: skip
+                       spin_i, spin_f, a.v_sd_mps, b.v_sd_mps)  # fmt: skip
 
     plane = local_plane(terrain, point[0], point[1], footprint_m)
     if plane is None:

@@ -52,6 +52,11 @@ class Flight3D:
         Fitted position and velocity at ``t_ref_s`` (3-vectors).
     rms_m
         Root-mean-square 3-D residual of the fit [m].
+    v_sd_mps
+        Standard uncertainty of each velocity component from the sampling noise
+        (``sigma / sqrt(sum (tau - mean tau)^2)``: the slope of a straight-line
+        fit; the same at every time, g being fixed) [m/s]; NaN when no noise SD
+        was given to :func:`fit_flight`.
     """
 
     start: int
@@ -60,6 +65,7 @@ class Flight3D:
     p0_m: np.ndarray
     v0_mps: np.ndarray
     rms_m: float
+    v_sd_mps: float = float("nan")
 
     @property
     def samples(self) -> int:
@@ -96,8 +102,15 @@ def noise_sd(t_s: np.ndarray, xyz_m: np.ndarray) -> float:
     return float(1.4826 * mad * dt * dt / np.sqrt(6.0))
 
 
-def fit_flight(t_s: np.ndarray, xyz_m: np.ndarray, start: int, end: int) -> Flight3D:
-    """Least-squares ballistic fit (g fixed) to samples ``start .. end - 1``."""
+def fit_flight(
+    t_s: np.ndarray,
+    xyz_m: np.ndarray,
+    start: int,
+    end: int,
+    sigma_m: float | None = None,
+) -> Flight3D:
+    """Least-squares ballistic fit (g fixed) to samples ``start .. end - 1``
+    (``sigma_m``: the noise SD per coordinate, for :attr:`Flight3D.v_sd_mps`)."""
     t = t_s[start:end]
     tau = t - t[0]
     q = xyz_m[start:end].copy()
@@ -112,7 +125,15 @@ def fit_flight(t_s: np.ndarray, xyz_m: np.ndarray, start: int, end: int) -> Flig
         coef[0].copy(),
         coef[1].copy(),
         float(np.sqrt(np.mean(np.sum(res * res, axis=1)))),
+        _slope_sd(tau, sigma_m),
     )
+
+
+def _slope_sd(tau: np.ndarray, sigma_m: float | None) -> float:
+    if sigma_m is None:
+        return float("nan")
+    spread = float(np.sum((tau - tau.mean()) ** 2))
+    return float(max(sigma_m, MIN_NOISE_SD_M) / np.sqrt(spread))
 
 
 class _Growing:

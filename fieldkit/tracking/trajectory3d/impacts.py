@@ -85,7 +85,7 @@ def reduce_trajectory(
     sigma = noise_sd(t, p) if noise_sd_m is None else float(noise_sd_m)
     ranges = segment_flights(t, p, sigma)
     ranges = refine_joins(t, p, ranges, sigma)
-    flights = [fit_flight(t, p, a, b) for a, b in ranges]
+    flights = [fit_flight(t, p, a, b, sigma) for a, b in ranges]
     ground = [
         on_the_ground(t, p, f, terrain, radius_m=body.radius_m,
                       tolerance_m=tolerance_m, footprint_m=footprint_m,
@@ -126,6 +126,34 @@ def lateral_deg(vi_mps: np.ndarray, vf_mps: np.ndarray) -> float:
     return float(np.degrees(np.arctan2(cross, dot)))
 
 
+#: Uncertainty columns of a track3d row (from the sampling noise).
+SD_NAMES = ("vin_sd_mps", "vit_sd_mps", "vfn_sd_mps", "vft_sd_mps", "e_n_sd",
+            "e_t_sd", "lateral_sd_deg")  # fmt: skip
+#: The plan direction of a velocity is undefined when its plan speed is below this
+#: many of its standard uncertainties: ``lateral_deg`` is then empty.
+LATERAL_MIN_SDS = 3.0
+
+
+def _uncertainties(c: Contact, vin, vit, vfn, vft) -> dict:
+    """Standard uncertainties from the two flights' velocity SDs (linearised;
+    the DEM's normal taken as exact), and ``lateral_deg`` (NaN when a plan
+    direction is undefined: plan speed below :data:`LATERAL_MIN_SDS` SDs)."""
+    si, sf = c.vi_sd_mps, c.vf_sd_mps
+    en, et = -vfn / vin, vft / vit if vit > 0 else float("nan")
+    pi_, pf = float(np.hypot(*c.vi_mps[:2])), float(np.hypot(*c.vf_mps[:2]))
+    defined = pi_ > LATERAL_MIN_SDS * si and pf > LATERAL_MIN_SDS * sf
+    if not (np.isfinite(si) and np.isfinite(sf)):
+        defined = pi_ > 0 and pf > 0
+    return {
+        "vin_sd_mps": si, "vit_sd_mps": si, "vfn_sd_mps": sf, "vft_sd_mps": sf,
+        "e_n_sd": float(np.hypot(sf, en * si) / abs(vin)),
+        "e_t_sd": float(np.hypot(sf, et * si) / vit) if vit > 0 else float("nan"),
+        "lateral_sd_deg": float(np.degrees(np.hypot(si / pi_, sf / pf)))
+        if defined else float("nan"),
+        "_lateral": lateral_deg(c.vi_mps, c.vf_mps) if defined else float("nan"),
+    }  # fmt: skip
+
+
 def _chainage(red: Reduction3D, trajectory: Trajectory3D) -> dict[int, float]:
     """Plan distance from the first fitted sample to each join (by flight number)."""
     if not red.flights:
@@ -160,18 +188,19 @@ def impact_rows(
             tang = vt / vit if vit > 0 else np.array([n[2], 0.0, -n[0]]) / np.hypot(
                 n[2], n[0]
             )
+            vft = float(c.vf_mps @ tang)
+            sd = _uncertainties(c, vin, vit, float(c.vf_mps @ n), vft)
             recs.append({
                 "rock": k, "t_s": c.t_s, "x_m": c.point_m[0], "y_m": c.point_m[1],
                 "z_m": c.point_m[2], "material_index": 0, "vin_mps": vin,
-                "vit_mps": vit, "vfn_mps": float(c.vf_mps @ n),
-                "vft_mps": float(c.vf_mps @ tang),
+                "vit_mps": vit, "vfn_mps": float(c.vf_mps @ n), "vft_mps": vft,
                 "omega_i_radps": c.omega_i_radps, "omega_f_radps": c.omega_f_radps,
                 "normal_x": n[0], "normal_y": n[1], "normal_z": n[2],
                 "tangent_x": tang[0], "tangent_y": tang[1], "tangent_z": tang[2],
                 "mass_kg": body.mass_kg, "radius_m": body.radius_m,
                 "gyration_m": body.gyration_m, "tree_strike": 0.0,
                 "_path": red.path_id, "_chainage": chain[c.flight],
-                "_lateral": lateral_deg(c.vi_mps, c.vf_mps),
+                "_lateral": sd.pop("_lateral"), **sd,
                 "_duration": c.duration_s, "_height": c.height_m,
             })  # fmt: skip
     cols = [
@@ -185,6 +214,8 @@ def impact_rows(
     frame["path_id"] = [r["_path"] for r in recs]
     frame["material"] = np.nan if material is None else material
     frame = frame.drop(columns=["tree_strike"])  # trees are not seen in a trajectory
+    for name in SD_NAMES:
+        frame[name] = [r[name] for r in recs]
     frame["chainage_m"] = [r["_chainage"] for r in recs]
     frame["lateral_deg"] = [r["_lateral"] for r in recs]
     frame["contact_duration_s"] = [r["_duration"] for r in recs]

@@ -10,7 +10,8 @@ the kept part before the first flight shorter than ``min_flight_s`` (a sampling 
 100-200 Hz cannot fit it), samples the flights at ``fps`` from a random phase, and
 adds Gaussian noise of SD ``noise_sd_m`` to every coordinate. The truth is the
 impact rows of the kept part that have a kept flight on both sides, with the
-lateral deflection of their velocities.
+lateral deflection of their velocities (NaN where one has no plan component: a
+vertical drop).
 """
 
 from __future__ import annotations
@@ -133,7 +134,9 @@ def sampled_runs(
         for i in kept:
             _, vi, vf = _vectors(rows, i)
             cross = vi[0] * vf[1] - vi[1] * vf[0]
-            lat.append(np.degrees(np.arctan2(cross, vi[0] * vf[0] + vi[1] * vf[1])))
+            plan = min(np.hypot(*vi[:2]), np.hypot(*vf[:2]))
+            lat.append(np.degrees(np.arctan2(cross, vi[0] * vf[0] + vi[1] * vf[1]))
+                       if plan > 1e-9 else np.nan)  # fmt: skip
         truth["lateral_deg"] = lat
         truth["path_id"] = f"run{k}"
         out.append(SampledRun(samples, truth))
