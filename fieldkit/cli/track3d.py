@@ -32,7 +32,8 @@ DEFAULT_TOLERANCE_M = 0.1
 
 
 @one_line_errors(flags={"tolerance_m": "--tolerance", "footprint_m": "--footprint",
-                        "noise_sd_m": "--noise-sd"})  # fmt: skip
+                        "noise_sd_m": "--noise-sd",
+                        "drag_per_m": "--air-drag"})  # fmt: skip
 def track3d(
     trajectories: Annotated[
         Path,
@@ -76,6 +77,14 @@ def track3d(
             "from each trajectory (stated).",
         ),
     ] = None,
+    air_drag: Annotated[
+        float,
+        typer.Option(
+            "--air-drag",
+            help="Quadratic air drag of the flights, k = rho C_d A / (2 m) in 1/m "
+            "(dv/dt = -g z - k |v| v); default 0: ballistic (stated).",
+        ),
+    ] = 0.0,
     material: Annotated[
         str | None,
         typer.Option(
@@ -91,7 +100,8 @@ def track3d(
 ) -> None:
     """Reduce 3-D trajectories (x, y, z, t at 100-200 Hz) on a DEM to an ImpactTable.
 
-    Flights are ballistic fits with g = 9.81 m/s^2 fixed (no air drag). Two
+    Flights are ballistic fits with g = 9.81 m/s^2 fixed (no air drag unless
+    --air-drag gives its parameter). Two
     consecutive flights meeting within --tolerance, with the centre within
     radius + --tolerance of the ground plane fitted to the DEM over the
     block's footprint, are an impact; a join anywhere else is reported as a
@@ -119,6 +129,9 @@ def track3d(
     if dem is None:
         raise ArgumentError("a DEM is required (the ground at every contact)",
                             source="--dem")  # fmt: skip
+    if not air_drag >= 0:
+        raise ArgumentError(f"drag_per_m must be >= 0 1/m (got {air_drag:g})",
+                            source="drag_per_m")  # fmt: skip
     for value, name in ((tolerance, "tolerance_m"), (footprint, "footprint_m"),
                         (noise_sd, "noise_sd_m")):  # fmt: skip
         if value is not None and not (math.isfinite(value) and value >= 0):
@@ -151,7 +164,12 @@ def track3d(
         gyration_m,
     )
     foot = body.radius_m if footprint is None else footprint
-    note("flights: ballistic fits with g = 9.81 m/s^2 fixed, no air drag")
+    if air_drag > 0:
+        note(f"flights: g = 9.81 m/s^2 fixed and quadratic air drag k = "
+             f"{air_drag:g} 1/m (--air-drag)")  # fmt: skip
+    else:
+        note("flights: ballistic fits with g = 9.81 m/s^2 fixed, no air drag "
+             "(--air-drag 0, the default)")  # fmt: skip
     note(
         f"ground at each contact: a plane fitted to the DEM over a disc of radius "
         f"{foot:g} m{' (the block radius)' if footprint is None else ''} "
@@ -164,7 +182,8 @@ def track3d(
         for run in runs:
             reductions.append((
                 reduce_trajectory(run, terrain, b3, tolerance_m=tolerance,
-                                  footprint_m=foot, noise_sd_m=noise_sd),
+                                  footprint_m=foot, noise_sd_m=noise_sd,
+                                  drag_per_m=air_drag),
                 run,
             ))  # fmt: skip
     table = impact_rows(reductions, b3, foot, material)

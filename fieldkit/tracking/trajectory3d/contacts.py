@@ -116,7 +116,21 @@ def on_the_ground(
 
 
 def meet_time(a: Flight3D, b: Flight3D) -> float:
-    """Time at which two fitted flights come closest (g cancels: linear difference)."""
+    """Time at which two fitted flights come closest (g cancels: linear difference;
+    with air drag, searched between the first's last sample and the second's
+    first, widened by their gap either side)."""
+    if a.drag_per_m > 0 or b.drag_per_m > 0:
+        gap = max(b.t_ref_s - a.t_last_s, 1e-3)
+        lo, hi = a.t_last_s - gap, b.t_ref_s + gap
+        for _ in range(3):
+            ts = np.linspace(lo, hi, 41)
+            d = a.position(ts) - b.position(ts)
+            i = int(np.argmin(np.einsum("ij,ij->i", d, d)))
+            step = ts[1] - ts[0]
+            lo, hi = ts[max(i - 1, 0)], ts[min(i + 1, 40)]
+            if step < 1e-6:
+                break
+        return float(ts[i])
     # p(t) = p0 + v0 (t - tr) - g (t - tr)^2/2 z = c + lin t - g t^2/2 z: the
     # difference of two flights is c_a - c_b + (lin_a - lin_b) t
     c_a = a.p0_m - a.v0_mps * a.t_ref_s - 0.5 * G * a.t_ref_s**2 * _Z
@@ -138,7 +152,11 @@ def _fits(t, p, idx, fl, sigma, bound) -> bool:
 
 
 def refine_joins(
-    t_s: np.ndarray, xyz_m: np.ndarray, ranges: list[tuple[int, int]], sigma_m: float
+    t_s: np.ndarray,
+    xyz_m: np.ndarray,
+    ranges: list[tuple[int, int]],
+    sigma_m: float,
+    drag_per_m: float = 0.0,
 ) -> list[tuple[int, int]]:
     """Move the samples around each join to the flight on their side of the time
     the two flights meet (fitted without :data:`BOUNDARY_SAMPLES` at the join),
@@ -152,8 +170,10 @@ def refine_joins(
     for j in range(len(out) - 1):
         for _ in range(REFINE_PASSES):
             (a0, a1), (b0, b1) = out[j], out[j + 1]
-            fa = fit_flight(t, p, a0, max(a0 + m, a1 - k) if a1 - a0 > m else a1)
-            fb = fit_flight(t, p, min(b1 - m, b0 + k) if b1 - b0 > m else b0, b1)
+            fa = fit_flight(t, p, a0, max(a0 + m, a1 - k) if a1 - a0 > m else a1,
+                            drag_per_m=drag_per_m)  # fmt: skip
+            fb = fit_flight(t, p, min(b1 - m, b0 + k) if b1 - b0 > m else b0, b1,
+                            drag_per_m=drag_per_m)  # fmt: skip
             ts = meet_time(fa, fb)
             if not np.isfinite(ts):
                 break
@@ -181,6 +201,17 @@ def _reach(f: Flight3D, plane: LocalPlane, at: np.ndarray, h_m: float,
     (the plane's point under ``at``); NaN if never."""
     n = plane.normal
     ground = np.array([at[0], at[1], plane.z_m])
+    if f.drag_per_m > 0:
+        span = max(abs(near_s - f.t_ref_s), abs(near_s - f.t_last_s), 0.05)
+        ts = np.linspace(near_s - span, near_s + span, 801)
+        h = (f.position(ts) - ground) @ n - h_m
+        cross = np.flatnonzero(np.sign(h[:-1]) != np.sign(h[1:]))
+        if cross.size == 0:
+            return float("nan")
+        tc = ts[cross] - h[cross] * (ts[cross + 1] - ts[cross]) / (
+            h[cross + 1] - h[cross]
+        )
+        return float(tc[np.argmin(np.abs(tc - near_s))])
     tr = f.t_ref_s
     # (p0 + v0 tau - g tau^2/2 z - ground) . n = h
     qa = -0.5 * G * n[2]

@@ -79,13 +79,16 @@ def reduce_trajectory(
     tolerance_m: float,
     footprint_m: float,
     noise_sd_m: float | None = None,
+    drag_per_m: float = 0.0,
 ) -> Reduction3D:
-    """Flights, impacts and misfits of one trajectory on a DEM."""
+    """Flights, impacts and misfits of one trajectory on a DEM (``drag_per_m``:
+    the quadratic air drag parameter ``k = rho C_d A / (2 m)`` of the flights
+    [1/m]; 0 = ballistic)."""
     t, p = trajectory.t_s, trajectory.xyz_m
     sigma = noise_sd(t, p) if noise_sd_m is None else float(noise_sd_m)
-    ranges = segment_flights(t, p, sigma)
-    ranges = refine_joins(t, p, ranges, sigma)
-    flights = [fit_flight(t, p, a, b, sigma) for a, b in ranges]
+    ranges = segment_flights(t, p, sigma, drag_per_m)
+    ranges = refine_joins(t, p, ranges, sigma, drag_per_m)
+    flights = [fit_flight(t, p, a, b, sigma, drag_per_m) for a, b in ranges]
     ground = [
         on_the_ground(t, p, f, terrain, radius_m=body.radius_m,
                       tolerance_m=tolerance_m, footprint_m=footprint_m,
