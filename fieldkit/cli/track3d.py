@@ -39,7 +39,8 @@ def track3d(
         Path,
         typer.Argument(
             help="CSV of samples: path_id (or trajectory/run/id), t_s, x_m, y_m, z_m "
-            "(the block's centre in the DEM's coordinates), optional omega_radps.",
+            "(the block's centre in the DEM's coordinates), optional omega_radps or "
+            "omega_x_radps, omega_y_radps, omega_z_radps.",
             show_default=False,
         ),
     ],
@@ -200,8 +201,13 @@ def track3d(
         )
         for m in red.misfits:
             warn(f"{red.path_id}: {m.reason}")
-    if any(run.omega_radps is None for _, run in reductions):
-        note("no omega_radps column: omega_i/omega_f empty (omega_source none)")
+    if any(run.omega_radps is None and run.omega_vector_radps is None
+           for _, run in reductions):  # fmt: skip
+        note("no omega_radps or omega_x/y/z_radps columns: omega_i/omega_f empty "
+             "(omega_source none)")
+    elif any(run.omega_vector_radps is not None for _, run in reductions):
+        note("spin: the angular velocity's component about N x T at each impact, "
+             "omega = -w . (N x T) (rolling toward travel negative)")
     f = table.frame
     resolved = int(f["contact_duration_s"].notna().sum()) if len(f) else 0
     note(

@@ -78,6 +78,8 @@ class Contact:
     omega_f_radps: float
     vi_sd_mps: float = float("nan")
     vf_sd_mps: float = float("nan")
+    omega_vector_i_radps: np.ndarray | None = None
+    omega_vector_f_radps: np.ndarray | None = None
 
 
 def on_the_ground(
@@ -224,6 +226,12 @@ def _reach(f: Flight3D, plane: LocalPlane, at: np.ndarray, h_m: float,
     return float(roots[np.argmin(np.abs(roots - near_s))])
 
 
+def _spin_vector(omega, idx) -> np.ndarray | None:
+    if omega is None:
+        return None
+    return np.array([_spin(omega[:, c], idx) for c in range(3)])
+
+
 def _spin(omega, idx) -> float:
     if omega is None:
         return float("nan")
@@ -244,14 +252,17 @@ def classify_join(
     footprint_m: float,
     omega: np.ndarray | None,
     xyz_m: np.ndarray | None = None,
+    omega_vector: np.ndarray | None = None,
 ) -> Contact:
     """The join of flights ``a`` and ``b`` (flight numbers ``j``, ``j + 1``)."""
     t = np.asarray(t_s, float)
     dt = float(np.median(np.diff(t)))
     ts = meet_time(a, b)
     t_end, t_start = t[a.end - 1], t[b.start]
-    spin_i = _spin(omega, np.arange(max(a.start, a.end - SPIN_SAMPLES), a.end))
-    spin_f = _spin(omega, np.arange(b.start, min(b.end, b.start + SPIN_SAMPLES)))
+    before = np.arange(max(a.start, a.end - SPIN_SAMPLES), a.end)
+    after = np.arange(b.start, min(b.end, b.start + SPIN_SAMPLES))
+    spin_i = _spin(omega, before)
+    spin_f = _spin(omega, after)
     meets = np.isfinite(ts) and t_end - dt <= ts <= t_start + dt
     miss = float(np.linalg.norm(a.position(ts) - b.position(ts))) if meets else np.inf
     meets = meets and miss <= tolerance_m
@@ -270,7 +281,9 @@ def classify_join(
     def done(kind, reason, plane=None, height=float("nan")):
         return Contact(j, kind, reason, float(t_c), point, vi, vf, plane, height,
                        miss, duration if kind == "impact" else float("nan"),
-                       spin_i, spin_f, a.v_sd_mps, b.v_sd_mps)  # fmt: skip
+                       spin_i, spin_f, a.v_sd_mps, b.v_sd_mps,
+                       _spin_vector(omega_vector, before),
+                       _spin_vector(omega_vector, after))  # fmt: skip
 
     plane = local_plane(terrain, point[0], point[1], footprint_m)
     if plane is None:

@@ -110,6 +110,7 @@ def reduce_trajectory(
                 j + 1, t, flights[j], flights[j + 1], terrain,
                 radius_m=body.radius_m, tolerance_m=tolerance_m,
                 footprint_m=footprint_m, omega=trajectory.omega_radps, xyz_m=p,
+                omega_vector=trajectory.omega_vector_radps,
             )  # fmt: skip
         )
     return out
@@ -192,12 +193,17 @@ def impact_rows(
                 n[2], n[0]
             )
             vft = float(c.vf_mps @ tang)
+            spin_i, spin_f = c.omega_i_radps, c.omega_f_radps
+            if c.omega_vector_i_radps is not None:
+                axis = np.cross(n, tang)  # rolling toward T: w along N x T
+                spin_i = -float(c.omega_vector_i_radps @ axis)
+                spin_f = -float(c.omega_vector_f_radps @ axis)
             sd = _uncertainties(c, vin, vit, float(c.vf_mps @ n), vft)
             recs.append({
                 "rock": k, "t_s": c.t_s, "x_m": c.point_m[0], "y_m": c.point_m[1],
                 "z_m": c.point_m[2], "material_index": 0, "vin_mps": vin,
                 "vit_mps": vit, "vfn_mps": float(c.vf_mps @ n), "vft_mps": vft,
-                "omega_i_radps": c.omega_i_radps, "omega_f_radps": c.omega_f_radps,
+                "omega_i_radps": spin_i, "omega_f_radps": spin_f,
                 "normal_x": n[0], "normal_y": n[1], "normal_z": n[2],
                 "tangent_x": tang[0], "tangent_y": tang[1], "tangent_z": tang[2],
                 "mass_kg": body.mass_kg, "radius_m": body.radius_m,

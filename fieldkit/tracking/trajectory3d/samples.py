@@ -4,7 +4,10 @@ Columns (any order, names as :func:`fieldkit.io.csv_table.normalise_name` reads
 them): a trajectory id (``path_id``, ``trajectory``, ``run`` or ``id``; optional,
 one trajectory when absent), ``t_s``, ``x_m``, ``y_m``, ``z_m`` (the block's centre
 in the DEM's coordinates), optional ``omega_radps`` (spin about the axis across the
-direction of travel, the ImpactTable's sign: rolling toward travel is negative).
+direction of travel, the ImpactTable's sign: rolling toward travel is negative) or
+``omega_x_radps, omega_y_radps, omega_z_radps`` (the angular velocity vector in the
+DEM's axes; at each impact its component about ``N x T`` gives the spin, sign as
+the ImpactTable's: ``omega = -w . (N x T)``).
 Read strictly: a missing column, text in a number, an infinite value, an empty
 required cell or a time that does not increase within a trajectory is a one-line
 error naming the file, the row and the column.
@@ -24,6 +27,7 @@ from fieldkit.io.csv_table import read_csv_table
 ID_NAMES = ("path_id", "trajectory", "run", "id")
 REQUIRED = {"t_s": ("t",), "x_m": ("x",), "y_m": ("y",), "z_m": ("z",)}
 OMEGA_NAMES = ("omega", "omega_radps")
+OMEGA_VECTOR_NAMES = ("omega_x_radps", "omega_y_radps", "omega_z_radps")
 #: Fewest samples a trajectory needs (two flights of the shortest length).
 MIN_SAMPLES = 12
 
@@ -44,6 +48,8 @@ class Trajectory3D:
         Spin per sample [rad/s], or None when the file has none.
     rows
         The file row of every sample (for messages).
+    omega_vector_radps
+        ``(n, 3)`` angular velocity vectors in the DEM's axes [rad/s], or None.
     """
 
     path_id: str
@@ -51,6 +57,7 @@ class Trajectory3D:
     xyz_m: np.ndarray
     omega_radps: np.ndarray | None
     rows: np.ndarray
+    omega_vector_radps: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.t_s)
@@ -88,6 +95,26 @@ def read_trajectories(path: str | PathLike[str]) -> list[Trajectory3D]:
     )
     id_col = table.find(ID_NAMES, "the trajectory id")
     omega_col = table.find(OMEGA_NAMES, "the spin")
+    vec_cols = [table.find((name,), name) for name in OMEGA_VECTOR_NAMES]
+    if any(c is not None for c in vec_cols):
+        missing = [n for n, c in zip(OMEGA_VECTOR_NAMES, vec_cols, strict=True)
+                   if c is None]  # fmt: skip
+        if missing:
+            raise InputFileError(
+                f"the spin vector needs {', '.join(OMEGA_VECTOR_NAMES)}; missing "
+                f"{', '.join(missing)}",
+                source=source,
+                where="row 1",
+            )
+        if omega_col is not None:
+            raise InputFileError(
+                f"columns '{omega_col.header.strip()}' and omega_x/y/z_radps both give "
+                "the spin; keep one",
+                source=source,
+                where="row 1",
+            )
+    else:
+        vec_cols = []
     ids: list[str] = []
     values: list[list[float]] = []
     rows: list[int] = []
@@ -106,6 +133,7 @@ def read_trajectories(path: str | PathLike[str]) -> list[Trajectory3D]:
                 if omega_col is not None
                 else np.nan
             ]
+            + [table.number(number, row, c, required=False) for c in vec_cols]
         )
         rows.append(number)
     data = np.array(values, float)
@@ -133,5 +161,6 @@ def read_trajectories(path: str | PathLike[str]) -> list[Trajectory3D]:
                 where=f"row {r[0]}",
             )
         omega = data[sel, 4] if omega_col is not None else None
-        out.append(Trajectory3D(str(pid), t, data[sel, 1:4].copy(), omega, r))
+        vec = data[sel, 5:8].copy() if vec_cols else None
+        out.append(Trajectory3D(str(pid), t, data[sel, 1:4].copy(), omega, r, vec))
     return out
