@@ -6,6 +6,7 @@ import math
 from pathlib import Path
 from typing import Annotated
 
+import numpy as np
 import typer
 
 from fieldkit.cli.common import (
@@ -22,7 +23,7 @@ from fieldkit.cli.common import (
     warn,
 )
 from fieldkit.cli.progress import report_written, step
-from fieldkit.errors import ArgumentError
+from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.impact_table import table_format
 from fieldkit.outputs import OutputSet
 
@@ -152,6 +153,18 @@ def track3d(
         note("no -o given; printing the summary only")
     runs = read_trajectories(trajectories)
     terrain = terrain_from_dem(read_dem(dem))
+    for run in runs:
+        over = np.isfinite(terrain.heights(run.xyz_m[:, 0], run.xyz_m[:, 1]))
+        if not over.any():
+            x0, y0, x1, y1 = terrain.surface_extent()
+            raise InputFileError(
+                f"trajectory {run.path_id}: no sample lies over the DEM's surface "
+                f"(x {x0:g}..{x1:g}, y {y0:g}..{y1:g} m; the first sample is at x "
+                f"{run.xyz_m[0, 0]:g}, y {run.xyz_m[0, 1]:g}): are the trajectory "
+                "and the DEM in the same coordinates?",
+                source=str(trajectories),
+                where=f"row {run.rows[0]}",
+            )
     print_body_notes(body)
     nan = float("nan")
     gyration_m = body.gyration_m

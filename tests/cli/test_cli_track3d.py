@@ -148,6 +148,21 @@ def test_bad_samples_are_one_line_and_write_nothing(cli, fails, tmp_path, digest
     assert digest(samples) == before
 
 
+def test_a_trajectory_off_the_dem_is_refused(cli, fails, tmp_path):
+    """Samples in other coordinates than the DEM (shifted 5 km): one line naming
+    the file, the trajectory's first row and the DEM's extent; nothing written."""
+    terrain, runs = simulated_runs(100.0, rocks=2)
+    run = runs[0]
+    s = run.samples.copy()
+    s["x_m"] += 5000.0
+    samples, dem = write_site(tmp_path, terrain, [type(run)(s, run.truth)])
+    out = tmp_path / "out.csv"
+    fails(cli("track3d", samples, "--dem", dem, "--radius", RADIUS_M, "-o", out),
+          "trajectories.csv", "row 2", "no sample lies over the DEM",
+          "same coordinates")  # fmt: skip
+    assert not out.exists()
+
+
 def test_no_dem_no_radius(cli, fails, tmp_path):
     terrain, runs = simulated_runs(100.0, rocks=2)
     samples, dem = write_site(tmp_path, terrain, runs[:1])
