@@ -83,6 +83,13 @@ def test_every_impact_found_with_en_et_lateral_recovered(cli, tmp_path, fps):
         assert np.abs(f[c] - t[c]).max() < 0.03, c
         assert np.median(np.abs(f[c] - t[c])) < 0.005, c
     assert np.abs(f["dip_deg"] - t["dip_deg"]).max() < 1.0
+    # ... and the other columns of the simulator's rows, column by column
+    for name, tol in (("t_s", 0.005), ("x_m", 0.05), ("y_m", 0.05), ("z_m", 0.05),
+                      ("slope_deg", 1.0), ("vi_mps", 0.15), ("vf_mps", 0.15),
+                      ("vin_mps", 0.15), ("vfn_mps", 0.15), ("vit_mps", 0.15),
+                      ("vft_mps", 0.15), ("theta_i_deg", 1.0),
+                      ("energy_head_i_m", 0.1)):  # fmt: skip
+        assert np.abs(f[name] - t[name]).max() < tol, name
     # the lumped-mass contact is on the DEM: within a few noise SDs of the plane
     assert np.abs(f["contact_height_m"]).max() < 3 * NOISE_SD_M
     assert (f["surface_footprint_m"] == RADIUS_M).all()
