@@ -135,7 +135,7 @@ class ProfileGround:
         if x.ndim != 1 or x.shape != z.shape or len(x) < 2:
             raise ArgumentError(
                 "a ground profile needs matching x_m, z_m with at least 2 vertices",
-                source="profile",
+                source="ground_profile",
             )
         if (
             not (np.isfinite(x).all() and np.isfinite(z).all())
@@ -143,7 +143,7 @@ class ProfileGround:
         ):
             raise ArgumentError(
                 "a ground profile needs finite vertices with x strictly increasing",
-                source="profile",
+                source="ground_profile",
             )
         object.__setattr__(self, "x_m", x)
         object.__setattr__(self, "z_m", z)
@@ -206,7 +206,7 @@ class DemSectionGround:
         )
         if not length > 0:
             raise ArgumentError(
-                "the section line's two plan points are identical", source="section"
+                "the section line's two plan points are identical", source="section_line"
             )
         if not (math.isfinite(self.footprint_m) and self.footprint_m > 0):
             raise ArgumentError(
