@@ -206,7 +206,8 @@ class DemSectionGround:
         )
         if not length > 0:
             raise ArgumentError(
-                "the section line's two plan points are identical", source="section_line"
+                "the section line's two plan points are identical",
+                source="section_line",
             )
         if not (math.isfinite(self.footprint_m) and self.footprint_m > 0):
             raise ArgumentError(
