@@ -280,3 +280,21 @@ def test_contact_off_the_dem_one_error_nothing_written(cli, scene, tmp_path):
     assert len(errors) == 1 and "Traceback" not in result.stderr
     assert "dem.asc" in errors[0] and "off the grid or nodata" in errors[0]
     assert not out.exists()
+
+
+def test_track_body_from_block_dimensions(cli, scene, tmp_path):
+    """The track's body from a block's principal lengths (`--shape block`): k of the
+    solid ellipsoid rolling about its shortest axis reaches every impact row; the
+    restitution on the known ground does not depend on it."""
+    table, result = _track(
+        cli, scene, tmp_path, "--surface-profile", scene["profile"],
+        "--shape", "block", "--dimensions", "0.05,0.09,0.07",
+    )  # fmt: skip
+    k = math.sqrt((0.09**2 + 0.07**2) / 20.0)
+    np.testing.assert_allclose(table["gyration_m"], k, rtol=1e-12)
+    # --radius 0.0375 overrides the block's contact radius (0.045 + 0.035) / 2
+    np.testing.assert_allclose(table["radius_m"], RADIUS_M)
+    assert "note: --radius 0.0375 m overrides the block's contact radius 0.04 m" in (
+        result.stderr
+    )
+    _check_per_impact(table, scene["truth"], "profile")
