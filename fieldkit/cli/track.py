@@ -88,8 +88,9 @@ def track(
         float | None,
         typer.Option(
             "--surface-angle",
-            help="Dip of the impact surface (deg), positive descending along travel "
-            "(default: estimated from the contact points).",
+            help="Dip of the impact surface (deg), positive descending along travel, "
+            "one for every contact (default: estimated from the contact points; a "
+            "slope per contact: --surface-profile or --surface-dem).",
         ),
     ] = None,
     surface_profile: Annotated[
