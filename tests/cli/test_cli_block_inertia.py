@@ -122,3 +122,25 @@ def test_reduce_with_a_block_of_principal_lengths(cli, repo, tmp_path):
     assert table["radius_m"].to_numpy() == pytest.approx((0.23 + 0.15) / 2)
     assert (table["mass_kg"] == 40).all()
     assert "note: --mass 40 kg overrides the" in result.stderr
+
+
+def test_2d_model_body_dimensions_give_k(cli, tmp_path):
+    """The profile (2-D) model file reads the same body block."""
+    data = {
+        "profile": {"x_m": [0, 12, 40], "z_m": [100, 80, 62],
+                    "material": ["rock", "talus"]},
+        "materials": {"rock": {"e_n": 0.6, "e_t": 0.9, "friction_deg": 30},
+                      "talus": {"e_n": 0.5, "e_t": 0.85, "friction_deg": 35}},
+        "body": {"mass_kg": MASS_KG, "radius_m": RADIUS_M,
+                 "dimensions_m": list(PLATE)},
+        "seeder": {"x_m": 0.5, "z_m": 101.0, "vx_mps": 4.0, "vz_mps": 1.0,
+                   "omega_radps": 0.0},
+    }  # fmt: skip
+    model = tmp_path / "model.json"
+    model.write_text(json.dumps(data))
+    out = tmp_path / "impacts.csv"
+    result = cli("simulate", model, "--rocks", "2", "--seed", "1", "--impacts", out)
+    assert result.exit_code == 0, result.stderr
+    table = pd.read_csv(out)
+    assert len(table) > 0
+    np.testing.assert_allclose(table["gyration_m"], K_PLATE, rtol=1e-12)
