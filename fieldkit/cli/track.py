@@ -392,8 +392,8 @@ def ground_for_body(ground, footprint_default: bool, radius_m: float):
 
 
 def ground_gap_warnings(ground, analysis, radius_m: float) -> list[str]:
-    """A warning per impact whose centre lies off a surveyed profile by more than
-    one radius beyond contact (is the profile in the track's frame?)."""
+    """A warning per impact whose centre lies off the known ground (a profile, a
+    DEM) by more than one radius beyond contact (is it in the track's frame?)."""
     from fieldkit.tracking.flights.contact_impacts import travel_direction
 
     if not hasattr(ground, "distance_m"):
@@ -401,13 +401,14 @@ def ground_gap_warnings(ground, analysis, radius_m: float) -> list[str]:
     frame = analysis.impacts.frame
     messages = []
     sx = travel_direction(analysis.flights)  # the table's x is mirrored toward -x
+    what = "surface profile" if ground.source == "profile" else "DEM's plane"
     for _, row in frame.iterrows():
         gap = ground.distance_m(sx * float(row["x_m"]), float(row["z_m"])) - radius_m
         if abs(gap) > radius_m:
             messages.append(
                 f"impact {row['point']}: the body's centre is {gap:+.3f} m off "
-                f"contact with the surface profile (radius {radius_m:g} m): is the "
-                "profile in the track's frame?"
+                f"contact with the {what} (radius {radius_m:g} m): is it in the "
+                "track's frame?"
             )
     return messages
 

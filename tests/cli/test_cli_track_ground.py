@@ -106,6 +106,22 @@ def bounce_on_profile() -> tuple[np.ndarray, list[dict]]:
     return poses, impacts
 
 
+def write_dem(path, offset_m: float = 0.0):
+    """The section extruded across, z(E, N) = profile(E - E0) + offset, 0.05 m cells."""
+    px, pz = profile_vertices()
+    e = np.arange(-0.3, 1.4, DEM_CELL_M)
+    rows = 8
+    z_row = np.interp(e + 0.5 * DEM_CELL_M, px, pz) + offset_m
+    path.write_text(
+        f"ncols {len(e)}\nnrows {rows}\nxllcorner {E0_M + e[0]}\n"
+        f"yllcorner {N0_M - rows * DEM_CELL_M / 2}\ncellsize {DEM_CELL_M}\n"
+        "NODATA_value -9999\n"
+        + "\n".join(" ".join(f"{v:.9f}" for v in z_row) for _ in range(rows))
+        + "\n"
+    )
+    return path
+
+
 @pytest.fixture(scope="module")
 def scene(repo, tmp_path_factory):
     """The rendered clip, its homography, the profile CSV and the DEM."""
@@ -139,18 +155,7 @@ def scene(repo, tmp_path_factory):
     profile.write_text(
         "x_m,z_m\n" + "\n".join(f"{x:.9f},{z:.9f}" for x, z in zip(px, pz, strict=True))
     )
-    # the section extruded across: z(E, N) = profile(E - E0), 0.05 m cells
-    e = np.arange(-0.3, 1.4, DEM_CELL_M)
-    rows = 8
-    z_row = np.interp(e + 0.5 * DEM_CELL_M, px, pz)
-    dem = folder / "dem.asc"
-    dem.write_text(
-        f"ncols {len(e)}\nnrows {rows}\nxllcorner {E0_M + e[0]}\n"
-        f"yllcorner {N0_M - rows * DEM_CELL_M / 2}\ncellsize {DEM_CELL_M}\n"
-        "NODATA_value -9999\n"
-        + "\n".join(" ".join(f"{v:.9f}" for v in z_row) for _ in range(rows))
-        + "\n"
-    )
+    dem = write_dem(folder / "dem.asc")
     return dict(
         video=video, homography=homography, profile=profile, dem=dem, truth=impacts
     )
@@ -205,6 +210,7 @@ def test_dem_plane_fit_gives_each_impact_its_own_slope(cli, scene, tmp_path):
         result.stderr
     )
     assert "over a disc of radius 0.05 m" in result.stderr
+    assert "off contact" not in result.stderr  # the DEM is in the track's frame
 
 
 def test_one_mean_slope_fails_the_same_check(cli, scene, tmp_path):
@@ -227,7 +233,7 @@ def test_one_mean_slope_fails_the_same_check(cli, scene, tmp_path):
     assert np.abs(errors[:, 1]).min() > 0.07, errors
 
 
-def test_misaligned_profile_is_warned_about(cli, scene, tmp_path):
+def test_misaligned_ground_is_warned_about(cli, scene, tmp_path):
     shifted = tmp_path / "shifted.csv"
     px, pz = profile_vertices()
     shifted.write_text(
@@ -235,6 +241,19 @@ def test_misaligned_profile_is_warned_about(cli, scene, tmp_path):
     )
     _, result = _track(cli, scene, tmp_path, "--surface-profile", shifted)
     assert result.stderr.count("off contact with the surface profile") == 2
+    dem = write_dem(tmp_path / "low.asc", offset_m=-0.3)
+    section = f"{E0_M},{N0_M},{E0_M + 1},{N0_M}"
+    table, result = _track(
+        cli, scene, tmp_path, "--surface-dem", dem, "--section", section
+    )
+    assert result.stderr.count("off contact with the DEM's plane") == 2
+    # the ground 0.3 m too low: the centre is 0.3 cos(psi) farther from its plane
+    for point, psi in zip("12", DIPS_DEG, strict=True):
+        gap = 0.3 * math.cos(math.radians(psi))
+        assert f"impact {point}: the body's centre is {gap:+.3f} m off" in (
+            result.stderr
+        )
+    np.testing.assert_allclose(table["slope_deg"], DIPS_DEG, atol=0.01)
 
 
 @pytest.mark.parametrize(

@@ -240,22 +240,40 @@ class DemSectionGround:
         inside = de**2 + dn**2 <= 1.0 + 1e-12
         return self.footprint_m * de[inside], self.footprint_m * dn[inside]
 
-    def dip_deg(self, x_m: np.ndarray, z_m: np.ndarray, travel: float) -> np.ndarray:
+    def plane_at(self, x_m: float) -> tuple[float, float]:
+        """The fitted plane below section x ``x_m`` [m]: its height there [m] and
+        its slope along the section line (dz per metre of x).
+
+        Raises
+        ------
+        InputFileError
+            Naming the DEM, when the footprint reaches off the grid or into nodata.
+        """
         ue, un = self.direction
         de, dn = self._offsets()
+        e0 = self.start_m[0] + float(x_m) * ue
+        n0 = self.start_m[1] + float(x_m) * un
+        z, _, _, status = self.grid.sample(e0 + de, n0 + dn)
+        if (status != INSIDE).any():
+            raise InputFileError(
+                f"the contact at section x {float(x_m):.3f} m (plan {e0:.2f}, "
+                f"{n0:.2f}) has DEM cells off the grid or nodata within "
+                f"{self.footprint_m:g} m",
+                source=self.grid.source or None,
+            )
         design = np.column_stack([np.ones_like(de), de, dn])
+        (a, b, c), *_ = np.linalg.lstsq(design, z, rcond=None)
+        return float(a), float(b * ue + c * un)
+
+    def dip_deg(self, x_m: np.ndarray, z_m: np.ndarray, travel: float) -> np.ndarray:
         out = np.empty(np.shape(x_m))
         for k, x in enumerate(np.ravel(x_m)):
-            e0 = self.start_m[0] + float(x) * ue
-            n0 = self.start_m[1] + float(x) * un
-            z, _, _, status = self.grid.sample(e0 + de, n0 + dn)
-            if (status != INSIDE).any():
-                raise InputFileError(
-                    f"the contact at section x {float(x):.3f} m (plan {e0:.2f}, "
-                    f"{n0:.2f}) has DEM cells off the grid or nodata within "
-                    f"{self.footprint_m:g} m",
-                    source=self.grid.source or None,
-                )
-            (_, b, c), *_ = np.linalg.lstsq(design, z, rcond=None)
-            out.flat[k] = travel * -math.degrees(math.atan(b * ue + c * un))
+            _, slope = self.plane_at(float(x))
+            out.flat[k] = travel * -math.degrees(math.atan(slope))
         return out
+
+    def distance_m(self, x_m: float, z_m: float) -> float:
+        """Distance [m] of the point ``(x_m, z_m)`` from the fitted plane below it
+        (the track's z must then be elevation in the DEM's datum)."""
+        height, slope = self.plane_at(float(x_m))
+        return abs(float(z_m) - height) / math.sqrt(1.0 + slope * slope)
