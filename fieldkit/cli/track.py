@@ -97,10 +97,11 @@ def track(
         Path | None,
         typer.Option(
             "--surface-profile",
-            help="Surveyed section of the ground in the track's frame (x along the "
-            "track, z up, metres): a profile CSV (x_m,z_m[,material], as `fieldkit "
-            "profile` writes) or a model file's profile. The slope at each contact "
-            "is the dip of the segment nearest the body's centre.",
+            help="Surveyed section of the ground in the calibrated frame (the "
+            "homography's or scale points' x, z up, metres): a profile CSV "
+            "(x_m,z_m[,material], as `fieldkit profile` writes) or a model file's "
+            "profile. The slope at each contact is the dip of the segment nearest "
+            "the body's centre.",
         ),
     ] = None,
     surface_dem: Annotated[
@@ -395,7 +396,9 @@ def ground_gap_warnings(ground, analysis, radius_m: float) -> list[str]:
     """A warning per impact whose centre lies off the known ground (a profile, a
     DEM) by more than one radius beyond contact (is it in the track's frame?)."""
     from fieldkit.tracking.flights.contact_impacts import travel_direction
+    from fieldkit.tracking.flights.ground import in_track_frame
 
+    ground = in_track_frame(ground, analysis.track.meta)
     if not hasattr(ground, "distance_m"):
         return []
     frame = analysis.impacts.frame

@@ -123,25 +123,33 @@ def write_dem(path, offset_m: float = 0.0):
 
 
 @pytest.fixture(scope="module")
-def scene(repo, tmp_path_factory):
-    """The rendered clip, its homography, the profile CSV and the DEM."""
+def render(repo):
     name = "fieldkit_video_render_for_ground"
     spec = importlib.util.spec_from_file_location(name, repo / "video" / "render.py")
-    render = importlib.util.module_from_spec(spec)
-    sys.modules[name] = render
-    spec.loader.exec_module(render)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
 
-    folder = tmp_path_factory.mktemp("ground")
-    poses, impacts = bounce_on_profile()
-    assert [i["segment"] for i in impacts] == [0, 1]
-    assert impacts[-1]["t_s"] < (FRAMES - 60) / FPS  # a flight after the 2nd impact
+
+def _render_clip(render, path, poses):
     camera = render.Camera(width=560, height=300, origin_u_px=40.0, origin_v_px=225.0)
     rng = np.random.default_rng(7)
     plate_away = render.BounceScene(plate_point_m=(0.0, -5.0))  # not drawn in view
     bg = np.clip(render.background(camera, rng, plate_away) + 0.5, 0, 255)
-    video = render.write_clip(
-        folder / "ground.avi", camera, render.Ball(), bg.astype(np.uint8), poses, rng
+    return render.write_clip(
+        path, camera, render.Ball(), bg.astype(np.uint8), poses, rng
     )
+
+
+@pytest.fixture(scope="module")
+def scene(render, tmp_path_factory):
+    """The rendered clip, its homography, the profile CSV and the DEM."""
+    folder = tmp_path_factory.mktemp("ground")
+    poses, impacts = bounce_on_profile()
+    assert [i["segment"] for i in impacts] == [0, 1]
+    assert impacts[-1]["t_s"] < (FRAMES - 60) / FPS  # a flight after the 2nd impact
+    video = _render_clip(render, folder / "ground.avi", poses)
     corners = [(40, 225), (540, 225), (540, 25), (40, 25)]
     homography = folder / "h.csv"
     homography.write_text(
@@ -317,3 +325,30 @@ def test_track_body_from_block_dimensions(cli, scene, tmp_path):
         result.stderr
     )
     _check_per_impact(table, scene["truth"], "profile")
+
+
+def test_travel_toward_minus_x_turns_the_profile_dip(cli, scene, render, tmp_path):
+    """The same bounce mirrored (x -> 1 - x): the ball travels toward -x down a
+    profile that rises toward +x; the table's x is mirrored, and each impact's slope
+    is still 10 and 30 deg descending along travel."""
+    poses, _ = bounce_on_profile()
+    poses[:, 0] = 1.0 - poses[:, 0]
+    poses[:, 2] = np.pi - poses[:, 2]
+    video = _render_clip(render, tmp_path / "mirrored.avi", poses)
+    px, pz = profile_vertices()
+    profile = tmp_path / "mirrored.csv"
+    profile.write_text(
+        "x_m,z_m\n"
+        + "\n".join(
+            f"{1 - x:.9f},{z:.9f}" for x, z in zip(px[::-1], pz[::-1], strict=True)
+        )
+    )
+    out = tmp_path / "impacts.csv"
+    result = cli(
+        "track", video, "--fps", FPS, "--homography", scene["homography"],
+        "--radius", RADIUS_M, "--impacts", out, "--surface-profile", profile,
+    )  # fmt: skip
+    assert result.exit_code == 0, result.stderr
+    assert "the body travels toward -x" in result.stderr
+    assert "off contact" not in result.stderr
+    _check_per_impact(pd.read_csv(out), scene["truth"], "profile")

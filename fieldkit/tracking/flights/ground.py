@@ -8,12 +8,14 @@ contact (a surveyed section, :class:`ProfileGround`; a DEM cut by a section line
 (``slope_deg``) and where it came from (``slope_source``: ``given``, ``profile``,
 ``dem``).
 
-Frames. A ground is given in the track's own frame: ``x`` horizontal (for a DEM, the
-plan distance along the section line from its first point), ``z`` up.
-:meth:`Ground.dip_deg` answers in the ImpactTable's travel frame (docs/architecture.md
-§2: positive when the ground descends in the direction of travel), so for a body
-travelling toward -x a profile's dip changes sign; a constant angle is already given
-along travel.
+Frames. A ground is given in the calibrated frame of the track: ``x`` horizontal (for
+a DEM, the plan distance along the section line from its first point), ``z`` up. A
+video track whose body travels toward -x is stored mirrored (``x -> -x``,
+``meta["mirrored_x"]``, :mod:`fieldkit.tracking.video.pipeline`);
+:func:`in_track_frame` turns the ground to match. :meth:`Ground.dip_deg` answers in the
+ImpactTable's travel frame (docs/architecture.md §2: positive when the ground descends
+in the direction of travel), so for a body travelling toward -x a profile's dip changes
+sign; a constant angle is already given along travel.
 
 How the local slope is computed:
 
@@ -277,3 +279,41 @@ class DemSectionGround:
         (the track's z must then be elevation in the DEM's datum)."""
         height, slope = self.plane_at(float(x_m))
         return abs(float(z_m) - height) / math.sqrt(1.0 + slope * slope)
+
+
+@dataclass(frozen=True)
+class MirroredGround:
+    """``ground`` seen from a track stored with ``x -> -x`` (:func:`in_track_frame`).
+
+    Examples
+    --------
+    >>> g = ProfileGround(np.array([0.0, 1.0, 2.0]), np.array([0.0, -0.2, -1.2]))
+    >>> m = MirroredGround(g)  # travel toward +x in the track: up this profile
+    >>> float(m.dip_deg(np.array([-1.6]), np.array([-0.5]), 1.0)[0])
+    -45.0
+    """
+
+    ground: Ground
+
+    @property
+    def source(self) -> str:
+        return self.ground.source
+
+    @property
+    def description(self) -> str:
+        return self.ground.description
+
+    def dip_deg(self, x_m: np.ndarray, z_m: np.ndarray, travel: float) -> np.ndarray:
+        return self.ground.dip_deg(-np.asarray(x_m, float), z_m, -travel)
+
+    def distance_m(self, x_m: float, z_m: float) -> float:
+        return self.ground.distance_m(-float(x_m), z_m)  # type: ignore[attr-defined]
+
+
+def in_track_frame(ground: Ground | None, meta: dict) -> Ground | None:
+    """``ground`` (given in the calibrated frame) in the frame of a track with
+    metadata ``meta``: mirrored when the track was stored with ``x -> -x``
+    (``meta["mirrored_x"]``). A constant angle is given along travel and stays."""
+    if ground is None or isinstance(ground, ConstantGround):
+        return ground
+    return MirroredGround(ground) if meta.get("mirrored_x") else ground

@@ -28,7 +28,7 @@ from fieldkit.tracking.flights.contact_impacts import (
     build_impact_table,
     find_contact_events,
 )
-from fieldkit.tracking.flights.ground import ConstantGround, Ground
+from fieldkit.tracking.flights.ground import ConstantGround, Ground, in_track_frame
 from fieldkit.tracking.flights.net_contacts import (
     NetContact,
     analyse_net_contact,
@@ -175,8 +175,11 @@ def analyse_track(
     path_id
         Identifier written to the ImpactTable.
     ground
-        The known ground (:mod:`fieldkit.tracking.flights.ground`): a dip per
-        contact from a surveyed profile or a DEM; excludes ``surface_angle_deg``.
+        The known ground (:mod:`fieldkit.tracking.flights.ground`) in the track's
+        calibrated frame (turned by
+        :func:`~fieldkit.tracking.flights.ground.in_track_frame` when the track is
+        stored mirrored): a dip per contact from a surveyed profile or a DEM;
+        excludes ``surface_angle_deg``.
 
     Returns
     -------
@@ -201,6 +204,7 @@ def analyse_track(
                 source="surface_angle_deg",
             )
         ground = ConstantGround(surface_angle_deg)
+    ground = in_track_frame(ground, track.meta)
     if mass_kg is not None and not mass_kg > 0:
         raise ArgumentError(f"mass_kg must be > 0 (got {mass_kg:g})", source="mass_kg")
     if gyration_m is not None and not gyration_m > 0:
