@@ -8,7 +8,8 @@ Tracker or Kinovea):
 2. :func:`fieldkit.tracking.flights.ballistic_fit.fit_flight` fits each flight with g
    free (its g and standard error are checked against 9.81) and with g fixed;
 3. :mod:`fieldkit.tracking.flights.contact_impacts` evaluates the fits at each contact
-   and builds the ImpactTable (surface angle given or estimated);
+   and builds the ImpactTable (the ground given -- one angle, a profile, a DEM:
+   :mod:`fieldkit.tracking.flights.ground` -- or its angle estimated);
 4. :mod:`fieldkit.tracking.flights.net_contacts` describes every extended contact (net).
 """
 
