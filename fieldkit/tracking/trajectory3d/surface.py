@@ -70,7 +70,7 @@ def local_plane(
     --------
     >>> t = Terrain(0.0, 0.0, 1.0, np.add.outer(np.zeros(4), -0.5 * np.arange(4)))
     >>> p = local_plane(t, 1.5, 1.5, 0.2)
-    >>> [round(float(v), 4) for v in p.normal], round(p.z_m, 6)
+    >>> [round(float(v), 4) + 0.0 for v in p.normal], round(p.z_m, 6)
     ([0.4472, 0.0, 0.8944], -0.5)
     """
     dx, dy = _disc(footprint_m)
