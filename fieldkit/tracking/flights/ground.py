@@ -23,8 +23,11 @@ How the local slope is computed:
   (the segment the body touches: at a kink the centre lies within one radius of the
   segment it meets, and farther from the other);
 * DEM: a least-squares plane ``z = a + b e + c n`` through the DEM (bilinear) sampled
-  on a square grid of :data:`FOOTPRINT_SAMPLES` x :data:`FOOTPRINT_SAMPLES` points
-  clipped to a disc of the footprint radius around the plan point below the centre;
+  on a square grid of :data:`~fieldkit.io.dem.FOOTPRINT_SAMPLES` x
+  :data:`~fieldkit.io.dem.FOOTPRINT_SAMPLES` points clipped to a disc of the footprint
+  radius around the plan point below the centre
+  (:func:`fieldkit.io.dem.footprint_offsets`, :func:`fieldkit.io.dem.footprint_plane`:
+  the same plane ``fieldkit track3d`` fits at a 3-D contact);
   the dip is that plane's slope along the section line, ``psi = -atan(b u_e + c u_n)``
   (``u`` the line's unit plan direction). The footprint radius is stated by the
   caller (default: the body radius, at least one DEM cell, so that the fit sees more
@@ -40,10 +43,12 @@ from typing import Protocol
 import numpy as np
 
 from fieldkit.errors import ArgumentError, InputFileError
-from fieldkit.io.dem import INSIDE, DemGrid
-
-#: Points per side of the square sampling grid of a DEM footprint (clipped to a disc).
-FOOTPRINT_SAMPLES = 9
+from fieldkit.io.dem import (
+    INSIDE,
+    DemGrid,
+    footprint_offsets,
+    footprint_plane,
+)
 
 
 class Ground(Protocol):
@@ -237,10 +242,7 @@ class DemSectionGround:
         ).replace("DEM  over", "DEM over")
 
     def _offsets(self) -> tuple[np.ndarray, np.ndarray]:
-        s = np.linspace(-1.0, 1.0, FOOTPRINT_SAMPLES)
-        de, dn = np.meshgrid(s, s)
-        inside = de**2 + dn**2 <= 1.0 + 1e-12
-        return self.footprint_m * de[inside], self.footprint_m * dn[inside]
+        return footprint_offsets(self.footprint_m)
 
     def plane_at(self, x_m: float) -> tuple[float, float]:
         """The fitted plane below section x ``x_m`` [m]: its height there [m] and
@@ -263,9 +265,8 @@ class DemSectionGround:
                 f"{self.footprint_m:g} m",
                 source=self.grid.source or None,
             )
-        design = np.column_stack([np.ones_like(de), de, dn])
-        (a, b, c), *_ = np.linalg.lstsq(design, z, rcond=None)
-        return float(a), float(b * ue + c * un)
+        a, b, c, _ = footprint_plane(de, dn, z)
+        return a, b * ue + c * un
 
     def dip_deg(self, x_m: np.ndarray, z_m: np.ndarray, travel: float) -> np.ndarray:
         out = np.empty(np.shape(x_m))

@@ -2,12 +2,15 @@
 
 The DEM's surface is the 3-D simulator's (:class:`fieldkit.model.terrain.Terrain`:
 bilinear between cell centres). At a contact the plane ``z = a + b (x - x0) + c (y -
-y0)`` is fitted by least squares to that surface at :data:`FOOTPRINT_POINTS` points
-spread evenly over a disc of radius ``footprint_m`` about the contact's plan position
-(the block's radius by default: the ground it can touch). N is the plane's upward unit
-normal. Over a disc inside one DEM patch the fit gives the bilinear surface's own
-gradient at the centre exactly (the twist term is orthogonal to a plane over a
-symmetric disc), so on a simulated run N is the normal the simulator used.
+y0)`` is fitted by least squares to that surface at the points of a square grid
+over a disc of radius ``footprint_m`` about the contact's plan position (the block's
+radius by default: the ground it can touch) -- the footprint and the fit of
+:func:`fieldkit.io.dem.footprint_offsets` and :func:`fieldkit.io.dem.footprint_plane`,
+shared with the 2-D tracks' DEM ground (:mod:`fieldkit.tracking.flights.ground`).
+N is the plane's upward unit normal. Over a disc inside one DEM patch the fit gives
+the bilinear surface's own gradient at the centre exactly (the twist term is
+orthogonal to a plane over a symmetric disc), so on a simulated run N is the normal
+the simulator used.
 """
 
 from __future__ import annotations
@@ -16,12 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fieldkit.io.dem import footprint_offsets, footprint_plane
 from fieldkit.model.terrain import Terrain
-
-#: Rings x points of the footprint disc the plane is fitted to (centre included).
-FOOTPRINT_RINGS = 3
-FOOTPRINT_SPOKES = 12
-FOOTPRINT_POINTS = 1 + FOOTPRINT_RINGS * FOOTPRINT_SPOKES
 
 
 @dataclass(frozen=True)
@@ -51,14 +50,6 @@ class LocalPlane:
         return float((np.asarray(xyz_m, float) - ground) @ self.normal)
 
 
-def _disc(radius_m: float) -> tuple[np.ndarray, np.ndarray]:
-    r = radius_m * np.arange(1, FOOTPRINT_RINGS + 1) / FOOTPRINT_RINGS
-    a = 2 * np.pi * np.arange(FOOTPRINT_SPOKES) / FOOTPRINT_SPOKES
-    dx = np.r_[0.0, (r[:, None] * np.cos(a)[None, :]).ravel()]
-    dy = np.r_[0.0, (r[:, None] * np.sin(a)[None, :]).ravel()]
-    return dx, dy
-
-
 def local_plane(
     terrain: Terrain, x_m: float, y_m: float, footprint_m: float
 ) -> LocalPlane | None:
@@ -73,18 +64,11 @@ def local_plane(
     >>> [round(float(v), 4) + 0.0 for v in p.normal], round(p.z_m, 6)
     ([0.4472, 0.0, 0.8944], -0.5)
     """
-    dx, dy = _disc(footprint_m)
+    dx, dy = footprint_offsets(footprint_m)
     z = terrain.heights(x_m + dx, y_m + dy)
     ok = np.isfinite(z)
-    if ok.sum() < FOOTPRINT_POINTS / 2:
+    if ok.sum() < dx.size / 2:
         return None
-    a = np.c_[np.ones(ok.sum()), dx[ok], dy[ok]]
-    coef, *_ = np.linalg.lstsq(a, z[ok], rcond=None)
-    res = z[ok] - a @ coef
-    n = np.array([-coef[1], -coef[2], 1.0])
-    return LocalPlane(
-        float(coef[0]),
-        n / np.linalg.norm(n),
-        int(ok.sum()),
-        float(np.sqrt(np.mean(res * res))),
-    )
+    a, b, c, rms = footprint_plane(dx[ok], dy[ok], z[ok])
+    n = np.array([-b, -c, 1.0])
+    return LocalPlane(a, n / np.linalg.norm(n), int(ok.sum()), rms)
