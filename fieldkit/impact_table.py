@@ -192,6 +192,43 @@ EXTENSION_COLUMNS: tuple[Column, ...] = (
         "dip_deg", "float", False, "3-D rows: dip of the surface N is normal to [deg]"
     ),
     Column(
+        "chainage_m",
+        "float",
+        False,
+        "3-D rows from a trajectory (fieldkit track3d): plan distance along the path "
+        "from its first sample to the impact (unrolled; flights are straight in "
+        "plan) [m]",
+    ),
+    Column(
+        "lateral_deg",
+        "float",
+        False,
+        "3-D rows from a trajectory: change of the plan direction of travel at the "
+        "impact, from the incoming to the outgoing velocity, counter-clockwise "
+        "positive seen from above, in (-180, 180] [deg]",
+    ),
+    Column(
+        "lateral_sd_deg",
+        "float",
+        False,
+        "standard uncertainty of lateral_deg from the sampling noise [deg]",
+    ),
+    Column(
+        "contact_height_m",
+        "float",
+        False,
+        "3-D rows from a trajectory: the centre's distance above the local ground "
+        "plane at the impact, along N (about the radius for a block, 0 for a "
+        "simulated lumped mass) [m]",
+    ),
+    Column(
+        "surface_footprint_m",
+        "float",
+        False,
+        "3-D rows from a trajectory: radius of the disc of DEM the local ground "
+        "plane (N) was fitted over [m]",
+    ),
+    Column(
         "vin_vfn_corr",
         "float",
         False,

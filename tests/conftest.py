@@ -78,6 +78,7 @@ BUNDLED = (
     "tests/io/data",
     "examples/tschamut",
     "examples/rstone_tornado",
+    "examples/track3d",
 )
 
 

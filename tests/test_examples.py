@@ -153,6 +153,18 @@ EXPECTED = {
         r"null threshold [+-]\d+\.\d% \(19 campaigns\)",
         r"^the hidden law is (first found with \d+|not found with up to \d+)",
     ],
+    # Issue 22 item 4: raw 3-D trajectories (the 3-D simulator's, 200 Hz, 2 cm
+    # noise) -> fieldkit track3d -> fieldkit diagnose; every true impact found
+    "track3d_to_diagnose.py": [
+        r"raw trajectories: 8 runs, \d+ samples at 200 Hz, noise SD 2 cm",
+        r"^run0: \d+ samples at 200 Hz, noise SD 2\d\.\d mm \(estimated\); "
+        r"\d+ flights, \d+ impacts, 0 misfits",
+        r"truth \(the simulator's impact rows\): (\d+) impacts; found \1, missed 0, "
+        r"extra 0",
+        r"^  e_n error: median 0\.0\d\d, max 0\.0[0-4]\d",
+        r"^  lateral_deg error: median \d\.\d+, max [01]\.\d+",
+        r"diagnose: baseline held-out error 0\.0\d+ m/s; recommended None",
+    ],
 }
 
 #: Modules a script needs that may not be merged yet (the script is skipped until then).

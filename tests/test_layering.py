@@ -64,6 +64,9 @@ STAGE_EDGES: frozenset[tuple[str, str]] = frozenset(
         ("campaign", "model"),
         ("export", "model"),
         ("export", "fit"),
+        # tracking.trajectory3d reads the ground as the 3-D model does (Terrain),
+        # writes the 3-D simulator's impact rows (results3d.impact_table3d) and
+        # samples its synthetic runs from the 3-D simulator
         # the flight segmentation tells mid-air misfits from contacts with the
         # simulator's own drag law (model.drag_flight, model.effects.air_drag)
         ("tracking", "model"),

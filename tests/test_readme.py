@@ -54,10 +54,10 @@ def test_shell_blocks_run(repo_copy, shell_commands, run_shell, monkeypatch):
     ran = run_blocks(selected, repo_copy, shell_commands, run_shell, monkeypatch)
     # --version, reduce, impact, fence, view (2), effects, simulate, simulate (3-D),
     # profile, synth, fit, fit --paths (2), fit (3-D), diagnose, synth --track,
-    # diagnose (track), synth --survey,
+    # diagnose (track), track3d (2: its data, the command), synth --survey,
     # reduce --campaign, diagnose (campaign), export (3), import-model,
     # import-results; the video block runs when slow
-    assert ran == 26
+    assert ran == 28
     # every README command writes under out/ only (issue 17): nothing new at the root
     assert {p.name for p in repo_copy.iterdir()} - before == {"out"}
     out = repo_copy / "out"
@@ -76,6 +76,7 @@ def test_shell_blocks_run(repo_copy, shell_commands, run_shell, monkeypatch):
     assert (out / "rstone_results" / "summary.json").is_file()
     assert (out / "diagnosis" / "report.md").is_file()
     assert (out / "track_diagnosis" / "report.md").is_file()
+    assert (out / "track3d" / "impacts.csv").is_file()
     assert (out / "campaign" / "campaign.json").is_file()
     campaign = (out / "campaign_diagnosis.json").read_text()
     assert '"kind": "campaigns"' in campaign and '"size": 19' in campaign
@@ -107,7 +108,7 @@ def test_every_command_shown_is_in_a_block_that_runs():
     inline = re.findall(r"`(fieldkit [^`]*)`", FENCE.sub("", README))
     assert inline
     for text in inline:
-        assert re.fullmatch(r"fieldkit [a-z][a-z-]*( --help)?", text), text
+        assert re.fullmatch(r"fieldkit [a-z][a-z0-9-]*( --help)?", text), text
 
 
 def test_points_only_inside_the_repository():

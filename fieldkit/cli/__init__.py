@@ -41,6 +41,7 @@ from fieldkit.cli import (
     simulate,
     synth,
     track,
+    track3d,
     view,
 )
 
@@ -78,6 +79,7 @@ app.command("reduce")(reduce.reduce)
 app.command("impact")(impact.impact)
 app.command("fence")(fence.fence)
 app.command("track")(track.track)
+app.command("track3d")(track3d.track3d)
 app.command("view")(view.view)
 app.command("profile")(profile.profile)
 app.command("simulate")(simulate.simulate)

@@ -355,7 +355,8 @@ DimensionsOpt = Annotated[
         "--dimensions",
         help="Shape dimensions (m), as 1.6,1.3,1.3 or 1.6x1.3x1.3: cube L; sphere r "
         "(radius); cylinder L,r; ellipsoid 2a,2b,2c (full axis lengths, rotating "
-        "about c).",
+        "about c); block L1,L2,L3 (a block's principal lengths, any order: the "
+        "ellipsoid of those axes rolling about the shortest).",
     ),
 ]
 UnitWeightOpt = Annotated[

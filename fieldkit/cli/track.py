@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from pathlib import Path
@@ -35,7 +36,16 @@ PROGRESS_MIN_FRAMES = 300
 BODY_NEEDS = ("radius_m",)
 
 
-@one_line_errors
+#: Names of the ground's arguments (fieldkit.tracking.flights.ground) -> this
+#: command's flags.
+GROUND_FLAGS = {
+    "ground_profile": "--surface-profile",
+    "section_line": "--section",
+    "footprint_m": "--footprint",
+}
+
+
+@one_line_errors(flags=GROUND_FLAGS)
 def track(
     video: Annotated[
         Path,
@@ -78,8 +88,46 @@ def track(
         float | None,
         typer.Option(
             "--surface-angle",
-            help="Dip of the impact surface (deg), positive descending along travel "
-            "(default: estimated from the contact points).",
+            help="Dip of the impact surface (deg), positive descending along travel, "
+            "one for every contact (default: estimated from the contact points; a "
+            "slope per contact: --surface-profile or --surface-dem).",
+        ),
+    ] = None,
+    surface_profile: Annotated[
+        Path | None,
+        typer.Option(
+            "--surface-profile",
+            help="Surveyed section of the ground in the calibrated frame (the "
+            "homography's or scale points' x, z up, metres): a profile CSV "
+            "(x_m,z_m[,material], as `fieldkit profile` writes) or a model file's "
+            "profile. The slope at each contact is the dip of the segment nearest "
+            "the body's centre.",
+        ),
+    ] = None,
+    surface_dem: Annotated[
+        Path | None,
+        typer.Option(
+            "--surface-dem",
+            help="DEM of the ground (ESRI ASCII grid, GeoTIFF), with --section: the "
+            "slope at each contact is a plane fitted over the block's footprint "
+            "(--footprint), its dip along the section line.",
+        ),
+    ] = None,
+    section: Annotated[
+        str | None,
+        typer.Option(
+            "--section",
+            metavar="E1,N1,E2,N2",
+            help="--surface-dem: plan line of the section (DEM coordinates); the "
+            "track's x is the plan distance from E1,N1 toward E2,N2.",
+        ),
+    ] = None,
+    footprint: Annotated[
+        float | None,
+        typer.Option(
+            "--footprint",
+            help="--surface-dem: radius of the plane fit (m; default the body "
+            "radius, at least one DEM cell).",
         ),
     ] = None,
     mass: MassOpt = None,
@@ -170,6 +218,29 @@ def track(
             f"must be between -90 and 90 degrees, got {surface_angle:g}",
             source="--surface-angle",
         )
+    ground_options = [
+        flag
+        for flag, value in (
+            ("--surface-angle", surface_angle),
+            ("--surface-profile", surface_profile),
+            ("--surface-dem", surface_dem),
+        )
+        if value is not None
+    ]
+    if len(ground_options) > 1:
+        raise ArgumentError(
+            f"give one of {' and '.join(ground_options)}: each is the ground",
+            source=ground_options[1],
+        )
+    if surface_dem is None:
+        for value, flag in ((section, "--section"), (footprint, "--footprint")):
+            if value is not None:
+                raise ArgumentError("applies to --surface-dem", source=flag)
+    elif section is None:
+        raise ArgumentError(
+            "--surface-dem needs --section E1,N1,E2,N2 (the section's plan line)",
+            source="--section",
+        )
     if homography is not None and (scale_points or scale_length is not None):
         raise ArgumentError(
             "give either --homography or --scale-points/--scale-length, not both",
@@ -184,7 +255,7 @@ def track(
         )
     if impacts is not None:
         table_format(impacts)  # CSV for /dev/null or a FIFO, else by its extension
-    outputs = OutputSet(inputs=[video, homography])
+    outputs = OutputSet(inputs=[video, homography, surface_profile, surface_dem])
     outputs.confine(figures)
     for path, flag in ((out, "-o"), (impacts, "--impacts"), (rrd, "--rrd")):
         if path is not None:
@@ -197,6 +268,7 @@ def track(
     if out is None and impacts is None and rrd is None and figures is None:
         note("no -o, --impacts, --rrd or --figures given; printing the summary only")
 
+    ground = read_ground(surface_profile, surface_dem, section, footprint, outputs)
     reader = VideoReader(video)
     info = reader.info
     size = (info.width, info.height)
@@ -220,6 +292,7 @@ def track(
         if len(whole):
             body = body.with_measured_radius(float(whole.median()))
     body.require(*BODY_NEEDS, source="fieldkit track")
+    ground = ground_for_body(ground, footprint is None, body.radius_m)
     analysis = analyse_track(
         track_data,
         radius_m=body.radius_m,
@@ -227,8 +300,13 @@ def track(
         mass_kg=body.mass_kg,
         gyration_m=body.gyration_m,
         path_id=path_id or video.stem,
+        ground=ground,
     )
     print_body_notes(body)
+    if ground is not None:
+        note(ground.description)
+        for message in ground_gap_warnings(ground, analysis, body.radius_m):
+            warn(message)
     for message in analysis.warnings:
         warn(message)
 
@@ -255,6 +333,87 @@ def track(
         written = outputs.commit()
     _summary(video, track_data, detections, analysis, calibration.description)
     report_written(written)
+
+
+def read_ground(surface_profile, surface_dem, section, footprint, outputs):
+    """The ground the options describe (:mod:`fieldkit.tracking.flights.ground`), or
+    None (one angle, ``--surface-angle``, or estimated); read and checked before the
+    video is tracked. A DEM's footprint not given is set by :func:`ground_for_body`.
+    """
+    from fieldkit.tracking.flights.ground import DemSectionGround, ProfileGround
+
+    if surface_profile is not None:
+        if surface_profile.suffix.lower() in (".json", ".yaml", ".yml"):
+            from fieldkit.model.model_file import read_model
+
+            profile = read_model(surface_profile, outputs=outputs).profile
+            x_m, z_m = profile.x_m, profile.z_m
+        else:
+            from fieldkit.io.profile_csv import read_profile_csv
+
+            vertices = read_profile_csv(surface_profile)
+            x_m, z_m = vertices.x_m, vertices.z_m
+        return ProfileGround(x_m, z_m, name=surface_profile.name)
+    if surface_dem is None:
+        return None
+    from fieldkit.io.dem import read_dem
+
+    parts = section.replace(";", ",").split(",")
+    try:
+        e1, n1, e2, n2 = (float(p) for p in parts)
+    except ValueError:
+        raise ArgumentError(
+            f"'{section}' is not E1,N1,E2,N2 (four numbers in metres)",
+            source="--section",
+        ) from None
+    if not all(math.isfinite(v) for v in (e1, n1, e2, n2)):
+        raise ArgumentError(f"'{section}' must be finite numbers", source="--section")
+    grid = read_dem(surface_dem)
+    return DemSectionGround(
+        grid,
+        (e1, n1),
+        (e2, n2),
+        footprint_m=grid.cellsize_m if footprint is None else footprint,
+    )
+
+
+def ground_for_body(ground, footprint_default: bool, radius_m: float):
+    """``ground`` with a DEM footprint not given set to the body radius, at least
+    one DEM cell (stated in a note)."""
+    from fieldkit.tracking.flights.ground import DemSectionGround
+
+    if not (isinstance(ground, DemSectionGround) and footprint_default):
+        return ground
+    footprint = max(radius_m, ground.grid.cellsize_m)
+    note(
+        f"--footprint not given: the DEM plane is fitted within {footprint:g} m "
+        "(the body radius, at least one DEM cell)"
+    )
+    return dataclasses.replace(ground, footprint_m=footprint)
+
+
+def ground_gap_warnings(ground, analysis, radius_m: float) -> list[str]:
+    """A warning per impact whose centre lies off the known ground (a profile, a
+    DEM) by more than one radius beyond contact (is it in the track's frame?)."""
+    from fieldkit.tracking.flights.contact_impacts import travel_direction
+    from fieldkit.tracking.flights.ground import in_track_frame
+
+    ground = in_track_frame(ground, analysis.track.meta)
+    if not hasattr(ground, "distance_m"):
+        return []
+    frame = analysis.impacts.frame
+    messages = []
+    sx = travel_direction(analysis.flights)  # the table's x is mirrored toward -x
+    what = "surface profile" if ground.source == "profile" else "DEM's plane"
+    for _, row in frame.iterrows():
+        gap = ground.distance_m(sx * float(row["x_m"]), float(row["z_m"])) - radius_m
+        if abs(gap) > radius_m:
+            messages.append(
+                f"impact {row['point']}: the body's centre is {gap:+.3f} m off "
+                f"contact with the {what} (radius {radius_m:g} m): is it in the "
+                "track's frame?"
+            )
+    return messages
 
 
 def _run_tracking(video, reader, fps, calibration, roi, radius, *, show: bool):

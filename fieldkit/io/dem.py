@@ -61,6 +61,51 @@ _TIFF_SIGNATURES = (b"II*\x00", b"MM\x00*", b"II+\x00", b"MM\x00+")
 INSIDE, OUTSIDE, NODATA = 0, 1, 2
 
 
+#: Points per side of the square grid a block's footprint is sampled on (clipped to
+#: a disc): :func:`footprint_offsets`.
+FOOTPRINT_SAMPLES = 9
+
+
+def footprint_offsets(radius_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """Plan offsets [m] of the DEM points a ground plane is fitted to: a square grid
+    of :data:`FOOTPRINT_SAMPLES` x :data:`FOOTPRINT_SAMPLES` points over
+    ``[-r, r]^2`` kept inside the disc of radius ``r`` (the block's footprint).
+
+    Examples
+    --------
+    >>> dx, dy = footprint_offsets(2.0)
+    >>> dx.size, float(np.hypot(dx, dy).max())
+    (49, 2.0)
+    """
+    s = np.linspace(-1.0, 1.0, FOOTPRINT_SAMPLES)
+    de, dn = np.meshgrid(s, s)
+    inside = de**2 + dn**2 <= 1.0 + 1e-12
+    return radius_m * de[inside], radius_m * dn[inside]
+
+
+def footprint_plane(
+    dx_m: np.ndarray, dy_m: np.ndarray, z_m: np.ndarray
+) -> tuple[float, float, float, float]:
+    """Least-squares plane ``z = a + b dx + c dy`` through DEM heights sampled at
+    plan offsets (:func:`footprint_offsets`) about a point: ``(a, b, c, rms)``,
+    ``a`` the plane's height at the point, ``(b, c)`` its gradient, ``rms`` the
+    misfit of the heights [m]. Over a disc inside one bilinear cell the twist term
+    is orthogonal to the plane, so ``(b, c)`` is the surface's gradient at the point.
+
+    Examples
+    --------
+    >>> dx, dy = footprint_offsets(1.0)
+    >>> a, b, c, rms = footprint_plane(dx, dy, 3 - 0.5 * dx + dx * dy)
+    >>> [round(v, 9) + 0.0 for v in (a, b, c)], rms > 0  # the twist is misfit
+    ([3.0, -0.5, 0.0], True)
+    """
+    design = np.column_stack([np.ones_like(dx_m), dx_m, dy_m])
+    coef, *_ = np.linalg.lstsq(design, z_m, rcond=None)
+    res = z_m - design @ coef
+    a, b, c = (float(v) for v in coef)
+    return a, b, c, float(np.sqrt(np.mean(res * res)))
+
+
 @dataclass(frozen=True)
 class DemGrid:
     """A regular elevation grid, north up.

@@ -138,20 +138,63 @@ def read_core(data: dict, source: str) -> dict[str, float]:
 
 def read_body(data: dict, source: str) -> Body:
     """The body, bounded (:data:`BODY_BOUNDS`) and checked as
-    :class:`fieldkit.physics.bodies.Body` checks a body (k <= r)."""
-    from fieldkit.physics.bodies import Body as PhysicalBody
+    :class:`fieldkit.physics.bodies.Body` checks a body (k <= r).
 
-    refuse_unknown(data, set(BODY_BOUNDS), "body", source)
+    The radius of gyration is ``gyration_m`` when given; else, from the block's
+    three principal lengths ``dimensions_m`` when given (the solid ellipsoid of
+    those axes rolling about the shortest,
+    :func:`fieldkit.physics.bodies.principal_gyration_m`; ``radius_m`` stays the
+    contact radius); else the solid sphere's ``sqrt(2/5) radius_m``.
+    """
+    from fieldkit.physics.bodies import Body as PhysicalBody
+    from fieldkit.physics.bodies import principal_gyration_m
+
+    refuse_unknown(data, {*BODY_BOUNDS, "dimensions_m"}, "body", source)
     values = {}
     for key in ("mass_kg", "radius_m"):
         if key not in data:
             raise InputFileError("missing", source=source, where=f"body.{key}")
-    # Solid sphere k = sqrt(2/5) r when not given (physics.bodies, Table 4-1).
     given = {"gyration_m": None, **data}
+    gyration_from = None
+    if data.get("dimensions_m") is not None:
+        if data.get("gyration_m") is not None:
+            raise InputFileError(
+                "give body.gyration_m or body.dimensions_m (which gives k), not both",
+                source=source,
+                where="body.dimensions_m",
+            )
+        lengths = data["dimensions_m"]
+        if not isinstance(lengths, list) or len(lengths) != 3:
+            raise InputFileError(
+                "must be the block's 3 principal lengths [m], e.g. [0.5, 0.3, 0.39]",
+                source=source,
+                where="body.dimensions_m",
+            )
+        gyration_from = [
+            check_number(
+                v,
+                0.0,
+                BODY_BOUNDS["radius_m"][1] * 2,
+                source=source,
+                where=f"body.dimensions_m[{i}]",
+                unit="m",
+            )  # fmt: skip
+            for i, v in enumerate(lengths)
+        ]
+        for i, v in enumerate(gyration_from):
+            if v <= 0:
+                raise InputFileError(
+                    f"must be > 0 (got {v:g})",
+                    source=source,
+                    where=f"body.dimensions_m[{i}]",
+                )
     for key, (lower, upper) in BODY_BOUNDS.items():
         value = given[key]
         if value is None and key == "gyration_m":
-            value = math.sqrt(0.4) * values["radius_m"]
+            if gyration_from is not None:
+                value = principal_gyration_m(gyration_from)
+            else:  # solid sphere k = sqrt(2/5) r (physics.bodies, Table 4-1)
+                value = math.sqrt(0.4) * values["radius_m"]
         values[key] = check_number(
             value, lower, upper, source=source, where=f"body.{key}",
             unit="kg" if key == "mass_kg" else "m",
@@ -162,8 +205,8 @@ def read_body(data: dict, source: str) -> Body:
                 source=source,
                 where=f"body.{key}",
             )
-    try:
-        PhysicalBody(**values)
+    try:  # an elongated block may have k > r, as the shapes of Table 4-1 may
+        PhysicalBody(**values, shape="block" if gyration_from is not None else None)
     except ArgumentError as exc:
         raise InputFileError(
             exc.message, source=source, where=f"body.{exc.source}"

@@ -23,7 +23,11 @@ enough to catch a typing or unit error:
   sphere of r = 29 m); beyond that it is a rock avalanche, which a lumped-mass
   model does not describe; the gyration k must be <= r
   (:class:`fieldkit.physics.bodies.Body`: every mass point lies within r of the
-  centre, a thin hoop is the limit k = r);
+  centre, a thin hoop is the limit k = r). k is ``gyration_m`` when given, else
+  from the block's three principal lengths ``dimensions_m`` (the solid ellipsoid of
+  those axes rolling about the shortest,
+  :func:`fieldkit.physics.bodies.principal_gyration_m`; then k may exceed r), else
+  the solid sphere's ``sqrt(2/5) radius_m``;
 * seeder (:data:`SEEDER_BOUNDS`): speeds |v| <= 100 m/s (a free fall of 500 m) and
   spin |omega| <= 500 rad/s (a 0.2 m block rolling at 100 m/s), SDs as large; the
   start at most 1000 m above the ground; a release height <= 1000 m;

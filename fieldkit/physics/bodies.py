@@ -24,6 +24,12 @@ ellipsoid  ``(2a, 2b, 2c)``      the three AXIS LENGTHS (Table 4-1 "axes 2a, 2b,
                                  Table 2-6 "axes lengths 1.6, 1.3, 1.3 m"); rotation
                                  about axis c, k = sqrt((a^2 + b^2)/5),
                                  r_contact = (a + b)/2 (worked example 6B)
+block      ``(L1, L2, L3)``      a natural block's measured principal lengths, any
+                                 order (e.g. the Tschamut 2014 shape metadata): the
+                                 solid ellipsoid of those axes rolling about the
+                                 SHORTEST one (:func:`principal_gyration_m` says why),
+                                 k = sqrt((L1^2 + L2^2)/20) with L1 >= L2 >= L3,
+                                 r_contact = (L1 + L2)/4, volume pi L1 L2 L3 / 6
 ========== ===================== ==================================================
 
 Contact radius range per shape (:attr:`Shape.contact_radius_range`): a given
@@ -41,6 +47,7 @@ cube       L/2 to L/sqrt(2)                     face-normal axis: the section is
 sphere     r to r                               every contact point is r away
 cylinder   min(r, L/2) to sqrt(r^2 + (L/2)^2)   the L x 2r rectangle through the axis
 ellipsoid  min(a, b) to max(a, b)               the a-b ellipse (rotation about c)
+block      L2/2 to L1/2                         the L1-L2 ellipse (rotation about L3)
 ========== ==================================== ========================================
 
 Example: Tornado Mountain boulder A, ``shape_body("ellipsoid", (1.6, 1.3, 1.3))`` gives
@@ -113,7 +120,97 @@ def _semi(dims: Sequence[float]) -> tuple[float, float, float]:
     return dims[0] / 2.0, dims[1] / 2.0, dims[2] / 2.0
 
 
-#: Thesis Table 4-1: volume, radius of gyration and default contact radius per shape.
+#: Solid bodies whose principal lengths give a radius of gyration
+#: (:func:`principal_gyration_m`).
+GYRATION_MODELS = ("ellipsoid", "cuboid")
+
+
+def principal_gyration_m(lengths_m: Sequence[float], model: str = "ellipsoid") -> float:
+    """Radius of gyration k [m] of a block from its three principal lengths, about
+    the axis it rolls on: its shortest principal axis.
+
+    With ``L1 >= L2 >= L3`` the full lengths of the block along its principal axes,
+    about the axis along ``L3``:
+
+    * solid ellipsoid with axes ``L1, L2, L3`` (semi-axes ``a = L1/2``, ``b = L2/2``):
+      ``I = m (a^2 + b^2) / 5``, so ``k = sqrt((L1^2 + L2^2) / 20)`` (thesis Table
+      4-1, "ellipsoid"; any table of moments of inertia, e.g. Goldstein, *Classical
+      Mechanics*, 3rd ed., §5.3);
+    * solid cuboid ``L1 x L2 x L3``: ``I = m (L1^2 + L2^2) / 12``, so
+      ``k = sqrt((L1^2 + L2^2) / 12)`` (Table 4-1's cube, ``k = L/sqrt(6)``, is its
+      equal-sided case).
+
+    **Which axis.** The shortest principal axis carries the largest moment of
+    inertia. A tumbling block loses energy while its angular momentum is kept
+    between contacts, so its rotation drifts to the axis of largest inertia (the
+    major-axis rule: Landau & Lifshitz, *Mechanics*, §37; a lumped model carries one
+    k, and this is the one a rolling block ends up with): a plate rolls on its edge
+    like a wheel, not end over end. The Tschamut "Plate" (0.46 x 0.30 x 0.20 m)
+    rolls about its 0.20 m axis.
+
+    **Which solid.** The ellipsoid is the default: a natural block's measured
+    (bounding) lengths enclose less rock than their box. For the three Tschamut 2014
+    blocks (``tests/data/tschamut2014/block_metadata.csv``, weighed 69, 79, 40 kg)
+    the ellipsoids of their lengths give densities of 3008, 2579 and 2768 kg/m^3
+    (rock), their boxes 1575, 1350 and 1449 kg/m^3 (lighter than any rock). Use
+    ``model="cuboid"`` for sawn or cast blocks (concrete cubes, EOTA-like bricks).
+
+    Parameters
+    ----------
+    lengths_m
+        The three principal lengths [m] (full lengths, not semi-axes), any order.
+    model
+        ``"ellipsoid"`` (default) or ``"cuboid"`` (:data:`GYRATION_MODELS`).
+
+    Returns
+    -------
+    float
+        k [m] about the shortest principal axis; ``I = m k^2``.
+
+    Raises
+    ------
+    ArgumentError
+        ``source="dimensions_m"`` for other than three positive lengths,
+        ``source="model"`` for an unknown model.
+
+    Examples
+    --------
+    The sphere limit (all lengths 2r) gives the solid sphere, k = r sqrt(2/5); a
+    cube of side L as a cuboid gives Table 4-1's L/sqrt(6):
+
+    >>> round(principal_gyration_m((2.0, 2.0, 2.0)) / math.sqrt(0.4), 12)
+    1.0
+    >>> round(principal_gyration_m((0.6, 0.6, 0.6), "cuboid") * math.sqrt(6), 12)
+    0.6
+    >>> round(principal_gyration_m((0.46, 0.30, 0.20)), 4)  # Tschamut "Plate"
+    0.1228
+    """
+    if model not in GYRATION_MODELS:
+        raise ArgumentError(
+            f"model must be one of {', '.join(GYRATION_MODELS)} (got {model!r})",
+            source="model",
+        )
+    values = tuple(lengths_m) if not isinstance(lengths_m, int | float) else ()
+    if len(values) != 3:
+        raise ArgumentError(
+            f"dimensions_m must be the block's 3 principal lengths (got {len(values)})",
+            source="dimensions_m",
+        )
+    first, second, _ = sorted(
+        (_require_positive("dimensions_m", v) for v in values), reverse=True
+    )
+    divisor = 20.0 if model == "ellipsoid" else 12.0
+    return math.sqrt((first**2 + second**2) / divisor)
+
+
+def _rolling_semi_axes(dims: Sequence[float]) -> tuple[float, float]:
+    """The two longer semi-axes (the plane the block rolls in) [m]."""
+    first, second, _ = sorted(dims, reverse=True)
+    return first / 2.0, second / 2.0
+
+
+#: Thesis Table 4-1: volume, radius of gyration and default contact radius per shape,
+#: and ``block``: a natural block of three measured principal lengths.
 SHAPES: dict[str, Shape] = {
     "cube": Shape(
         name="cube",
@@ -156,6 +253,22 @@ SHAPES: dict[str, Shape] = {
             max(_semi(d)[:2]),
         ),
         rotation_axis="axis c (the third dimension)",
+    ),
+    "block": Shape(
+        name="block",
+        dimension_names=(
+            "L1",
+            "L2",
+            "L3 principal lengths, any order",
+        ),
+        volume=lambda d: math.pi / 6.0 * math.prod(d),
+        gyration=lambda d: principal_gyration_m(d, "ellipsoid"),
+        contact_radius=lambda d: sum(_rolling_semi_axes(d)) / 2.0,
+        contact_radius_range=lambda d: (
+            min(_rolling_semi_axes(d)),
+            max(_rolling_semi_axes(d)),
+        ),
+        rotation_axis="its shortest principal axis (principal_gyration_m)",
     ),
 }
 

@@ -20,6 +20,7 @@ COMMANDS = [
     "impact",
     "fence",
     "track",
+    "track3d",
     "view",
     "profile",
     "simulate",

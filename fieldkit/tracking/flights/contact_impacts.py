@@ -14,7 +14,9 @@ For each contact between two fitted flights
 * **Velocities.** Impact velocity from the flight before, restitution velocity from the
   flight after, both evaluated at the contact time(s) (fixed-g fits).
 * **Surface angle** ``slope_deg`` (psi, docs/architecture.md §2), always on the side
-  facing the incoming body so that ``vin < 0``: given, or estimated from the contact
+  facing the incoming body so that ``vin < 0``: from the known ground (one angle, or
+  per contact from a profile or a DEM: :mod:`fieldkit.tracking.flights.ground`), or
+  estimated from the contact
   points, the spin balance or the contact's chord; left NaN (e_n, e_t NaN, with a
   warning) when the data cannot identify it (a net without spin). Details and measured
   accuracy in :mod:`fieldkit.tracking.flights.contact_surface`.
@@ -42,6 +44,7 @@ from fieldkit.physics.constants import G
 from fieldkit.track import Track
 from fieldkit.tracking.flights.ballistic_fit import FlightFit
 from fieldkit.tracking.flights.contact_surface import surface_angles
+from fieldkit.tracking.flights.ground import Ground
 from fieldkit.tracking.flights.impact_uncertainty import contact_sds
 from fieldkit.tracking.flights.net_contacts import contact_onset
 from fieldkit.tracking.flights.segmentation import EXTENDED_CONTACT_SAMPLES, ContactSpan
@@ -200,13 +203,16 @@ def build_impact_table(
     flights: list[FlightFit],
     *,
     radius_m: float,
-    surface_angle_deg: float | None = None,
+    ground: Ground | None = None,
     mass_kg: float | None = None,
     gyration_m: float | None = None,
     path_id: str = "video",
 ) -> tuple[ImpactTable | None, list[str]]:
     """The ImpactTable of the contact events, and warnings.
 
+    ``ground`` (:mod:`fieldkit.tracking.flights.ground`) gives the dip at each
+    contact, queried at the contact centre in the track's frame; without it the dip
+    is estimated (:func:`fieldkit.tracking.flights.contact_surface.surface_angles`).
     Returns ``(None, warnings)`` when there is no contact.
     """
     warnings: list[str] = []
@@ -240,8 +246,17 @@ def build_impact_table(
             )
         )
     f = pd.DataFrame(rows)
+    known = None
+    if ground is not None:
+        known = ground.dip_deg(
+            np.array([ev.x_m for ev in events]), np.array([ev.z_m for ev in events]), sx
+        )
     slope, source, slope_warnings = surface_angles(
-        f, radius_m=radius_m, gyration_m=k, surface_angle_deg=surface_angle_deg
+        f,
+        radius_m=radius_m,
+        gyration_m=k,
+        surface_angle_deg=known,
+        given_source=ground.source if ground is not None else "given",
     )
     warnings.extend(slope_warnings)
     f["slope_deg"] = slope

@@ -15,8 +15,9 @@ depend on the sign of T.
 
 Where psi comes from (:func:`surface_angles`):
 
-* ``surface_angle_deg`` when given (its side is chosen facing the body, with a warning
-  when that flips it);
+* the known ground when given: one angle, or one per contact from a surveyed profile
+  or a DEM (:mod:`fieldkit.tracking.flights.ground`); its side is chosen facing the
+  body, with a warning when that flips it;
 * short impacts, two or more: the least-squares line through the centres at the
   impact instants (one radius off a plane surface, so parallel to it);
 * a single short impact: the angular-momentum balance of a rigid sphere about its
@@ -159,25 +160,29 @@ def surface_angles(
     *,
     radius_m: float,
     gyration_m: float,
-    surface_angle_deg: float | None = None,
+    surface_angle_deg: float | np.ndarray | None = None,
+    given_source: str = "given",
 ) -> tuple[np.ndarray, np.ndarray, list[str]]:
     """Dip psi [deg] of the surface at every contact, its source, and warnings.
 
     ``f`` holds one row per contact (travel frame): ``x_m, z_m, x_end_m, z_end_m``,
     ``vi_*``, ``vf_*``, ``omega_i/f_radps``, ``contact_duration_s``, ``extended``.
-    Every angle is then turned to the side facing the incoming body
-    (:func:`facing_body`), so ``vin < 0``. An estimated surface the body does not
-    leave (``vfn <= 0``) was not identified: its psi is NaN (e_n, e_t NaN) with a
-    warning; a given one is kept, with a warning.
+    ``surface_angle_deg``, when known, is one dip for every contact or one per
+    contact (a profile or a DEM, :mod:`fieldkit.tracking.flights.ground`), recorded
+    with source ``given_source``. Every angle is then turned to the side facing the
+    incoming body (:func:`facing_body`), so ``vin < 0``. An estimated surface the
+    body does not leave (``vfn <= 0``) was not identified: its psi is NaN (e_n, e_t
+    NaN) with a warning; a known one is kept, with a warning.
     """
     n = len(f)
     slope = np.full(n, np.nan)
     source = np.full(n, "video", dtype=object)
     warnings: list[str] = []
     extended = f["extended"].to_numpy(bool)
-    if surface_angle_deg is not None:
+    given = surface_angle_deg is not None
+    if given:
         slope[:] = surface_angle_deg
-        source[:] = "given"
+        source[:] = given_source
     short = ~extended
     if surface_angle_deg is None and short.sum() >= 2:
         psi, se = surface_angle_from_points(f.loc[short, "x_m"], f.loc[short, "z_m"])
@@ -225,7 +230,7 @@ def surface_angles(
         if not np.isfinite(slope[i]):
             continue
         turned = facing_body(slope[i], vi)
-        if source[i] == "given" and turned != wrap_angle_deg(slope[i]):
+        if given and turned != wrap_angle_deg(slope[i]):
             warnings.append(
                 f"contact {i + 1}: the body meets the given surface from below; "
                 f"psi = {turned:.2f} deg (the same line, normal facing the body)"
@@ -238,7 +243,7 @@ def surface_angles(
         what = (
             f"vin = {float(vin):.3f}, vfn = {float(vfn):.3f} m/s on psi = {turned:.2f}"
         )
-        if source[i] == "given":
+        if given:
             warnings.append(
                 f"contact {i + 1}: the body does not leave the given surface ({what})"
             )

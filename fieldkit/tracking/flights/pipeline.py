@@ -8,7 +8,8 @@ Tracker or Kinovea):
 2. :func:`fieldkit.tracking.flights.ballistic_fit.fit_flight` fits each flight with g
    free (its g and standard error are checked against 9.81) and with g fixed;
 3. :mod:`fieldkit.tracking.flights.contact_impacts` evaluates the fits at each contact
-   and builds the ImpactTable (surface angle given or estimated);
+   and builds the ImpactTable (the ground given -- one angle, a profile, a DEM:
+   :mod:`fieldkit.tracking.flights.ground` -- or its angle estimated);
 4. :mod:`fieldkit.tracking.flights.net_contacts` describes every extended contact (net).
 """
 
@@ -28,6 +29,7 @@ from fieldkit.tracking.flights.contact_impacts import (
     build_impact_table,
     find_contact_events,
 )
+from fieldkit.tracking.flights.ground import ConstantGround, Ground, in_track_frame
 from fieldkit.tracking.flights.net_contacts import (
     NetContact,
     analyse_net_contact,
@@ -155,6 +157,7 @@ def analyse_track(
     mass_kg: float | None = None,
     gyration_m: float | None = None,
     path_id: str = "video",
+    ground: Ground | None = None,
 ) -> TrackAnalysis:
     """Find flights, impacts and net contacts in a track.
 
@@ -167,10 +170,17 @@ def analyse_track(
     surface_angle_deg
         Dip of the impact surface psi [deg], positive descending toward travel; when
         None it is estimated (see :mod:`fieldkit.tracking.flights.contact_impacts`).
+        The same as ``ground=ConstantGround(surface_angle_deg)``.
     mass_kg, gyration_m
         Body mass [kg] and radius of gyration [m] for energies (optional).
     path_id
         Identifier written to the ImpactTable.
+    ground
+        The known ground (:mod:`fieldkit.tracking.flights.ground`) in the track's
+        calibrated frame (turned by
+        :func:`~fieldkit.tracking.flights.ground.in_track_frame` when the track is
+        stored mirrored): a dip per contact from a surveyed profile or a DEM;
+        excludes ``surface_angle_deg``.
 
     Returns
     -------
@@ -188,14 +198,14 @@ def analyse_track(
         raise ArgumentError(
             f"radius_m must be > 0 (got {radius_m:g})", source="radius_m"
         )
-    if surface_angle_deg is not None and not (
-        np.isfinite(surface_angle_deg) and -180.0 < surface_angle_deg <= 180.0
-    ):
-        raise ArgumentError(
-            "surface_angle_deg must be a dip in (-180, 180] deg "
-            f"(docs/architecture.md §2), got {surface_angle_deg:g}",
-            source="surface_angle_deg",
-        )
+    if surface_angle_deg is not None:
+        if ground is not None:
+            raise ArgumentError(
+                "surface_angle_deg and `ground` both give the surface; give one",
+                source="surface_angle_deg",
+            )
+        ground = ConstantGround(surface_angle_deg)
+    ground = in_track_frame(ground, track.meta)
     if mass_kg is not None and not mass_kg > 0:
         raise ArgumentError(f"mass_kg must be > 0 (got {mass_kg:g})", source="mass_kg")
     if gyration_m is not None and not gyration_m > 0:
@@ -273,7 +283,7 @@ def analyse_track(
         events,
         flights,
         radius_m=radius_m,
-        surface_angle_deg=surface_angle_deg,
+        ground=ground,
         mass_kg=mass_kg,
         gyration_m=gyration_m,
         path_id=path_id,
