@@ -283,7 +283,10 @@ def build_impact_table(
     extended = f["extended"].to_numpy(bool)
     internal = ["x_end_m", "z_end_m", "extended", "sag_rms_m"]
     table = ImpactTable(f.drop(columns=internal), source=path_id).derive()
-    refused = refused_impacts(table.frame, extended, radius_m=radius_m)
+    gap = np.full(len(events), np.nan)
+    if ground is not None and hasattr(ground, "distance_m"):  # a profile, a DEM
+        gap = np.array([ground.distance_m(ev.x_m, ev.z_m) for ev in events]) - radius_m
+    refused = refused_impacts(table.frame, extended, radius_m=radius_m, gap_m=gap)
     if refused:
         for i, reason in refused.items():
             row = table.frame.iloc[i]
@@ -303,40 +306,38 @@ def build_impact_table(
     return table, warnings
 
 
-#: How far beyond one radius from a given surface a contact's centre may lie, as a
-#: share of the radius (a given angle fixes the surface's dip; its height is that of
-#: the lowest contact).
-SURFACE_TOLERANCE_FRACTION = 0.5
+#: How far a contact's centre may lie beyond one radius from a known ground (a
+#: profile, a DEM), as a share of the radius (the threshold of `fieldkit track`'s
+#: warning about a ground off the track's frame).
+SURFACE_TOLERANCE_FRACTION = 1.0
 
 
 def refused_impacts(
-    f: pd.DataFrame, extended: np.ndarray, *, radius_m: float
+    f: pd.DataFrame,
+    extended: np.ndarray,
+    *,
+    radius_m: float,
+    gap_m: np.ndarray | None = None,
 ) -> dict[int, str]:
     """Rows of a derived impact table that cannot be impacts, with the reason.
 
     Only instantaneous impacts are judged (an extended contact may overhang: a net).
     Refused are an impact on a surface turned past vertical to face the body (the
     body would have struck the ground from below), one with ``e_n < 0`` (the body
-    does not leave the surface it struck), and, on a given surface
-    (``slope_source == "given"``), one whose centre lies more than
-    ``(1 + SURFACE_TOLERANCE_FRACTION) r`` from the surface line of that dip through
-    the lowest such contact: a contact needs the ground.
+    does not leave the surface it struck), and, on a ground whose position is known
+    (a profile, a DEM: ``gap_m``, the centre's distance from it less one radius),
+    one whose centre lies more than ``SURFACE_TOLERANCE_FRACTION r`` beyond contact
+    while another contact touches it: a contact needs the ground. (When no contact
+    touches the ground it is rather off the track's frame, which `fieldkit track`
+    warns about; one angle, ``--surface-angle``, fixes the dip but not where the
+    ground is, so it refuses no contact by height.)
     """
     out = {}
     short = ~np.asarray(extended, bool)
     psi_all = f["slope_deg"].to_numpy(float)
-    given = short & (f["slope_source"].astype(str).to_numpy() == "given")
-    given &= np.isfinite(psi_all) & (np.abs(psi_all) <= 90.0)
-    height = np.full(len(f), np.nan)
-    if given.any():
-        rad = np.radians(psi_all)
-        # the centre's distance along N = (sin psi, cos psi) from a line of dip psi
-        height = f["x_m"].to_numpy(float) * np.sin(rad) + f["z_m"].to_numpy(
-            float
-        ) * np.cos(rad)
-        height = np.where(given, height - np.nanmin(np.where(given, height, np.nan)),
-                          np.nan)  # fmt: skip
     tolerance = SURFACE_TOLERANCE_FRACTION * radius_m
+    gap = np.full(len(f), np.nan) if gap_m is None else np.asarray(gap_m, float)
+    touching = short & np.isfinite(gap) & (np.abs(gap) <= tolerance)
     for i in range(len(f)):
         if not short[i]:
             continue
@@ -351,12 +352,12 @@ def refused_impacts(
                 f"e_n = {e_n:.3f} < 0 (the body does not leave the surface it "
                 "struck)"
             )
-        elif np.isfinite(height[i]) and height[i] > tolerance:
+        elif touching.any() and np.isfinite(gap[i]) and gap[i] > tolerance:
             out[i] = (
-                f"the centre is {height[i] * 1e3:.1f} mm above the surface at the "
-                f"lowest contact (a line of the given dip {psi:.1f} deg), beyond "
-                f"the tolerance of {tolerance * 1e3:.1f} mm "
-                f"({SURFACE_TOLERANCE_FRACTION:g} radius): the body is in mid-air"
+                f"the centre is {gap[i] * 1e3:.1f} mm beyond contact with the known "
+                f"ground ({f['slope_source'].iloc[i]}), more than the tolerance of "
+                f"{tolerance * 1e3:.1f} mm ({SURFACE_TOLERANCE_FRACTION:g} radius) "
+                "while other contacts touch it: the body is in mid-air"
             )
     return out
 
