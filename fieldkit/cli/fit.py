@@ -59,6 +59,7 @@ FLAGS = {
     "design_rocks": "--design-rocks",
     "tracked_extent": "--tracked-extent",
     "holdout_seeds": "--holdout-seeds",
+    "virtual_campaigns": "--virtual-campaigns",
     **SUSPECT_FLAGS,
 }
 
@@ -264,6 +265,7 @@ def _plan(options: dict) -> None:
         given=options,
         tracked_extent=options["tracked_extent"],
         holdout_seeds=options["holdout_seeds"],
+        virtual_campaigns=options["virtual_campaigns"],
     )
 
 
@@ -414,6 +416,16 @@ def fit(
             "comparison averages over (1 to 20; default 3).",
         ),
     ] = None,
+    virtual_campaigns: Annotated[
+        int | None,
+        typer.Option(
+            "--virtual-campaigns",
+            help="3-D fit with held-out runs: virtual campaigns drawn from the "
+            "calibrated model, which measure how often a perfect forecast would "
+            "beat the climatology by 2 paired SEs on a held-out set of this size "
+            "(0 = off, 2 to 10,000; default 200).",
+        ),
+    ] = None,
 ) -> None:
     """Fit restitution and effect parameters to measured impacts (weighted LSQ).
 
@@ -454,7 +466,12 @@ def fit(
     --bound); held-out runs are scored (fair energy score, fair distance CRPS)
     for the calibrated model, the start and the climatology with paired
     differences +- SE over runs, over --holdout-seeds fits (default 3);
-    --tracked-extent censors every forecast at the surveyed area's edge. The
+    --tracked-extent censors every forecast at the surveyed area's edge. What
+    such a test can show at all is measured beside it: --virtual-campaigns
+    campaigns drawn from the calibrated model give the share in which a perfect
+    forecast beats the climatology by 2 paired SEs, and where every block has 5
+    runs, the climatology of the run's own block against the pooled one
+    (repeated 5-fold over all runs) bounds what knowing the block is worth. The
     calibrated file is the base file with the fitted values and provenance.fit;
     its terrain block's file names are made relative to the calibrated file's
     folder.
@@ -480,7 +497,7 @@ def fit(
     if releases is not None and is_terrain_model(model_file):
         _plan(locals())
         return
-    for name in ("tracked_extent", "holdout_seeds"):
+    for name in ("tracked_extent", "holdout_seeds", "virtual_campaigns"):
         if locals()[name] is not None:
             raise ArgumentError(
                 "for a fit of a terrain (3-D) model only (a model file with a "

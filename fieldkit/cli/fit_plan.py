@@ -29,6 +29,10 @@ PLAN_DEFAULTS = {"rocks": 60, "seed": 0, "screen": 0}
 HOLDOUT_ROCKS = 200
 #: Held-out scoring: fits (seeds seed, seed + 1, ...) the comparison averages over.
 HOLDOUT_SEEDS = 3
+#: Virtual campaigns drawn from the calibrated model (fieldkit.fit.plan_power).
+VIRTUAL_CAMPAIGNS = 200
+#: Folds of the block-climatology bound (every block needs this many runs).
+GROUP_FOLDS = 5
 #: Scores of the held-out comparison.
 HOLDOUT_SCORES = ("energy_fair_m", "distance_crps_fair_m")
 #: Options of the profile path fit that a 3-D fit has no use for (refused).
@@ -122,6 +126,7 @@ def fit_plan_command(
     given: dict,
     tracked_extent: str | None = None,
     holdout_seeds: int | None = None,
+    virtual_campaigns: int | None = None,
 ) -> None:
     """Run the 3-D plan fit (module docstring). ``given``: the other options of
     `fieldkit fit` as given (those of :data:`NOT_3D` are refused)."""
@@ -171,6 +176,19 @@ def fit_plan_command(
     if not 1 <= holdout_seeds <= 20:
         raise ArgumentError(f"must be 1..20 (got {holdout_seeds})",
                             source="holdout_seeds")  # fmt: skip
+    if virtual_campaigns is not None and holdout_releases is None:
+        raise ArgumentError("needs --holdout-paths and --holdout-deposits",
+                            source="virtual_campaigns")  # fmt: skip
+    if virtual_campaigns is None:
+        virtual_campaigns = VIRTUAL_CAMPAIGNS if holdout_releases is not None else 0
+        if holdout_releases is not None:
+            said.append(
+                f"{virtual_campaigns} virtual campaigns from the calibrated model "
+                "measure what the held-out test can show (default)"
+            )
+    if virtual_campaigns != 0 and not 2 <= virtual_campaigns <= 10_000:
+        raise ArgumentError(f"must be 0 or 2..10,000 (got {virtual_campaigns})",
+                            source="virtual_campaigns")  # fmt: skip
     box = parse_bounds(bounds)
     inputs = [model_file, releases, deposits, holdout_releases, holdout_deposits]
     with OutputSet(inputs=[p for p in inputs if p is not None]) as outputs:
@@ -279,6 +297,12 @@ def fit_plan_command(
                 "seeds": seeds,
                 "comparisons": comparisons,
             }
+            attainable_lines, attainable = _attainable(
+                runs, hold, result.model, censor, seed=seed,
+                campaigns=virtual_campaigns,
+            )  # fmt: skip
+            held_lines += attainable_lines
+            fit_record["holdout"]["attainable"] = attainable
         data = calibrated_model_dict(
             model_file, dict(zip(result.names, result.values, strict=True)),
             fit_record, output,
@@ -349,3 +373,45 @@ def _holdout(runs, hold, result, model_fit, names, censor, *, rocks, seeds, scre
             lines += c.lines()
             comparisons.append(c.to_dict())
     return lines, comparisons
+
+
+def _attainable(
+    runs, hold, model, censor, *, seed, campaigns
+) -> tuple[list[str], dict]:
+    """What the held-out test can show (:mod:`fieldkit.fit.plan_power`): virtual
+    campaigns from the calibrated model, and the block-climatology bound where
+    every block has :data:`GROUP_FOLDS` runs among the calibration and held-out
+    runs."""
+    from fieldkit.fit.plan_power import group_climatology_skill, virtual_campaigns
+
+    lines = [
+        "what this held-out test can show (the climatology's fair score is unbiased: "
+        "a forecast beats it only by what it knows of each run):"
+    ]
+    out: dict = {}
+    if campaigns:
+        with step(f"{campaigns} virtual campaigns from the calibrated model"):
+            v = virtual_campaigns(model, runs, hold, campaigns=campaigns,
+                                  holdout_rocks=HOLDOUT_ROCKS, seed=seed,
+                                  extent=censor)  # fmt: skip
+        lines += v.lines()
+        out["virtual_campaigns"] = v.to_dict()
+    every = [*runs, *hold]
+    labels = [r.group for r in every]
+    counts = {g: labels.count(g) for g in set(labels)}
+    if all(labels) and len(counts) > 1 and min(counts.values()) >= GROUP_FOLDS:
+        g = group_climatology_skill(
+            np.array([r.release_xy for r in every]),
+            np.array([r.deposit_xy for r in every]),
+            labels, k=GROUP_FOLDS, extent=censor, split_runs=len(hold), label="block",
+        )  # fmt: skip
+        lines += g.lines()
+        lines.append(
+            "  note: the block bound reads every run, held-out ones included "
+            "(a property of the data, used by no fit)"
+        )
+        out["block_climatology"] = g.to_dict()
+    elif all(labels) and len(counts) > 1:
+        lines.append(f"  block-climatology bound: not computed (a block has fewer "
+                     f"than {GROUP_FOLDS} runs)")  # fmt: skip
+    return (lines if len(lines) > 1 else []), out

@@ -121,6 +121,17 @@ def test_fit_of_a_terrain_model_recovers_friction_and_writes_a_model_simulate_ru
     assert comp[("start", "energy_fair_m")]["mean_difference"] < 0
     scores = ("energy_fair_m", "distance_crps_fair_m")
     assert set(comp) == {(b, s) for b in ("start", "climatology") for s in scores}
+    # what the test can show: virtual campaigns from the calibrated model (the
+    # default 200); these runs have no block_id, so no block bound
+    assert "200 virtual campaigns from the calibrated model measure" in text
+    assert (
+        "a perfect forecast (the model as the truth) against the climatology "
+        "(200 virtual campaigns of 4 held-out runs)" in text
+    )
+    virtual = fit["holdout"]["attainable"]["virtual_campaigns"]
+    assert virtual["tests"] == 200 and virtual["split_runs"] == 4
+    assert 0.0 <= virtual["energy"]["pass_rate_2se"] <= 1.0
+    assert "block_climatology" not in fit["holdout"]["attainable"]
     # the calibrated file: fitted value in place, terrain files relative to its
     # folder, readable there and after the folder is moved
     calibrated = json.loads((out / "calibrated_3d.json").read_text())
@@ -228,6 +239,7 @@ def test_tracked_extent_censors_rocks_at_its_edge_and_is_recorded(
         (("--tracked-extent", "0,45,21"), "--tracked-extent", "four numbers"),
         (("--tracked-extent", "5,45,1,81"), "--tracked-extent", "x_min < x_max"),
         (("--holdout-seeds", "2"), "--holdout-seeds", "needs --holdout-paths"),
+        (("--virtual-campaigns", "20"), "--virtual-campaigns", "needs --holdout-paths"),
     ],
 )
 def test_bad_tracked_extent_or_seeds_is_one_line(cli, plan_site, tmp_path, args,
@@ -253,3 +265,48 @@ def test_tracked_extent_is_refused_by_a_profile_fit(cli, repo, tmp_path):
     assert result.exit_code == 1
     assert "--tracked-extent" in result.stderr and "terrain (3-D)" in result.stderr
     assert len(result.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("value", ["1", "-3", "10001"])
+def test_bad_virtual_campaigns_is_one_line(cli, plan_site, tmp_path, value):
+    site = plan_site
+    result = cli(
+        "fit", "--model", site / "model3d.json",
+        "--paths", site / "cal_releases.csv", "--deposits", site / "cal_deposits.csv",
+        "--holdout-paths", site / "hold_releases.csv",
+        "--holdout-deposits", site / "hold_deposits.csv",
+        "--virtual-campaigns", value, "-o", tmp_path / "c.json",
+    )  # fmt: skip
+    assert result.exit_code == 1
+    assert "--virtual-campaigns" in result.stderr and "0 or 2..10,000" in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "c.json").exists()
+
+
+def test_block_bound_on_runs_with_blocks_and_campaigns_off(cli, plan_site, tmp_path):
+    """Runs with a block_id, every block with >= 5 runs: the block-climatology bound
+    is printed and recorded; --virtual-campaigns 0 turns the campaigns off."""
+    site = plan_site
+    for stem in ("cal", "hold"):
+        path = site / f"{stem}_releases.csv"
+        lines = path.read_text().splitlines()
+        out = [lines[0] + ",block_id"]
+        out += [f"{line},{'ab'[i % 2]}" for i, line in enumerate(lines[1:])]
+        path.write_text("\n".join(out) + "\n")
+    result = cli(
+        "fit", "--model", site / "model3d.json",
+        "--paths", site / "cal_releases.csv", "--deposits", site / "cal_deposits.csv",
+        "--holdout-paths", site / "hold_releases.csv",
+        "--holdout-deposits", site / "hold_deposits.csv",
+        "--free", "materials.ground.friction_deg", "--rocks", "4", "--seed", "1",
+        "--holdout-seeds", "1", "--virtual-campaigns", "0",
+        "-o", tmp_path / "c.json", "--json", tmp_path / "fit.json",
+    )  # fmt: skip
+    assert result.exit_code == 0, result.stderr + result.stdout
+    assert "virtual campaigns" not in result.stdout
+    assert ("the climatology of the run's own block against the pooled one "
+            "(20 repeats of 12 held-out runs)") in result.stdout  # fmt: skip
+    assert "blocks: a (6), b (6)" in result.stdout
+    bound = json.loads((tmp_path / "fit.json").read_text())["holdout"]["attainable"]
+    assert set(bound) == {"block_climatology"}
+    assert bound["block_climatology"]["split_runs"] == 4
