@@ -13,6 +13,31 @@ REPO = Path(__file__).resolve().parents[1]
 
 EXAMPLES = sorted((REPO / "examples").glob("*.py"))
 
+#: What examples/calibrate_tschamut_3d.py prints in every mode.
+TSCHAMUT_3D = [
+    r"fixed split: 17 calibration runs \(v033 = v034 counted once\), 18 held-out",
+    r"^release: a drop of 0\.5 m onto the DEM",
+    r"^tracked extent x 12\.5\.\.132\.5 m, y 132\.5\.\.267\.5 m",
+    r"^  objective \(mean fair energy score in plan\): start 1\d\.\d+ m -> "
+    r"optimum 1\d\.\d+ m",
+    r"^3-D calibrated +1\d\.\d\d +\d+\.\d\d +\d\.\d\d +\d+% +[+-]\d+\.\d m",
+    r"^2-D calibrated +2\d\.\d\d +1\d\.\d\d",
+    r"^climatology +11\.82 +7\.67 +7\.12 +72%",
+    r"^climatology of the block +9\.85 +6\.01",
+    r"^energy_fair_m: 3-D calibrated \d+\.\d+ vs climatology 11\.82\d \(18 runs, "
+    r"3 seed\(s\)\)",
+    r"3-D calibrated - 2-D calibrated = -\d+\.\d+ \+- \d+\.\d+",
+    r"^seed 1: a perfect forecast \(the model as the truth\) against the climatology "
+    r"\(\d+ virtual campaigns of 18 held-out runs\)",
+    r"^  energy score: -0\.92 \+- 0\.47 m per run \(SD 4\.21 m\); beats the "
+    r"climatology by >= 2 paired SEs on 18 held-out runs with probability 14 % "
+    r"\(normal approximation\); held-out runs for 80 %: 167",
+    r"^  distance CRPS: -0\.95 \+- 0\.51 m per run",
+    r"wrote .*calibrate_tschamut_3d\.json",
+]
+#: Arguments an example runs with in the fast suite (its default run is slow).
+ARGS = {"calibrate_tschamut_3d.py": ["--quick"]}
+
 #: Numbers each walk-through must print (independent thesis references).
 EXPECTED = {
     # Fig. 2.8 / §2.2.2: impact A26 e_N 1.29, e_T 0.27 (recomputed 1.28, 0.28)
@@ -122,29 +147,10 @@ EXPECTED = {
     # Issue 21 item 3: the 3-D model calibrated in plan on the Tschamut split, held
     # out beside its start, the 2-D calibrated model and the plan climatology, all
     # censored at the scan's extent; the climatology's figures are exact (no random
-    # numbers), the others' shapes; the assumptions moved in the last table
-    "calibrate_tschamut_3d.py": [
-        r"fixed split: 17 calibration runs \(v033 = v034 counted once\), 18 held-out",
-        r"^release: a drop of 0\.5 m onto the DEM",
-        r"^tracked extent x 12\.5\.\.132\.5 m, y 132\.5\.\.267\.5 m",
-        r"^  objective \(mean fair energy score in plan\): start 1\d\.\d+ m -> "
-        r"optimum 1\d\.\d+ m",
-        r"^3-D calibrated +1\d\.\d\d +\d+\.\d\d +\d\.\d\d +\d+% +[+-]\d+\.\d m",
-        r"^2-D calibrated +2\d\.\d\d +1\d\.\d\d",
-        r"^climatology +11\.82 +7\.67 +7\.12 +72%",
-        r"^climatology of the block +9\.85 +6\.01",
-        r"^energy_fair_m: 3-D calibrated \d+\.\d+ vs climatology 11\.82\d \(18 runs, "
-        r"3 seed\(s\)\)",
-        r"3-D calibrated - 2-D calibrated = -\d+\.\d+ \+- \d+\.\d+",
-        r"^off +0\.0m +1\d\.\d\d +11\.82",
-        # r.stone with the exported parameters, where GRASS and r.stone are present
-        # (else one line saying why not): footprints only, no deposits
-        r"^(r\.stone +\d+\.\dm +[+-]\d+\.\dm +\d+% +\d+\.\dm +\d+% +\d+\.\dm$"
-        r"|r\.stone comparison skipped: .+)",
-        r"^(  not compared: deposit energy score, distance CRPS.*no deposits"
-        r"|r\.stone comparison skipped: .+)",
-        r"wrote .*calibrate_tschamut_3d\.json",
-    ],
+    # numbers), the others' shapes; what the split can show (virtual campaigns, the
+    # block bound: exact, no random numbers). Run --quick here (ARGS); the default
+    # run, with the assumption table and r.stone, is test_calibrate_tschamut_3d_default
+    "calibrate_tschamut_3d.py": TSCHAMUT_3D,
     # Issue 18: a virtual campaign with eq. 7.1 hidden, surveyed, reduced with the
     # assumed launch angle and diagnosed with its null through the same reduction
     "diagnose_virtual_campaign.py": [
@@ -176,7 +182,12 @@ def test_example_runs(script, tmp_path):
     if script.name in REQUIRES:
         pytest.importorskip(REQUIRES[script.name])
     done = subprocess.run(
-        [sys.executable, str(script), str(tmp_path / "out")],
+        [
+            sys.executable,
+            str(script),
+            str(tmp_path / "out"),
+            *ARGS.get(script.name, []),
+        ],
         capture_output=True,
         text=True,
         cwd=tmp_path,
@@ -213,3 +224,31 @@ def test_example_runs(script, tmp_path):
 def test_every_example_has_expectations_or_is_new():
     missing = [p.name for p in EXAMPLES if p.name not in EXPECTED]
     assert not missing, f"add expected numbers for {missing}"
+
+
+@pytest.mark.slow
+def test_calibrate_tschamut_3d_default(tmp_path):
+    """The default run: the assumption table and, where GRASS and r.stone are
+    present (else one line saying why not), r.stone's footprints (4.5 min with
+    r.stone on one idle core)."""
+    script = REPO / "examples" / "calibrate_tschamut_3d.py"
+    done = subprocess.run(
+        [sys.executable, str(script), str(tmp_path / "out")],
+        capture_output=True, text=True, cwd=tmp_path, timeout=1200,
+        env={"MPLBACKEND": "Agg", "PATH": "/usr/bin:/bin"},
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr[-2000:]
+    for pattern in [
+        *TSCHAMUT_3D,
+        r"^off +0\.0m +energy +meadow +1\d\.\d\d +11\.82",
+        r"^on +0\.5m +energy +3 slope classes +1\d\.\d\d +11\.82",
+        # r.stone with the exported parameters: footprints only, no deposits
+        r"^(r\.stone +\d+\.\dm +[+-]\d+\.\dm +\d+% +\d+\.\dm +\d+% +\d+\.\dm$"
+        r"|r\.stone comparison skipped: .+)",
+        r"^(  not compared: deposit energy score, distance CRPS.*no deposits"
+        r"|r\.stone comparison skipped: .+)",
+    ]:
+        assert re.search(pattern, done.stdout, re.MULTILINE), (
+            pattern,
+            done.stdout[-2000:],
+        )
