@@ -61,7 +61,8 @@ and 30 / 80 / 160 evaluations (Sobol screen 0 / 0 / 16 points); held-out 60 / 20
 500 rocks per run; virtual campaigns 50 / 200 / 1000 per seed. Measured on one
 core of an idle machine: about 30 s (no assumption table, no r.stone), 4.5 min
 (r.stone's section 105 s of it, where GRASS is present; 2.5 min without) and
-15 min (with the k-fold's ten fits).
+40 min (the assumption table at full size, r.stone 4.5 min, the k-fold's ten fits
+10 min).
 
 Run:  python examples/calibrate_tschamut_3d.py [OUT_DIR] [--quick | --full]
 """

@@ -36,7 +36,13 @@ TSCHAMUT_3D = [
     r"wrote .*calibrate_tschamut_3d\.json",
 ]
 #: Arguments an example runs with in the fast suite (its default run is slow).
-ARGS = {"calibrate_tschamut_3d.py": ["--quick"]}
+ARGS = {
+    "calibrate_tschamut_3d.py": ["--quick"],
+    "diagnose_virtual_campaign.py": ["--quick"],
+}
+#: Examples of more than a minute on a loaded 2-core machine (each 60-110 s; their
+#: parts are tested on their own): run by `make test-all` (test_slow_example_runs).
+SLOW_EXAMPLES = ("calibrate_tornado_mountain.py", "export_tornado_mountain.py")
 
 #: Numbers each walk-through must print (independent thesis references).
 EXPECTED = {
@@ -177,7 +183,14 @@ EXPECTED = {
 REQUIRES = {"simulate_tornado_mountain.py": "fieldkit.model.simulate"}
 
 
-@pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.name)
+@pytest.mark.parametrize(
+    "script",
+    [
+        pytest.param(p, marks=pytest.mark.slow) if p.name in SLOW_EXAMPLES else p
+        for p in EXAMPLES
+    ],
+    ids=lambda p: p.name,
+)
 def test_example_runs(script, tmp_path):
     if script.name in REQUIRES:
         pytest.importorskip(REQUIRES[script.name])
