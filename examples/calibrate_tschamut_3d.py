@@ -85,7 +85,6 @@ from fieldkit.fit.plan_scores import (
     duplicate_runs,
     mean_direction,
     paired_comparison,
-    plan_climatology,
     repeated_kfold,
     score_runs,
     section_to_plan,
@@ -94,7 +93,7 @@ from fieldkit.fit.plan_scores import (
 from fieldkit.fit.tracked_extent import (
     Extent,
     censor_chainage,
-    censor_straight_ensembles,
+    censored_climatology,
     clip_model,
     exit_chainage,
 )
@@ -164,20 +163,13 @@ def _plan2d(model_2d, hold_obs, rocks, seed, extent):
     return out, cut / (rocks * len(runs))
 
 
-def _climatology(cal_rel, cal_dep, rel, extent):
-    ens = plan_climatology(cal_rel, cal_dep, rel)
-    if extent is None:
-        return ens, 0.0
-    return censor_straight_ensembles(rel, ens, extent)
-
-
 def _block_climatology(cal, hold, cal_rel, cal_dep, rel, extent):
     """The climatology of the held-out run's own block only (6 or 5 vectors): the
     most per-run information an empirical forecast has here."""
     g = np.array([r.group for r in cal])
     out = []
     for i, r in enumerate(hold):
-        ens, _ = _climatology(cal_rel[g == r.group], cal_dep[g == r.group],
+        ens, _ = censored_climatology(cal_rel[g == r.group], cal_dep[g == r.group],
                               rel[[i]], extent)  # fmt: skip
         out.append(ens[0])
     return out
@@ -347,7 +339,7 @@ def fixed_split(settings: dict, extent: Extent | None, height: float,
         ens2d, share = _plan2d(fit2d.model, hold_obs, rocks, seed, censor)
         forecasts["2-D calibrated"].append(score_runs(ens2d, rel, dep, u))
         exited["2-D calibrated"].append(share)
-    ens_c, clim_cut = _climatology(cal_rel, cal_dep, rel, censor)
+    ens_c, clim_cut = censored_climatology(cal_rel, cal_dep, rel, censor)
     clim = score_runs(ens_c, rel, dep, u)
     block = score_runs(
         _block_climatology(cal, hold, cal_rel, cal_dep, rel, censor), rel, dep, u
@@ -430,7 +422,8 @@ def sensitivity(settings: dict, main: dict) -> list[dict]:
     )
     out = []
     for on, height, objective, materials in [
-        (True, DROP_M, "energy", "meadow"), *cases
+        (True, DROP_M, "energy", "meadow"),
+        *cases,
     ]:
         s = (
             main
@@ -697,7 +690,7 @@ def kfold(settings: dict, repeats: int = 2, k: int = 5, seed: int = 1) -> dict:
             ("3-D", ens),
             (
                 "clim",
-                _climatology(
+                censored_climatology(
                     rel[f.calibration], dep[f.calibration], rel[f.holdout], censor
                 )[0],
             ),

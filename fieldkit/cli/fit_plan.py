@@ -330,10 +330,9 @@ def _holdout(runs, hold, result, model_fit, names, censor, *, rocks, seeds, scre
     from fieldkit.fit.plan_scores import (
         mean_direction,
         paired_comparison,
-        plan_climatology,
         score_runs,
     )
-    from fieldkit.fit.tracked_extent import censor_straight_ensembles
+    from fieldkit.fit.tracked_extent import censored_climatology
 
     cal_rel = np.array([r.release_xy for r in runs])
     cal_dep = np.array([r.deposit_xy for r in runs])
@@ -351,9 +350,7 @@ def _holdout(runs, hold, result, model_fit, names, censor, *, rocks, seeds, scre
             for name, m in (("calibrated", fitted), ("start", model_fit)):
                 ens = plan_ensembles(m, hold, HOLDOUT_ROCKS, s, stream=HOLDOUT_STREAM)
                 per_seed[name].append(score_runs(ens.deposits_xy, rel, dep, u))
-    clim = plan_climatology(cal_rel, cal_dep, rel)
-    if censor is not None:
-        clim, _ = censor_straight_ensembles(rel, clim, censor)
+    clim, _ = censored_climatology(cal_rel, cal_dep, rel, censor)
     clim_scores = score_runs(clim, rel, dep, u)
     lines = [
         f"held-out: {len(hold)} runs, {HOLDOUT_ROCKS} rocks per run on streams no "

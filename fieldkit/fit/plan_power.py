@@ -50,11 +50,10 @@ from fieldkit.fit.plan_fit import HOLDOUT_STREAM, PlanRun, plan_ensembles
 from fieldkit.fit.plan_scores import (
     _pair_distance_sum,
     fair_crps,
-    plan_climatology,
     release_deposit_distance_m,
     repeated_kfold,
 )
-from fieldkit.fit.tracked_extent import Extent, censor_straight_ensembles
+from fieldkit.fit.tracked_extent import Extent, censored_climatology
 from fieldkit.model.model3d import Model3D
 
 #: Stream tag of the virtual observations (``default_rng([seed, VIRTUAL_STREAM,
@@ -65,8 +64,6 @@ VIRTUAL_STREAM = 130_363
 N_SE = 2.0
 #: Power at which :meth:`SkillTest.runs_needed` is quoted.
 POWER = 0.8
-#: The scores tested (plan_scores names).
-SCORES = ("energy_fair_m", "distance_crps_fair_m")
 
 
 @dataclass(frozen=True)
@@ -104,9 +101,7 @@ class SkillTest:
     def pass_rate(self, n_se: float = N_SE) -> float:
         """Share of tests in which A beats B by >= ``n_se`` paired SEs."""
         ok = np.isfinite(self.ses)
-        if not ok.any():
-            return math.nan
-        return float(np.mean(self.differences[ok] <= -n_se * self.ses[ok]))
+        return float(np.mean(self.passes(n_se)[ok])) if ok.any() else math.nan
 
     def passes(self, n_se: float = N_SE) -> np.ndarray:
         """Per test, whether A beats B by >= ``n_se`` paired SEs."""
@@ -195,11 +190,15 @@ class Attainable:
     :func:`group_climatology_skill`)."""
 
     what: str
-    tests: int
     energy: SkillTest
     distance: SkillTest
     split_runs: int
     notes: list[str] = field(default_factory=list)
+
+    @property
+    def tests(self) -> int:
+        """Tests (virtual campaigns, or repeats of the k-fold)."""
+        return int(self.energy.differences.size)
 
     @property
     def both_pass_rate(self) -> float:
@@ -269,13 +268,6 @@ def _fair_energy_rows(ens: np.ndarray, obs: np.ndarray) -> np.ndarray:
     to_obs = np.sqrt(((ens - obs[:, None, :]) ** 2).sum(axis=2)).mean(axis=1)
     pair = np.sqrt(((ens[:, :, None, :] - ens[:, None, :, :]) ** 2).sum(axis=3))
     return to_obs - pair.sum(axis=(1, 2)) / (2.0 * m * (m - 1))
-
-
-def _climatology(cal_rel, cal_dep, rel, extent):
-    ens = plan_climatology(cal_rel, cal_dep, rel)
-    if extent is None:
-        return ens
-    return np.stack(censor_straight_ensembles(rel, ens, extent)[0])
 
 
 def virtual_campaigns(
@@ -364,7 +356,7 @@ def virtual_campaigns(
     crps_clim = np.empty_like(es_truth)
     say("scoring the perfect forecast against each campaign's climatology")
     for c in range(campaigns):
-        clim = _climatology(cal_rel, obs[:n_cal, c], hold_rel, extent)
+        clim = censored_climatology(cal_rel, obs[:n_cal, c], hold_rel, extent)[0]
         y = hold_obs[:, c]
         es_clim[c] = _fair_energy_rows(clim, y)
         crps_clim[c] = fair_crps(
@@ -381,7 +373,6 @@ def virtual_campaigns(
     ]
     return Attainable(
         what="a perfect forecast (the model as the truth) against the climatology",
-        tests=int(campaigns),
         energy=_skill("energy_fair_m", es_truth - es_clim, same_runs=False),
         distance=_skill(
             "distance_crps_fair_m", crps_truth - crps_clim, same_runs=False
@@ -447,7 +438,7 @@ def group_climatology_skill(
     diff = np.zeros((repeats, n, 2))
     for f in repeated_kfold(n, k=k, repeats=repeats, seed=seed, groups=list(g)):
         cal, hold = f.calibration, f.holdout
-        pooled = _climatology(rel[cal], dep[cal], rel[hold], extent)
+        pooled = censored_climatology(rel[cal], dep[cal], rel[hold], extent)[0]
         y = dep[hold]
         dist_obs = release_deposit_distance_m(rel[hold], y)
         es_p = _fair_energy_rows(pooled, y)
@@ -455,7 +446,7 @@ def group_climatology_skill(
                            dist_obs)  # fmt: skip
         for j, i in enumerate(hold):
             own = cal[g[cal] == g[i]]
-            ens = _climatology(rel[own], dep[own], rel[[i]], extent)
+            ens = censored_climatology(rel[own], dep[own], rel[[i]], extent)[0]
             diff[f.repeat, i, 0] = _fair_energy_rows(ens, y[[j]])[0] - es_p[j]
             diff[f.repeat, i, 1] = (
                 fair_crps(release_deposit_distance_m(rel[i], ens[0]), dist_obs[j])
@@ -471,7 +462,6 @@ def group_climatology_skill(
     ]
     return Attainable(
         what=f"the climatology of the run's own {label} against the pooled one",
-        tests=int(repeats),
         energy=energy,
         distance=distance,
         split_runs=int(split_runs),

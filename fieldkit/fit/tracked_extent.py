@@ -37,6 +37,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from fieldkit.errors import ArgumentError
+from fieldkit.fit.plan_scores import plan_climatology
 from fieldkit.model.model3d import Model3D
 
 
@@ -238,3 +239,26 @@ def censor_straight_ensembles(
         cut += int(was_cut.sum())
         total += was_cut.size
     return out, (cut / total if total else math.nan)
+
+
+def censored_climatology(
+    calibration_release_xy: np.ndarray,
+    calibration_deposit_xy: np.ndarray,
+    release_xy: np.ndarray,
+    extent: Extent | None,
+) -> tuple[np.ndarray, float]:
+    """The climatology in plan (:func:`fieldkit.fit.plan_scores.plan_climatology`),
+    each member cut at its first exit from ``extent`` along its straight vector
+    (:func:`censor_straight_ensembles`; None: not cut), and the share of members
+    cut (0.0 without an extent).
+
+    Returns
+    -------
+    tuple
+        (runs, n, 2) deposit ensembles and the share cut.
+    """
+    ens = plan_climatology(calibration_release_xy, calibration_deposit_xy, release_xy)
+    if extent is None:
+        return ens, 0.0
+    cut, share = censor_straight_ensembles(release_xy, ens, extent)
+    return np.stack(cut), share
