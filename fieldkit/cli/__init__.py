@@ -28,6 +28,7 @@ import typer
 
 from fieldkit._version import __version__
 from fieldkit.cli import (
+    corridor,
     diagnose,
     effects,
     export,
@@ -87,6 +88,7 @@ app.command("effects")(effects.effects)
 app.command("synth")(synth.synth)
 app.command("fit")(fit.fit)
 app.command("diagnose")(diagnose.diagnose)
+app.command("corridor")(corridor.corridor)
 app.command("export")(export.export)
 app.command("import-model")(import_model.import_model)
 app.command("import-results")(import_results.import_results)

@@ -227,7 +227,7 @@ def impact_table3d(rows: dict[str, np.ndarray], material_names) -> ImpactTable:
 
 def _path_fields(result) -> dict[str, np.ndarray]:
     path = result.path
-    names = ("x_m", "y_m", "z_m", "speed_mps", "ke_j", "height_m")
+    names = ("x_m", "y_m", "z_m", "speed_mps", "ke_j", "re_j", "height_m")
     return {k: np.asarray(path[k], float) for k in names}
 
 
@@ -364,8 +364,8 @@ def line_crossings(result, xy_m: np.ndarray) -> dict[str, np.ndarray]:
     -------
     dict
         ``rock`` (the crossing rocks, ascending) and, at each one's first crossing
-        along its path, ``x_m, y_m, speed_mps, ke_j, height_m`` (linear between the
-        two samples around it).
+        along its path, ``x_m, y_m, speed_mps, ke_j, re_j, height_m`` (linear
+        between the two samples around it; ``re_j`` the rotational energy).
     """
     f = _path_fields(result)
     start, rock = _segments(result)
@@ -390,7 +390,7 @@ def line_crossings(result, xy_m: np.ndarray) -> dict[str, np.ndarray]:
     seg, t = seg[keep], t[keep]
     a = start[seg]
     out = {"rock": rock[seg].astype(np.int64)}
-    for key in ("x_m", "y_m", "speed_mps", "ke_j", "height_m"):
+    for key in ("x_m", "y_m", "speed_mps", "ke_j", "re_j", "height_m"):
         out[key] = f[key][a] + t * (f[key][a + 1] - f[key][a])
     return out
 
