@@ -8,8 +8,11 @@ Layers, lowest first (a module may import its own layer's package and any lower 
 2. the data types ``survey``, ``track``, ``impact_table``, ``path_observations``,
    ``measured`` (the ImpactTable's derived columns are thesis equations, so it
    imports ``physics``);
-3. ``io`` -- field formats in, data types out;
-4. the stages ``reduce``, ``tracking``, ``model``, ``fit``, ``diagnose``, ``export``;
+3. ``io`` -- field formats in, data types out; ``parallel`` -- the Dask engine that
+   runs a stage's independent units (it imports no stage: the stages hand it
+   functions and units);
+4. the stages ``reduce``, ``tracking``, ``model``, ``fit``, ``diagnose``, ``export``,
+   ``corridor``;
    a stage imports another stage only along :data:`STAGE_EDGES`;
 5. ``viz`` -- figures and recordings of results;
 6. ``cli`` -- the command line;
@@ -39,6 +42,7 @@ LAYERS: dict[str, int] = {
     "path_observations": 2,
     "measured": 2,
     "io": 3,
+    "parallel": 3,
     "reduce": 4,
     "tracking": 4,
     "model": 4,
@@ -46,6 +50,7 @@ LAYERS: dict[str, int] = {
     "diagnose": 4,
     "campaign": 4,
     "export": 4,
+    "corridor": 4,
     "viz": 5,
     "cli": 6,
     "": 7,
@@ -64,6 +69,8 @@ STAGE_EDGES: frozenset[tuple[str, str]] = frozenset(
         ("campaign", "model"),
         ("export", "model"),
         ("export", "fit"),
+        # a corridor scan cuts sections and runs the 2-D and 3-D simulators
+        ("corridor", "model"),
         # tracking.trajectory3d reads the ground as the 3-D model does (Terrain),
         # writes the 3-D simulator's impact rows (results3d.impact_table3d) and
         # samples its synthetic runs from the 3-D simulator

@@ -177,9 +177,16 @@ def corridor(
     """
     from fieldkit.cli.progress import report_written
     from fieldkit.cli.progress import step as progress_step
-    from fieldkit.corridor.scan import UNIT_ROCKS_3D, check_rocks, scan2d, scan3d
-    from fieldkit.corridor.sections import SectionSetup
-    from fieldkit.corridor.stations import stations_along
+    from fieldkit.corridor.scan import (
+        TINY_ROCKS,
+        UNIT_ROCKS_3D,
+        check_rocks,
+        check_same_dem,
+        scan2d,
+        scan3d,
+    )
+    from fieldkit.corridor.sections import SectionSetup, check_base_model
+    from fieldkit.corridor.stations import check_on_dem, stations_along
     from fieldkit.io.alignment import read_alignment
     from fieldkit.io.dem import read_dem
     from fieldkit.model.dem_profile import parse_material_ranges
@@ -223,11 +230,18 @@ def corridor(
             if on:
                 raise ArgumentError(f"{flag} cuts 2-D sections; {model} is a terrain "
                                     "(3-D) model")  # fmt: skip
+    stations = stations_along(xy, spacing)
+    if three_d:
+        check_same_dem(the_model, grid)
+    check_on_dem(stations, grid)
+    if not three_d:
+        check_base_model(the_model, setup)
     if seed is None:
         seed = secrets.randbits(32)
         note(f"`seed` not given: used {seed}; pass --seed {seed} to reproduce")
     with Engine(spec, notify=note) as engine:
-        n = len(stations_along(xy, spacing))
+        n = len(stations)
+        engine.start(tiny=rocks * (1 if three_d else n) <= TINY_ROCKS)
         what = (f"{rocks:,} rocks from the model's releases across {n} stations"
                 if three_d else f"{n} stations x {rocks:,} rocks")  # fmt: skip
         units = -(-rocks // UNIT_ROCKS_3D) if three_d else n

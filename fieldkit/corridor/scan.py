@@ -362,7 +362,7 @@ def scan3d(
     check_model3d(model)
     stations = stations_along(alignment_xy, spacing_m)
     check_same_dem(model, grid)
-    check_on_dem(stations, grid)
+    check_on_dem(stations, grid)  # the model's DEM: its own check
     n_units = -(-rocks // unit_rocks)
     seeds = _seeds(seed, n_units)
     xy = stations.alignment_xy

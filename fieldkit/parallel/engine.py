@@ -245,6 +245,12 @@ class Engine:
             return False
         return not (spec.workers is None and tiny)
 
+    def start(self, tiny: bool = False) -> None:
+        """Start the cluster or connect to the scheduler now, if :meth:`map` would
+        (so a scheduler that does not answer fails before any work)."""
+        if self.remote(tiny):
+            self._connect()
+
     def _connect(self) -> None:
         if self._client is not None:
             return

@@ -15,6 +15,7 @@ import fieldkit
 from fieldkit.cli import app
 
 COMMANDS = [
+    "corridor",
     "diagnose",
     "reduce",
     "impact",
@@ -49,7 +50,7 @@ def test_every_registered_command_is_listed():
 
 
 #: Commands whose examples need the simulator core.
-NEEDS_CORE = {"simulate", "effects", "synth", "fit", "diagnose"}
+NEEDS_CORE = {"simulate", "effects", "synth", "fit", "diagnose", "corridor"}
 
 #: Commands whose examples render and track a video clip (about 15 s).
 SLOW_EXAMPLES = {"track"}
