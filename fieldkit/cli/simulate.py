@@ -11,6 +11,14 @@ import typer
 
 from fieldkit.cli.common import note, one_line_errors, warn
 from fieldkit.cli.design import parse_measured
+from fieldkit.cli.engine_options import (
+    ENGINE_FLAGS,
+    Retries,
+    Scheduler,
+    Timeout,
+    WorkerMemory,
+    Workers,
+)
 from fieldkit.errors import ArgumentError
 from fieldkit.outputs import OutputSet, write_json
 
@@ -22,6 +30,7 @@ FLAGS = {
     "analysis_x_m": "--at",
     "trajectories": "--trajectories",
     "envelope_dx_m": "--envelope-dx",
+    **ENGINE_FLAGS,
 }
 
 def _fmt(d: dict, key: str, unit: str = "") -> str:
@@ -53,6 +62,20 @@ def _runout_values(r: dict, censored: dict) -> str:
             f"{', '.join(at_end)} ≥ {end:g} m ({censored_words(censored['fraction'])})"
         )
     return ", ".join(parts)
+
+
+def engine_given(workers, scheduler, worker_memory, timeout, retries):
+    """The engine spec when a run is sent to Dask (--workers >= 1, --scheduler or
+    Dask's configured scheduler), else None (this process, as without Dask)."""
+    from fieldkit.cli.engine_options import engine_spec
+    from fieldkit.parallel.engine import configured_scheduler
+
+    spec = engine_spec(workers, scheduler, worker_memory, timeout, retries)
+    if workers == 0 or not (workers or scheduler or configured_scheduler()):
+        if worker_memory is not None:
+            raise ArgumentError("--worker-memory needs --workers N or --scheduler")
+        return None
+    return spec
 
 
 @one_line_errors(flags=FLAGS)
@@ -163,6 +186,11 @@ def simulate(
             "in the recording.",
         ),
     ] = None,
+    workers: Workers = None,
+    scheduler: Scheduler = None,
+    worker_memory: WorkerMemory = None,
+    timeout: Timeout = 10.0,
+    retries: Retries = 2,
 ) -> None:
     """Simulate rock falls down a slope profile and say what a designer reads.
 
@@ -200,6 +228,11 @@ def simulate(
     column means in 3-D and which stay empty is printed). --at, --measured and
     --envelope-dx are for profile models; --deposits, --rasters, --line and
     --observed for terrain models.
+
+    A terrain model's hazard map runs in tiles of release cells through Dask with
+    --workers N (local processes), --scheduler ADDRESS (a running cluster) or
+    Dask's configured scheduler; the rocks' random numbers are drawn once here, so
+    the maps and numbers are those of the run in this process with the same seed.
 
     Example (from the repository root; thesis §7.5.4, Tornado Mountain with
     the RocFall inputs of Table 7-1):
@@ -263,8 +296,16 @@ def simulate(
                 model, outputs, rocks=rocks, seed=seed, summary=summary,
                 deposits=deposits, rasters=rasters, lines=line, observed=observed,
                 figures=figures, rrd=rrd, trajectories=trajectories, impacts=impacts,
+                engine=engine_given(workers, scheduler, worker_memory, timeout,
+                                    retries),
             )  # fmt: skip
             return
+        if workers is not None or scheduler is not None or worker_memory is not None:
+            raise ArgumentError(
+                "--workers, --scheduler and --worker-memory run a terrain (3-D) "
+                f"model's tiles; {model_file.name} describes a profile, which runs "
+                "in this process on every core"
+            )
         refuse_options(given, TERRAIN_ONLY, "is for a terrain (3-D) model; "
                        f"{model_file.name} describes a profile")  # fmt: skip
         analysis_x = [float(x) for x in (at or [])]

@@ -71,12 +71,15 @@ def simulate_terrain(
     rrd: Path | None,
     trajectories: int,
     impacts: Path | None = None,
+    engine=None,
 ) -> None:
     """Run a 3-D model and write what was asked (:mod:`fieldkit.model.results3d`).
 
     ``impacts``: every impact as an ImpactTable row
     (:func:`fieldkit.model.results3d.impact_table3d`), streamed chunk by chunk; the
     3-D meaning of its columns and the columns left empty are stated on stderr.
+    ``engine``: an :class:`~fieldkit.parallel.engine.EngineSpec` to run the rocks
+    in tiles through Dask (:mod:`fieldkit.model.hazard_tiles`), or None.
     """
     from fieldkit.cli.progress import report_written, step
     from fieldkit.io.impact_stream import ImpactTableOutput
@@ -104,6 +107,11 @@ def simulate_terrain(
         raise ArgumentError(
             f"must be from 0 to {MAX_TRAJECTORIES:,} (got {trajectories})",
             source="--trajectories",
+        )
+    if engine is not None and impacts is not None:
+        raise ArgumentError(
+            "--impacts streams every impact from this process; run it without "
+            "--workers/--scheduler (the tiles return maps and numbers, not impacts)"
         )
     analysis = []
     for text in lines or []:
@@ -144,7 +152,30 @@ def simulate_terrain(
     doing = f"simulating {rocks:,} rocks on the DEM"
     recording = {}
     writer = None
-    if impacts is not None:
+    tiled = None
+    if engine is not None:
+        from fieldkit.model.hazard_tiles import simulate3d_tiled
+        from fieldkit.parallel.engine import Engine
+
+        with Engine(engine, notify=note) as dask_engine:
+            dask_engine.start()
+            with step(doing + " in tiles of release cells", total=1) as advance:
+                tiled = simulate3d_tiled(
+                    model, rocks, rng, dask_engine,
+                    lines=[ln.xy_m for ln in analysis], paths=trajectories,
+                    progress=advance,
+                )  # fmt: skip
+        result = tiled.result
+        note(
+            f"{tiled.units} units in {tiled.tiles} tile(s) of 32 x 32 release cells "
+            f"(at most 5,000 rocks a unit; a unit's sampled paths held at most "
+            f"{tiled.largest_unit_path_bytes / 2**20:.1f} MiB on its worker); the "
+            "rocks' random numbers drawn once here, so the results are those of the "
+            "run in this process with this seed"
+        )
+        for line in dask_engine.retried:
+            warn(line)
+    if tiled is None and impacts is not None:
         writer = ImpactTableOutput(impacts, outputs, argument="--impacts")
         names = list(model.materials)
         recording = {
@@ -153,8 +184,9 @@ def simulate_terrain(
         }
         doing += f", recording their impacts for {impacts}"
     try:
-        with step(doing):
-            result = run(model, rocks, rng, **recording)
+        if tiled is None:
+            with step(doing):
+                result = run(model, rocks, rng, **recording)
     finally:
         if writer is not None:
             writer.close()
@@ -168,14 +200,17 @@ def simulate_terrain(
     result.seed = seed
     for text in getattr(result, "notes", None) or []:
         note(text)  # what the simulator assumed (a default that changes a result)
-    stats = summary3d(result, model, analysis)
+    stats = summary3d(result, model, analysis,
+                      None if tiled is None else tiled.crossings)  # fmt: skip
+    if tiled is not None:
+        stats["engine"] = dask_engine.describe()
     if summary is not None:
         write_json(summary, stats, outputs)
     if deposits is not None:
         frame = deposits_frame(result)
         write_file(deposits, lambda tmp: frame.to_csv(tmp, index=False), outputs)
-    grids = None
-    if rasters is not None or figures is not None:
+    grids = None if tiled is None else tiled.rasters
+    if grids is None and (rasters is not None or figures is not None):
         grids = make_rasters(result, model.terrain)
     if rasters is not None:
         for name in RASTERS:

@@ -314,13 +314,20 @@ def rasters(result, terrain: Terrain) -> dict[str, np.ndarray]:
         grid = maxima[key]
         grid[~np.isfinite(grid)] = np.nan
         out[name] = grid.reshape(ny, nx)
+    count = deposit_counts(result, terrain)
+    rocks = max(int(result.rocks), 1)
+    out["deposit_density_per_m2"] = count / (rocks * terrain.cell_m**2)
+    return out
+
+
+def deposit_counts(result, terrain: Terrain) -> np.ndarray:
+    """Rocks stopped in each cell (int, ``terrain.shape``, row 0 south)."""
+    ny, nx = terrain.shape
     xyz = np.asarray(result.deposit_xyz, float)
     stopped = np.asarray(result.state) == STOPPED
     row, col, inside = cells_of(terrain, xyz[stopped, 0], xyz[stopped, 1])
-    count = np.bincount(row[inside] * nx + col[inside], minlength=cells)
-    rocks = max(int(result.rocks), 1)
-    out["deposit_density_per_m2"] = count.reshape(ny, nx) / (rocks * terrain.cell_m**2)
-    return out
+    count = np.bincount(row[inside] * nx + col[inside], minlength=ny * nx)
+    return count.reshape(ny, nx)
 
 
 def write_geotiff(path, values: np.ndarray, terrain: Terrain) -> None:
@@ -395,11 +402,13 @@ def line_crossings(result, xy_m: np.ndarray) -> dict[str, np.ndarray]:
     return out
 
 
-def line_summary(result, xy_m: np.ndarray, name: str) -> dict:
+def line_summary(result, xy_m: np.ndarray, name: str, crossing=None) -> dict:
     """The analysis-line entry of summary.json: passing count and fraction with its
     SE, and p50/p95/p99 (with SEs) of speed, KE and bounce height of the crossing
-    rocks at their first crossing."""
-    crossing = line_crossings(result, xy_m)
+    rocks at their first crossing (``crossing``: :func:`line_crossings` already
+    made, e.g. merged from the tiles of a run)."""
+    if crossing is None:
+        crossing = line_crossings(result, xy_m)
     rocks = int(result.rocks)
     passing = int(crossing["rock"].size)
     fraction, se = fraction_se(passing, rocks)
@@ -415,7 +424,7 @@ def line_summary(result, xy_m: np.ndarray, name: str) -> dict:
     return entry
 
 
-def summary3d(result, model, lines: list) -> dict:
+def summary3d(result, model, lines: list, crossings: list | None = None) -> dict:
     """summary.json of a 3-D run: rocks, impacts, wall_s, seed, final states, the
     stopped fraction, release-to-deposit distance in plan, the analysis lines
     (``lines``: :class:`~fieldkit.model.terrain_file.AnalysisLine`) and, with
@@ -443,7 +452,9 @@ def summary3d(result, model, lines: list) -> dict:
             "over": "stopped rocks; distance in plan from the release point",
         },
         "lines": [
-            line_summary(result, ln.xy_m, ln.label(i)) for i, ln in enumerate(lines)
+            line_summary(result, ln.xy_m, ln.label(i),
+                         None if crossings is None else crossings[i])
+            for i, ln in enumerate(lines)
         ],  # fmt: skip
     }
     if "tree_impacts" in (model.effects or {}):

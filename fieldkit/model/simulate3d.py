@@ -254,6 +254,7 @@ def simulate3d(
     chunk_rocks: int = CHUNK_ROCKS,
     keep_paths: bool = True,
     on_impact_rows: Callable[[dict[str, np.ndarray]], None] | None = None,
+    drawn: dict | None = None,
 ) -> Result3D:
     """Simulate ``rocks`` rocks of ``model`` with the random numbers of ``rng``.
 
@@ -282,6 +283,12 @@ def simulate3d(
         :attr:`Result3D.impact_rows`, consecutive rocks in order) as soon as the
         chunk has run, instead of keeping them (``impact_rows`` is then None):
         memory bounded by one chunk's impacts.
+    drawn
+        The rocks' starts already drawn (:func:`draw_rocks3d`, or a subset of its
+        arrays, ``rocks`` long): run them instead of drawing (``rng`` unused). Each
+        rock's numbers depend only on its start and key, so a run split into
+        subsets gives each rock what the whole run gives it
+        (:mod:`fieldkit.model.hazard_tiles`).
 
     Returns
     -------
@@ -336,7 +343,12 @@ def simulate3d(
             "(hit_probability 1: 3-D strikes are geometric)"
             + (f"; {off} stem(s) off the DEM's surface never reached" if off else "")
         )
-    d = draw_rocks3d(model, rocks, rng)
+    if drawn is not None and len(drawn["keys"]) != rocks:
+        raise ArgumentError(
+            f"drawn holds {len(drawn['keys'])} rocks, not `rocks` {rocks}",
+            source="drawn",
+        )
+    d = draw_rocks3d(model, rocks, rng) if drawn is None else drawn
     impacts = np.zeros(rocks, np.int64)
     states = np.zeros(rocks, np.int64)
     deposit = np.zeros((rocks, 3))
