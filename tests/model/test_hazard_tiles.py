@@ -77,8 +77,9 @@ def test_cli_workers_writes_the_same_files(cli, repo, tmp_path, monkeypatch):
     assert a == b
 
 
-def test_cli_refuses_impacts_in_tiles_and_workers_for_a_profile(cli, fails, repo,
-                                                                tmp_path, monkeypatch):  # fmt: skip
+def test_cli_refuses_impacts_in_tiles_and_profile_workers(
+    cli, fails, repo, tmp_path, monkeypatch
+):
     monkeypatch.chdir(repo)
     r = cli("simulate", "examples/tschamut/model_3d.json", "--rocks", "10",
             "--workers", "2", "--impacts", tmp_path / "i.csv")  # fmt: skip
