@@ -78,11 +78,9 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import multiprocessing
 import os
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -485,14 +483,12 @@ def e2e_task(job: tuple) -> dict:
 
 
 def spawn_map(fn, jobs: list, workers: int):
-    """``fn`` over ``jobs`` on ``workers`` spawned processes, in order, as they end."""
-    if workers == 1:
-        for job in jobs:
-            yield fn(job)
-        return
-    context = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
-        yield from pool.map(fn, jobs)
+    """``fn`` over ``jobs`` through the Dask engine on ``workers`` local processes
+    (1: this process), in order."""
+    from fieldkit.parallel.engine import Engine, EngineSpec
+
+    with Engine(EngineSpec(workers=0 if workers == 1 else workers)) as engine:
+        yield from engine.map(fn, jobs, label="campaign")
 
 
 def run_e2e(world, args, out, workers) -> dict:

@@ -64,7 +64,12 @@ core of an idle machine: about 30 s (no assumption table, no r.stone), 4.5 min
 40 min (the assumption table at full size, r.stone 4.5 min, the k-fold's ten fits
 10 min).
 
+The seeds' fits, and the k-fold's, are independent units
+(:mod:`fieldkit.fit.plan_sweep`): ``--workers N`` runs them on N local Dask
+processes, ``--scheduler ADDRESS`` on a running cluster, with the same numbers.
+
 Run:  python examples/calibrate_tschamut_3d.py [OUT_DIR] [--quick | --full]
+      [--workers N | --scheduler ADDRESS]
 """
 
 from __future__ import annotations
@@ -90,6 +95,7 @@ from fieldkit.fit.plan_scores import (
     section_to_plan,
     unique_runs,
 )
+from fieldkit.fit.plan_sweep import PlanFitUnit, plan_fit_sweep
 from fieldkit.fit.tracked_extent import (
     Extent,
     censor_chainage,
@@ -101,6 +107,7 @@ from fieldkit.io.dem import read_dem
 from fieldkit.io.path_observations import read_release_deposit
 from fieldkit.model.model_file import read_model
 from fieldkit.model.simulate import simulate
+from fieldkit.parallel.engine import Engine, EngineSpec
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "tests" / "data" / "tschamut2014"
@@ -291,25 +298,28 @@ def fixed_split(settings: dict, extent: Extent | None, height: float,
         "3-D calibrated",)  # fmt: skip
     forecasts: dict[str, list] = {name: [] for name in names}
     exited = {name: [] for name in forecasts}
-    for seed in SEEDS:
-        tic = time.perf_counter()
-        fit = plan_fit.fit_plan(
-            cal,
-            base3d,
-            free,
+    # the three seeds' 3-D fits (and their held-out ensembles) are independent
+    # units: through the Dask engine (--workers / --scheduler), same numbers
+    units = [
+        PlanFitUnit(
+            f"3-D fit, seed {seed}", tuple(cal), tuple(hold), tuple(free), seed,
             rocks=settings["fit_rocks"],
-            seed=seed,
             max_evaluations=settings["evaluations"] * (2 if grouping else 1),
-            screen=settings["screen"],
-            distance_weight=distance_weight,
+            screen=settings["screen"], distance_weight=distance_weight,
+            holdout_rocks=settings["holdout_rocks"],
         )
+        for seed in SEEDS
+    ]  # fmt: skip
+    swept = plan_fit_sweep(base3d, units, ENGINE)
+    for seed, fit in zip(SEEDS, swept, strict=True):
+        model = fit.model(base3d)
         if fits is not None:
-            fits.append(fit.model)
-        say(f"seed {seed}: 3-D fit in {time.perf_counter() - tic:.1f} s")
-        for line in fit.lines():
+            fits.append(model)
+        say(f"seed {seed}: 3-D fit in {fit.seconds:.1f} s")
+        for line in fit.lines:
             say("  " + line)
         rocks = settings["holdout_rocks"]
-        ens, share = _plan3d(fit.model, hold, rocks, seed)
+        ens, share = fit.holdout_xy, fit.holdout_exited_share
         forecasts["3-D calibrated"].append(score_runs(ens, rel, dep, u))
         exited["3-D calibrated"].append(share)
         if not verbose:
@@ -673,19 +683,19 @@ def kfold(settings: dict, repeats: int = 2, k: int = 5, seed: int = 1) -> dict:
     )
     per_run = {n: np.zeros((repeats, len(runs), 2)) for n in ("3-D", "clim")}
     tic = time.perf_counter()
-    for f in folds:
-        cal = [runs[i] for i in f.calibration]
-        hold = [runs[i] for i in f.holdout]
-        u = mean_direction(rel[f.calibration], dep[f.calibration])
-        fit = plan_fit.fit_plan(
-            cal,
-            base3d,
-            FREE,
-            rocks=settings["fit_rocks"],
-            seed=seed,
+    units = [
+        PlanFitUnit(
+            f"fold {f.fold} of repeat {f.repeat}",
+            tuple(runs[i] for i in f.calibration), tuple(runs[i] for i in f.holdout),
+            tuple(FREE), seed, rocks=settings["fit_rocks"],
             max_evaluations=settings["evaluations"],
+            holdout_rocks=settings["holdout_rocks"],
         )
-        ens, _ = _plan3d(fit.model, hold, settings["holdout_rocks"], seed)
+        for f in folds
+    ]  # fmt: skip
+    for f, fit in zip(folds, plan_fit_sweep(base3d, units, ENGINE), strict=True):
+        u = mean_direction(rel[f.calibration], dep[f.calibration])
+        ens = fit.holdout_xy
         for name, e in (
             ("3-D", ens),
             (
@@ -720,7 +730,35 @@ def kfold(settings: dict, repeats: int = 2, k: int = 5, seed: int = 1) -> dict:
     return {"comparisons": out}
 
 
+#: Where the fits run (main sets it from --workers N / --scheduler ADDRESS).
+ENGINE = Engine(EngineSpec(workers=0))
+
+
+def _engine_options(argv: list[str]) -> tuple[EngineSpec, list[str]]:
+    """``--workers N`` (local Dask processes) / ``--scheduler ADDRESS`` out of argv;
+    default: this process."""
+    spec, rest, it = EngineSpec(workers=0), [], iter(argv)
+    for a in it:
+        if a == "--workers":
+            spec = EngineSpec(workers=int(next(it)))
+        elif a == "--scheduler":
+            spec = EngineSpec(scheduler=next(it))
+        else:
+            rest.append(a)
+    return spec.check(), rest
+
+
 def main(argv: list[str]) -> None:
+    global ENGINE
+    spec, argv = _engine_options(argv)
+    ENGINE = Engine(spec, notify=print)
+    try:
+        _main(argv)
+    finally:
+        ENGINE.close()
+
+
+def _main(argv: list[str]) -> None:
     full = "--full" in argv
     quick = "--quick" in argv
     args = [a for a in argv if a not in ("--full", "--quick")]

@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import secrets
 from collections.abc import Callable, Iterator
+from dataclasses import replace
 from pathlib import Path
 from typing import Annotated
 
@@ -17,6 +18,7 @@ from fieldkit.cli.design import (
     DesignRocksOpt,
     MeasuredOpt,
 )
+from fieldkit.cli.engine_options import Scheduler, Timeout
 from fieldkit.cli.material_options import MaterialOpt, PresetOpt, mapped_table
 from fieldkit.cli.progress import report_written, step
 from fieldkit.errors import ArgumentError
@@ -37,6 +39,8 @@ FLAGS = {
     "power": "--power",
     "null_quantile": "--null-quantile",
     "workers": "--workers",
+    "scheduler": "--scheduler",
+    "timeout_s": "--timeout",
     "input_files": "TABLE_OR_TRACK",
     "at": "--at",
     "measured": "--measured",
@@ -313,9 +317,12 @@ def diagnose(
         int | None,
         typer.Option(
             "--workers",
-            help="Processes for the null and power campaigns (default: every core).",
+            help="Local Dask worker processes for the null and power campaigns "
+            "(default: every core; 1: this process).",
         ),
     ] = None,
+    scheduler: Scheduler = None,
+    timeout: Timeout = 10.0,
     sensitivity: Annotated[
         bool | None,
         typer.Option(
@@ -502,11 +509,20 @@ def diagnose(
                     f"{size} effect-free campaigns and {power} per candidate, each "
                     "simulated, surveyed, reduced and diagnosed"
                 ) as advance:
-                    diagnosis = diagnose_surveyed(
-                        table, base, seed=seed, folds=folds, null_size=size,
-                        power_size=power, quantile=null_quantile, workers=workers,
-                        loop_progress=advance,
-                    )  # fmt: skip
+                    from fieldkit.diagnose.survey_loop import engine_spec_of
+                    from fieldkit.parallel.engine import Engine
+
+                    spec = engine_spec_of(workers)
+                    if scheduler is not None:
+                        spec = replace(spec, scheduler=scheduler)
+                    spec = replace(spec, timeout_s=timeout).check()
+                    with Engine(spec, notify=note) as engine:
+                        engine.start(tiny=size + power < 4)
+                        diagnosis = diagnose_surveyed(
+                            table, base, seed=seed, folds=folds, null_size=size,
+                            power_size=power, quantile=null_quantile,
+                            workers=engine, loop_progress=advance,
+                        )  # fmt: skip
                 floor = (diagnosis.null or {}).get("threshold")
             else:
                 with _step_once_checked(
@@ -560,7 +576,6 @@ def diagnose(
             with step(f"writing the recording {rrd}", announce=False):
                 write_diagnosis_recording(rrd, diagnosis, text, outputs=outputs)
         if output is not None:
-            from dataclasses import replace
 
             from fieldkit.model.model_file import write_model
 

@@ -37,10 +37,7 @@ compares the null campaigns' baseline error with the observed one.
 from __future__ import annotations
 
 import math
-import multiprocessing
-import os
 from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -431,27 +428,36 @@ def run_task(task: LoopTask) -> dict:
 
 def run_tasks(
     tasks: list[LoopTask],
-    workers: int | None = None,
+    workers=None,
     progress: Callable[[int], None] | None = None,
 ) -> list[dict]:
-    """Every task, on ``workers`` processes (None: every core; 1: in this one)."""
-    workers = workers or os.cpu_count() or 1
-    out: list[dict] = []
-    if workers == 1 or len(tasks) < 4:
-        for task in tasks:
-            out.append(run_task(task))
-            if progress:
-                progress(1)
-        return out
-    # spawn, not fork: the parent may hold OpenMP threads (numba, BLAS), and a
-    # forked child of such a process can deadlock or abort
-    context = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
-        for result in pool.map(run_task, tasks, chunksize=2):
-            out.append(result)
-            if progress:
-                progress(1)
-    return out
+    """Every task, in order, through the Dask engine (:mod:`fieldkit.parallel.
+    engine`): ``workers`` an :class:`~fieldkit.parallel.engine.Engine`, or a count
+    of local worker processes (None: one per core, fewer than 4 tasks in this
+    process; 1: this process). Each task carries its own seed, so the results do
+    not depend on where it ran."""
+    from fieldkit.parallel.engine import Engine
+
+    if not isinstance(workers, Engine):
+        with Engine(engine_spec_of(workers)) as engine:
+            return run_tasks(tasks, engine, progress)
+    last = 0
+
+    def advance(done: int, total: int) -> None:
+        nonlocal last
+        if progress:
+            progress(done - last)
+        last = done
+
+    return workers.map(run_task, tasks, label="campaign", progress=advance,
+                       tiny=len(tasks) < 4)  # fmt: skip
+
+
+def engine_spec_of(workers: int | None):
+    """The engine of a worker count (:func:`run_tasks`)."""
+    from fieldkit.parallel.engine import EngineSpec
+
+    return EngineSpec(workers=0 if workers == 1 else workers)
 
 
 def check_loop_options(
@@ -612,8 +618,18 @@ def calibrate(
     ``first`` is the plain diagnosis of ``table`` (its baseline's fitted
     parameters and the candidates' fitted sizes are what the campaigns simulate).
     Null and power campaigns draw from streams spawned from ``seed`` apart from
-    the diagnosis's own fold deal.
+    the diagnosis's own fold deal. ``workers``: as :func:`run_tasks` (one engine
+    for every campaign of the call).
     """
+    from fieldkit.parallel.engine import Engine
+
+    if not isinstance(workers, Engine):
+        with Engine(engine_spec_of(workers)) as engine:
+            return calibrate(
+                table, first, model=model, candidates=candidates, folds=folds,
+                seed=seed, null_size=null_size, power_size=power_size,
+                quantile=quantile, workers=engine, progress=progress,
+            )  # fmt: skip
     paths, notes = loop_paths(table)
     materials, effects = baseline_world(table, first.baseline.params, model)
     root = np.random.SeedSequence([int(seed), 18])
