@@ -323,14 +323,12 @@ class Engine:
         workers = spec.workers or os.cpu_count() or 1
         memory = spec.memory_per_worker or machine_memory() // workers
         source = "given" if spec.memory_per_worker else "the machine's memory / workers"
-        self._cluster = LocalCluster(
-            n_workers=workers,
-            threads_per_worker=1,
-            processes=True,
-            memory_limit=memory,
-            dashboard_address=None,
-            silence_logs=logging.CRITICAL,
-        )
+        import dask
+
+        # a unit whose worker died comes straight back to map() (KilledWorker), to
+        # be reported and run again there, not re-run silently by the scheduler
+        with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+            self._cluster = self._local_cluster(LocalCluster, workers, memory)
         self._client = Client(self._cluster)
         self.workers, self.threads_per_worker = workers, 1
         self.memory_per_worker = memory
@@ -340,6 +338,18 @@ class Engine:
             "95 % of it is restarted and its unit run again)"
         )
         self.notify(f"running on a {self.where}")
+
+    @staticmethod
+    def _local_cluster(factory, workers: int, memory: int):
+        return factory(
+            n_workers=workers,
+            threads_per_worker=1,
+            processes=True,
+            memory_limit=memory,
+            dashboard_address=":0",  # any free port: never a clash with another
+            # cluster on this machine (a warning otherwise)
+            silence_logs=logging.CRITICAL,
+        )
 
     # -- work ---------------------------------------------------------------------
     def map(
@@ -413,6 +423,7 @@ class Engine:
             return client.submit(_run_unit, fn, unit, threads, shared, with_shared,
                                  pure=False)  # fmt: skip
 
+        before = set(client.scheduler_info()["workers"])
         futures = {}
         for i, unit in enumerate(units):
             futures[submit(unit)] = (i, 0)
@@ -438,6 +449,15 @@ class Engine:
             again = submit(units[i])
             futures[again] = (i, attempt + 1)
             pending.add(again)
+        gone = before - set(client.scheduler_info()["workers"])
+        if gone:
+            line = (
+                f"{len(gone)} worker(s) left during the run "
+                f"({', '.join(sorted(gone))}); their units were run again (results "
+                "unchanged: a seed per unit)"
+            )
+            self.retried.append(line)
+            self.notify(line)
         return results
 
     def _cancel(self, futures: dict) -> None:
@@ -447,7 +467,12 @@ class Engine:
     def _failed(
         self, unit: str, attempt: int, exc: BaseException, futures=None
     ) -> None:
-        why = f"{type(exc).__name__}: {' '.join(str(exc).split())}"[:300]
+        if type(exc).__name__ == "KilledWorker":
+            last = getattr(exc, "last_worker", None)
+            where = getattr(last, "address", None) or "a worker"
+            why = f"its worker died: {where}"
+        else:
+            why = f"{type(exc).__name__}: {' '.join(str(exc).split())}"[:300]
         if attempt >= self.spec.retries:
             if futures:
                 self._cancel(futures)

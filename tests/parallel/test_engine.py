@@ -148,3 +148,29 @@ def test_memory_sizes():
     assert parse_memory("1.5 GiB") == int(1.5 * 2**30)
     with pytest.raises(ArgumentError, match="not a size"):
         parse_memory("lots")
+
+
+def slow_pid(i: int) -> tuple[int, int]:
+    import os
+
+    time.sleep(0.4)
+    return i, os.getpid()
+
+
+def test_a_killed_worker_is_reported_and_its_units_run_again():
+    """kill -9 of a worker mid-run: its unit comes back (KilledWorker), is reported
+    and run again; every unit's result is there, in order."""
+    import os
+    import signal
+    import threading
+
+    lines: list[str] = []
+    with Engine(EngineSpec(workers=2), notify=lines.append) as engine:
+        engine.start()
+        victim = sorted(engine._client.run(os.getpid).values())[0]
+        threading.Timer(1.0, os.kill, (victim, signal.SIGKILL)).start()
+        out = engine.map(slow_pid, range(8), label="tile")
+    assert [o[0] for o in out] == list(range(8))
+    text = "\n".join(lines)
+    assert "failed (its worker died: tcp://" in text and "running it again" in text
+    assert "1 worker(s) left during the run" in text
