@@ -56,8 +56,9 @@ def test_shell_blocks_run(repo_copy, shell_commands, run_shell, monkeypatch):
     # profile, synth, fit, fit --paths (2), fit (3-D), diagnose, synth --track,
     # diagnose (track), track3d (2: its data, the command), synth --survey,
     # reduce --campaign, diagnose (campaign), export (3), import-model,
-    # import-results; the video block runs when slow
-    assert ran == 28
+    # import-results, corridor (2: 2-D, 3-D on 2 workers); the video block runs when
+    # slow
+    assert ran == 30
     # every README command writes under out/ only (issue 17): nothing new at the root
     assert {p.name for p in repo_copy.iterdir()} - before == {"out"}
     out = repo_copy / "out"
