@@ -214,7 +214,7 @@ def corridor(
     if materials is not None:
         parse_material_ranges(materials)
     xy = read_alignment(alignment)
-    stations_along(xy, spacing)  # spacing checked before the DEM is read
+    stations = stations_along(xy, spacing)  # spacing checked before the DEM is read
     grid = read_dem(dem)
     the_model = read_model(model, outputs=outputs, terrain=True)
     three_d = not hasattr(the_model, "profile")
@@ -230,7 +230,6 @@ def corridor(
             if on:
                 raise ArgumentError(f"{flag} cuts 2-D sections; {model} is a terrain "
                                     "(3-D) model")  # fmt: skip
-    stations = stations_along(xy, spacing)
     if three_d:
         check_same_dem(the_model, grid)
     check_on_dem(stations, grid)

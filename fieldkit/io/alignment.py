@@ -22,10 +22,7 @@ from os import PathLike
 import numpy as np
 
 from fieldkit.errors import InputFileError
-from fieldkit.io.csv_table import length_factor, read_csv_table
-
-X_ALIASES = ("x", "easting")
-Y_ALIASES = ("y", "northing")
+from fieldkit.io.csv_table import plan_columns, read_csv_table
 
 
 def read_alignment(path: str | PathLike[str]) -> np.ndarray:
@@ -38,30 +35,12 @@ def read_alignment(path: str | PathLike[str]) -> np.ndarray:
         number, fewer than two vertices, or a vertex repeating the one before.
     """
     table = read_csv_table(path)
-    found = table.require(
-        {"x": X_ALIASES, "y": Y_ALIASES},
-        "an alignment file needs plan coordinates in columns x, y (e.g. x_m, y_m)",
-    )
-    for column in found.values():
-        if column.unit is None:
-            header = column.header.strip()
-            raise InputFileError(
-                f"column '{header}' has no length unit: name it in the header "
-                f"('{header}_m', '{header}_ft'), in the DEM's coordinate system",
-                source=table.source,
-                where="row 1",
-            )
-    factors = {k: length_factor(table, c, None) for k, c in found.items()}
+    found, factors = plan_columns(table, "an alignment file")
     xy, rows = [], []
     for number, row in table.rows:
+        # table.number refuses empty cells, text and non-finite numbers
         x = table.number(number, row, found["x"]) * factors["x"]
         y = table.number(number, row, found["y"]) * factors["y"]
-        if not (np.isfinite(x) and np.isfinite(y)):
-            raise InputFileError(
-                "x and y must be finite numbers",
-                source=table.source,
-                where=f"row {number}",
-            )
         if xy and (x, y) == xy[-1]:
             raise InputFileError(
                 f"vertex ({x:g}, {y:g}) repeats the one before (row {rows[-1]})",

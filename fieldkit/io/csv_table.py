@@ -689,6 +689,35 @@ def length_factor(
     return LENGTH_UNITS[column.unit]
 
 
+#: Plan coordinates in a DEM's coordinate system (release and alignment files).
+PLAN_X_ALIASES = ("x", "easting")
+PLAN_Y_ALIASES = ("y", "northing")
+
+
+def plan_columns(table: CsvTable, what: str) -> tuple[dict, dict]:
+    """The ``x``, ``y`` plan-coordinate columns of ``table`` (a file of ``what``,
+    e.g. ``"a release file"``) and each one's factor to metres.
+
+    A DEM's coordinate system gives no default unit, so each column must name its
+    length unit in the header (``x_m``, ``x_ft``); without one, an
+    :class:`InputFileError` says how to name it (row 1).
+    """
+    found = table.require(
+        {"x": PLAN_X_ALIASES, "y": PLAN_Y_ALIASES},
+        f"{what} needs plan coordinates in columns x, y (e.g. x_m, y_m)",
+    )
+    for column in found.values():
+        if column.unit is None:
+            header = column.header.strip()
+            raise InputFileError(
+                f"column '{header}' has no length unit: name it in the header "
+                f"('{header}_m', '{header}_ft'), in the DEM's coordinate system",
+                source=table.source,
+                where="row 1",
+            )
+    return found, {k: length_factor(table, c, None) for k, c in found.items()}
+
+
 def units_factor(units: str) -> float:
     """Metres per unit of ``units`` (``m`` or ``ft``, international)."""
     if units not in ("m", "ft"):

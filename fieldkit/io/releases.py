@@ -26,10 +26,8 @@ from os import PathLike
 import numpy as np
 
 from fieldkit.errors import InputFileError
-from fieldkit.io.csv_table import length_factor, read_csv_table
+from fieldkit.io.csv_table import plan_columns, read_csv_table
 
-X_ALIASES = ("x", "easting")
-Y_ALIASES = ("y", "northing")
 POLYGON_ALIASES = ("polygon", "polygon_id")
 COUNT_ALIASES = ("count", "rocks")
 #: Most rocks one release point may start (a count beyond is a typing error).
@@ -103,22 +101,9 @@ def read_releases(path: str | PathLike[str]) -> Releases:
     ([[5.0, 5.0]], (5,), (2, 3, 4), '1 point, polygon A (3 vertices)')
     """
     table = read_csv_table(path)
-    found = table.require(
-        {"x": X_ALIASES, "y": Y_ALIASES},
-        "a release file needs plan coordinates in columns x, y (e.g. x_m, y_m)",
-    )
+    found, factors = plan_columns(table, "a release file")
     polygon = table.find(POLYGON_ALIASES, "polygon")
     count = table.find(COUNT_ALIASES, "count")
-    for column in found.values():
-        if column.unit is None:
-            header = column.header.strip()
-            raise InputFileError(
-                f"column '{header}' has no length unit: name it in the header "
-                f"('{header}_m', '{header}_ft'), in the DEM's coordinate system",
-                source=table.source,
-                where="row 1",
-            )
-    factors = {k: length_factor(table, c, None) for k, c in found.items()}
     points, point_rows, counts = [], [], []
     vertices: dict[str, list[tuple[float, float, int]]] = {}
     for number, row in table.rows:

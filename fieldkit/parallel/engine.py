@@ -216,6 +216,7 @@ class Engine:
         self.threads_per_worker = 1
         self.memory_per_worker: int | None = None
         self.retried: list[str] = []
+        self._said_local = False
 
     # -- lifetime -----------------------------------------------------------------
     def __enter__(self) -> Engine:
@@ -305,7 +306,7 @@ class Engine:
             info = client.scheduler_info()["workers"].values()
             self.workers = len(info)
             threads = sorted({int(w.get("nthreads", 1)) for w in info})
-            self.threads_per_worker = threads[0] if len(threads) == 1 else threads[0]
+            self.threads_per_worker = threads[0]  # the fewest any worker has
             limits = [int(w.get("memory_limit") or 0) for w in info]
             self.memory_per_worker = min(limits) if all(limits) else None
             memory = (
@@ -398,7 +399,7 @@ class Engine:
         name = (lambda i: names[i]) if names is not None else (lambda i: f"{label} {i}")
         with_shared = shared is not None
         if not self.remote(tiny):
-            if self.where == "this process" and not getattr(self, "_said_local", False):
+            if self.where == "this process" and not self._said_local:
                 self._said_local = True
                 self.notify(
                     "running in this process"
