@@ -33,6 +33,7 @@ from fieldkit.corridor.sections import (
     SectionSetup,
     StationSection,
     check_base_model,
+    start_height_m,
     station_section,
 )
 from fieldkit.corridor.stations import (
@@ -265,8 +266,6 @@ def scan2d(
             "beyond_used_m": [s.beyond_m for s in sections],
         },
     )
-    from fieldkit.corridor.sections import start_height_m
-
     short = [
         i for i, s in enumerate(sections) if s.alignment_x_m < setup.upslope_m - 1e-6
     ]
