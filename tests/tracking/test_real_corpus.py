@@ -12,6 +12,7 @@ import math
 import pytest
 from real_corpus import (
     CORPUS_ENV,
+    EXTENDED_KINDS,
     G_MPS2,
     SURFACE_KINDS,
     clip_file,
@@ -27,7 +28,7 @@ from real_corpus import (
 
 LABELS = load_labels()
 PERMISSIVE = ("MIT", "BSD", "Apache-2.0", "CC0", "CC-BY", "Unlicense", "ISC")
-KINDS = (*SURFACE_KINDS, "hand")
+KINDS = (*SURFACE_KINDS, *EXTENDED_KINDS, "hand")
 
 
 def _corpus_or_skip():
@@ -57,17 +58,19 @@ def test_labels_are_complete_and_consistent(label):
     u, v, bw, bh = label["body"]["first_box_px"]
     assert 0 <= u and u + bw <= w and 0 <= v and v + bh <= h
     assert 0 <= label["body"]["first_box_frame"] < n
-    spans = []
     for c in label["contacts"]:
         assert c["kind"] in KINDS
         assert 0 <= c["first_frame"] <= c["last_frame"] < n
-        spans.append((c["first_frame"], c["last_frame"]))
-    for f in label["flights"]:
-        assert 0 <= f["first_frame"] < f["last_frame"] < n
-        spans.append((f["first_frame"], f["last_frame"]))
-    # contacts and flights follow one another without overlapping
-    spans.sort()
+    spans = sorted((f["first_frame"], f["last_frame"]) for f in label["flights"])
+    assert all(0 <= a < b < n for a, b in spans)
+    # flights follow one another, and no flight overlaps a contact (contacts may
+    # overlap each other: a hand pushing a ball at rest)
     assert all(b < c for (_, b), (c, _) in zip(spans, spans[1:], strict=False))
+    for c in label["contacts"]:
+        assert all(b < c["first_frame"] or a > c["last_frame"] for a, b in spans), (
+            c,
+            spans,
+        )
 
 
 @pytest.mark.parametrize("label", LABELS, ids=[lb["clip"] for lb in LABELS])
@@ -132,6 +135,23 @@ def test_score_events_checks_g_with_the_scale_uncertainty():
     label = _label(m_per_px=0.01, m_per_px_sd=0.0005, derived_from_gravity=True)
     *_, flights = score_events(label, [], [(12, 48, 30.0, 0.2), (52, 88, 30.0, 0.2)])
     assert all(f.ok and not f.g_checked for f in flights)
+
+
+def test_a_flight_fitted_in_a_rolling_contact_misses_it():
+    label = {**_label(), "flights": []}
+    label["contacts"] = [
+        {"first_frame": 0, "last_frame": 8, "kind": "rest"},
+        {"first_frame": 9, "last_frame": 50, "kind": "rolling"},
+    ]
+    # no flight: both found, no event needed
+    found, missed, false, flights = score_events(label, [], [])
+    assert found == [(0, 8, 0), (9, 50, 9)] and not missed and not false
+    assert flights == []
+    # a flight one frame into the rest is tolerated; one over 20-40 is not
+    found, missed, *_ = score_events(
+        label, [30], [(7, 9, 9.8, 0.1), (20, 40, 9.8, 0.1)]
+    )
+    assert found == [(0, 8, 0)] and missed == [(9, 50)]
 
 
 @pytest.mark.slow
