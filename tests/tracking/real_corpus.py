@@ -168,6 +168,7 @@ class ClipResult:
     flights: list[FlightCheck] = field(default_factory=list)
     seconds: float = 0.0
     warnings: list[str] = field(default_factory=list)
+    summary: str = ""
 
     @property
     def passed(self) -> bool:
@@ -188,6 +189,8 @@ class ClipResult:
         if self.status != "checked":
             return [f"{head} {self.message}"]
         out = [f"{head} ({self.seconds:.0f} s)"]
+        if self.summary:
+            out.append(f"  tracker: {self.summary}")
         out.append(
             "  contacts found: "
             + (", ".join(f"{a}-{b} at {f}" for a, b, f in self.found) or "none")
@@ -202,7 +205,7 @@ class ClipResult:
 
 def score_events(
     label: dict,
-    event_frames: list[int],
+    event_frames: list[int | tuple[int, int]],
     fitted: list[tuple[int, int, float, float]],
 ) -> tuple[list, list, list, list[FlightCheck]]:
     """Compare found events and fitted flights with a clip's labels.
@@ -212,21 +215,25 @@ def score_events(
     label
         The clip's label dictionary.
     event_frames
-        Frame of every impact or contact the tracker reported.
+        Frame of every impact the tracker reported, or ``(first, last)`` frames of
+        an extended contact (a net, a rolling phase).
     fitted
         ``(first frame, last frame, g, g standard error)`` of every fitted flight.
 
     Returns
     -------
     found, missed, false_events, flights
-        ``(first, last, found frame)`` per labelled impact or net contact found within
-        :data:`CONTACT_TOLERANCE_FRAMES` (per rolling or resting contact no fitted
-        flight claims: its first frame); ``(first, last)`` per one missed; frames of
-        events inside no labelled contact (of any kind); one :class:`FlightCheck`
-        per labelled free flight, with the fitted flight overlapping it most.
+        ``(first, last, found frame)`` per labelled impact or net contact found (an
+        event beginning and ending within :data:`CONTACT_TOLERANCE_FRAMES` of the
+        label's first and last frames), and per rolling or resting contact no fitted
+        flight claims (its first frame); ``(first, last)`` per one missed; the first
+        frame of each event not inside a labelled contact (of any kind, within the
+        tolerance); one :class:`FlightCheck` per labelled free flight, with the
+        fitted flight overlapping it most.
     """
     tol = CONTACT_TOLERANCE_FRAMES
     contacts = label["contacts"]
+    events = [(e, e) if isinstance(e, int) else tuple(e) for e in event_frames]
     found, missed = [], []
     for c in contacts:
         a, b = c["first_frame"], c["last_frame"]
@@ -240,16 +247,16 @@ def score_events(
             continue
         if c["kind"] not in SURFACE_KINDS:
             continue
-        near = [f for f in event_frames if a - tol <= f <= b + tol]
+        near = [s for s, e in events if abs(s - a) <= tol and abs(e - b) <= tol]
         if near:
             found.append((a, b, near[0]))
         else:
             missed.append((a, b))
     false_events = [
-        f
-        for f in event_frames
+        s
+        for s, e in events
         if not any(
-            c["first_frame"] - tol <= f <= c["last_frame"] + tol for c in contacts
+            c["first_frame"] - tol <= s and e <= c["last_frame"] + tol for c in contacts
         )
     ]
     _, _, scale_rel = scale_of(label)
@@ -303,7 +310,16 @@ def evaluate_clip(corpus: Path, label: dict) -> ClipResult:
     finally:
         result.seconds = time.perf_counter() - start
     frames = track.frame["frame"].to_numpy()
-    events = [int(round(t * fps)) for t in analysis.impacts.frame["t_s"].astype(float)]
+    table = analysis.impacts.frame
+    start = table["t_s"].astype(float).to_numpy()
+    if "contact_duration_s" in table.columns:
+        duration = table["contact_duration_s"].astype(float).fillna(0.0).to_numpy()
+    else:
+        duration = 0.0 * start
+    events = [
+        (int(round(t * fps)), int(round((t + d) * fps)))
+        for t, d in zip(start, duration, strict=True)
+    ]
     fitted = [
         (int(frames[f.rows[0]]), int(frames[f.rows[-1]]), f.g_mps2, f.g_se_mps2)
         for f in analysis.flights
@@ -312,6 +328,9 @@ def evaluate_clip(corpus: Path, label: dict) -> ClipResult:
         label, events, fitted
     )
     result.warnings = [*track.meta.get("warnings", []), *analysis.warnings]
+    result.summary = (
+        f"{analysis.counts_text()}; body in {len(frames)} of {label['frames']} frames"
+    )
     return result
 
 
