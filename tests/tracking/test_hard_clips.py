@@ -356,3 +356,59 @@ def test_handheld_truth_gives_the_camera_motion(hard, tmp_path):
     t = np.linspace(0, clip.frames / clip.camera.capture_fps, 50)
     u0, v0 = hard.project(clip.camera, shake, 0.0, 0.0, t)
     assert np.ptp(u0) > 3 and np.ptp(v0) > 3
+
+
+def test_shadow_touches_the_ball_at_contact_and_lies_down_light_when_high(hard):
+    clip = hard.CLIPS["hard_shadow"]
+    sh, scene, r = clip.shadow, clip.scene, clip.body.radius_m
+    psi = math.radians(scene.surface_deg)
+    tangent = np.array([math.cos(psi), -math.sin(psi)])
+    normal = np.array([math.sin(psi), math.cos(psi)])
+    p0 = np.array(scene.plate_point_m)
+    foot = p0 + 0.3 * tangent
+    # at contact: just below the contact point the ground is in full shadow
+    centre = foot + r * normal
+    below = foot - 0.3 * r * normal
+    fac = hard.shadow_factor(clip, below[0], below[1], *centre)
+    assert fac < 1 - 0.8 * sh.strength  # 0.42 at 0.65 strength
+    edge = foot - 0.02 * r * normal  # the shadow's edge reaches the contact point
+    fac = hard.shadow_factor(clip, edge[0], edge[1], *centre)
+    assert fac < 1 - 0.4 * sh.strength
+    # 0.3 m above the plate: no shadow under the ball, full shadow down the light
+    centre = foot + (r + 0.3) * normal
+    fac = hard.shadow_factor(clip, below[0], below[1], *centre)
+    assert fac > 0.999  # only the logistic penumbra tail
+    light = np.array(
+        [math.cos(math.radians(sh.light_deg)), -math.sin(math.radians(sh.light_deg))]
+    )
+    hit = centre + (r + 0.3) / -(light @ normal) * light  # the ray meets the plate
+    spot = hit - sh.face_offset_r * r * normal
+    fac = hard.shadow_factor(clip, spot[0], spot[1], *centre)
+    soft = (sh.soft_r * r + sh.soft_per_m * 0.3) / (sh.across_r * r)  # penumbra
+    assert fac == pytest.approx(1 - sh.strength / (1 + math.exp(-1 / soft)), rel=1e-9)
+    assert fac < 1 - 0.9 * sh.strength  # its darkest point: 0.40
+    assert np.linalg.norm(hit - foot) > 0.2  # the shadow lies > 0.2 m from the ball
+    # nothing above the plate's surface line is shaded
+    above = hit + 0.01 * normal
+    assert hard.shadow_factor(clip, above[0], above[1], *centre) == 1.0
+
+
+def test_dust_appears_at_the_impacts_above_the_plate_and_fades(hard):
+    clip = hard.CLIPS["hard_dust"]
+    times = np.arange(clip.frames) / clip.camera.capture_fps
+    _, impacts = hard.motion(clip, times)
+    impacts = [imp for imp in impacts if imp["t_s"] <= times[-1]]
+    particles = hard.dust_particles(clip, impacts, np.random.default_rng(3))
+    assert len(particles) == clip.dust.particles * len(impacts)
+    t1 = impacts[0]["t_s"]
+    assert len(hard.dust_state(clip, particles, t1 - 1e-6)[0]) == 0
+    psi = math.radians(clip.scene.surface_deg)
+    normal = np.array([math.sin(psi), math.cos(psi)])
+    opacity = []
+    for dt in (0.01, 0.05, 0.2):
+        x, z, size, opac = hard.dust_state(clip, particles, t1 + dt)
+        assert len(x) == clip.dust.particles
+        height = (np.c_[x, z] - clip.scene.plate_point_m) @ normal
+        assert height.min() > 0.0
+        opacity.append(opac.sum())
+    assert opacity[0] > opacity[1] > opacity[2]
