@@ -412,3 +412,78 @@ def test_dust_appears_at_the_impacts_above_the_plate_and_fades(hard):
         assert height.min() > 0.0
         opacity.append(opac.sum())
     assert opacity[0] > opacity[1] > opacity[2]
+
+
+_ALL_CLIPS = (
+    "hard_shadow",
+    "hard_dark",
+    "hard_blur",
+    "hard_rolling",
+    "hard_lens",
+    "hard_lens_checker",
+    "hard_handheld",
+    "hard_h264",
+    "hard_h264_120",
+    "hard_h264_30",
+    "hard_block",
+    "hard_dust",
+    "hard_freefall",
+    "hard_table",
+    "hard_all",
+)
+
+
+@pytest.mark.parametrize(
+    "name", sorted(n for n in _ALL_CLIPS if n != "hard_lens_checker")
+)
+def test_labels_agree_with_the_exact_truth(hard, tmp_path, name):
+    """Every clip's labels (the real corpus's schema) against its truth files."""
+    truth = hard.render_hard(name, tmp_path, video=False)
+    clip = hard.CLIPS[name]
+    cam, fps = clip.camera, clip.camera.capture_fps
+    labels = json.loads((tmp_path / f"{name}.labels.json").read_text())
+    table = pd.read_csv(tmp_path / f"{name}.truth.csv")
+    assert labels["capture_fps"] == fps and labels["container_fps"] == cam.container_fps
+    assert labels["file"] == f"{name}{cam.extension}"
+    assert labels["conditions"] == truth["conditions"] and labels["conditions"]
+    assert len(table) == labels["frames"] == clip.frames
+    # contacts bracket the exact impact times; none in a free fall
+    assert len(labels["contacts"]) == len(truth["impacts"])
+    for c, imp in zip(labels["contacts"], truth["impacts"], strict=True):
+        assert c["first_frame"] <= imp["t_s"] * fps < c["first_frame"] + 1
+        assert c["sub_frame"] is True and c["kind"] == "impact"
+        assert c["surface"] == clip.surface
+    # flights: the in-image frames strictly between contacts
+    times = table["t_s"].to_numpy()
+    for f in labels["flights"]:
+        sel = slice(f["first_frame"], f["last_frame"] + 1)
+        assert table["visible"][sel].all()
+        inside = [
+            imp
+            for imp in truth["impacts"]
+            if times[sel][0] < imp["t_s"] < times[sel][-1]
+        ]
+        assert inside == []
+    # world <-> pixel through the camera model at each frame's time
+    shake = hard.Shake(
+        *(
+            np.array(truth["camera_model"]["shake"][k])
+            for k in ("freq_hz", "amp", "phase_rad")
+        )
+    )
+    u, v = hard.project(cam, shake, table["x_m"], table["z_m"], times)
+    np.testing.assert_allclose(
+        np.c_[table["u_px"], table["v_px"]], np.c_[u, v], atol=1e-6
+    )
+    x, z = hard.pixel_to_world(cam, shake, table["u_px"], table["v_px"], times)
+    np.testing.assert_allclose(np.c_[x, z], table[["x_m", "z_m"]], atol=1e-8)
+    # the scale points are the scale marks' images, the box the body's first image
+    for (xm, zm), (us, vs) in zip(
+        truth["scale_points_m"], labels["scale"]["points_px"], strict=True
+    ):
+        assert hard.project(cam, shake, xm, zm, 0.0) == pytest.approx(
+            (us, vs), abs=1e-6
+        )
+    k = labels["body"]["first_box_frame"]
+    u0, v0, w, h = labels["body"]["first_box_px"]
+    assert u0 < table["u_px"][k] < u0 + w and v0 < table["v_px"][k] < v0 + h
