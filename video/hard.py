@@ -38,7 +38,6 @@ Run through ``render.py``: ``python video/render.py --out DIR hard_shadow``.
 from __future__ import annotations
 
 import importlib.util
-import json
 import math
 import sys
 from dataclasses import asdict, dataclass, field, replace
@@ -966,6 +965,7 @@ def _clips() -> dict:
         ),
         frames=288,
         shadow=Shadow(),
+        world=World(plate_level=150.0),  # a light floor: the shadow shows
         conditions=("shadow", "shadow_merges_at_contact"),
     )
     dark = base.Ball(
@@ -1236,6 +1236,7 @@ def _clips() -> dict:
         ),
         frames=120,
         shadow=Shadow(),
+        world=World(plate_level=150.0),  # a light floor: the shadow shows
         dust=Dust(),
         conditions=("shadow", "motion_blur", "handheld", "compression_mp4v", "dust"),
     )
@@ -1615,8 +1616,3 @@ def clip_files(name: str, out_dir: Path) -> list[Path]:
             "labels.json",
         )
     ]
-
-
-if __name__ == "__main__":  # pragma: no cover
-    for arg in sys.argv[1:] or NAMES:
-        print(json.dumps(render_hard(arg, HERE / "hard")["frames"]))

@@ -352,6 +352,15 @@ def test_handheld_truth_gives_the_camera_motion(hard, tmp_path):
     np.testing.assert_allclose(table[cols].to_numpy(), pose.T, atol=1e-9)
     u, v = hard.project(clip.camera, shake, table["x_m"], table["z_m"], table["t_s"])
     np.testing.assert_allclose(table["u_px"], u, atol=1e-6)
+    # the stated sds: sum_k a_k^2 / 2 per axis, drift and shake together
+    cam = clip.camera
+    stated = (
+        np.array([cam.drift_m] * 3 + [cam.drift_rad] * 3) ** 2
+        + np.array([cam.shake_m] * 3 + [cam.shake_rad] * 3) ** 2
+    )
+    np.testing.assert_allclose(0.5 * (shake.amp**2).sum(axis=1), stated, rtol=1e-9)
+    long = shake.pose(np.arange(0, 400, 0.01))
+    np.testing.assert_allclose(long.std(axis=1), np.sqrt(stated), rtol=0.05)
     # the camera moves: the world origin's image drifts by pixels over the clip
     t = np.linspace(0, clip.frames / clip.camera.capture_fps, 50)
     u0, v0 = hard.project(clip.camera, shake, 0.0, 0.0, t)
