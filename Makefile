@@ -4,7 +4,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test test-all test-rstone bench bench-diagnose lint video clean
+.PHONY: demo test test-all test-rstone bench bench-diagnose lint video video-hard clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -53,6 +53,10 @@ bench-diagnose: $(STAMP)
 ## Re-render the synthetic high-speed clips in video/ (deterministic).
 video: $(STAMP)
 	$(BIN)/python video/render.py
+
+## Render the hard synthetic clips (video/hard.py; not committed) into video/hard/.
+video-hard: $(STAMP)
+	$(BIN)/python video/render.py --out video/hard hard
 
 lint: $(STAMP)
 	$(BIN)/ruff check fieldkit tests benchmarks examples

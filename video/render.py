@@ -33,6 +33,7 @@ Usage::
     python video/render.py               # both clips into video/
     python video/render.py --out /tmp/v bounce_drag_short   # the dragged ball
     python video/render.py --out /tmp/v --frames 300 bounce
+    python video/render.py --out /tmp/v hard_shadow     # a hard clip (video/hard.py)
 """
 
 from __future__ import annotations
@@ -848,21 +849,49 @@ def clip_files(name: str, out_dir: Path, extension: str = ".avi") -> list[Path]:
     ]
 
 
+def _hard():
+    """The hard clips' module (``video/hard.py``, which builds on this one)."""
+    import importlib.util
+    import sys
+
+    name = "fieldkit_video_render_hard"
+    if name not in sys.modules:
+        spec = importlib.util.spec_from_file_location(name, HERE / "hard.py")
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        spec.loader.exec_module(module)
+    return sys.modules[name]
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
         "clips",
         nargs="*",
-        help=f"clips to render: {', '.join(sorted(PRESETS))} (default: bounce net)",
+        help=f"clips to render: {', '.join(sorted(PRESETS))}, the hard clips of "
+        "video/hard.py (hard_shadow, ..., or 'hard' for all) (default: bounce net)",
     )
     parser.add_argument("--out", type=Path, default=HERE)
     parser.add_argument("--frames", type=int, default=None)
     args = parser.parse_args(argv)
     args.clips = args.clips or ["bounce", "net"]
-    unknown = sorted(set(args.clips) - set(PRESETS))
+    if "hard" in args.clips:  # every hard clip
+        args.clips = [c for c in args.clips if c != "hard"] + list(_hard().NAMES)
+    hard_names = [c for c in args.clips if c.startswith("hard_")]
+    unknown = sorted(set(args.clips) - set(PRESETS) - set(hard_names))
+    unknown += sorted(set(hard_names) - set(_hard().NAMES)) if hard_names else []
     if unknown:
         parser.error(f"unknown clip(s) {', '.join(unknown)}")
-    for name in args.clips:
+    for name in hard_names:
+        hard = _hard()
+        truth = hard.render_hard(name, args.out, frames=args.frames)
+        print(
+            f"{args.out / truth['clip']}: {truth['frames']} frames, "
+            f"{len(truth.get('impacts', []))} impacts"
+        )
+        for path in hard.clip_files(name, args.out):
+            print(f"wrote {path}")
+    for name in [c for c in args.clips if c not in hard_names]:
         truth = render(name, args.out, frames=args.frames)
         print(
             f"{args.out / truth['clip']}: {truth['frames']} frames, "
