@@ -32,6 +32,7 @@ from fieldkit.tracking.video.reader import VideoReader
 from fieldkit.viz.figure_files import save_png
 from fieldkit.viz.track_report_figure import (
     contact_frames,
+    flagged_frames,
     flight_frame_range,
     plot_frames,
     plot_g_per_flight,
@@ -207,6 +208,11 @@ def _clip_section(analysis, detections, video) -> list[str]:
         f"* events: {analysis.counts_text()}",
         "",
     ]
+    flags = flagged_frames(detections) if detections is not None else {}
+    if flags:
+        out += ["| detection flag | frames | count |", "|---|---|---|"]
+        out += [_row(k, frame_ranges(v), len(v)) for k, v in flags.items()]
+        out.append("")
     return out
 
 

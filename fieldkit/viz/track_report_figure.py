@@ -163,6 +163,29 @@ def frame_flags(row: pd.Series, status: str = "") -> list[str]:
     return flags
 
 
+def flagged_frames(detections: pd.DataFrame) -> dict[str, np.ndarray]:
+    """Frames of accepted detections by flag: ``partial``, every other boolean
+    column that is True (e.g. a detector's ``blurred``), and every status text that
+    is not clean; flags no frame carries are left out."""
+    found = detections[detections["found"].fillna(False).astype(bool)]
+    frames = found["frame"].to_numpy(int)
+    out: dict[str, np.ndarray] = {}
+    for name in found.columns:
+        if name in NOT_FLAGS:
+            continue
+        values = found[name]
+        if not values.map(lambda x: isinstance(x, bool | np.bool_)).all():
+            continue
+        hit = values.to_numpy(bool)
+        if hit.any():
+            out[str(name)] = frames[hit]
+    status = detection_status(found)
+    clean = status.str.strip().str.lower().isin(CLEAN_STATUS).to_numpy(bool)
+    for text in pd.unique(status[~clean]):
+        out[str(text)] = frames[(status == text).to_numpy(bool)]
+    return out
+
+
 def sheet_frames(
     analysis: TrackAnalysis,
     detections: pd.DataFrame,
@@ -421,6 +444,22 @@ def plot_time_height(
             mew=0.8,
             label="partial detection (body cut by the frame edge)",
         )
+    if detections is not None and "frame" in f.columns:
+        flags = {k: v for k, v in flagged_frames(detections).items() if k != "partial"}
+        if flags:
+            hit = np.isin(
+                f["frame"].to_numpy(int), np.concatenate(list(flags.values()))
+            )
+            ax.plot(
+                t[hit],
+                z[hit],
+                "s",
+                mfc="none",
+                mec="crimson",
+                ms=5,
+                mew=0.8,
+                label="flagged detection (" + ", ".join(sorted(flags)) + ")",
+            )
     if detections is not None:
         refused = refused_frames(detections)
         if len(refused):

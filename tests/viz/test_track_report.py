@@ -237,6 +237,12 @@ def test_refused_frames_and_flags_show_a_detectors_fields():
     assert flags[1] == ["refused: blurred: streak 4 px"]
     assert flags[3] == ["blurred"]
     assert flags[4] == ["low contrast"]
+    flagged = track_report_figure.flagged_frames(det)
+    assert {k: v.tolist() for k, v in flagged.items()} == {
+        "partial": [0],
+        "blurred": [3],
+        "low contrast": [4],
+    }
     # without the columns: nothing refused, no flag
     plain = det[["frame"]].assign(found=True)
     assert refused_frames(plain).empty
