@@ -172,7 +172,7 @@ def _clip_section(analysis, detections, video) -> list[str]:
         if "width_px" in meta and "height_px" in meta
         else "size unknown"
     )
-    decoded = len(detections) if detections is not None else meta.get("frames_decoded")
+    decoded = len(detections) if detections is not None else "no per-frame table"
     f = track.frame
     partial = (
         int(f["partial"].fillna(False).astype(bool).sum()) if "partial" in f else 0
@@ -307,6 +307,8 @@ def _refusal_section(analysis, detections) -> list[str]:
             out.append(
                 _row(reason, frame_ranges(group["frame"].to_numpy()), len(group))
             )
+    elif refused is None:
+        out.append("No per-frame detections were given (not tracked from a video).")
     else:
         out.append("No frame was refused: a body was accepted in every frame.")
     more = getattr(analysis, "refusals", None)  # contacts the analysis refused

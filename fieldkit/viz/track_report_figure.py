@@ -81,8 +81,8 @@ class ContactFrames:
     @property
     def label(self) -> str:
         same = self.first == self.last
-        frames = f"{self.first}" if same else f"{self.first}-{self.last}"
-        return f"{self.kind} {self.point} (frame {frames})"
+        frames = f"frame {self.first}" if same else f"frames {self.first}-{self.last}"
+        return f"{self.kind} {self.point} ({frames})"
 
 
 def contact_frames(analysis: TrackAnalysis) -> list[ContactFrames]:

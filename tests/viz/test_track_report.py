@@ -276,3 +276,25 @@ def test_cli_report_holds_every_warning_it_printed(cli, clip, tmp_path):
     assert [(r[0], r[4]) for r in flights] == [
         (i, g.replace("+/-", "±")) for i, g in g_lines
     ]
+
+
+def test_net_contact_is_a_band_with_its_frames():
+    from fieldkit.tracking.flights.synthetic_tracks import net_capture
+    from fieldkit.viz.track_report import markdown
+
+    sim = net_capture(noise_m=3e-4, rng=np.random.default_rng(4))
+    a = analyse_track(sim.track, radius_m=0.0375, mass_kg=0.14)
+    (net,) = a.contacts
+    (c,) = contact_frames(a)
+    fps = a.track.fps
+    assert c.kind == "net"
+    assert (c.t_start_s, c.t_end_s) == pytest.approx((net.t_start_s, net.t_end_s))
+    assert (c.first, c.last) == (round(net.t_start_s * fps), round(net.t_end_s * fps))
+    ax = plot_time_height(a, None, title="net").axes[0]
+    (band,) = [p for p in ax.patches if p.get_label() == "net contact"]
+    span = (band.get_x(), band.get_x() + band.get_width())
+    assert span == pytest.approx((net.t_start_s, net.t_end_s))
+    text = markdown(a, None, video="net.avi", warnings=[])
+    (row,) = _table(text, "Contacts")
+    assert row[1:3] == ["net", f"{c.first}–{c.last}"]
+    assert net.summary() in text
