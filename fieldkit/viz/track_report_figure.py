@@ -220,7 +220,7 @@ def sheet_frames(
     spare = max(count - len(chosen), 0)
     if spare and frames.size:
         for k in np.unique(np.linspace(0, frames.size - 1, spare + 2).round()):
-            if len(chosen) >= max(count, len(chosen)):
+            if len(chosen) >= count:
                 break
             add(int(frames[int(k)]))
     return sorted(chosen)
