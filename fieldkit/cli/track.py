@@ -18,10 +18,12 @@ from fieldkit.cli.common import (
     ShapeOpt,
     UnitWeightOpt,
     body_from_options,
+    command_flags,
     note,
     one_line_errors,
     print_body_notes,
     warn,
+    with_flags,
 )
 from fieldkit.cli.progress import report_written, step
 from fieldkit.errors import ArgumentError
@@ -168,6 +170,16 @@ def track(
         Path | None,
         typer.Option("--figures", help="Folder for PNG figures of the track."),
     ] = None,
+    report: Annotated[
+        Path | None,
+        typer.Option(
+            "--report",
+            help="Folder for a report to check by eye: report.md (calibration, "
+            "flights with g, contacts, refused frames, every warning), frames.png "
+            "(detections drawn on sampled frames), time_height.png, "
+            "g_per_flight.png.",
+        ),
+    ] = None,
     quiet: Annotated[
         bool, typer.Option("--quiet", "-q", help="No progress bar.")
     ] = False,
@@ -192,7 +204,7 @@ def track(
           --homography out/clips/bounce_short.homography.json \\
           --radius 0.0375 --mass 0.14 --surface-angle 15 \\
           -o out/bounce_track.csv --impacts out/bounce_impacts.csv \\
-          --figures out/bounce
+          --figures out/bounce --report out/bounce_report
     """
     from fieldkit.tracking.flights.pipeline import analyse_track
     from fieldkit.tracking.video.calibration import (
@@ -257,6 +269,7 @@ def track(
         table_format(impacts)  # CSV for /dev/null or a FIFO, else by its extension
     outputs = OutputSet(inputs=[video, homography, surface_profile, surface_dem])
     outputs.confine(figures)
+    outputs.confine(report)
     for path, flag in ((out, "-o"), (impacts, "--impacts"), (rrd, "--rrd")):
         if path is not None:
             outputs.plan(path, argument=flag)
@@ -265,8 +278,16 @@ def track(
 
         for name in TRACK_FIGURE_NAMES:
             outputs.plan(figures / name, argument="--figures")
-    if out is None and impacts is None and rrd is None and figures is None:
-        note("no -o, --impacts, --rrd or --figures given; printing the summary only")
+    if report is not None:
+        from fieldkit.viz.track_report import REPORT_NAMES
+
+        for name in REPORT_NAMES:
+            outputs.plan(report / name, argument="--report")
+    if all(p is None for p in (out, impacts, rrd, figures, report)):
+        note(
+            "no -o, --impacts, --rrd, --figures or --report given; printing the "
+            "summary only"
+        )
 
     ground = read_ground(surface_profile, surface_dem, section, footprint, outputs)
     reader = VideoReader(video)
@@ -284,9 +305,9 @@ def track(
         video, reader, fps, calibration, search, body.radius_m, show=not quiet
     )
     rate_message = fps_mismatch_message(info, fps)
-    for message in [rate_message, *track_data.meta.get("warnings", [])]:
-        if message:
-            warn(message)
+    warned = [m for m in [rate_message, *track_data.meta.get("warnings", [])] if m]
+    for message in warned:
+        warn(message)
     if body.radius_m is None:
         whole = track_data.frame.loc[~track_data.frame["partial"], "radius_m"]
         if len(whole):
@@ -303,12 +324,13 @@ def track(
         ground=ground,
     )
     print_body_notes(body)
+    later = list(analysis.warnings)
     if ground is not None:
         note(ground.description)
-        for message in ground_gap_warnings(ground, analysis, body.radius_m):
-            warn(message)
-    for message in analysis.warnings:
+        later = ground_gap_warnings(ground, analysis, body.radius_m) + later
+    for message in later:
         warn(message)
+    warned += later
 
     if out is not None:
         analysis.track.write(out, outputs=outputs)
@@ -329,7 +351,16 @@ def track(
         write_track_figures(
             figures, analysis, background_frame=background, outputs=outputs
         )
-    with step("writing the outputs", announce=rrd is not None or figures is not None):
+    if report is not None:
+        from fieldkit.viz.track_report import write_track_report
+
+        write_track_report(
+            report, analysis, detections, video=video, reader=reader,
+            warnings=[with_flags(m, command_flags()) for m in warned],  # as printed
+            outputs=outputs,
+        )  # fmt: skip
+    announce = rrd is not None or figures is not None or report is not None
+    with step("writing the outputs", announce=announce):
         written = outputs.commit()
     _summary(video, track_data, detections, analysis, calibration.description)
     report_written(written)
