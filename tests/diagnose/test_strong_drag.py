@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from fieldkit.cli.diagnose_track import diagnose_track_file
-from fieldkit.diagnose.flights import FlightSamples, diagnose_flights
+from fieldkit.diagnose.flights import FlightSamples, diagnose_flights, sphere_mass_kg
 from fieldkit.model.effects import air_drag
 from fieldkit.tracking.flights.pipeline import analyse_track
 from fieldkit.tracking.flights.synthetic_tracks import bouncing_ball
@@ -126,3 +126,20 @@ def test_the_same_ball_without_drag_recommends_nothing():
     assert d.recommended is None
     assert d.baseline.cv_rmse == pytest.approx(NOISE_M, rel=0.05)
     assert d.candidates[0].params["air_drag.cd"] * PER_CD < 0.01
+
+
+def test_without_the_mass_the_same_drag_is_found(dragged):
+    """A track without the body's mass (`track` run without --mass): the assumed
+    rock sphere (0.585 kg) only changes the cd stated. Before, its cd <= 3 meant
+    k <= 0.014 1/m: +4.0 % held-out gain, time-ordered residuals (rho -0.90,
+    +0.83), the numbers of the issue's private clip."""
+    d = diagnose_flights(
+        true_flights(light_ball()), radius_m=RADIUS_M, rng=np.random.default_rng(1)
+    )
+    c, with_mass = d.candidates[0], dragged.candidates[0]
+    assert d.recommended == "air_drag"
+    assert c.improvement == pytest.approx(with_mass.improvement, abs=1e-9)
+    rock = sphere_mass_kg(RADIUS_M)
+    rock_per_cd = float(air_drag.drag_factor(1.0, 1.225, RADIUS_M, rock))
+    k = c.params["air_drag.cd"] * rock_per_cd
+    assert abs(k / K_PER_M - 1) < 0.05, k
