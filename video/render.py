@@ -1,6 +1,7 @@
 """Render the synthetic high-speed clips in ``video/`` deterministically.
 
-Two scenes (the bounce also with quadratic air drag: ``bounce_drag``), filmed "at"
+Two scenes (the bounce also with quadratic air drag: ``bounce_drag``, and with the
+strong drag of a light ball: ``bounce_drag_strong``), filmed "at"
 1205 frames/s (thesis §8.5) and stored as MJPG ``.avi``
 with a 30 frames/s playback rate, as high-speed cameras do:
 
@@ -709,6 +710,22 @@ def _short_drag_bounce_scene() -> BounceScene:
     )
 
 
+def _strong_drag_bounce_scene() -> BounceScene:
+    # cd 18.1: k = 0.35 1/m for the bundled 75 mm, 140 g ball, the drag of a light
+    # ball; launched upward so that the flights are long enough to bend
+    return BounceScene(
+        surface_deg=18.0,
+        plate_point_m=(0.0, 0.40),
+        plate_end_x_m=1.40,
+        start_m=(-0.07, 0.55),
+        start_velocity_mps=(2.0, 1.0),
+        start_omega_radps=0.0,
+        e_n=(0.7, 0.65, 0.6),
+        duration_s=0.9,
+        drag_cd=18.1,
+    )
+
+
 #: clip name -> (camera factory, scene factory). ``bounce_short`` (480x320, 542
 #: frames, 3 impacts) is the reduced clip the fast tests render.
 PRESETS = {
@@ -717,6 +734,7 @@ PRESETS = {
     "bounce_short": (_short_bounce_camera, _short_bounce_scene),
     "bounce_drag": (Camera, _drag_bounce_scene),
     "bounce_drag_short": (_short_bounce_camera, _short_drag_bounce_scene),
+    "bounce_drag_strong": (Camera, _strong_drag_bounce_scene),
 }
 
 

@@ -8,13 +8,20 @@ plain :class:`FlightSamples`). Two models are compared by their held-out error:
   position and velocity are nuisance parameters (closed-form least squares);
 * **air_drag** -- quadratic drag ``a = g - k |v| v`` with ``k = rho C_d pi r^2 /
   (2 m)`` exactly as in the simulator (:mod:`fieldkit.model.effects.air_drag`), one
-  **global** ``air_drag.cd`` (air density held at the registry default), the same
-  four nuisance parameters per flight (:mod:`fieldkit.model.drag_flight`).
+  **global** ``k``, the same four nuisance parameters per flight. The fit is
+  :func:`fieldkit.model.drag_flight.fit_drag`, the one `fieldkit track` makes of a
+  dragged flight, over the same range ``0 <= k <=``
+  :data:`~fieldkit.model.drag_flight.MAX_K_PER_M`; it is reported as
+  ``air_drag.cd`` for the body (air density held at the registry default) and as
+  ``k`` in the notes. The range is one of ``k``, not the registry's ``cd <= 3``
+  for rough rocks: a light ball's ``k`` is far beyond it (a 75 mm, 140 g ball with
+  ``k = 0.35 1/m`` has ``cd = 18``), and a ``cd`` clipped at 3 left that drag in
+  the residuals.
 
 Cross-validation holds out whole flights (the groups of
-:func:`~fieldkit.diagnose.groups.make_groups`): ``cd`` is fitted on the training
+:func:`~fieldkit.diagnose.groups.make_groups`): ``k`` is fitted on the training
 flights (Newton on the sum of squares profiled over the flights' own parameters),
-then each held-out flight's initial state is refitted with ``cd`` fixed. The
+then each held-out flight's initial state is refitted with ``k`` fixed. The
 baseline has no global parameter, so its held-out residuals are its per-flight fits;
 both models thus get the same freedom per held-out flight, and the gain is the
 improvement of the held-out RMS of the position residuals (``cv_rmse_m``, per
@@ -69,9 +76,6 @@ MAX_RADIUS_M = 25.0
 MAX_MASS_KG = 2.0e8
 #: Family-wise level of the residual dependence tests (Holm correction).
 DEPENDENCE_ALPHA = 0.05
-#: Newton iterations on ``cd`` and Gauss-Newton iterations per flight.
-_OUTER, _INNER = 30, 8
-
 _SPEC = air_drag.SPEC
 _RHO = next(p.default for p in _SPEC.parameters if p.name == "air_density_kg_m3")
 _CD_MAX = next(p.upper for p in _SPEC.parameters if p.name == "cd")
@@ -182,50 +186,19 @@ def _collect(flights: list[FlightSamples], source: str | None) -> _Data:
     )
 
 
-def _fit_at(data: _Data, k: float, params: np.ndarray) -> tuple[float, float, float]:
-    """Per-flight fits at drag factor ``k``: ``(sse, r.j_k, |j_k perp|^2)`` totals."""
-    sse, grad, info = drag_flight.fit_flights(
-        data.t, data.x, data.z, data.start, k, G, drag_flight.MAX_STEP_S, params, _INNER
-    )
-    return float(sse.sum()), float(grad.sum()), float(info.sum())
-
-
-def _fit(data: _Data, k_max: float, k: float | None = None) -> _Fit:
-    """Fit the flights with ``k`` fixed (given) or ``k`` in ``[0, k_max]`` fitted.
-
-    ``k`` is found by projected Newton on ``sse/2`` profiled over the flights'
-    states (the model is nearly linear in ``k``: two or three steps), halving a step
-    that does not lower the sum of squares.
-    """
-    params = np.full((data.n_flights, 4), np.nan)
-    k_now = 0.0 if k is None else k
-    sse, grad, info = _fit_at(data, k_now, params)
-    if k is None:
-        for _ in range(_OUTER):
-            step = grad / info if info > 0 else 0.0
-            trial_k = min(max(k_now + step, 0.0), k_max)
-            if trial_k == k_now:
-                break
-            trial_p = params.copy()
-            trial = _fit_at(data, trial_k, trial_p)
-            while trial[0] > sse and abs(trial_k - k_now) > 1e-9 * (k_max + k_now):
-                trial_k = 0.5 * (trial_k + k_now)
-                trial_p = params.copy()
-                trial = _fit_at(data, trial_k, trial_p)
-            if trial[0] > sse:
-                break
-            done = abs(trial_k - k_now) <= 1e-7 * max(trial_k, 1e-12)
-            k_now, params = trial_k, trial_p
-            sse, grad, info = trial
-            if done:
-                break
+def _fit(data: _Data, k: float | None = None) -> _Fit:
+    """Fit the flights with ``k`` fixed (given) or fitted: the fit `fieldkit track`
+    makes of a dragged flight (:func:`fieldkit.model.drag_flight.fit_drag`), here
+    with one ``k`` shared by the flights."""
+    fit = drag_flight.fit_drag(data.t, data.x, data.z, data.start, G, k_per_m=k)
     residual, speed = drag_flight.residuals(
-        data.t, data.x, data.z, data.start, k_now, G, drag_flight.MAX_STEP_S, params
-    )
-    return _Fit(k_now, params, sse, info, residual, speed)
+        data.t, data.x, data.z, data.start, fit.k_per_m, G, drag_flight.MAX_STEP_S,
+        fit.params,
+    )  # fmt: skip
+    return _Fit(fit.k_per_m, fit.params, fit.sse_m2, fit.info, residual, speed)
 
 
-def _held_out_drag(data: _Data, fold: np.ndarray, k_max: float) -> np.ndarray:
+def _held_out_drag(data: _Data, fold: np.ndarray) -> np.ndarray:
     """Held-out residuals ``(n, 2)`` of the drag model: ``k`` from the other folds,
     each held-out flight's state refitted with that ``k``."""
     out = np.empty((data.t.size, 2))
@@ -233,9 +206,9 @@ def _held_out_drag(data: _Data, fold: np.ndarray, k_max: float) -> np.ndarray:
     for f in np.unique(fold_of_flight):
         test = np.flatnonzero(fold_of_flight == f)
         train = np.flatnonzero(fold_of_flight != f)
-        k = _fit(data.subset(train), k_max).k
+        k = _fit(data.subset(train)).k
         rows = np.isin(data.flight, test)
-        out[rows] = _fit(data.subset(test), k_max, k=k).residual
+        out[rows] = _fit(data.subset(test), k=k).residual
     return out
 
 
@@ -293,6 +266,25 @@ def _free_g_note(data: _Data) -> str:
         "quadratic drag lowers the apparent g of falling flights, raises it on "
         "rising ones, and slows x (which a parabola keeps linear)"
     )
+
+
+def _drag_note(
+    k: float, k_sd: float, cd: float, radius_m: float, mass_kg: float
+) -> str:
+    """The fitted drag factor as `fieldkit track` states it, and its ``cd``; a
+    ``cd`` beyond the registry's range is said to be so (a light body, or a mass or
+    radius that is not the body's)."""
+    text = (
+        f"air_drag fitted: k = {k:.4g} ± {k_sd:.2g} 1/m in a = g - k |v| v (one k "
+        f"for all flights, the fit `fieldkit track` makes of a dragged flight), "
+        f"cd = {cd:.4g} for radius {radius_m:g} m and mass {mass_kg:.4g} kg"
+    )
+    if cd > _CD_MAX:
+        text += (
+            f"; cd is beyond the registry's {_CD_MAX:g} for a rough block: check the "
+            "mass and radius, and a model file takes cd only within its range"
+        )
+    return text
 
 
 def _skipped() -> dict[str, str]:
@@ -389,15 +381,12 @@ def diagnose_flights(
             "the assumed mass / radius^2"
         )
     per_cd = float(air_drag.drag_factor(1.0, _RHO, radius_m, mass_kg))
-    k_max = _CD_MAX * per_cd
 
     groups = make_groups(data.flight, rng, folds=folds, min_paths=MIN_FLIGHTS)
     n_groups = groups.n_groups
-    base = _fit(data, k_max, k=0.0)
+    base = _fit(data, k=0.0)
     base_ho = held_out(base.residual, 1.0, groups.group, n_groups)
-    drag_ho = held_out(
-        _held_out_drag(data, groups.fold, k_max), 1.0, groups.group, n_groups
-    )
+    drag_ho = held_out(_held_out_drag(data, groups.fold), 1.0, groups.group, n_groups)
     gain, se = improvement(base_ho, drag_ho)
     # the impact-level rule, 1 % floor included: detection errors correlated over
     # frames let a tiny cd absorb them with a small jackknife SE (the plain
@@ -405,12 +394,13 @@ def diagnose_flights(
     # a parameter
     ok = meaningful(gain, se, z=z, min_gain=MIN_GAIN)
 
-    full = _fit(data, k_max)
+    full = _fit(data)
     n_obs = 2 * data.t.size
     dof = max(1, n_obs - 4 * data.n_flights - 1)
     sigma2 = full.sse / dof
-    cd = full.k / per_cd
-    cd_sd = math.sqrt(sigma2 / full.info) / per_cd if full.info > 0 else math.inf
+    k_sd = math.sqrt(sigma2 / full.info) if full.info > 0 else math.inf
+    cd, cd_sd = full.k / per_cd, k_sd / per_cd
+    notes.append(_drag_note(full.k, k_sd, cd, radius_m, mass_kg))
     drag_params = {"air_drag.cd": cd, "air_drag.air_density_kg_m3": _RHO}
     candidate = Candidate(
         effect="air_drag",

@@ -12,12 +12,20 @@ Beside the positions, :func:`flight_path` integrates the variational equations: 
 derivatives of ``x(t)``, ``z(t)`` with respect to the initial velocity ``(vx0, vz0)``
 and to ``k``. The derivatives with respect to the initial position are 1 (a
 translation), so a flight is fitted by Gauss-Newton in four parameters
-(:func:`fit_flights`) and ``k`` by Newton on the profiled sum of squares.
+(:func:`fit_flights`) and ``k`` by Newton on the profiled sum of squares
+(:func:`fit_drag`).
+
+:func:`fit_drag` is the one fit of quadratic drag to tracked flights: `fieldkit
+track` fits one flight with it (:mod:`fieldkit.tracking.flights.free_flight`) and
+`fieldkit diagnose` fits one ``k`` shared by a track's flights
+(:mod:`fieldkit.diagnose.flights`), both over the same range of ``k``
+(:data:`MAX_K_PER_M`), so the drag `track` finds is the drag `diagnose` scores.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
@@ -25,6 +33,13 @@ from numba import njit
 #: Longest RK4 step [s]: drag changes the velocity on a time scale 1/(k|v|) of tens
 #: of seconds for rocks, so 5 ms leaves the truncation error far below a micrometre.
 MAX_STEP_S = 0.005
+#: Largest drag factor fitted [1/m]: a ping-pong ball (2.7 g, r 20 mm, cd 0.5) has
+#: 0.28 / m; ten times that is drag no tracked body has. A bound on ``k``, not on
+#: ``cd``: the registry's ``cd`` range is that of a rough rock, while a tracked body
+#: (a light ball) can show ``k`` far beyond what ``cd <= 3`` gives for its mass.
+MAX_K_PER_M = 3.0
+#: Newton iterations on ``k`` and Gauss-Newton iterations per flight and ``k``.
+_OUTER, _INNER = 30, 8
 #: Size of the state: x, z, vx, vz and d(x, z, vx, vz)/d(vx0, vz0, k).
 _N = 16
 
@@ -216,3 +231,102 @@ def residuals(t, x, z, start, k, g, max_step_s, params):
             out[a + i, 1] = z[a + i] - zm[i]
             speed[a + i] = math.sqrt(vel[i, 0] ** 2 + vel[i, 1] ** 2)
     return out, speed
+
+
+@dataclass
+class DragFit:
+    """Flights fitted with one drag factor (:func:`fit_drag`).
+
+    Attributes
+    ----------
+    k_per_m
+        The drag factor ``k`` [1/m] (given or fitted).
+    params
+        ``(n_flights, 4)``: ``x0, z0, vx0, vz0`` at each flight's first sample.
+    sse_m2
+        Sum of the squared x and z residuals of all flights [m^2].
+    info
+        ``sum |j_k perp|^2``: the curvature of ``sse / 2`` in ``k`` profiled over
+        the flights' states (``sigma^2 / info`` is the variance of ``k``).
+    """
+
+    k_per_m: float
+    params: np.ndarray
+    sse_m2: float
+    info: float
+
+
+def _fit_at(t, x, z, start, k, g, params):
+    sse, grad, info = fit_flights(t, x, z, start, k, g, MAX_STEP_S, params, _INNER)
+    return float(sse.sum()), float(grad.sum()), float(info.sum())
+
+
+def fit_drag(
+    t_s: np.ndarray,
+    x_m: np.ndarray,
+    z_m: np.ndarray,
+    start: np.ndarray,
+    g_mps2: float,
+    *,
+    k_per_m: float | None = None,
+    k_max_per_m: float = MAX_K_PER_M,
+) -> DragFit:
+    """Flights with quadratic drag: one ``k`` shared by all, each its own state.
+
+    ``k`` in ``[0, k_max_per_m]`` is found by projected Newton on ``sse / 2``
+    profiled over the flights' initial positions and velocities (the model is nearly
+    linear in ``k``: a few steps), a step that does not lower the sum of squares
+    halved; each flight's state by Gauss-Newton (:func:`fit_flights`) from the
+    parabola, then from the previous ``k``'s fit.
+
+    Parameters
+    ----------
+    t_s, x_m, z_m
+        Samples of all flights, concatenated; flight ``i`` is
+        ``start[i]:start[i + 1]`` (times increasing within it).
+    start
+        Flight boundaries (``int64``, ``n_flights + 1`` values).
+    g_mps2
+        Gravity [m/s^2].
+    k_per_m
+        A fixed drag factor (only the states are fitted), or None to fit it.
+    k_max_per_m
+        Upper bound of the fitted ``k``.
+
+    Returns
+    -------
+    DragFit
+
+    Examples
+    --------
+    >>> t = np.arange(0.0, 0.4, 1 / 500)
+    >>> x, z, _, _ = flight_path(t, 0.0, 0.5, 3.0, 1.0, 0.35, 9.81, MAX_STEP_S)
+    >>> fit = fit_drag(t, x, z, np.array([0, t.size]), 9.81)
+    >>> round(fit.k_per_m, 6), fit.sse_m2 < 1e-20
+    (0.35, True)
+    """
+    t, x, z = (np.ascontiguousarray(a, dtype=float) for a in (t_s, x_m, z_m))
+    start = np.ascontiguousarray(start, dtype=np.int64)
+    params = np.full((start.size - 1, 4), np.nan)
+    k = 0.0 if k_per_m is None else float(k_per_m)
+    sse, grad, info = _fit_at(t, x, z, start, k, g_mps2, params)
+    if k_per_m is None and np.isfinite(sse):
+        for _ in range(_OUTER):
+            step = grad / info if info > 0 else 0.0
+            trial_k = min(max(k + step, 0.0), k_max_per_m)
+            if trial_k == k:
+                break
+            trial_p = params.copy()
+            trial = _fit_at(t, x, z, start, trial_k, g_mps2, trial_p)
+            while not trial[0] <= sse and abs(trial_k - k) > 1e-9 * k_max_per_m:
+                trial_k = 0.5 * (trial_k + k)
+                trial_p = params.copy()
+                trial = _fit_at(t, x, z, start, trial_k, g_mps2, trial_p)
+            if not trial[0] <= sse:
+                break
+            done = abs(trial_k - k) <= 1e-7 * max(trial_k, 1e-12)
+            k, params = trial_k, trial_p
+            sse, grad, info = trial
+            if done:
+                break
+    return DragFit(k, params, sse, info)
