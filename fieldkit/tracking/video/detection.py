@@ -139,6 +139,14 @@ def _hysteresis(
     return keep[labels].astype(np.uint8) * 255
 
 
+def _closed(mask: np.ndarray, size: int) -> np.ndarray:
+    """Morphological closing with a disc ``size`` px wide (no-op for size < 3)."""
+    if size < 3:
+        return mask
+    kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (size, size))
+    return cv2.morphologyEx(mask, cv2.MORPH_CLOSE, kernel)
+
+
 def _is_shadow(part, bg, contour, shadow, detector) -> bool:
     """Whether a blob is a cast shadow: mostly shadow-like pixels (:func:`shadow_mask`)
     over background texture the frame preserves (correlation > 0.6), or over a plain
@@ -246,6 +254,7 @@ class BallDetector:
         *,
         threshold: float | None = None,
         velocity: tuple[float, float] | None = None,
+        close_px: int = 0,
     ) -> list[Candidate]:
         """Bodies in ``window``; refused blobs go to ``self._refused`` with a reason.
 
@@ -253,7 +262,9 @@ class BallDetector:
         body remains the whole difference is searched again and a blob that is
         mostly shadow over a background texture it preserves is refused as
         ``"shadow"``. Each blob grows by hysteresis into its neighbours above half the
-        threshold, so the dim side of a low-contrast body is part of its silhouette.
+        threshold, so the dim side of a low-contrast body is part of its silhouette;
+        ``close_px`` > 0 closes gaps that wide (a body on a background of nearly its
+        own colour in places).
         """
         u0, v0, u1, v1 = window
         part = frame[v0:v1, u0:u1]
@@ -274,12 +285,31 @@ class BallDetector:
             body[shadow] = 0
             body = cv2.morphologyEx(body, cv2.MORPH_OPEN, _OPEN_KERNEL)
             grown = _hysteresis(diff, body, low_level, exclude=shadow)
+            if close_px:
+                grown = _closed(self._colour_grow(part, grown, close_px // 2), close_px)
             found = self._shapes(part, bg, grown, window, velocity, None)
             if found or not (shadow & (high > 0)).any():
                 return found
             self._refused.clear()
         grown = _hysteresis(diff, high, low_level)
+        if close_px:
+            grown = _closed(self._colour_grow(part, grown, close_px // 2), close_px)
         return self._shapes(part, bg, grown, window, velocity, shadow)
+
+    def _colour_grow(self, part, seeds: np.ndarray, reach: int) -> np.ndarray:
+        """``seeds`` plus the pixels within ``reach`` of them that have the body's
+        colour (given, else the median of the seed pixels) within the noise: where
+        the background matches the body, the difference misses part of it."""
+        if not seeds.any():
+            return seeds
+        colour = self.body_colour
+        if colour is None:
+            colour = np.median(part[seeds > 0].reshape(-1, 3), axis=0)
+        kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * reach + 1,) * 2)
+        near = cv2.dilate(seeds, kernel) > 0
+        like = np.abs(part.astype(np.float32) - colour).max(axis=2)
+        like = like < 3.0 * self.noise_sd + 4.0
+        return np.where(near & like, 255, seeds).astype(np.uint8)
 
     def _shapes(self, part, bg, mask, window, velocity, shadow) -> list[Candidate]:
         """Shape test of every blob of ``mask`` (see :meth:`_candidates`)."""
@@ -527,7 +557,7 @@ class BallDetector:
         return uc, vc
 
     # ---------------------------------------------------------------- public
-    def _search(self, frame, prediction, velocity, threshold=None):
+    def _search(self, frame, prediction, velocity, threshold=None, close_px=0):
         """Candidates near the prediction, else in the whole region of interest."""
         w, h = self.size
         self._refused = []
@@ -542,7 +572,11 @@ class BallDetector:
             )
             if window[2] - window[0] > 8 and window[3] - window[1] > 8:
                 candidates = self._candidates(
-                    frame, window, threshold=threshold, velocity=velocity
+                    frame,
+                    window,
+                    threshold=threshold,
+                    velocity=velocity,
+                    close_px=close_px,
                 )
                 if candidates:
                     return candidates, prediction
@@ -560,7 +594,9 @@ class BallDetector:
             min(v1 + margin, h),
         )
         self._refused = []
-        found = self._candidates(frame, window, threshold=threshold, velocity=velocity)
+        found = self._candidates(
+            frame, window, threshold=threshold, velocity=velocity, close_px=close_px
+        )
         return found, None
 
     def detect(
@@ -577,21 +613,32 @@ class BallDetector:
         if self.compensate_flicker:
             self._gain = brightness_gain(frame, self.background)
         self._ambiguous = False
-        candidates, prediction = self._search(frame, prediction, velocity)
+        given = prediction
+        candidates, prediction = self._search(frame, given, velocity)
         best = self._choose(candidates, prediction)
         low_contrast = False
-        if (
-            best is None
-            and not candidates
-            and not self._refused  # nothing at all differs from the background
-            and self.settings.low_contrast
-            and 5.0 * self.noise_sd < 0.8 * self.threshold
-        ):
-            candidates, prediction = self._search(
-                frame, prediction, velocity, threshold=5.0 * self.noise_sd
+        if best is None and not candidates and self.settings.low_contrast:
+            refused = self._refused
+            holes = {r for _, r in refused} & {"not_round", "too_small"}
+            expected = self.expected_radius_px or (
+                float(np.median(self._radii[-25:])) if self._radii else 10.0
             )
-            best = self._choose(candidates, prediction)
-            low_contrast = best is not None
+            close = 2 * int(max(2.0, 0.25 * expected)) + 1
+            passes = []
+            if holes:  # a body in parts: parts of the background match its colour
+                passes.append((None, close))
+            if not refused and 5.0 * self.noise_sd < 0.8 * self.threshold:
+                passes.append((5.0 * self.noise_sd, close))  # nothing differs enough
+            for threshold, close_px in passes:
+                candidates, prediction = self._search(
+                    frame, given, velocity, threshold=threshold, close_px=close_px
+                )
+                best = self._choose(candidates, prediction)
+                if best is not None:
+                    low_contrast = True
+                    break
+            if best is None and not candidates:
+                self._refused = refused
         if best is None:
             self.status = self._refusal(candidates)
             return None
