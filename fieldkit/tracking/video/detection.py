@@ -147,14 +147,16 @@ def _closed(mask: np.ndarray, size: int) -> np.ndarray:
     return cv2.morphologyEx(mask, cv2.MORPH_CLOSE, kernel)
 
 
-def _is_shadow(part, bg, contour, shadow, detector) -> bool:
+def _is_shadow(part, bg, contour, detector) -> bool:
     """Whether a blob is a cast shadow: mostly shadow-like pixels (:func:`shadow_mask`)
-    over background texture the frame preserves (correlation > 0.6), or over a plain
-    background with a soft edge. An opaque body hides the texture behind it."""
-    fill = np.zeros(shadow.shape, np.uint8)
+    over background texture the frame preserves (correlation > 0.6); an opaque body
+    hides the texture behind it. Over a plain background a grey body and a shadow
+    look alike: the blob is kept (its shape and the prediction decide)."""
+    fill = np.zeros(part.shape[:2], np.uint8)
     cv2.drawContours(fill, [contour], -1, 255, -1)
     inside = fill > 0
-    if np.count_nonzero(shadow & inside) < 0.7 * np.count_nonzero(inside):
+    dimmed = shadow_mask(part[inside], bg[inside], noise=detector.noise_sd)
+    if np.count_nonzero(dimmed) < 0.7 * dimmed.size:
         return False
     f = part[inside].astype(np.float32).mean(axis=1)
     b = bg[inside].astype(np.float32).mean(axis=1)
@@ -277,7 +279,9 @@ class BallDetector:
         low_level = max(0.5 * thr, 3.0 * self.noise_sd)
         shadow = None
         if self.settings.suppress_shadows:
-            shadow = shadow_mask(part, bg, noise=self.noise_sd)
+            shadow = np.zeros(diff.shape, bool)
+            where = np.nonzero(diff > low_level)  # only where it matters: fast
+            shadow[where] = shadow_mask(part[where], bg[where], noise=self.noise_sd)
             if self.body_colour is not None:  # the body's own colour is never shadow
                 near = np.abs(part.astype(np.float32) - self.body_colour).max(axis=2)
                 shadow &= near > 3.0 * self.noise_sd + 10.0
@@ -332,7 +336,7 @@ class BallDetector:
             if (cut & inner).any() or inner.sum() < 10:
                 continue  # cut by the search window, not the frame: search wider
             partial = not bool(inner.all())  # touches the frame border
-            if shadow is not None and _is_shadow(part, bg, contour, shadow, self):
+            if shadow is not None and _is_shadow(part, bg, contour, self):
                 self._refused.append((area, "shadow"))
                 continue
             cand, reason = self._round(u, v, inner, area, partial)

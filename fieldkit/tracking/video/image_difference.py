@@ -57,6 +57,8 @@ def shadow_mask(
 ) -> np.ndarray:
     """Pixels that look like the background in shadow (bool, one channel).
 
+    ``frame`` and ``background`` are BGR images (or BGR pixel lists, shape (n, 3)).
+
     The test of Prati, Cucchiara et al. (IEEE PAMI 25, 2003), as in OpenCV's MOG2
     shadow label: a cast shadow dims the scene by a factor within ``darkening`` and
     keeps its chromaticity, so every channel is dimmed by the same factor. A pixel is
@@ -75,16 +77,14 @@ def shadow_mask(
     """
     f = frame.astype(np.float32) + 0.5
     b = background.astype(np.float32) + 0.5
-    if f.ndim == 2:
-        ratio = f / b
-        return (ratio >= darkening[0]) & (ratio <= darkening[1])
-    brightness = f.sum(axis=2) / b.sum(axis=2)
+    b_sum = b.sum(axis=-1)
+    brightness = f.sum(axis=-1) / b_sum
     ratios = f / b
-    spread = ratios.max(axis=2) - ratios.min(axis=2)
-    allowed = chroma_tolerance * brightness + 2.0 * noise / b.min(axis=2)
+    spread = ratios.max(axis=-1) - ratios.min(axis=-1)
+    allowed = chroma_tolerance * brightness + 2.0 * noise / b.min(axis=-1)
     return (
         (brightness >= darkening[0])
         & (brightness <= darkening[1])
         & (spread <= allowed)
-        & (b.sum(axis=2) > 90.0)  # too dark a scene to tell a shadow
+        & (b_sum > 90.0)  # too dark a scene to tell a shadow
     )
