@@ -94,6 +94,7 @@ class Candidate:
     blurred: bool = False
     streak_px: float = 0.0  # streak length beyond the body's diameter
     colour: np.ndarray | None = None  # mean BGR inside the blob (with a body colour)
+    twin: bool = False  # the streak reading of a blob also read as a larger circle
 
 
 @dataclass(frozen=True)
@@ -340,10 +341,17 @@ class BallDetector:
                 self._refused.append((area, "shadow"))
                 continue
             cand, reason = self._round(u, v, inner, area, partial)
-            if cand is None and not partial:
+            streak = None
+            if not partial:
                 streak = self._streak(contour, u0, v0, area, velocity)
-                if streak is not None:
-                    cand, reason = streak, ""
+                if cand is None and streak is not None:
+                    cand, reason, streak = streak, "", None
+                elif streak is not None and streak.r * 1.15 < cand.r:
+                    # a short streak also passes for a larger circle: offer both,
+                    # the expected radius chooses
+                    streak.twin = True
+                else:
+                    streak = None
             if cand is None:
                 self._refused.append((area, reason))
                 continue
@@ -358,6 +366,9 @@ class BallDetector:
                 cv2.drawContours(fill, [contour], -1, 255, -1)
                 cand.colour = np.array(cv2.mean(part, mask=fill)[:3], np.float32)
             out.append(cand)
+            if streak is not None:
+                streak.colour = cand.colour
+                out.append(streak)
         return out
 
     def _round(self, u, v, inner, area, partial):
@@ -472,8 +483,11 @@ class BallDetector:
             return None
         costs.sort(key=lambda item: item[0])
         # several bodies and nothing (a prediction, a size, a colour) to tell them apart
+        rivals = [c for c in costs if not c[1].twin]
         self._ambiguous = (
-            prediction is None and len(costs) > 1 and costs[1][0] - costs[0][0] < 0.25
+            prediction is None
+            and len(rivals) > 1
+            and rivals[1][0] - rivals[0][0] < 0.25
         )
         return costs[0][1]
 
