@@ -145,6 +145,47 @@ def track(
             help="Search only this image region (pixels).",
         ),
     ] = None,
+    first_box: Annotated[
+        str | None,
+        typer.Option(
+            "--first-box",
+            metavar="U,V,WIDTH,HEIGHT",
+            help="A box around the body in frame --first-box-frame (pixels): its "
+            "size, colour and place there, for when the automatic detection is "
+            "unsure.",
+        ),
+    ] = None,
+    first_box_frame: Annotated[
+        int,
+        typer.Option("--first-box-frame", min=0, help="Frame of --first-box."),
+    ] = 0,
+    body_colour: Annotated[
+        str | None,
+        typer.Option(
+            "--body-colour",
+            metavar="R,G,B",
+            help="The body's colour (0-255): preferred among candidates, never "
+            "taken for a shadow.",
+        ),
+    ] = None,
+    stabilise: Annotated[
+        bool | None,
+        typer.Option(
+            "--stabilise/--no-stabilise",
+            help="Remove camera drift measured on background features (default: "
+            "when the clip drifts by more than 0.3 px).",
+            show_default=False,
+        ),
+    ] = None,
+    lens: Annotated[
+        Path | None,
+        typer.Option(
+            "--lens",
+            help="Lens distortion JSON (fieldkit.tracking.video.calibration."
+            "calibrate_lens_from_clip on a checkerboard clip): centres and "
+            "calibration points are undistorted.",
+        ),
+    ] = None,
     path_id: Annotated[
         str | None,
         typer.Option("--path-id", help="Test identifier (default: the video's name)."),
@@ -210,9 +251,10 @@ def track(
     from fieldkit.tracking.video.calibration import (
         parse_scale_points,
         read_homography_file,
+        read_lens_file,
         two_point_scale,
     )
-    from fieldkit.tracking.video.pipeline import parse_roi
+    from fieldkit.tracking.video.pipeline import parse_colour, parse_roi
     from fieldkit.tracking.video.reader import VideoReader, fps_mismatch_message
 
     if fps is None:
@@ -293,16 +335,33 @@ def track(
     reader = VideoReader(video)
     info = reader.info
     size = (info.width, info.height)
+    lens_model = read_lens_file(lens, size) if lens is not None else None
     if homography is not None:
-        calibration = read_homography_file(homography, size)
+        calibration = read_homography_file(homography, size, lens=lens_model)
     else:
-        calibration = two_point_scale(
-            parse_scale_points(scale_points), scale_length, size
-        )
+        points = parse_scale_points(scale_points)
+        if lens_model is not None:
+            u, v = lens_model.undistort(points[0::2], points[1::2])
+            points = (u[0], v[0], u[1], v[1])
+        calibration = two_point_scale(points, scale_length, size)
     search = parse_roi(roi, size)
+    hints = {
+        "first_box": parse_roi(first_box, size, source="first_box"),
+        "first_box_frame": first_box_frame,
+        "body_colour_rgb": parse_colour(body_colour),
+        "stabilise": stabilise,
+        "lens": lens_model,
+    }
 
     track_data, detections = _run_tracking(
-        video, reader, fps, calibration, search, body.radius_m, show=not quiet
+        video,
+        reader,
+        fps,
+        calibration,
+        search,
+        body.radius_m,
+        show=not quiet,
+        **hints,
     )
     rate_message = fps_mismatch_message(info, fps)
     warned = [m for m in [rate_message, *track_data.meta.get("warnings", [])] if m]
@@ -447,9 +506,9 @@ def ground_gap_warnings(ground, analysis, radius_m: float) -> list[str]:
     return messages
 
 
-def _run_tracking(video, reader, fps, calibration, roi, radius, *, show: bool):
+def _run_tracking(video, reader, fps, calibration, roi, radius, *, show: bool, **hints):
     """track_video, shown as a progress step (:func:`fieldkit.cli.progress.step`)
-    for long videos."""
+    for long videos; ``hints``: its detection options (first box, colour, ...)."""
     from fieldkit.tracking.video.pipeline import track_video
 
     run = functools.partial(
@@ -460,6 +519,7 @@ def _run_tracking(video, reader, fps, calibration, roi, radius, *, show: bool):
         roi=roi,
         radius_m=radius,
         reader=reader,
+        **hints,
     )
     total = reader.info.frame_count
     if not show or total < PROGRESS_MIN_FRAMES:
@@ -474,6 +534,8 @@ def _summary(video, track_data, detections, analysis, calibration_text) -> None:
         f"{video}: {len(detections)} frames, body in {len(track_data)}; "
         f"{calibration_text}"
     )
+    for line in detection_status_lines(track_data.meta):
+        typer.echo(f"  {line}")
     typer.echo(analysis.counts_text())
     print_flight_gravity(analysis.flights)
     for (_, row), net in zip(frame.iterrows(), analysis.net_rows, strict=True):
@@ -513,3 +575,19 @@ def print_flight_gravity(flights) -> None:
         )
     for flight in flights:
         typer.echo(f"  {flight.gravity_summary()}")
+
+
+def detection_status_lines(meta: dict) -> list[str]:
+    """One line per detection status: frames found how, frames refused why."""
+    from fieldkit.tracking.video.detection import REFUSAL_REASONS
+
+    counts = meta.get("detect_status") or {}
+    lines = []
+    for status, count in sorted(counts.items(), key=lambda item: -item[1]):
+        why = REFUSAL_REASONS.get(status)
+        text = f"no body ({status}: {why})" if why else f"body found ({status})"
+        lines.append(f"{count} frames: {text}")
+    drift = meta.get("camera_drift_px")
+    if drift is not None and meta.get("stabilised"):
+        lines.append(f"camera drift up to {drift:.1f} px removed (stabilised)")
+    return lines

@@ -1,5 +1,5 @@
 """Video -> Track: pixels to world positions and spin (reader, background, detection,
-calibration, marker spin).
+stabilisation, calibration and lens, marker spin).
 
 FFmpeg, OpenCV's video backend, prints its own decoder complaints to stderr
 (``[mjpeg @ 0x...] overread 8``); fieldkit reports damaged frames itself, in one line

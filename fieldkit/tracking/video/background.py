@@ -160,9 +160,9 @@ def repair_resting_body(
     found = []  # (sample, uc, vc, r)
     for i, frame in enumerate(frames):
         window = (0, 0, w, h)
-        for uc, vc, r, _, partial, _ in detector._candidates(frame, window):
-            if not partial:
-                found.append((i, uc, vc, r))
+        for cand in detector._candidates(frame, window):
+            if not cand.partial and not cand.blurred:
+                found.append((i, cand.u, cand.v, cand.r))
     clusters: list[list[tuple]] = []
     for item in found:
         for cluster in clusters:

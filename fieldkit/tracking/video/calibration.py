@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from itertools import combinations
 from pathlib import Path
 
+import cv2
 import numpy as np
 
 from fieldkit.errors import ArgumentError, InputFileError
@@ -295,13 +296,16 @@ def _direct_linear_transform(src: np.ndarray, dst: np.ndarray) -> np.ndarray | N
 
 
 def read_homography_file(
-    path: str | os.PathLike[str], image_size: tuple[int, int] | None = None
+    path: str | os.PathLike[str],
+    image_size: tuple[int, int] | None = None,
+    lens: Lens | None = None,
 ) -> Calibration:
     """Read image <-> world points (JSON or CSV, see the module docstring) and fit.
 
     Every problem is reported against the file (and the point at fault): bad JSON
     or CSV, too few points, and layouts no homography can come from
-    (:func:`homography_from_points`).
+    (:func:`homography_from_points`). With a ``lens`` the image points (read on the
+    distorted frames) are undistorted first, to match undistorted detections.
     """
     path = Path(path)
     if not path.is_file():
@@ -349,6 +353,12 @@ def read_homography_file(
                 [table.number(number, row, c) * factors[k] for k, c in columns.items()]
             )
     points = np.array(rows, dtype=float).reshape(-1, 4)
+    if lens is not None:
+        for i, (u, v) in enumerate(points[:, :2]):
+            if image_size is not None:
+                _check_inside(u, v, image_size, str(path), f"point {i + 1}")
+        points[:, 0], points[:, 1] = lens.undistort(points[:, 0], points[:, 1])
+        image_size = None  # undistorted points may lie beyond the frame's edge
     cal = homography_from_points(
         points[:, :2], points[:, 2:], image_size=image_size, source=str(path)
     )
@@ -358,3 +368,183 @@ def read_homography_file(
         cal.residual_m,
         {**cal.meta, "homography_file": str(path)},
     )
+
+
+@dataclass(frozen=True)
+class Lens:
+    """Lens distortion of a camera (OpenCV's pinhole + radial/tangential model).
+
+    ``camera_matrix`` is the 3x3 intrinsic matrix [px], ``distortion`` OpenCV's
+    coefficients ``(k1, k2, p1, p2, k3)``; ``rms_px`` is the calibration's RMS
+    reprojection error.
+
+    Examples
+    --------
+    >>> lens = Lens(np.array([[500.0, 0, 320], [0, 500, 240], [0, 0, 1]]),
+    ...             np.array([-0.2, 0.0, 0.0, 0.0, 0.0]), (640, 480))
+    >>> u, v = lens.undistort(np.array([320.0, 600.0]), np.array([240.0, 240.0]))
+    >>> round(float(u[0]), 6), bool(u[1] > 600.0)  # barrel: the edge moves out
+    (320.0, True)
+    """
+
+    camera_matrix: np.ndarray
+    distortion: np.ndarray
+    image_size: tuple[int, int]
+    rms_px: float = 0.0
+    frames_used: int = 0
+    source: str = ""
+
+    @property
+    def description(self) -> str:
+        k = np.ravel(self.distortion)
+        return (
+            f"lens {self.source or 'model'}: f = {self.camera_matrix[0, 0]:.1f} px, "
+            f"k1 = {k[0]:.4g}, RMS reprojection {self.rms_px:.3f} px"
+        )
+
+    def undistort(self, u, v) -> tuple[np.ndarray, np.ndarray]:
+        """Distorted pixel positions -> undistorted ones [px] (``cv2.undistortPoints``
+        with the same camera matrix, so the pixel scale stays)."""
+        u = np.asarray(u, dtype=float)
+        v = np.asarray(v, dtype=float)
+        pts = np.stack([u.ravel(), v.ravel()], axis=1).reshape(-1, 1, 2)
+        if len(pts) == 0:
+            return u.copy(), v.copy()
+        criteria = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-9)
+        out = cv2.undistortPoints(  # iterated to 1e-9: strong barrel near corners
+            pts,
+            self.camera_matrix,
+            self.distortion,
+            R=None,
+            P=self.camera_matrix,
+            criteria=criteria,
+        ).reshape(-1, 2)
+        return out[:, 0].reshape(u.shape), out[:, 1].reshape(v.shape)
+
+    def to_dict(self) -> dict:
+        return {
+            "camera_matrix": np.asarray(self.camera_matrix).tolist(),
+            "distortion": np.ravel(self.distortion).tolist(),
+            "image_size_px": list(self.image_size),
+            "rms_reprojection_px": self.rms_px,
+            "frames_used": self.frames_used,
+        }
+
+    def write(self, path: str | os.PathLike[str]) -> None:
+        """Save as JSON (:func:`read_lens_file` reads it back)."""
+        import json
+
+        Path(path).write_text(json.dumps(self.to_dict(), indent=1) + "\n")
+
+
+def read_lens_file(
+    path: str | os.PathLike[str], image_size: tuple[int, int] | None = None
+) -> Lens:
+    """Read a lens JSON written by :meth:`Lens.write` (checked against the frame)."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputFileError("lens file not found", source=path)
+    data = read_json(path, kind="lens")
+    try:
+        matrix = np.array(data["camera_matrix"], dtype=float).reshape(3, 3)
+        dist = np.array(data["distortion"], dtype=float).ravel()
+        size = tuple(int(x) for x in data["image_size_px"])
+    except (KeyError, TypeError, ValueError):
+        raise InputFileError(
+            "needs camera_matrix (3x3), distortion and image_size_px", source=path
+        ) from None
+    if not (np.all(np.isfinite(matrix)) and np.all(np.isfinite(dist))) or len(
+        dist
+    ) not in (4, 5, 8, 12, 14):
+        raise InputFileError("camera_matrix or distortion not valid", source=path)
+    if image_size is not None and tuple(image_size) != size:
+        raise InputFileError(
+            f"calibrated for {size[0]}x{size[1]} frames, the video has "
+            f"{image_size[0]}x{image_size[1]}",
+            source=path,
+        )
+    return Lens(
+        matrix,
+        dist,
+        (size[0], size[1]),
+        float(data.get("rms_reprojection_px", 0.0)),
+        int(data.get("frames_used", 0)),
+        path.name,
+    )
+
+
+def calibrate_lens(
+    frames,
+    pattern: tuple[int, int],
+    *,
+    max_frames: int = 40,
+    fix_k3: bool = True,
+    source: str = "checkerboard",
+) -> Lens:
+    """Lens distortion from images of a checkerboard (``cv2.calibrateCamera``).
+
+    Parameters
+    ----------
+    frames
+        Iterable of uint8 BGR (or grey) images of a flat checkerboard in various
+        positions and tilts (e.g. frames sampled from a clip).
+    pattern
+        Inner corners per row and per column (a board of 10 x 7 squares has 9 x 6).
+    max_frames
+        At most this many views with the whole pattern found are used (evenly).
+    fix_k3
+        Keep the sixth-order radial term at 0 (OpenCV's advice for all but
+        fisheye lenses): with it free, ``k2`` and ``k3`` trade off and the model
+        extrapolates wildly beyond the area the board covered.
+
+    Raises
+    ------
+    InputFileError
+        Fewer than 3 views show the whole pattern.
+    """
+    cols, rows = int(pattern[0]), int(pattern[1])
+    board = np.zeros((cols * rows, 3), np.float32)
+    board[:, :2] = np.mgrid[0:cols, 0:rows].T.reshape(-1, 2)
+    criteria = (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_MAX_ITER, 40, 1e-3)
+    views, size = [], None
+    for image in frames:
+        grey = image if image.ndim == 2 else cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
+        size = (grey.shape[1], grey.shape[0])
+        found, corners = cv2.findChessboardCorners(
+            grey,
+            (cols, rows),
+            flags=cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE,
+        )
+        if found:
+            views.append(cv2.cornerSubPix(grey, corners, (5, 5), (-1, -1), criteria))
+    if len(views) < 3:
+        raise InputFileError(
+            f"the {cols}x{rows} inner corners were found in {len(views)} frame(s); "
+            "at least 3 views of the whole board are needed",
+            source=source,
+        )
+    if len(views) > max_frames:
+        keep = np.linspace(0, len(views) - 1, max_frames).round().astype(int)
+        views = [views[i] for i in keep]
+    rms, matrix, dist, _, _ = cv2.calibrateCamera(
+        [board] * len(views),
+        views,
+        size,
+        None,
+        None,
+        flags=cv2.CALIB_FIX_K3 if fix_k3 else 0,
+    )
+    return Lens(matrix, dist.ravel(), size, float(rms), len(views), source)
+
+
+def calibrate_lens_from_clip(
+    path: str | os.PathLike[str], pattern: tuple[int, int], *, samples: int = 60
+) -> Lens:
+    """:func:`calibrate_lens` on ``samples`` frames spread over a checkerboard clip."""
+    from fieldkit.tracking.video.reader import VideoReader
+
+    reader = VideoReader(path)
+    count = max(reader.info.frame_count, 1)
+    indices = np.unique(np.linspace(0, count - 1, samples).astype(int))
+    frames = (img for _, img in reader.read_frames(list(indices)))
+    return calibrate_lens(frames, pattern, source=Path(path).name)

@@ -45,3 +45,46 @@ def brightness_gain(frame: np.ndarray, background: np.ndarray, step: int = 20) -
 def scaled(image: np.ndarray, gain: float) -> np.ndarray:
     """``image`` times ``gain`` (saturating uint8); unchanged when the gain is ~1."""
     return image if abs(gain - 1.0) < 0.004 else cv2.convertScaleAbs(image, alpha=gain)
+
+
+def shadow_mask(
+    frame: np.ndarray,
+    background: np.ndarray,
+    *,
+    darkening: tuple[float, float] = (0.4, 0.95),
+    chroma_tolerance: float = 0.1,
+    noise: float = 3.0,
+) -> np.ndarray:
+    """Pixels that look like the background in shadow (bool, one channel).
+
+    ``frame`` and ``background`` are BGR images (or BGR pixel lists, shape (n, 3)).
+
+    The test of Prati, Cucchiara et al. (IEEE PAMI 25, 2003), as in OpenCV's MOG2
+    shadow label: a cast shadow dims the scene by a factor within ``darkening`` and
+    keeps its chromaticity, so every channel is dimmed by the same factor. A pixel is
+    shadow when its brightness ratio to the background lies in ``darkening`` and its
+    channel ratios differ from one another by less than ``chroma_tolerance`` (relative
+    to their mean) plus what ``noise`` [grey levels] allows on a dark background.
+
+    Examples
+    --------
+    >>> bg = np.full((1, 3, 3), (60, 120, 180), np.uint8)
+    >>> f = bg.copy()
+    >>> f[0, 0] = (36, 72, 108)      # dimmed to 60 %: shadow
+    >>> f[0, 1] = (40, 40, 40)       # grey body: another chromaticity
+    >>> shadow_mask(f, bg)[0].tolist()
+    [True, False, False]
+    """
+    f = frame.astype(np.float32) + 0.5
+    b = background.astype(np.float32) + 0.5
+    b_sum = b.sum(axis=-1)
+    brightness = f.sum(axis=-1) / b_sum
+    ratios = f / b
+    spread = ratios.max(axis=-1) - ratios.min(axis=-1)
+    allowed = chroma_tolerance * brightness + 2.0 * noise / b.min(axis=-1)
+    return (
+        (brightness >= darkening[0])
+        & (brightness <= darkening[1])
+        & (spread <= allowed)
+        & (b_sum > 90.0)  # too dark a scene to tell a shadow
+    )

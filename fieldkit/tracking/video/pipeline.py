@@ -16,7 +16,7 @@ import pandas as pd
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.track import Track
 from fieldkit.tracking.video.background import background_model, flickers
-from fieldkit.tracking.video.calibration import Calibration
+from fieldkit.tracking.video.calibration import Calibration, Lens
 from fieldkit.tracking.video.detection import BallDetector
 from fieldkit.tracking.video.reader import VideoReader
 from fieldkit.tracking.video.spin import (
@@ -25,6 +25,7 @@ from fieldkit.tracking.video.spin import (
     measure_marker,
     unwrap_angle,
 )
+from fieldkit.tracking.video.stabilisation import MIN_DRIFT_PX, Stabiliser
 
 #: frames sampled across the clip for the median background
 BACKGROUND_SAMPLES = 11
@@ -56,8 +57,29 @@ def frame_ranges(frames: np.ndarray) -> str:
     return ", ".join(parts)
 
 
+def parse_colour(text: str | None) -> tuple[float, float, float] | None:
+    """Parse a colour ``"R,G,B"`` (0-255).
+
+    Examples
+    --------
+    >>> parse_colour("200, 40,10")
+    (200.0, 40.0, 10.0)
+    """
+    if text is None:
+        return None
+    try:
+        values = tuple(float(p) for p in str(text).split(","))
+    except ValueError:
+        values = ()
+    if len(values) != 3 or not all(0.0 <= c <= 255.0 for c in values):
+        raise ArgumentError(
+            f"expected R,G,B from 0 to 255, got {text!r}", source="body_colour_rgb"
+        )
+    return values  # type: ignore[return-value]
+
+
 def parse_roi(
-    roi: str | None, image_size: tuple[int, int]
+    roi: str | None, image_size: tuple[int, int], source: str = "roi"
 ) -> tuple[int, int, int, int] | None:
     """Parse ``roi`` ``"U,V,WIDTH,HEIGHT"`` [px] and check it overlaps the frame.
 
@@ -75,12 +97,12 @@ def parse_roi(
         values = []
     if len(values) != 4 or values[2] <= 0 or values[3] <= 0:
         raise ArgumentError(
-            f"expected U,V,WIDTH,HEIGHT in pixels, got {text!r}", source="roi"
+            f"expected U,V,WIDTH,HEIGHT in pixels, got {text!r}", source=source
         )
     u, v, w, h = values
     width, height = image_size
     if u >= width or v >= height or u + w <= 0 or v + h <= 0:
-        raise ArgumentError(f"lies outside the {width}x{height} frame", source="roi")
+        raise ArgumentError(f"lies outside the {width}x{height} frame", source=source)
     return u, v, w, h
 
 
@@ -93,6 +115,11 @@ def track_video(
     radius_m: float | None = None,
     progress: Callable[[int, int], None] | None = None,
     reader: VideoReader | None = None,
+    first_box: tuple[int, int, int, int] | None = None,
+    first_box_frame: int = 0,
+    body_colour_rgb: tuple[float, float, float] | None = None,
+    stabilise: bool | None = None,
+    lens: Lens | None = None,
 ) -> tuple[Track, pd.DataFrame]:
     """Track one ball through a video.
 
@@ -112,16 +139,35 @@ def track_video(
         Called as ``progress(frames_done, frames_total)``.
     reader
         An already opened :class:`VideoReader` of ``path`` (saves reopening it).
+    first_box
+        ``(u, v, width, height)`` [px] around the body in frame ``first_box_frame``:
+        the body's size and colour where the automatic detection is unsure, and its
+        place in that frame.
+    body_colour_rgb
+        The body's colour (R, G, B, 0-255): preferred among candidates, never taken
+        for a shadow (a ``first_box`` gives it too).
+    stabilise
+        Remove camera drift (:mod:`~fieldkit.tracking.video.stabilisation`): True,
+        False, or None to do so when the background samples drift by more than
+        :data:`MIN_DRIFT_PX` from the first frame.
+    lens
+        Lens distortion (:class:`~fieldkit.tracking.video.calibration.Lens`): the
+        detected centres are undistorted before ``calibration`` maps them, so
+        ``calibration`` must come from undistorted image points.
 
     Returns
     -------
     track, detections
         The :class:`~fieldkit.track.Track` (one row per frame with a body;
         extra columns ``omega_sd_radps, u_px, v_px, radius_px, radius_m, partial,
-        visible_fraction``; ``meta["warnings"]`` lists one-line warnings) and a
-        per-frame table (every decoded frame; ``found`` False where no body was
-        seen; pixel centre, radius, marker offset ``marker_du_px, marker_dv_px``
-        and ``marker_axial``).
+        visible_fraction, detect_status, blurred, position_sd_px``;
+        ``meta["warnings"]`` lists one-line warnings, ``meta["detect_status"]``
+        counts the frames by :attr:`BallDetector.status`) and a per-frame table
+        (every decoded frame; ``found`` False where no body was seen and
+        ``detect_status`` says why, a key of
+        :data:`~fieldkit.tracking.video.detection.REFUSAL_REASONS`; pixel centre,
+        radius, marker offset ``marker_du_px, marker_dv_px`` and ``marker_axial``;
+        ``drift_px``, the camera drift removed).
 
     Raises
     ------
@@ -144,9 +190,30 @@ def track_video(
     if len(samples) < 3:  # seeking failed (damaged index): read the first frames
         samples = [img for _, img in reader.frames(0, BACKGROUND_SAMPLES)]
     centre = (info.width / 2.0, info.height / 2.0)
+    stabiliser = Stabiliser(samples[0])
+    drifts = [stabiliser.drift_px(stabiliser.motion(img)) for img in samples[1:]]
+    sample_drift = float(np.nanmax(drifts)) if np.isfinite(drifts).any() else 0.0
+    if stabilise is None:
+        stabilise = sample_drift > MIN_DRIFT_PX
+    if stabilise:
+        samples = [stabiliser.warp(img, stabiliser.motion(img)) for img in samples]
     expected = None
     if radius_m is not None and radius_m > 0:
         expected = float(radius_m / calibration.metres_per_pixel(*centre))
+    body_colour = None
+    if body_colour_rgb is not None:
+        body_colour = tuple(float(c) for c in body_colour_rgb[::-1])
+    box_prediction = None
+    if first_box is not None:
+        box_image = reader.read_frames([int(first_box_frame)])
+        if not box_image:
+            raise ArgumentError(
+                f"frame {first_box_frame} of the first box cannot be read",
+                source="first_box_frame",
+            )
+        box_colour, box_radius, box_prediction = _box_hint(box_image[0][1], first_box)
+        body_colour = body_colour or box_colour
+        expected = expected or box_radius
     background, threshold = background_model(
         samples, roi=roi, expected_radius_px=expected
     )
@@ -156,13 +223,14 @@ def track_video(
         roi=roi,
         expected_radius_px=expected,
         compensate_flicker=flickers(samples, background),
+        body_colour=body_colour,
     )
 
     rows = []
     last: list[tuple[int, float, float, float]] = []
     total = max(info.frame_count, 1)
     for index, image in reader.frames(prefetch=PREFETCH):
-        prediction = None
+        prediction = velocity = None
         if last and index - last[-1][0] <= 3:
             k, u, v, r = last[-1]
             vu = vv = 0.0
@@ -175,9 +243,24 @@ def track_video(
                 v + vv * gap,
                 2.5 * r + 3.0 * np.hypot(vu, vv) * gap + 8.0,
             )
-        det = detector.detect(image, prediction)
+            velocity = (vu, vv) if len(last) >= 2 else None
+        elif box_prediction is not None and index == first_box_frame:
+            prediction = box_prediction
+        drift = 0.0
+        if stabilise:
+            matrix = stabiliser.motion(image, exclude=prediction)
+            drift = stabiliser.drift_px(matrix)
+            image = stabiliser.warp(image, matrix, fill=background)
+        det = detector.detect(image, prediction, velocity)
         if det is None:
-            rows.append({"frame": index, "found": False})
+            rows.append(
+                {
+                    "frame": index,
+                    "found": False,
+                    "detect_status": detector.status,
+                    "drift_px": drift,
+                }
+            )
         else:
             du, dv, axial = (np.nan, np.nan, False)
             if not det.partial:
@@ -197,6 +280,11 @@ def track_video(
                     "marker_du_px": du,
                     "marker_dv_px": dv,
                     "marker_axial": axial,
+                    "detect_status": det.status,
+                    "blurred": det.blurred,
+                    "position_sd_px": det.position_sd_px,
+                    "ambiguous": det.ambiguous,
+                    "drift_px": drift,
                 }
             )
             last = (last + [(index, det.u_px, det.v_px, det.radius_px)])[-2:]
@@ -237,7 +325,14 @@ def track_video(
             "those frames are left out of the track"
         )
 
+    counts = detections["detect_status"].value_counts()
+    status_counts = {str(k): int(n) for k, n in counts.items()}
+    warnings.extend(
+        _unsure_messages(path, detections, hinted=first_box or body_colour_rgb)
+    )
     u, v = found["u_px"].to_numpy(float), found["v_px"].to_numpy(float)
+    if lens is not None:
+        u, v = lens.undistort(u, v)
     x, z = calibration.to_world(u, v)
     scale = calibration.metres_per_pixel(u, v)
     angle = marker_angle_world(
@@ -294,6 +389,9 @@ def track_video(
             "radius_m": found["radius_px"].to_numpy(float) * scale,
             "partial": found["partial"].to_numpy(bool),
             "visible_fraction": found["visible_fraction"].to_numpy(float),
+            "detect_status": found["detect_status"].to_numpy(str),
+            "blurred": found["blurred"].to_numpy(bool),
+            "position_sd_px": found["position_sd_px"].to_numpy(float),
         }
     )
     meta = {
@@ -309,9 +407,62 @@ def track_video(
         "roi": list(roi) if roi else None,
         "marker": "stripe (angle modulo pi)" if period < 4 else "spot",
         "mirrored_x": mirrored,
+        "detect_status": status_counts,
+        "stabilised": bool(stabilise),
+        "camera_drift_px": float(
+            np.nanmax(detections["drift_px"]) if stabilise else sample_drift
+        ),
+        "lens": lens.description if lens is not None else None,
         "warnings": warnings,
     }
     return Track(frame, source=str(path), fps=float(fps), meta=meta), detections
+
+
+def _box_hint(image: np.ndarray, box: tuple[int, int, int, int]):
+    """Body colour (BGR), radius [px] and search (u, v, reach) from a box around it.
+
+    The colour is the median of the box's central disc (60 % of the half-size), so
+    the background in the box's corners and the rim's blend are left out.
+    """
+    u0, v0, bw, bh = (int(round(x)) for x in box)
+    h, w = image.shape[:2]
+    patch = image[max(v0, 0) : min(v0 + bh, h), max(u0, 0) : min(u0 + bw, w)]
+    if patch.size == 0:
+        raise ArgumentError(f"the box {box} lies outside the frame", source="first_box")
+    uc, vc = u0 + (bw - 1) / 2.0, v0 + (bh - 1) / 2.0
+    radius = min(bw, bh) / 2.0
+    ph, pw = patch.shape[:2]
+    uu = np.arange(pw)[None, :] + max(u0, 0) - uc
+    vv = np.arange(ph)[:, None] + max(v0, 0) - vc
+    core = uu * uu + vv * vv <= (0.6 * radius) ** 2
+    colour = np.median(patch[core].reshape(-1, 3), axis=0) if core.any() else None
+    return (
+        None if colour is None else tuple(float(c) for c in colour),
+        float(radius),
+        (uc, vc, 1.5 * max(bw, bh)),
+    )
+
+
+def _unsure_messages(path, detections: pd.DataFrame, hinted) -> list[str]:
+    """One line where the automatic detection was unsure, suggesting a hint."""
+    messages = []
+    unsure = []
+    if "ambiguous" in detections:
+        frames = detections.loc[detections["ambiguous"].fillna(False).astype(bool)]
+        if len(frames):
+            unsure.append(
+                f"several candidates in frames {frame_ranges(frames['frame'])}"
+            )
+    status = detections["detect_status"]
+    low = detections.loc[status == "low_contrast", "frame"]
+    if len(low):
+        unsure.append(f"low contrast in frames {frame_ranges(low)}")
+    if unsure and not hinted:
+        messages.append(
+            f"{path}: detection unsure ({'; '.join(unsure)}); a box around the body "
+            "in one frame (`first_box`) or its colour (`body_colour_rgb`) settles it"
+        )
+    return messages
 
 
 def _nothing_found(
