@@ -229,3 +229,18 @@ def test_track_undistorts_with_the_lens_file(cli, calibrated, repo, tmp_path):
     assert np.max(np.abs(undistorted["u_px"] - u)) < 1e-6
     assert np.max(np.abs(undistorted["v_px"] - v)) < 1e-6
     assert np.max(np.hypot(u - raw["u_px"], v - raw["v_px"])) > 5.0  # it did move
+
+
+def test_board_seen_only_near_the_centre_is_warned():
+    fit = LensCalibration(TRUE, (9, 6), 30, 8, tuple(range(8)), (0.1,) * 8, 0.22)
+    (message,) = fit.warnings
+    assert "cover only 22% of the frame" in message
+
+
+def test_frames_of_two_sizes_are_refused():
+    from fieldkit.errors import InputFileError
+    from fieldkit.tracking.video.calibration import fit_lens
+
+    frames = _board_frames(TRUE, 2, seed=3)
+    with pytest.raises(InputFileError, match=r"frame 2: 160x120 px, the frames before"):
+        fit_lens([*frames, cv2.resize(frames[0], (160, 120))], (9, 6))
