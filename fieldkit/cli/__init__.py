@@ -37,6 +37,7 @@ from fieldkit.cli import (
     impact,
     import_model,
     import_results,
+    lens,
     profile,
     reduce,
     simulate,
@@ -81,6 +82,7 @@ app.command("impact")(impact.impact)
 app.command("fence")(fence.fence)
 app.command("track")(track.track)
 app.command("track3d")(track3d.track3d)
+app.command("lens")(lens.lens)
 app.command("view")(view.view)
 app.command("profile")(profile.profile)
 app.command("simulate")(simulate.simulate)

@@ -66,6 +66,8 @@ FLAGS: dict[str, str] = {
     "first_box_frame": "--first-box-frame",
     "body_colour_rgb": "--body-colour",
     "lens": "--lens",
+    "pattern": "--pattern",
+    "samples": "--samples",
     "surface_angle_deg": "--surface-angle",
     "unit": "--unit",
     "metres_per_pixel": "--metres-per-pixel",

@@ -181,9 +181,8 @@ def track(
         Path | None,
         typer.Option(
             "--lens",
-            help="Lens distortion JSON (fieldkit.tracking.video.calibration."
-            "calibrate_lens_from_clip on a checkerboard clip): centres and "
-            "calibration points are undistorted.",
+            help="Lens distortion JSON (`fieldkit lens` on a checkerboard clip): "
+            "centres and calibration points are undistorted.",
         ),
     ] = None,
     path_id: Annotated[
@@ -340,10 +339,10 @@ def track(
         calibration = read_homography_file(homography, size, lens=lens_model)
     else:
         points = parse_scale_points(scale_points)
-        if lens_model is not None:
+        calibration = two_point_scale(points, scale_length, size)  # inside the frame
+        if lens_model is not None:  # undistorted, they may lie beyond the frame's edge
             u, v = lens_model.undistort(points[0::2], points[1::2])
-            points = (u[0], v[0], u[1], v[1])
-        calibration = two_point_scale(points, scale_length, size)
+            calibration = two_point_scale((u[0], v[0], u[1], v[1]), scale_length)
     search = parse_roi(roi, size)
     hints = {
         "first_box": parse_roi(first_box, size, source="first_box"),

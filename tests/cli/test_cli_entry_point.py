@@ -22,6 +22,7 @@ COMMANDS = [
     "fence",
     "track",
     "track3d",
+    "lens",
     "view",
     "profile",
     "simulate",

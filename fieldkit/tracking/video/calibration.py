@@ -421,6 +421,15 @@ class Lens:
         ).reshape(-1, 2)
         return out[:, 0].reshape(u.shape), out[:, 1].reshape(v.shape)
 
+    def corner_shift_px(self) -> float:
+        """How far the lens moves a point at the image corners [px]: the largest
+        distance between a corner pixel and its undistorted position."""
+        w, h = self.image_size
+        u = np.array([0.0, w - 1.0, 0.0, w - 1.0])
+        v = np.array([0.0, 0.0, h - 1.0, h - 1.0])
+        ud, vd = self.undistort(u, v)
+        return float(np.max(np.hypot(ud - u, vd - v)))
+
     def to_dict(self) -> dict:
         return {
             "camera_matrix": np.asarray(self.camera_matrix).tolist(),
@@ -430,11 +439,12 @@ class Lens:
             "frames_used": self.frames_used,
         }
 
-    def write(self, path: str | os.PathLike[str]) -> None:
-        """Save as JSON (:func:`read_lens_file` reads it back)."""
-        import json
+    def write(self, path: str | os.PathLike[str], outputs=None) -> Path:
+        """Save as JSON (:func:`read_lens_file` reads it back; ``outputs``: a
+        :class:`fieldkit.outputs.OutputSet` to write with, all or nothing)."""
+        from fieldkit.outputs import write_json
 
-        Path(path).write_text(json.dumps(self.to_dict(), indent=1) + "\n")
+        return write_json(path, self.to_dict(), outputs, indent=1)
 
 
 def read_lens_file(
@@ -473,21 +483,181 @@ def read_lens_file(
     )
 
 
-def calibrate_lens(
+#: Fewest views of the whole board :func:`fit_lens` accepts by default: with fewer
+#: the focal length and the distortion terms trade off (five parameters and the
+#: principal point from a handful of poses).
+MIN_LENS_VIEWS = 5
+
+#: RMS reprojection error above which a lens calibration is suspect [px]: corners
+#: found to a tenth of a pixel fit the model to well below this, so a larger error
+#: means a wrong pattern, a bent board, motion blur or a lens the model cannot follow.
+MAX_LENS_RMS_PX = 1.0
+
+#: Fraction of the frame the board's corners should span (their convex hull): the
+#: distortion grows fastest toward the edges, and beyond the corners seen it is
+#: extrapolated from the polynomial (OpenCV's advice: cover the whole frame).
+MIN_LENS_COVERAGE = 0.3
+
+
+def parse_pattern(text: str) -> tuple[int, int]:
+    """Parse ``"9x6"`` (inner corners: columns x rows; ``,`` and ``*`` also work).
+
+    Raises :class:`~fieldkit.errors.ArgumentError` (source ``pattern``) unless both
+    counts are whole numbers of at least 3 (OpenCV's smallest board).
+
+    Examples
+    --------
+    >>> parse_pattern("9x6"), parse_pattern(" 10 , 7 ")
+    ((9, 6), (10, 7))
+    """
+    parts = [p.strip() for p in str(text).lower().replace("*", "x").replace(
+        ",", "x").split("x")]  # fmt: skip
+    try:
+        cols, rows = (int(p) for p in parts)
+    except ValueError:
+        raise ArgumentError(
+            f"expected inner corners COLUMNSxROWS, e.g. 9x6, got {text!r}",
+            source="pattern",
+        ) from None
+    if cols < 3 or rows < 3:
+        raise ArgumentError(
+            f"a checkerboard needs at least 3x3 inner corners, got {text!r}",
+            source="pattern",
+        )
+    return cols, rows
+
+
+@dataclass(frozen=True)
+class LensCalibration:
+    """A lens calibrated from checkerboard views, and how well the views fit it.
+
+    Attributes
+    ----------
+    lens
+        The fitted :class:`Lens`.
+    pattern
+        Inner corners (columns, rows) searched for.
+    frames_searched
+        Frames looked at.
+    views_found
+        Frames in which the whole pattern was found.
+    view_frames
+        The frame number of each view used (the frame's index among those
+        searched, or the clip's frame number).
+    view_rms_px
+        Each used view's RMS reprojection error [px].
+    coverage
+        Fraction of the frame inside the convex hull of every corner used: the
+        distortion beyond it is extrapolated.
+
+    Examples
+    --------
+    >>> lens = Lens(np.array([[500.0, 0, 320], [0, 500, 240], [0, 0, 1]]),
+    ...             np.array([-0.2, 0.0, 0.0, 0.0, 0.0]), (640, 480), 0.12, 8)
+    >>> fit = LensCalibration(lens, (9, 6), 60, 8, tuple(range(8)), (0.1,) * 8, 0.7)
+    >>> fit.summary()[0]
+    'the 9x6 inner corners were found in 8 of 60 frames searched; 8 views used'
+    """
+
+    lens: Lens
+    pattern: tuple[int, int]
+    frames_searched: int
+    views_found: int
+    view_frames: tuple[int, ...]
+    view_rms_px: tuple[float, ...]
+    coverage: float
+
+    @property
+    def warnings(self) -> list[str]:
+        """One line for each sign that the lens may not be trusted."""
+        out = []
+        if self.lens.rms_px > MAX_LENS_RMS_PX:
+            worst = int(np.argmax(self.view_rms_px))
+            out.append(
+                f"RMS reprojection error {self.lens.rms_px:.2f} px exceeds "
+                f"{MAX_LENS_RMS_PX:g} px (worst view: frame "
+                f"{self.view_frames[worst]}, {self.view_rms_px[worst]:.2f} px): a "
+                "bent or blurred board, or a lens the model cannot follow; check the "
+                "views"
+            )
+        if self.coverage < MIN_LENS_COVERAGE:
+            out.append(
+                f"the board's corners cover only {self.coverage:.0%} of the frame: "
+                "the distortion near the edges is extrapolated; film the board near "
+                "the edges and corners of the frame too"
+            )
+        return out
+
+    def summary(self) -> list[str]:
+        """The calibration in words: views, fit, intrinsics, distortion, its size."""
+        cols, rows = self.pattern
+        lens = self.lens
+        k = np.ravel(lens.distortion)
+        k = np.concatenate([k, np.zeros(max(0, 5 - len(k)))])
+        m = lens.camera_matrix
+        w, h = lens.image_size
+        shift = lens.corner_shift_px()
+        errors = np.asarray(self.view_rms_px)
+        return [
+            f"the {cols}x{rows} inner corners were found in {self.views_found} of "
+            f"{self.frames_searched} frames searched; {len(self.view_frames)} views "
+            "used",
+            f"RMS reprojection error {lens.rms_px:.3f} px (per view "
+            f"{errors.min():.3f}-{errors.max():.3f} px); the corners cover "
+            f"{self.coverage:.0%} of the {w}x{h} frame",
+            f"focal length fx = {m[0, 0]:.2f} px, fy = {m[1, 1]:.2f} px; principal "
+            f"point cx = {m[0, 2]:.2f} px, cy = {m[1, 2]:.2f} px",
+            f"distortion k1 = {k[0]:.5f}, k2 = {k[1]:.5f}, p1 = {k[2]:.5f}, "
+            f"p2 = {k[3]:.5f}, k3 = {k[4]:.5f}",
+            f"at the image corners the lens moves a point by up to {shift:.1f} px"
+            + (
+                " (negligible)"
+                if shift < 0.5
+                else " (undistorting matters)"
+                if shift >= 2.0
+                else ""
+            ),
+        ]
+
+    def to_dict(self) -> dict:
+        """The lens file's content (:func:`read_lens_file` reads it), with the
+        calibration's record."""
+        return {
+            **self.lens.to_dict(),
+            "source": self.lens.source,
+            "pattern_inner_corners": list(self.pattern),
+            "frames_searched": self.frames_searched,
+            "views_found": self.views_found,
+            "view_frames": list(self.view_frames),
+            "view_rms_px": list(self.view_rms_px),
+            "coverage": self.coverage,
+            "corner_shift_px": self.lens.corner_shift_px(),
+        }
+
+    def write(self, path: str | os.PathLike[str], outputs=None) -> Path:
+        """Save as the lens JSON (``outputs``: a :class:`fieldkit.outputs.OutputSet`
+        to write with, all or nothing)."""
+        from fieldkit.outputs import write_json
+
+        return write_json(path, self.to_dict(), outputs, indent=1)
+
+
+def fit_lens(
     frames,
     pattern: tuple[int, int],
     *,
     max_frames: int = 40,
     fix_k3: bool = True,
+    min_views: int = MIN_LENS_VIEWS,
     source: str = "checkerboard",
-) -> Lens:
+) -> LensCalibration:
     """Lens distortion from images of a checkerboard (``cv2.calibrateCamera``).
 
     Parameters
     ----------
     frames
         Iterable of uint8 BGR (or grey) images of a flat checkerboard in various
-        positions and tilts (e.g. frames sampled from a clip).
+        positions and tilts (e.g. frames sampled from a clip), all of one size.
     pattern
         Inner corners per row and per column (a board of 10 x 7 squares has 9 x 6).
     max_frames
@@ -496,19 +666,46 @@ def calibrate_lens(
         Keep the sixth-order radial term at 0 (OpenCV's advice for all but
         fisheye lenses): with it free, ``k2`` and ``k3`` trade off and the model
         extrapolates wildly beyond the area the board covered.
+    min_views
+        Fewest views of the whole board accepted.
+    source
+        The frames' origin (a clip's name), for messages.
 
     Raises
     ------
     InputFileError
-        Fewer than 3 views show the whole pattern.
+        The pattern is found in no frame (naming how many were searched), or in
+        fewer than ``min_views``; frames of different sizes.
     """
+    return _fit_numbered_frames(
+        enumerate(frames),
+        pattern,
+        max_frames=max_frames,
+        fix_k3=fix_k3,
+        min_views=min_views,
+        source=source,
+    )
+
+
+def _fit_numbered_frames(
+    numbered, pattern, *, max_frames, fix_k3, min_views, source
+) -> LensCalibration:
+    """:func:`fit_lens` on ``(frame number, image)`` pairs."""
     cols, rows = int(pattern[0]), int(pattern[1])
     board = np.zeros((cols * rows, 3), np.float32)
     board[:, :2] = np.mgrid[0:cols, 0:rows].T.reshape(-1, 2)
     criteria = (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_MAX_ITER, 40, 1e-3)
-    views, size = [], None
-    for image in frames:
+    views, numbers, size, searched = [], [], None, 0
+    for number, image in numbered:
+        searched += 1
         grey = image if image.ndim == 2 else cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
+        if size is not None and size != (grey.shape[1], grey.shape[0]):
+            raise InputFileError(
+                f"{grey.shape[1]}x{grey.shape[0]} px, the frames before it "
+                f"{size[0]}x{size[1]} px",
+                source=source,
+                where=f"frame {number}",
+            )
         size = (grey.shape[1], grey.shape[0])
         found, corners = cv2.findChessboardCorners(
             grey,
@@ -516,17 +713,39 @@ def calibrate_lens(
             flags=cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE,
         )
         if found:
-            views.append(cv2.cornerSubPix(grey, corners, (5, 5), (-1, -1), criteria))
-    if len(views) < 3:
+            half = _corner_window(corners.reshape(rows, cols, 2))
+            views.append(
+                cv2.cornerSubPix(grey, corners, (half, half), (-1, -1), criteria)
+            )
+            numbers.append(int(number))
+    if searched == 0:
+        raise InputFileError("no frame could be decoded", source=source)
+    if not views:
         raise InputFileError(
-            f"the {cols}x{rows} inner corners were found in {len(views)} frame(s); "
-            "at least 3 views of the whole board are needed",
+            f"no {cols}x{rows} checkerboard (inner corners, columns x rows) found in "
+            f"any of the {searched} frames searched; check `pattern` (a board of "
+            f"{cols + 1} x {rows + 1} squares has {cols}x{rows} inner corners)",
             source=source,
         )
+    if len(views) < min_views:
+        raise InputFileError(
+            f"the {cols}x{rows} inner corners were found in only {len(views)} of the "
+            f"{searched} frames searched; at least {min_views} views of the whole "
+            "board are needed ("
+            + (
+                "search more frames, or film it in more positions and tilts)"
+                if len(views) == searched
+                else "film it whole in more positions and tilts; check `pattern` "
+                "if it is)"
+            ),
+            source=source,
+        )
+    found_count = len(views)
     if len(views) > max_frames:
         keep = np.linspace(0, len(views) - 1, max_frames).round().astype(int)
         views = [views[i] for i in keep]
-    rms, matrix, dist, _, _ = cv2.calibrateCamera(
+        numbers = [numbers[i] for i in keep]
+    rms, matrix, dist, rvecs, tvecs = cv2.calibrateCamera(
         [board] * len(views),
         views,
         size,
@@ -534,17 +753,91 @@ def calibrate_lens(
         None,
         flags=cv2.CALIB_FIX_K3 if fix_k3 else 0,
     )
-    return Lens(matrix, dist.ravel(), size, float(rms), len(views), source)
+    errors = []
+    for corners, rvec, tvec in zip(views, rvecs, tvecs, strict=True):
+        projected, _ = cv2.projectPoints(board, rvec, tvec, matrix, dist)
+        diff = projected.reshape(-1, 2) - corners.reshape(-1, 2)
+        errors.append(float(np.sqrt(np.mean(np.sum(diff**2, axis=1)))))
+    hull = cv2.convexHull(np.concatenate(views).reshape(-1, 2).astype(np.float32))
+    coverage = float(cv2.contourArea(hull)) / float(size[0] * size[1])
+    lens = Lens(matrix, dist.ravel(), size, float(rms), len(views), source)
+    return LensCalibration(
+        lens,
+        (cols, rows),
+        searched,
+        found_count,
+        tuple(numbers),
+        tuple(errors),
+        min(coverage, 1.0),
+    )
+
+
+def _corner_window(grid: np.ndarray) -> int:
+    """Half-size of the corner refinement window [px]: at most 5 (an 11 px square
+    window), and less than a third of the closest corner spacing, so the window
+    never reaches the neighbouring corners on a board filmed small."""
+    spacing = min(
+        float(np.min(np.hypot(*np.moveaxis(np.diff(grid, axis=0), -1, 0)))),
+        float(np.min(np.hypot(*np.moveaxis(np.diff(grid, axis=1), -1, 0)))),
+    )
+    return int(np.clip(spacing // 3, 2, 5))
+
+
+def calibrate_lens(
+    frames,
+    pattern: tuple[int, int],
+    *,
+    max_frames: int = 40,
+    fix_k3: bool = True,
+    source: str = "checkerboard",
+) -> Lens:
+    """The :class:`Lens` of :func:`fit_lens` (which see), from at least 3 views."""
+    return fit_lens(
+        frames,
+        pattern,
+        max_frames=max_frames,
+        fix_k3=fix_k3,
+        min_views=3,
+        source=source,
+    ).lens
+
+
+def fit_lens_from_clip(
+    path: str | os.PathLike[str],
+    pattern: tuple[int, int],
+    *,
+    samples: int = 60,
+    min_views: int = MIN_LENS_VIEWS,
+) -> LensCalibration:
+    """:func:`fit_lens` on ``samples`` frames spread evenly over a checkerboard clip
+    (every frame when the clip has fewer); views are named by frame number."""
+    from fieldkit.tracking.video.reader import VideoReader
+
+    if int(samples) != samples or samples < 1:
+        raise ArgumentError(
+            f"samples must be a whole number >= 1, got {samples}", source="samples"
+        )
+    reader = VideoReader(path)
+    count = max(reader.info.frame_count, 1)
+    spread = np.linspace(0, count - 1, int(samples)).astype(int)
+    indices = [int(i) for i in np.unique(spread)]
+
+    def frames():
+        for start in range(0, len(indices), 8):  # a few decoded frames at a time
+            yield from reader.read_frames(indices[start : start + 8])
+
+    return _fit_numbered_frames(
+        frames(),
+        pattern,
+        max_frames=40,
+        fix_k3=True,
+        min_views=min_views,
+        source=str(path),
+    )
 
 
 def calibrate_lens_from_clip(
     path: str | os.PathLike[str], pattern: tuple[int, int], *, samples: int = 60
 ) -> Lens:
-    """:func:`calibrate_lens` on ``samples`` frames spread over a checkerboard clip."""
-    from fieldkit.tracking.video.reader import VideoReader
-
-    reader = VideoReader(path)
-    count = max(reader.info.frame_count, 1)
-    indices = np.unique(np.linspace(0, count - 1, samples).astype(int))
-    frames = (img for _, img in reader.read_frames(list(indices)))
-    return calibrate_lens(frames, pattern, source=Path(path).name)
+    """The :class:`Lens` of :func:`fit_lens_from_clip`, from at least 3 views."""
+    return fit_lens_from_clip(path, pattern, samples=samples, min_views=3).lens
