@@ -297,8 +297,8 @@ def _material_index(
             row, col = (int(a[0]) for a in np.nonzero(bad))
             xc, yc = cell_centres(terrain)
             raise InputFileError(
-                f"{path.name}: the cell at x = {xc[col]:g}, y = {yc[row]:g} m holds "
-                f"{codes[row, col]:g}; a cell holds the index of a material of "
+                f"{path.name}: the cell at x = {xc[col]:.10g}, y = {yc[row]:.10g} m "
+                f"holds {codes[row, col]:g}; a cell holds the index of a material of "
                 f'"materials", 0 to {len(names) - 1} ({", ".join(names)})',
                 source=source,
                 where=where,
@@ -345,7 +345,7 @@ def _material_index(
             row, col = (int(a[0]) for a in np.nonzero(missing))
             raise InputFileError(
                 f"{int(missing.sum())} DEM cells lie outside every polygon (e.g. the "
-                f"cell at x = {xc[col]:g}, y = {yc[row]:g} m); add an item "
+                f"cell at x = {xc[col]:.10g}, y = {yc[row]:.10g} m); add an item "
                 '{"material": name} without a polygon for every other cell',
                 source=source,
                 where=where,
@@ -551,8 +551,8 @@ def check_line_on_dem(
         if lo <= hi:
             return
     raise InputFileError(
-        f"the line never enters the DEM (x {x0:g} to {x1:g} m, y {y0:g} to "
-        f"{y1:g} m): check its coordinates are in the DEM's system",
+        f"the line never enters the DEM (x {x0:.10g} to {x1:.10g} m, y {y0:.10g} to "
+        f"{y1:.10g} m): check its coordinates are in the DEM's system",
         source=source,
         where=where,
     )
