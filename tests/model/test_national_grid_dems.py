@@ -455,3 +455,38 @@ def test_export_rockyfor3d_grids_keep_the_header(cli, tmp_path, repo, scene, ori
             assert g.y_bottom_m == pytest.approx(o[1], abs=1e-9)
         texts[name] = {p.name: p.read_text().splitlines()[5:] for p in grids}
     assert texts["local"] == texts["national"]  # the values, row by row
+
+
+def test_a_3d_scan_refuses_the_dem_shifted_by_one_cell(tmp_path):
+    """The corridor's same-DEM check compares header numbers with a tolerance of
+    the coordinates' rounding: a 5 cm DEM one cell off in LV95 is another DEM
+    (a relative tolerance of 1e-5 let through 28 m there)."""
+    from fieldkit.corridor.scan import check_same_dem
+    from fieldkit.errors import ArgumentError
+    from fieldkit.model.model_file import read_model
+
+    model = read_model(write_model3d(tmp_path, FINE, LV95, "asc"), terrain=True)
+    check_same_dem(model, read_dem(tmp_path / "dem.asc"))  # its own: accepted
+    shifted_dem = write_asc(tmp_path / "shifted.asc", FINE,
+                            (LV95[0] + FINE.cell, LV95[1]))  # fmt: skip
+    with pytest.raises(ArgumentError, match="is not the DEM of the terrain model"):
+        check_same_dem(model, read_dem(shifted_dem))
+
+
+def test_a_point_on_a_row_of_centres_beside_nodata_has_data():
+    """A point on a row of cell centres whose southern neighbour row is nodata,
+    off by one rounding of its coordinate (2.3e-10 m in LV95, 5e-9 of a 5 cm
+    cell): it has data, in LV95 as at the origin (it would lean on the nodata
+    row)."""
+    from fieldkit.io.dem import INSIDE, DemGrid
+
+    values = np.arange(20.0).reshape(4, 5)
+    values[3, :] = np.nan  # the southern row
+    for ox, oy in (LOCAL, LV95):
+        g = DemGrid.from_corner(values, x_left_m=ox, y_top_m=oy + 0.2,
+                                cellsize_m=0.05)  # fmt: skip
+        # row 2's centres, one rounding of the coordinate (2.3e-10 m in LV95) south
+        y = g.y_m[2] - math.ulp(g.y_m[2])
+        z, _, _, status = g.sample(np.array([ox + 0.1]), np.array([y]))
+        assert status.tolist() == [INSIDE]
+        assert z[0] == pytest.approx(values[2, 1] + 0.5, abs=1e-6)
