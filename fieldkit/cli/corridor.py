@@ -256,7 +256,8 @@ def corridor(
     for line in engine.retried:
         warn(line)
     frame = scan.frame
-    write_file(out, lambda tmp: frame.to_csv(tmp, index=False, float_format="%.6g"),
+    # 10 digits: a station's x in a national grid (2780001.234 m, LV95) to the mm
+    write_file(out, lambda tmp: frame.to_csv(tmp, index=False, float_format="%.10g"),
                outputs)  # fmt: skip
     if summary is not None:
         write_json(summary, scan.summary(), outputs)

@@ -59,7 +59,7 @@ def _describe_grid(grid: DemGrid) -> str:
     nrows, ncols = grid.shape
     size = (
         f"{grid.dx_m:g} m"
-        if math.isclose(grid.dx_m, grid.dy_m)
+        if grid.square
         else f"{grid.dx_m:g} x {grid.dy_m:g} m"
     )
     crs = grid.crs.splitlines()[0][:60] if grid.crs else "not given"

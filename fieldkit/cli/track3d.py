@@ -159,9 +159,9 @@ def track3d(
             x0, y0, x1, y1 = terrain.surface_extent()
             raise InputFileError(
                 f"trajectory {run.path_id}: no sample lies over the DEM's surface "
-                f"(x {x0:g}..{x1:g}, y {y0:g}..{y1:g} m; the first sample is at x "
-                f"{run.xyz_m[0, 0]:g}, y {run.xyz_m[0, 1]:g}): are the trajectory "
-                "and the DEM in the same coordinates?",
+                f"(x {x0:.10g}..{x1:.10g}, y {y0:.10g}..{y1:.10g} m; the first "
+                f"sample is at x {run.xyz_m[0, 0]:.10g}, y {run.xyz_m[0, 1]:.10g}): "
+                "are the trajectory and the DEM in the same coordinates?",
                 source=str(trajectories),
                 where=f"row {run.rows[0]}",
             )

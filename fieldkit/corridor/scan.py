@@ -44,7 +44,7 @@ from fieldkit.corridor.stations import (
 )
 from fieldkit.corridor.table import corridor_frame, station_numbers
 from fieldkit.errors import ArgumentError
-from fieldkit.io.dem import DemGrid
+from fieldkit.io.dem import DemGrid, same_origin_and_cell
 from fieldkit.parallel.engine import Engine
 
 #: Rocks per unit of a 3-D scan (fixed: the seeds, hence the results, depend on it).
@@ -330,8 +330,8 @@ def check_same_dem(model, grid: DemGrid) -> None:
     t, mine = terrain_from_dem(grid), model.terrain
     same = (
         t.shape == mine.shape
-        and np.isclose(t.x0_m, mine.x0_m) and np.isclose(t.y0_m, mine.y0_m)
-        and np.isclose(t.cell_m, mine.cell_m)
+        and same_origin_and_cell((t.x0_m, t.y0_m, t.cell_m),
+                                 (mine.x0_m, mine.y0_m, mine.cell_m))
         and np.allclose(t.z, mine.z, equal_nan=True)
     )  # fmt: skip
     if not same:

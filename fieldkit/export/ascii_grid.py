@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fieldkit.io.dem import DemGrid
+from fieldkit.io.dem import DemGrid, header_number_text
 
 
 def ascii_grid_text(
@@ -54,17 +54,14 @@ def ascii_grid_text(
     v = np.asarray(values, float)
     if v.shape != grid.shape:
         raise ValueError(f"values {v.shape} do not match the grid {grid.shape}")
-    if not np.isclose(grid.dx_m, grid.dy_m, rtol=1e-9):
+    if not grid.square:
         raise ValueError("an ESRI ASCII grid needs square cells")
-    cell = grid.dx_m
-    x0 = float(grid.x_m[0]) - 0.5 * cell
-    y0 = float(grid.y_m[-1]) - 0.5 * cell
-    header = [
+    header = [  # the grid's own header numbers, each written to read back exactly
         f"ncols {v.shape[1]}",
         f"nrows {v.shape[0]}",
-        f"xllcorner {x0:.10g}",
-        f"yllcorner {y0:.10g}",
-        f"cellsize {cell:.10g}",
+        f"xllcorner {header_number_text(grid.x_left_m)}",
+        f"yllcorner {header_number_text(grid.y_bottom_m)}",
+        f"cellsize {header_number_text(grid.dx_m)}",
         f"NODATA_value {nodata:g}",
     ]
     out = np.where(np.isfinite(v), v, nodata)

@@ -307,8 +307,8 @@ def whole_metre_site(site: ExportSite) -> tuple[ExportSite, str]:
             f"to resample to r.stone's whole-metre cells of {new:g} m",
             source="site",
         )
-    left = float(g.x_m[0] - g.dx_m / 2)
-    top = float(g.y_m[0] + g.dy_m / 2)
+    left = g.x_left_m
+    top = g.y_top_m
     x = left + new * (np.arange(ncols) + 0.5)
     y = top - new * (np.arange(nrows) + 0.5)
     xx, yy = np.meshgrid(x, y)
@@ -326,7 +326,7 @@ def whole_metre_site(site: ExportSite) -> tuple[ExportSite, str]:
     )
     release = np.zeros((nrows, ncols), bool)
     for r, c in np.argwhere(site.release):  # every release cell keeps one
-        rr = min(nrows - 1, int((g.y_m[0] + g.dy_m / 2 - g.y_m[r]) // new))
+        rr = min(nrows - 1, int((g.y_top_m - g.y_m[r]) // new))
         cc = min(ncols - 1, int((g.x_m[c] - left) // new))
         release[rr, cc] = True
     how = (
@@ -974,8 +974,8 @@ def record_text(model, site, source, per_cell, offset, chainage, options) -> str
         "grid": {
             "ncols": int(g.shape[1]),
             "nrows": int(g.shape[0]),
-            "x_left_m": float(g.x_m[0] - g.dx_m / 2),
-            "y_top_m": float(g.y_m[0] + g.dy_m / 2),
+            "x_left_m": g.x_left_m,
+            "y_top_m": g.y_top_m,
             "cellsize_m": float(g.cellsize_m),
         },
         "dem_offset_m": float(offset),

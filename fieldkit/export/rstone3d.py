@@ -287,7 +287,7 @@ def source_cell(inputs: Rstone3DInputs, x_m: float, y_m: float) -> tuple[int, in
     """
     g = inputs.grid
     cell = g.cellsize_m
-    left, top = float(g.x_m[0] - cell / 2), float(g.y_m[0] + cell / 2)
+    left, top = g.x_left_m, g.y_top_m
     col = math.floor((x_m - left) / cell)
     row = math.floor((top - y_m) / cell)
     rows, cols = g.shape

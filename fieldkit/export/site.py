@@ -131,16 +131,16 @@ def site_from_dem(
 def _cell_of(grid: DemGrid, x: float, y: float) -> tuple[int, int, str]:
     """``(row, column, "")`` of the cell holding ``(x, y)``, or a problem text: off
     the grid (its extent given) or on a nodata cell (1-based row and column)."""
-    col = math.floor((x - (grid.x_m[0] - grid.dx_m / 2)) / grid.dx_m)
-    row = math.floor(((grid.y_m[0] + grid.dy_m / 2) - y) / grid.dy_m)
+    col = math.floor((x - grid.x_left_m) / grid.dx_m)
+    row = math.floor((grid.y_top_m - y) / grid.dy_m)
     nrows, ncols = grid.shape
     if not (0 <= row < nrows and 0 <= col < ncols):
-        x0, y0 = grid.x_m[0] - grid.dx_m / 2, grid.y_m[-1] - grid.dy_m / 2
+        x0, y0 = grid.x_left_m, grid.y_bottom_m
         return (
             -1,
             -1,
-            f"outside the grid (x {x0:g}..{x0 + ncols * grid.dx_m:g} m, "
-            f"y {y0:g}..{y0 + nrows * grid.dy_m:g} m)",
+            f"outside the grid (x {x0:.10g}..{x0 + ncols * grid.dx_m:.10g} m, "
+            f"y {y0:.10g}..{y0 + nrows * grid.dy_m:.10g} m)",
         )
     if not np.isfinite(grid.values[row, col]):
         return row, col, f"a nodata cell (grid row {row + 1}, column {col + 1})"
@@ -339,7 +339,7 @@ def checked_site(site: ExportSite | None, target: str) -> ExportSite:
         raise ArgumentError(
             f"{target} needs a grid site: a DEM or the section extruded", source="site"
         )
-    if not np.isclose(site.grid.dx_m, site.grid.dy_m, rtol=1e-9):
+    if not site.grid.square:
         raise ArgumentError(
             f"{target} needs square cells (got {site.grid.dx_m:g} x "
             f"{site.grid.dy_m:g} m)",
@@ -409,8 +409,8 @@ def pad_site(site: ExportSite, cells: int) -> ExportSite:
     g = site.grid
     grid = DemGrid.from_corner(
         values,
-        x_left_m=float(g.x_m[0] - g.dx_m / 2 - left * g.dx_m),
-        y_top_m=float(g.y_m[0] + g.dy_m / 2 + top * g.dy_m),
+        x_left_m=float(g.x_left_m - left * g.dx_m),
+        y_top_m=float(g.y_top_m + top * g.dy_m),
         cellsize_m=g.dx_m,
         cellsize_y_m=g.dy_m,
         crs=g.crs,

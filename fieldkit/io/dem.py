@@ -30,6 +30,7 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass, field
+from functools import cached_property
 from os import PathLike
 from pathlib import Path
 
@@ -106,18 +107,78 @@ def footprint_plane(
     return a, b, c, float(np.sqrt(np.mean(res * res)))
 
 
+def header_number_text(value: float) -> str:
+    """A header number (corner, cell size) as the shortest text that reads back
+    as the same float: ``%g`` would write 2780000.025 as ``2.78e+06``.
+
+    Examples
+    --------
+    >>> [header_number_text(v) for v in (5.0, 2780000.025, 0.05)]
+    ['5', '2780000.025', '0.05']
+    """
+    text = repr(float(value))
+    return text[:-2] if text.endswith(".0") else text
+
+
+def coordinate_tolerance_m(*coords_m: float) -> float:
+    """A few rounding errors of the largest coordinate [m]: how far two
+    computations of one point may differ (4.7e-10 m is one at 2.8e6 m, LV95).
+
+    Examples
+    --------
+    >>> coordinate_tolerance_m(2_780_000.0, 1_185_000.0) < 1e-8
+    True
+    """
+    return 16.0 * math.ulp(max((abs(c) for c in coords_m), default=1.0) or 1.0)
+
+
+def same_origin_and_cell(
+    a: tuple[float, ...], b: tuple[float, ...], rel_cell: float = 1e-9
+) -> bool:
+    """Whether two grids' ``(x0, y0, cell_x[, cell_y])`` agree: cell sizes to
+    ``rel_cell``, origins within 1e-6 of a cell plus
+    :func:`coordinate_tolerance_m` of their magnitude.
+
+    Examples
+    --------
+    >>> same_origin_and_cell((2780000.0, 1185000.0, 0.05),
+    ...                      (2780000.0 + 1e-9, 1185000.0, 0.05 * (1 + 1e-12)))
+    True
+    >>> same_origin_and_cell((0.0, 0.0, 0.05), (0.05, 0.0, 0.05))
+    False
+    """
+    cells = list(zip(a[2:], b[2:], strict=True))
+    if not all(math.isclose(p, q, rel_tol=rel_cell) for p, q in cells):
+        return False
+    cell = min(a[2:])
+    return all(
+        abs(p - q) <= 1e-6 * cell + coordinate_tolerance_m(p, q)
+        for p, q in zip(a[:2], b[:2], strict=True)
+    )
+
+
 @dataclass(frozen=True)
 class DemGrid:
     """A regular elevation grid, north up.
+
+    The geometry is the file's own header (ESRI ``cellsize``/``dx``/``dy`` and
+    ``xllcorner``/``xllcenter``...) or GeoTIFF transform (``a``, ``-e``, ``c``,
+    ``f``), kept as given: the cell centres :attr:`x_m`, :attr:`y_m` are computed
+    from it, never the other way round. Differences of centres near 2.8e6 m (a
+    national grid) are off by ~1e-9 m, which is 2e-8 of a 5 cm cell.
 
     Attributes
     ----------
     values
         ``(nrows, ncols)`` elevations [m]; row 0 is the northern row; NaN = nodata.
-    x_m
-        ``(ncols,)`` x of the column centres [m], increasing.
-    y_m
-        ``(nrows,)`` y of the row centres [m], decreasing (row 0 north).
+    x_left_m
+        x of the western edge of the grid (of column 0's cells) [m].
+    y_top_m
+        y of the northern edge of the grid (of row 0's cells) [m].
+    dx_m
+        Column spacing (cell width) [m], > 0, as the header gives it.
+    dy_m
+        Row spacing (cell height) [m], > 0, as the header gives it.
     crs
         The coordinate reference system as the file gives it, or None.
     source
@@ -127,8 +188,10 @@ class DemGrid:
     """
 
     values: np.ndarray
-    x_m: np.ndarray
-    y_m: np.ndarray
+    x_left_m: float
+    y_top_m: float
+    dx_m: float
+    dy_m: float
     crs: str | None = None
     source: str = ""
     notes: tuple[str, ...] = field(default=())
@@ -155,12 +218,27 @@ class DemGrid:
         >>> g.x_m.tolist(), g.y_m.tolist(), g.cellsize_m
         ([2.5, 7.5, 12.5], [7.5, 2.5], 5.0)
         """
-        values = np.asarray(values, dtype=float)
         dy = cellsize_m if cellsize_y_m is None else cellsize_y_m
-        nrows, ncols = values.shape
-        x = x_left_m + cellsize_m * (np.arange(ncols) + 0.5)
-        y = y_top_m - dy * (np.arange(nrows) + 0.5)
-        return cls(values, x, y, crs=crs, source=source, notes=notes)
+        return cls(
+            np.asarray(values, dtype=float),
+            float(x_left_m),
+            float(y_top_m),
+            float(cellsize_m),
+            float(dy),
+            crs=crs,
+            source=source,
+            notes=notes,
+        )
+
+    @cached_property
+    def x_m(self) -> np.ndarray:
+        """``(ncols,)`` x of the column centres [m], increasing."""
+        return self.x_left_m + self.dx_m * (np.arange(self.shape[1]) + 0.5)
+
+    @cached_property
+    def y_m(self) -> np.ndarray:
+        """``(nrows,)`` y of the row centres [m], decreasing (row 0 north)."""
+        return self.y_top_m - self.dy_m * (np.arange(self.shape[0]) + 0.5)
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -168,25 +246,36 @@ class DemGrid:
         return self.values.shape  # type: ignore[return-value]
 
     @property
-    def dx_m(self) -> float:
-        """Column spacing [m]."""
-        return float(self.x_m[1] - self.x_m[0])
-
-    @property
-    def dy_m(self) -> float:
-        """Row spacing [m] (positive)."""
-        return float(self.y_m[0] - self.y_m[1])
+    def y_bottom_m(self) -> float:
+        """y of the southern edge of the grid [m]."""
+        return self.y_top_m - self.shape[0] * self.dy_m
 
     @property
     def cellsize_m(self) -> float:
         """The cell size [m]: the smaller of the column and row spacings."""
         return min(self.dx_m, self.dy_m)
 
+    @property
+    def square(self) -> bool:
+        """Whether the cells are square: the header's two sizes agree to 1e-9
+        (a file writes one ``cellsize``, or ``dx``/``dy`` as decimals that may
+        round differently in the last digit)."""
+        return math.isclose(self.dx_m, self.dy_m, rel_tol=1e-9)
+
+    def same_geometry(self, other: DemGrid) -> bool:
+        """Whether ``other`` lies on this grid: same shape and cell sizes (to
+        1e-9), origins within 1e-6 of a cell (and within a few rounding errors of
+        the coordinates' magnitude, so a 5 cm grid at 2.8e6 m compares)."""
+        return self.shape == other.shape and same_origin_and_cell(
+            (self.x_left_m, self.y_top_m, self.dx_m, self.dy_m),
+            (other.x_left_m, other.y_top_m, other.dx_m, other.dy_m),
+        )
+
     def extent_text(self) -> str:
         """Where interpolation is defined, for messages: the cell-centre rectangle."""
         return (
-            f"cell centres span x {self.x_m[0]:g}..{self.x_m[-1]:g} m, "
-            f"y {self.y_m[-1]:g}..{self.y_m[0]:g} m"
+            f"cell centres span x {self.x_m[0]:.10g}..{self.x_m[-1]:.10g} m, "
+            f"y {self.y_m[-1]:.10g}..{self.y_m[0]:.10g} m"
         )
 
     def sample(
@@ -208,14 +297,21 @@ class DemGrid:
         nrows, ncols = self.shape
         col = (x - self.x_m[0]) / self.dx_m
         row = (self.y_m[0] - y) / self.dy_m
-        tol = 1e-9
+        # a point on the grid's edge, computed another way, may be a few rounding
+        # errors of its coordinate off: at 2.8e6 m that is ~1e-8 of a 5 cm cell
+        tol_c = 1e-9 + coordinate_tolerance_m(self.x_left_m) / self.dx_m
+        tol_r = 1e-9 + coordinate_tolerance_m(self.y_top_m) / self.dy_m
+        # ... and so may a point on a line of cell centres: snapped onto it, so it
+        # does not lean on the next row or column (which may be nodata)
+        col = np.where(np.abs(col - np.round(col)) <= tol_c, np.round(col), col)
+        row = np.where(np.abs(row - np.round(row)) <= tol_r, np.round(row), row)
         inside = (
             np.isfinite(col)
             & np.isfinite(row)
-            & (col >= -tol)
-            & (col <= ncols - 1 + tol)
-            & (row >= -tol)
-            & (row <= nrows - 1 + tol)
+            & (col >= -tol_c)
+            & (col <= ncols - 1 + tol_c)
+            & (row >= -tol_r)
+            & (row <= nrows - 1 + tol_r)
         )
         col = np.clip(np.where(inside, col, 0.0), 0.0, ncols - 1)
         row = np.clip(np.where(inside, row, 0.0), 0.0, nrows - 1)
@@ -519,12 +615,12 @@ def _read_esri_ascii(file: Path) -> DemGrid:
     y_bottom = y_ll if y_key == "yllcorner" else y_ll - dy / 2
     prj = file.with_suffix(".prj")
     crs = (prj.read_text(errors="replace").strip() or None) if prj.is_file() else None
-    return DemGrid.from_corner(
+    return DemGrid(
         values,
         x_left_m=x_left,
         y_top_m=y_bottom + nrows * dy,
-        cellsize_m=dx,
-        cellsize_y_m=dy,
+        dx_m=dx,
+        dy_m=dy,
         crs=crs,
         source=source,
         notes=notes,
@@ -594,12 +690,12 @@ def _read_geotiff(file: Path) -> DemGrid:
             source=source,
         )
     values[~np.isfinite(values)] = np.nan
-    return DemGrid.from_corner(
+    return DemGrid(
         values,
-        x_left_m=t.c,
-        y_top_m=t.f,
-        cellsize_m=t.a,
-        cellsize_y_m=-t.e,
+        x_left_m=float(t.c),
+        y_top_m=float(t.f),
+        dx_m=float(t.a),
+        dy_m=float(-t.e),
         crs=crs,
         source=source,
     )

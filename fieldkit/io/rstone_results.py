@@ -39,7 +39,7 @@ import numpy as np
 import pandas as pd
 
 from fieldkit.errors import InputFileError
-from fieldkit.io.dem import read_dem
+from fieldkit.io.dem import read_dem, same_origin_and_cell
 
 #: The record of the grid, written by the export.
 RECORD = "fieldkit_export.json"
@@ -191,20 +191,20 @@ def read_rstone_results(folder: str | Path) -> RstoneResults:
                 source=path,
             )
         grid = read_dem(path)
-        left = grid.x_m[0] - grid.dx_m / 2
-        top = grid.y_m[0] + grid.dy_m / 2
-        same = (
-            grid.shape == (int(g["nrows"]), int(g["ncols"]))
-            and math.isclose(grid.dx_m, g["cellsize_m"], rel_tol=1e-9)
-            and math.isclose(left, g["x_left_m"], abs_tol=1e-6 * g["cellsize_m"])
-            and math.isclose(top, g["y_top_m"], abs_tol=1e-6 * g["cellsize_m"])
-        )
+        left = grid.x_left_m
+        top = grid.y_top_m
+        cell = g["cellsize_m"]
+        same = grid.shape == (int(g["nrows"]), int(g["ncols"])) and (
+            same_origin_and_cell((left, top, grid.dx_m, grid.dy_m),
+                                 (g["x_left_m"], g["y_top_m"], cell, cell))
+        )  # fmt: skip
         if not same:
             raise InputFileError(
                 f"{grid.shape[1]} x {grid.shape[0]} cells of {grid.dx_m:g} m from "
-                f"({left:g}, {top:g}); the export's grid ({RECORD}) is {g['ncols']} x "
-                f"{g['nrows']} cells of {g['cellsize_m']:g} m from ({g['x_left_m']:g}, "
-                f"{g['y_top_m']:g}): not r.stone's result on these files",
+                f"({left:.10g}, {top:.10g}); the export's grid ({RECORD}) is "
+                f"{g['ncols']} x {g['nrows']} cells of {g['cellsize_m']:g} m from "
+                f"({g['x_left_m']:.10g}, {g['y_top_m']:.10g}): not r.stone's result "
+                "on these files",
                 source=path,
             )
         values = grid.values

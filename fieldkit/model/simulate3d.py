@@ -24,6 +24,7 @@ from fieldkit.model.effects import registry
 from fieldkit.model.kernel import MATERIAL_COLUMNS
 from fieldkit.model.model3d import WHY_HIT_PROBABILITY_1, Model3D
 from fieldkit.model.model_file import CORE_DEFAULTS
+from fieldkit.model.terrain import Terrain
 
 #: Rocks per kernel call.
 CHUNK_ROCKS = 20_000
@@ -95,7 +96,8 @@ def check_model3d(model: Model3D) -> None:
         An effect not yet in 3-D (:data:`fieldkit.model.kernel3d.NOT_IN_3D`) is on;
         ``tree_impacts`` is on without ``trees`` or with a ``hit_probability``
         other than 1 (:func:`tree_hit_probability`);
-        ``material_index`` is not the DEM's shape or indexes past ``materials``;
+        ``material_index`` is not the DEM's shape or, on a cell with data, is not
+        an index into ``materials`` (a nodata cell's is not read);
         ``releases`` is not (n, 3) finite, has a point off the DEM's surface, or
         its weights are not >= 0 with a positive sum.
     """
@@ -117,10 +119,13 @@ def check_model3d(model: Model3D) -> None:
             f"material_index has shape {mi.shape}, the DEM {model.terrain.shape}",
             source="material_index",
         )
-    if mi.size and (mi.min() < 0 or mi.max() >= len(model.materials)):
+    # a nodata cell has no material (-1 from the model file); the kernel reads a
+    # cell's material only at an impact, which is on data (its four centres are)
+    used = mi[np.isfinite(model.terrain.z)]
+    if used.size and (used.min() < 0 or used.max() >= len(model.materials)):
         raise ArgumentError(
-            f"material_index holds {int(mi.min())}..{int(mi.max())}; "
-            f"{len(model.materials)} materials",
+            f"material_index holds {int(used.min())}..{int(used.max())} on cells "
+            f"with data; {len(model.materials)} materials",
             source="material_index",
         )
     rel = np.asarray(model.releases, float)
@@ -136,8 +141,8 @@ def check_model3d(model: Model3D) -> None:
     if off.size:
         i = int(off[0])
         raise ArgumentError(
-            f"release point {i + 1} (x {rel[i, 0]:g}, y {rel[i, 1]:g}) is off the "
-            "DEM's surface (outside its cell centres or beside nodata)",
+            f"release point {i + 1} (x {rel[i, 0]:.10g}, y {rel[i, 1]:.10g}) is off "
+            "the DEM's surface (outside its cell centres or beside nodata)",
             source="releases",
         )
     wts = np.asarray(model.release_weights, float)
@@ -209,7 +214,6 @@ def _tiny_model() -> Model3D:
     """A one-patch model exercising every kernel signature (the warm-up)."""
     from fieldkit.model.materials import Material
     from fieldkit.model.model_file import Body
-    from fieldkit.model.terrain import Terrain
 
     terrain = Terrain(0.0, 0.0, 1.0, np.array([[1.0, 0.0], [1.0, 0.0]]))
     return Model3D(
@@ -315,7 +319,12 @@ def simulate3d(
             source="sample_m",
         )
     core = {k: v[0] for k, v in CORE_DEFAULTS.items()} | dict(model.core)
-    grid = terrain.grid()
+    # The kernel runs with the origin at the DEM's lower-left corner: in a
+    # national grid (x ~ 2.8e6 m, LV95) a position is rounded to 4.7e-10 m, 1e-8
+    # of a 5 cm cell, enough to turn one contact into a chain of false ones.
+    ox, oy = float(terrain.x0_m), float(terrain.y0_m)
+    local = Terrain(0.0, 0.0, terrain.cell_m, terrain.z)
+    grid = local.grid()
     ground = kernel3d.Ground(
         grid.z,
         grid.xc0,
@@ -332,10 +341,12 @@ def simulate3d(
     )
     mat = _material_table(model.materials)
     flags, par = registry.kernel_arrays(model.effects)
-    stems = kernel3d.no_stems(terrain)
+    stems = kernel3d.no_stems(local)
     if "tree_impacts" in model.effects:
         tr = model.trees
-        stems = kernel3d.stems_of(tr.x_m, tr.y_m, tr.diameter_m, tr.height_m, terrain)
+        stems = kernel3d.stems_of(np.asarray(tr.x_m, float) - ox,
+                                  np.asarray(tr.y_m, float) - oy, tr.diameter_m,
+                                  tr.height_m, local)  # fmt: skip
         off = len(tr.x_m) - stems.x.size
         notes.append(
             f"tree_impacts: {stems.x.size} stems on the DEM, each struck where a "
@@ -362,6 +373,7 @@ def simulate3d(
         b = min(rocks, a + chunk_rocks)
         sel = slice(a, b)
         starts = [d[k][sel] for k in ("keys", "x", "y", "z", "vx", "vy", "vz", "w")]
+        starts[1], starts[2] = starts[1] - ox, starts[2] - oy  # the kernel's frame
         body = [d[k][sel] for k in ("m", "r", "kg")]
 
         def run(
@@ -401,11 +413,17 @@ def simulate3d(
             roff, rec = zeros, no_rec
         run(path, poff, keep_paths, rec, roff, record_impacts)
         wall += time.perf_counter() - tic
+        path.x_m[:] += ox  # back to the DEM's coordinates
+        path.y_m[:] += oy
+        rec[:, kernel3d.R_X] += ox
+        rec[:, kernel3d.R_Y] += oy
         path_parts.append(path)
         if record_impacts and on_impact_rows is not None:
             on_impact_rows(_impact_rows(rec))
         elif record_impacts:
             rec_parts.append(rec)
+    deposit[:, 0] += ox
+    deposit[:, 1] += oy
     offsets = np.zeros(rocks + 1, np.int64)
     if keep_paths:
         np.cumsum(samples, out=offsets[1:])

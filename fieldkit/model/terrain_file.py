@@ -52,7 +52,7 @@ from pathlib import Path
 import numpy as np
 
 from fieldkit.errors import InputFileError
-from fieldkit.io.dem import DemGrid, read_dem
+from fieldkit.io.dem import DemGrid, read_dem, same_origin_and_cell
 from fieldkit.io.releases import cells_inside, read_releases
 from fieldkit.model.materials import Material, check_number
 from fieldkit.model.model3d import (
@@ -117,17 +117,16 @@ def terrain_from_dem(grid: DemGrid) -> Terrain:
     InputFileError
         The cells are not square (naming the DEM).
     """
-    dx, dy = grid.dx_m, grid.dy_m
-    if not np.isclose(dx, dy, rtol=1e-9, atol=0.0):
+    if not grid.square:  # the header's sizes, not differences of coordinates
         raise InputFileError(
-            f"cells are {dx:g} x {dy:g} m; the 3-D model needs square cells "
-            "(resample it: gdalwarp -tr)",
+            f"cells are {grid.dx_m:g} x {grid.dy_m:g} m; the 3-D model needs square "
+            "cells (resample it: gdalwarp -tr)",
             source=grid.source,
         )
     return Terrain(
-        x0_m=float(grid.x_m[0] - dx / 2),
-        y0_m=float(grid.y_m[-1] - dy / 2),
-        cell_m=float(dx),
+        x0_m=grid.x_left_m,
+        y0_m=grid.y_bottom_m,
+        cell_m=grid.dx_m,
         z=np.flipud(grid.values),
         crs=grid.crs,
     )
@@ -247,19 +246,17 @@ def _file(value: object, base: Path, source: str, where: str) -> Path:
 def _grid_like(path: Path, terrain: Terrain, source: str, where: str) -> np.ndarray:
     """A raster on the DEM's grid (same size, origin, cell), row 0 south."""
     other = terrain_from_dem(read_dem(path))
-    same = (
-        other.shape == terrain.shape
-        and np.isclose(other.x0_m, terrain.x0_m, atol=1e-6 * terrain.cell_m)
-        and np.isclose(other.y0_m, terrain.y0_m, atol=1e-6 * terrain.cell_m)
-        and np.isclose(other.cell_m, terrain.cell_m, rtol=1e-9)
+    same = other.shape == terrain.shape and same_origin_and_cell(
+        (other.x0_m, other.y0_m, other.cell_m),
+        (terrain.x0_m, terrain.y0_m, terrain.cell_m),
     )
     if not same:
         ny, nx = other.shape
         raise InputFileError(
             f"{path.name} is not on the DEM's grid: {ny} x {nx} cells of "
-            f"{other.cell_m:g} m from ({other.x0_m:g}, {other.y0_m:g}), the DEM has "
-            f"{terrain.shape[0]} x {terrain.shape[1]} of {terrain.cell_m:g} m from "
-            f"({terrain.x0_m:g}, {terrain.y0_m:g})",
+            f"{other.cell_m:g} m from ({other.x0_m:.10g}, {other.y0_m:.10g}), the DEM "
+            f"has {terrain.shape[0]} x {terrain.shape[1]} of {terrain.cell_m:g} m from "
+            f"({terrain.x0_m:.10g}, {terrain.y0_m:.10g})",
             source=source,
             where=where,
         )
@@ -300,8 +297,8 @@ def _material_index(
             row, col = (int(a[0]) for a in np.nonzero(bad))
             xc, yc = cell_centres(terrain)
             raise InputFileError(
-                f"{path.name}: the cell at x = {xc[col]:g}, y = {yc[row]:g} m holds "
-                f"{codes[row, col]:g}; a cell holds the index of a material of "
+                f"{path.name}: the cell at x = {xc[col]:.10g}, y = {yc[row]:.10g} m "
+                f"holds {codes[row, col]:g}; a cell holds the index of a material of "
                 f'"materials", 0 to {len(names) - 1} ({", ".join(names)})',
                 source=source,
                 where=where,
@@ -348,7 +345,7 @@ def _material_index(
             row, col = (int(a[0]) for a in np.nonzero(missing))
             raise InputFileError(
                 f"{int(missing.sum())} DEM cells lie outside every polygon (e.g. the "
-                f"cell at x = {xc[col]:g}, y = {yc[row]:g} m); add an item "
+                f"cell at x = {xc[col]:.10g}, y = {yc[row]:.10g} m); add an item "
                 '{"material": name} without a polygon for every other cell',
                 source=source,
                 where=where,
@@ -554,8 +551,8 @@ def check_line_on_dem(
         if lo <= hi:
             return
     raise InputFileError(
-        f"the line never enters the DEM (x {x0:g} to {x1:g} m, y {y0:g} to "
-        f"{y1:g} m): check its coordinates are in the DEM's system",
+        f"the line never enters the DEM (x {x0:.10g} to {x1:.10g} m, y {y0:.10g} to "
+        f"{y1:.10g} m): check its coordinates are in the DEM's system",
         source=source,
         where=where,
     )

@@ -68,12 +68,12 @@ def save_profile_figure(
 
 
 def _draw_plan(fig, ax_plan, grid: DemGrid, section: Section) -> None:
-    half_x, half_y = grid.dx_m / 2, grid.dy_m / 2
+    ncols = grid.shape[1]
     extent = (
-        grid.x_m[0] - half_x,
-        grid.x_m[-1] + half_x,
-        grid.y_m[-1] - half_y,
-        grid.y_m[0] + half_y,
+        grid.x_left_m,
+        grid.x_left_m + ncols * grid.dx_m,
+        grid.y_bottom_m,
+        grid.y_top_m,
     )
     image = ax_plan.imshow(
         np.ma.masked_invalid(grid.values), extent=extent, cmap="terrain", origin="upper"

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import doctest
 import math
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
@@ -27,7 +28,7 @@ def surface_grid(func, *, n=41, cell=1.0, source="analytic.asc"):
     grid = DemGrid.from_corner(np.zeros((n, n)), x_left_m=-half, y_top_m=half,
                                cellsize_m=cell, source=source)  # fmt: skip
     x, y = np.meshgrid(grid.x_m, grid.y_m)
-    return DemGrid(func(x, y), grid.x_m, grid.y_m, source=source)
+    return replace(grid, values=func(x, y))
 
 
 def tilted(x, y):
@@ -64,7 +65,7 @@ def test_polyline_over_nodata_names_the_cell():
     grid = surface_grid(tilted)
     values = grid.values.copy()
     values[20, 25] = np.nan  # the cell centred at (5, 0)
-    grid = DemGrid(values, grid.x_m, grid.y_m, source="holes.asc")
+    grid = replace(grid, values=values, source="holes.asc")
     with pytest.raises(InputFileError, match=r"holes.asc: the line crosses nodata at "
                        r"\(x, y\) = \(4.50, 0.00\).*row 21, column 26"):  # fmt: skip
         profile_along_polyline(grid, [(0.0, 0.0), (10.0, 0.0)], 0.5)
@@ -196,7 +197,7 @@ def test_descent_stops_at_nodata():
     grid = surface_grid(tilted)
     values = grid.values.copy()
     values[30:, :] = np.nan  # everything south of y = -9.5
-    s = steepest_descent_line(DemGrid(values, grid.x_m, grid.y_m), (0.0, 0.0), 0.5)
+    s = steepest_descent_line(replace(grid, values=values, source=""), (0.0, 0.0), 0.5)
     assert s.ending == "nodata" and s.plan_y_m[-1] == pytest.approx(-9.0, abs=1e-5)
 
 

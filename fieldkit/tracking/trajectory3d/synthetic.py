@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from fieldkit.io.dem import header_number_text
 from fieldkit.physics.constants import G
 
 #: Largest mismatch of a rebuilt flight with the next impact row [m].
@@ -210,8 +211,9 @@ def write_site(folder, terrain, runs, *, samples_name: str = "trajectories.csv",
     rows = "\n".join(" ".join(f"{v:.9f}" for v in row) for row in terrain.z[::-1])
     dem = folder / dem_name
     dem.write_text(
-        f"ncols {nx}\nnrows {ny}\nxllcorner {terrain.x0_m:g}\nyllcorner "
-        f"{terrain.y0_m:g}\ncellsize {terrain.cell_m:g}\nNODATA_value -9999\n{rows}\n"
+        f"ncols {nx}\nnrows {ny}\nxllcorner {header_number_text(terrain.x0_m)}\n"
+        f"yllcorner {header_number_text(terrain.y0_m)}\n"
+        f"cellsize {header_number_text(terrain.cell_m)}\nNODATA_value -9999\n{rows}\n"
     )
     samples = folder / samples_name
     pd.concat([r.samples for r in runs]).to_csv(samples, index=False)
