@@ -142,7 +142,9 @@ def scale_mm_per_px(analysis: TrackAnalysis) -> float:
 def flight_rows(analysis: TrackAnalysis) -> list[dict]:
     """One dict per flight, the numbers of report.md's flight table: ``flight``,
     ``first_frame``, ``last_frame``, ``t_start_s``, ``t_end_s``, ``samples``,
-    ``g_mps2``, ``g_se_mps2``, ``g_sigmas`` (``|g - 9.81| / SE``), ``rms_mm``."""
+    ``g_mps2``, ``g_se_mps2`` (of the check against 9.81: the fit's and the stated
+    calibration's, ``FlightFit.g_check_se_mps2``), ``g_sigmas`` (``|g - 9.81| / SE``),
+    ``rms_mm``."""
     rows = []
     for fl in analysis.flights:
         a, b = flight_frame_range(analysis, fl)
@@ -155,7 +157,7 @@ def flight_rows(analysis: TrackAnalysis) -> list[dict]:
                 t_end_s=fl.t_end_s,
                 samples=fl.n_samples,
                 g_mps2=fl.g_mps2,
-                g_se_mps2=fl.g_se_mps2,
+                g_se_mps2=fl.g_check_se_mps2,
                 g_sigmas=abs(fl.g_sigmas),
                 rms_mm=1e3 * fl.rms_m,
             )

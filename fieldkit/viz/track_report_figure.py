@@ -10,7 +10,7 @@
   its apex, the contacts as labelled vertical lines (impact) or bands (net) with
   their frames;
 * ``g_per_flight.png`` -- each flight's fitted g with 1 and 3 standard errors (the
-  flight fit's own ``g_se_mps2``,
+  fit's and the stated scale and rate uncertainty's, ``g_check_se_mps2`` of
   :class:`~fieldkit.tracking.flights.ballistic_fit.FlightFit`, as ``fieldkit track``
   prints it) against 9.81 m/s², with the flight's frames.
 
@@ -530,7 +530,7 @@ def plot_g_per_flight(analysis: TrackAnalysis, *, title: str) -> Figure:
     ax.axhline(G, color="k", lw=1.0, label=f"g = {G:g} m/s²")
     names = []
     for i, fl in enumerate(analysis.flights):
-        se = fl.g_se_mps2 if np.isfinite(fl.g_se_mps2) else 0.0
+        se = fl.g_check_se_mps2 if np.isfinite(fl.g_check_se_mps2) else 0.0
         off = np.isfinite(fl.g_sigmas) and abs(fl.g_sigmas) > GRAVITY_WARNING_SIGMAS
         colour = "crimson" if off else _flight_colour(fl.index)
         ax.errorbar(i, fl.g_mps2, yerr=3 * se, fmt="none", ecolor=colour, lw=0.9,

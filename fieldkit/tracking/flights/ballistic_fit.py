@@ -223,6 +223,13 @@ class FlightFit:
         Part of ``g_se_mps2`` from a slowly varying detection error of size ``b``
         (``systematic_m`` of :func:`fit_flight`): ``8 b / T^2`` [m/s^2]; 0 when none
         is given.
+    g_calibration_rel_sd
+        Relative standard uncertainty of g from the stated calibration, shared by
+        every flight of a clip: ``sqrt(s_L^2 + (2 s_f)^2)`` for a length scale known
+        to the relative SD ``s_L`` and a capture rate to ``s_f`` (g scales with the
+        length and with the square of the rate; :func:`calibration_rel_sd`). Not in
+        ``g_se_mps2`` (which compares flights of one clip); in :attr:`g_check_se_mps2`,
+        the standard error of the test against 9.81. 0 when none is stated.
     """
 
     index: int
@@ -247,6 +254,7 @@ class FlightFit:
     )
     residual_rho: float = float("nan")
     g_systematic_mps2: float = 0.0
+    g_calibration_rel_sd: float = 0.0
 
     @property
     def n_samples(self) -> int:
@@ -264,12 +272,21 @@ class FlightFit:
         return (self.g_mps2 - G) / G
 
     @property
+    def g_check_se_mps2(self) -> float:
+        """Standard error of the fitted g against 9.81 [m/s^2]: the fit's
+        ``g_se_mps2`` and, in quadrature, the stated calibration's
+        ``g_calibration_rel_sd * g``."""
+        return float(np.hypot(self.g_se_mps2, self.g_calibration_rel_sd * self.g_mps2))
+
+    @property
     def g_sigmas(self) -> float:
-        """``(g_fitted - 9.81) / g_se``: standard errors from 9.81 (NaN when the
-        standard error is unknown or zero)."""
-        if not (np.isfinite(self.g_se_mps2) and self.g_se_mps2 > 0):
+        """``(g_fitted - 9.81) / g_check_se``: standard errors from 9.81, after the
+        stated scale and rate uncertainty (NaN when the standard error is unknown
+        or zero)."""
+        se = self.g_check_se_mps2
+        if not (np.isfinite(se) and se > 0):
             return float("nan")
-        return (self.g_mps2 - G) / self.g_se_mps2
+        return (self.g_mps2 - G) / se
 
     def gravity_summary(self) -> str:
         """One line: the flight's time span and fitted g with its standard error.
@@ -288,9 +305,10 @@ class FlightFit:
         )
 
     def g_text(self) -> str:
-        """``g +/- SE`` with the standard error to two significant digits (at least
-        two decimals): ``9.58 +/- 0.04``, ``9.8093 +/- 0.0012``."""
-        se = self.g_se_mps2
+        """``g +/- SE`` with the standard error (of the check against 9.81,
+        :attr:`g_check_se_mps2`) to two significant digits (at least two decimals):
+        ``9.58 +/- 0.04``, ``9.8093 +/- 0.0012``."""
+        se = self.g_check_se_mps2
         digits = 2
         if np.isfinite(se) and se > 0:
             digits = int(min(max(2, 1 - np.floor(np.log10(se))), 4))
@@ -334,6 +352,37 @@ class FlightFit:
             f"from 9.81; check the capture rate (`fps`; times {factor:.4g} would fit) "
             "or the length scale"
         )
+
+
+def calibration_rel_sd(scale_rel_sd: float = 0.0, fps_rel_sd: float = 0.0) -> float:
+    """Relative standard uncertainty of a fitted g from the calibration's.
+
+    A length scale too large by the fraction ``e_L`` makes g too large by ``e_L``;
+    a capture rate too large by ``e_f`` makes every time too short and g too large
+    by ``(1 + e_f)^2 - 1 ~ 2 e_f`` (module docstring). Independent, they add in
+    quadrature.
+
+    Parameters
+    ----------
+    scale_rel_sd
+        Relative standard uncertainty of the length scale (metres per pixel) [-].
+    fps_rel_sd
+        Relative standard uncertainty of the capture rate [-].
+
+    Returns
+    -------
+    float
+        ``sqrt(scale_rel_sd^2 + (2 fps_rel_sd)^2)`` [-].
+
+    Examples
+    --------
+    >>> round(calibration_rel_sd(0.03, 0.02), 6)
+    0.05
+    """
+    for name, value in (("scale_rel_sd", scale_rel_sd), ("fps_rel_sd", fps_rel_sd)):
+        if not (np.isfinite(value) and value >= 0):
+            raise ValueError(f"{name} must be >= 0 (got {value!r})")
+    return float(np.hypot(scale_rel_sd, 2.0 * fps_rel_sd))
 
 
 def ar1_inflation(*residuals: np.ndarray) -> tuple[float, float]:
