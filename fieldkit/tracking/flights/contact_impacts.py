@@ -4,7 +4,9 @@ For each contact between two fitted flights
 (:mod:`fieldkit.tracking.flights.segmentation`):
 
 * **Contact time.** A short contact (fewer than ``EXTENDED_CONTACT_SAMPLES`` measured
-  samples off both parabolas) is treated as instantaneous: the impact instant is where
+  samples off both parabolas, or paths that cross within one frame interval
+  whatever the samples between show: :func:`sub_frame`) is treated as
+  instantaneous: the impact instant is where
   the two fixed-g parabolas come closest (both share ``g``, so their separation is
   linear in time and the instant has a closed form), searched near the gap. An
   extended contact (a net, a rolling phase) starts and ends where the deviation from
@@ -43,6 +45,7 @@ from fieldkit.impact_table import ImpactTable
 from fieldkit.physics.constants import G
 from fieldkit.track import Track
 from fieldkit.tracking.flights.ballistic_fit import FlightFit
+from fieldkit.tracking.flights.contact_physics import join_duration
 from fieldkit.tracking.flights.contact_surface import surface_angles
 from fieldkit.tracking.flights.ground import Ground
 from fieldkit.tracking.flights.impact_uncertainty import contact_sds
@@ -101,6 +104,30 @@ def contact_instant(
     return float(np.clip(t0 - (d0 @ dv) / (dv @ dv), lo, hi))
 
 
+def sub_frame(
+    before: FlightFit, after: FlightFit, span: ContactSpan, dt: float
+) -> bool:
+    """True when the two flights' paths cross within one frame interval of each
+    other in time, within the span: a contact shorter than a frame (an impact),
+    whatever the samples in the span show (blurred or mis-detected frames).
+
+    Where the paths cross (:func:`~.contact_physics.join_duration`), the incoming
+    flight passes the crossing at ``t1`` and the outgoing one at ``t2``; a net or a
+    rolling phase holds the body for ``t2 - t1`` of many frames, an impact for less
+    than one.
+    """
+    if not np.isfinite(dt) or dt <= 0:
+        return False
+    guess = contact_instant(before, after, span, dt)
+    t1, t2, miss = join_duration(before, after, guess)
+    if not (np.isfinite(t1) and np.isfinite(t2)):
+        return False
+    lo, hi = span.t_last_before_s - dt, span.t_first_after_s + dt
+    inside = lo <= t1 <= hi and lo <= t2 <= hi
+    tolerance = 3.0 * max(before.rms_m, after.rms_m)
+    return bool(inside and abs(t2 - t1) < dt and miss <= tolerance)
+
+
 def flight_spin(track: Track, rows: np.ndarray) -> float:
     """Spin over a flight [rad/s]: line fit to the marker angle, else median omega."""
     t = track.t[rows]
@@ -125,6 +152,8 @@ def find_contact_events(
     for span in spans:
         fa, fb = flights[span.before], flights[span.after]
         extended = len(span.rows) >= EXTENDED_CONTACT_SAMPLES
+        if extended and sub_frame(fa, fb, span, frame_interval_s):
+            extended = False  # the flights meet within a frame: an impact
         if extended:
             ti = contact_onset(track, fa, span.rows, forward=True)
             tf = contact_onset(track, fb, span.rows, forward=False)
@@ -349,8 +378,7 @@ def refused_impacts(
             )
         elif np.isfinite(e_n) and e_n < 0:
             out[i] = (
-                f"e_n = {e_n:.3f} < 0 (the body does not leave the surface it "
-                "struck)"
+                f"e_n = {e_n:.3f} < 0 (the body does not leave the surface it struck)"
             )
         elif touching.any() and np.isfinite(gap[i]) and gap[i] > tolerance:
             out[i] = (

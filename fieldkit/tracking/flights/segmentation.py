@@ -147,6 +147,10 @@ class Segmentation:
         Median time between samples [s].
     misfits
         Flights that only a dragged flight explains (:func:`merge_free_flights`).
+    drift_joins
+        Joins that one flight seen through a slow detection drift explains (no
+        contact there): ``(last_before, first_after, drift_m)``, the track positions
+        of the samples on either side and the drift's size [m].
     """
 
     flights: list[np.ndarray]
@@ -155,6 +159,7 @@ class Segmentation:
     g_common_mps2: float
     frame_interval_s: float
     misfits: list[FlightMisfit] = field(default_factory=list)
+    drift_joins: list[tuple[int, int, float]] = field(default_factory=list)
 
 
 def estimate_noise(
@@ -190,6 +195,7 @@ def find_flights(
     window: int = 9,
     min_samples: int = 8,
     noise_floor_m: float = 0.0,
+    drift_limit_m: float = 0.0,
 ) -> Segmentation:
     """Find the ballistic flights of a track (see the module docstring for the method).
 
@@ -207,6 +213,9 @@ def find_flights(
         several frames (slowly changing background under the rim, compression), so
         the sample-to-sample scatter understates them; a floor of a few hundredths of
         a pixel keeps good samples in their flights.
+    drift_limit_m
+        Largest slow detection drift [m] that may explain two flights as one
+        (:func:`fieldkit.tracking.flights.free_flight.classify_join`); 0: none.
 
     Returns
     -------
@@ -299,7 +308,11 @@ def find_flights(
     # (a few %); far from it the capture rate or scale is wrong, and the track's g
     # stands in (the gravity check warns)
     g_free = G if abs(g_fix / G - 1.0) < G_TRUSTED_FRACTION else g_fix
-    flights, misfits = merge_free_flights(t, x, z, flights, g_free, sigma)
+    drift_joins: list[tuple[int, int, float]] = []
+    flights, misfits = merge_free_flights(
+        t, x, z, flights, g_free, sigma, drift_limit_m=drift_limit_m,
+        drift_joins=drift_joins,
+    )  # fmt: skip
     for k in range(len(flights) - 1):
         if flights[k + 1][0] - flights[k][-1] - 1 >= EXTENDED_CONTACT_SAMPLES:
             flights[k] = stable_end(t, x, z, flights[k], sigma, g_fix, at_start=False)
@@ -324,6 +337,7 @@ def find_flights(
         g_common_mps2=g_common,
         frame_interval_s=dt,
         misfits=misfits,
+        drift_joins=[(int(valid[a]), int(valid[b]), d) for a, b, d in drift_joins],
     )
 
 
@@ -334,6 +348,9 @@ def merge_free_flights(
     flights: list[np.ndarray],
     g_mps2: float,
     sigma: float,
+    *,
+    drift_limit_m: float = 0.0,
+    drift_joins: list[tuple[int, int, float]] | None = None,
 ) -> tuple[list[np.ndarray], list[FlightMisfit]]:
     """Join consecutive flights that one free flight explains (no contact between).
 
@@ -347,6 +364,9 @@ def merge_free_flights(
     on it (chi-square of :data:`~.segment_growth.CHI2_JOIN`), and the test is
     repeated with the next flight. A flight grown or joined as a dragged flight is
     returned as a :class:`FlightMisfit` (indices into the returned flights).
+    A join one flight explains only through a slow detection drift of at most
+    ``drift_limit_m`` is joined too and appended to ``drift_joins`` as
+    ``(last sample before, first after, drift [m])``.
     """
     flights = [np.asarray(r) for r in flights]
     joined: list[list[tuple[float, JoinTest | float]]] = [[] for _ in flights]
@@ -377,11 +397,14 @@ def merge_free_flights(
     while i < len(flights) - 1:
         a, b = flights[i], flights[i + 1]
         test = classify_join(
-            (t[a], x[a], z[a]), (t[b], x[b], z[b]), g_mps2=g_mps2, sigma_m=sigma
-        )
+            (t[a], x[a], z[a]), (t[b], x[b], z[b]), g_mps2=g_mps2, sigma_m=sigma,
+            drift_limit_m=drift_limit_m,
+        )  # fmt: skip
         if test.model == "contact":
             i += 1
             continue
+        if test.model == "drift" and drift_joins is not None:
+            drift_joins.append((int(a[-1]), int(b[0]), test.drift_m))
         rows = np.concatenate([a, b])
         gap = np.arange(a[-1] + 1, b[0])
         if gap.size:
