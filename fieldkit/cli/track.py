@@ -309,6 +309,9 @@ def track(
             warn(message)
     for message in analysis.warnings:
         warn(message)
+    for refusal in analysis.refusals:
+        if refusal.kind != "surface":  # the impact table's own: warned above
+            warn(refusal.message())
 
     if out is not None:
         analysis.track.write(out, outputs=outputs)

@@ -105,27 +105,41 @@ def contact_instant(
 
 
 def sub_frame(
-    before: FlightFit, after: FlightFit, span: ContactSpan, dt: float
+    track: Track, before: FlightFit, after: FlightFit, span: ContactSpan, dt: float
 ) -> bool:
-    """True when the two flights' paths cross within one frame interval of each
-    other in time, within the span: a contact shorter than a frame (an impact),
-    whatever the samples in the span show (blurred or mis-detected frames).
+    """True when the samples off both flights are an impact seen through blurred or
+    mis-detected frames, not an extended contact.
 
-    Where the paths cross (:func:`~.contact_physics.join_duration`), the incoming
-    flight passes the crossing at ``t1`` and the outgoing one at ``t2``; a net or a
-    rolling phase holds the body for ``t2 - t1`` of many frames, an impact for less
-    than one.
+    Two conditions: the two flights' paths cross within one frame interval of each
+    other in time, inside the span (where the paths cross,
+    :func:`~.contact_physics.join_duration`, the incoming flight passes the
+    crossing at ``t1`` and the outgoing one at ``t2``); and the samples of the span
+    lie on the impact's path -- the flight before until the crossing, the flight
+    after from it -- within the distance the body travels in one frame (what blur
+    or a mis-detection can shift a centre by; median over the span) plus three
+    times the flights' residual RMS. A net holds the body back from both flights by
+    decimetres: its samples are off that path, although a contact force along one
+    normal leaves crossing paths with ``t1 = t2``.
     """
-    if not np.isfinite(dt) or dt <= 0:
+    if not np.isfinite(dt) or dt <= 0 or len(span.rows) == 0:
         return False
     guess = contact_instant(before, after, span, dt)
     t1, t2, miss = join_duration(before, after, guess)
     if not (np.isfinite(t1) and np.isfinite(t2)):
         return False
     lo, hi = span.t_last_before_s - dt, span.t_first_after_s + dt
-    inside = lo <= t1 <= hi and lo <= t2 <= hi
-    tolerance = 3.0 * max(before.rms_m, after.rms_m)
-    return bool(inside and abs(t2 - t1) < dt and miss <= tolerance)
+    rms = 3.0 * max(before.rms_m, after.rms_m)
+    if not (lo <= t1 <= hi and lo <= t2 <= hi and abs(t2 - t1) < dt and miss <= rms):
+        return False
+    t = track.t[span.rows]
+    crossing = 0.5 * (t1 + t2)
+    xa, za = before.position(t)
+    xb, zb = after.position(t)
+    px, pz = np.where(t < crossing, xa, xb), np.where(t < crossing, za, zb)
+    off = np.hypot(track.x[span.rows] - px, track.z[span.rows] - pz)
+    off = off[np.isfinite(off)]
+    travel = dt * max(float(before.speed(t1)), float(after.speed(t2)))
+    return bool(len(off) and np.median(off) <= travel + rms)
 
 
 def flight_spin(track: Track, rows: np.ndarray) -> float:
@@ -152,7 +166,7 @@ def find_contact_events(
     for span in spans:
         fa, fb = flights[span.before], flights[span.after]
         extended = len(span.rows) >= EXTENDED_CONTACT_SAMPLES
-        if extended and sub_frame(fa, fb, span, frame_interval_s):
+        if extended and sub_frame(track, fa, fb, span, frame_interval_s):
             extended = False  # the flights meet within a frame: an impact
         if extended:
             ti = contact_onset(track, fa, span.rows, forward=True)

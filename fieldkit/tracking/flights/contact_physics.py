@@ -11,14 +11,16 @@ join is therefore judged by the physics of a contact before it is reported:
   quadrature, inflated for residuals correlated frame to frame); otherwise nothing
   acted on the body there.
 * **no energy gained.** A contact takes energy (a rigid or deformable surface, a
-  net). The change of kinetic energy per unit mass, ``(|v_f|^2 - |v_i|^2) / 2``
-  (plus ``k^2 (w_f^2 - w_i^2) / 2`` when the spin is measured on both sides), must
-  not be positive by more than :data:`ENERGY_GAIN_SIGMAS` of its standard error
-  (first-order propagation of the velocity errors).
-* **not an apex.** A surface below pushes the body up: a join where the vertical
-  velocity is zero within error on both sides, with no reversal (rising or level
-  before, falling or level after) and no reversal of the horizontal velocity (a
-  wall) is the top of one flight.
+  net). The change of mechanical energy per unit mass, ``(|v_f|^2 - |v_i|^2) / 2``
+  plus ``g`` times the rise over an extended contact, must not be positive by more
+  than :data:`ENERGY_GAIN_SIGMAS` of its standard error (first-order propagation of
+  the velocity errors). When the spin is measured on both sides the smaller of
+  that and the change with the spin's energy ``k^2 (w_f^2 - w_i^2) / 2`` counts
+  (spin feeds the translation in a topspin bounce).
+* **not an apex.** A surface below pushes the body up: an instantaneous join where
+  the body rises (or is level, within :data:`APEX_SIGMAS` errors) before and falls
+  (or is level) after, with no reversal of the horizontal velocity (a wall), is
+  the top of one flight.
 
 A join that fails is a :class:`Refusal` with its frames and a one-line reason. The
 pipeline joins the two flights into one when one free flight explains them
@@ -45,7 +47,7 @@ from fieldkit.tracking.flights.ballistic_fit import FlightFit
 IMPULSE_SIGMAS = 3.0
 #: Standard errors by which a contact may appear to gain kinetic energy.
 ENERGY_GAIN_SIGMAS = 3.0
-#: Standard errors within which a vertical velocity counts as zero at an apex.
+#: Standard errors within which a vertical velocity counts as level at an apex.
 APEX_SIGMAS = 3.0
 
 
@@ -78,11 +80,12 @@ class Refusal:
     merged: bool = False
 
     def message(self) -> str:
-        """``t = 0.0630-0.0680 s (frames 63-68): not a contact (apex): ...``."""
+        """``event at t = 0.0630-0.0680 s (frames 63-68) refused as a contact
+        (apex): ...``."""
         what = "; the flights on either side are one flight" if self.merged else ""
         return (
-            f"t = {self.t_start_s:.4f}-{self.t_end_s:.4f} s (frames "
-            f"{self.frames[0]}-{self.frames[1]}): not a contact ({self.kind}): "
+            f"event at t = {self.t_start_s:.4f}-{self.t_end_s:.4f} s (frames "
+            f"{self.frames[0]}-{self.frames[1]}) refused as a contact ({self.kind}): "
             f"{self.reason}{what}"
         )
 
@@ -142,37 +145,39 @@ def judge_join(
     if not size > IMPULSE_SIGMAS * se_dv * math.sqrt(2.0):
         return (
             "no_impulse",
-            f"the velocity changes by {size:.3f} m/s, within {IMPULSE_SIGMAS:g} "
-            f"standard errors ({se_dv:.3f} m/s per component) of none: nothing "
+            f"the velocity changes by {size:.3g} m/s, within {IMPULSE_SIGMAS:g} "
+            f"standard errors ({se_dv:.2g} m/s per component) of none: nothing "
             "struck the body",
         )
-    # vertical velocity zero within error on both sides and not reversed: an apex
+    # rising (or level) before, falling (or level) after, the horizontal motion not
+    # reversed: the top of a flight, not a push from a surface below
     zi, zf = vi_a[1], vf_a[1]
-    level_i = abs(zi) <= APEX_SIGMAS * se_i
-    level_f = abs(zf) <= APEX_SIGMAS * se_f
     rising_then_falling = zi >= -APEX_SIGMAS * se_i and zf <= APEX_SIGMAS * se_f
     wall = vi_a[0] * vf_a[0] < 0 and abs(vi_a[0]) > APEX_SIGMAS * se_i
-    if instantaneous and (level_i or level_f) and rising_then_falling and not wall:
+    if instantaneous and rising_then_falling and not wall:
         return (
             "apex",
             f"vertical velocity {zi:+.3f} m/s before and {zf:+.3f} m/s after "
-            f"(+/- {max(se_i, se_f):.3f}): the body is at the top of its flight, "
+            f"(+/- {max(se_i, se_f):.2g}): the body is at the top of its flight, "
             "no surface below pushed it",
         )
     gain = 0.5 * float(vf_a @ vf_a - vi_a @ vi_a) + G * rise_m
     var = float(vf_a @ vf_a) * se_f**2 + float(vi_a @ vi_a) * se_i**2
     spin = ""
     if gyration_m and np.isfinite(omega_i) and np.isfinite(omega_f):
-        gain += 0.5 * gyration_m**2 * (omega_f**2 - omega_i**2)
-        spin = " (with the spin's energy)"
+        # spin can feed the translation (a topspin bounce) and a measured spin
+        # may be off: refused only when the energy rises with and without it
+        with_spin = gain + 0.5 * gyration_m**2 * (omega_f**2 - omega_i**2)
+        if with_spin < gain:
+            gain, spin = with_spin, " (with the spin's energy)"
     se_gain = math.sqrt(var)
     if gain > ENERGY_GAIN_SIGMAS * se_gain:
         before = 0.5 * float(vi_a @ vi_a)
         share = f", {100 * gain / before:+.0f} %" if before > 0 else ""
         return (
             "energy_gain",
-            f"the mechanical energy per unit mass{spin} rises by {gain:.3f} +/- "
-            f"{se_gain:.3f} J/kg{share}: more than {ENERGY_GAIN_SIGMAS:g} standard "
+            f"the mechanical energy per unit mass{spin} rises by {gain:.4g} +/- "
+            f"{se_gain:.2g} J/kg{share}: more than {ENERGY_GAIN_SIGMAS:g} standard "
             "errors; a contact cannot give the body energy",
         )
     return None
