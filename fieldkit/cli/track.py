@@ -456,6 +456,8 @@ def _summary(video, track_data, detections, analysis, calibration_text) -> None:
             f"omega {row['omega_i_radps']:.1f} -> {row['omega_f_radps']:.1f} rad/s  "
             f"slope {row['slope_deg']:.2f} deg"
         )
+    for line in analysis.bridged:
+        typer.echo(f"  {line}")
     for contact in analysis.contacts:
         typer.echo(f"  {contact.summary()}")
     for line in analysis.net_rows_text():

@@ -44,6 +44,7 @@ from fieldkit.tracking.flights.contact_physics import (
 )
 from fieldkit.tracking.flights.free_flight import classify_join, explained_by_drift
 from fieldkit.tracking.flights.ground import ConstantGround, Ground, in_track_frame
+from fieldkit.tracking.flights.impact_uncertainty import contact_time_sd
 from fieldkit.tracking.flights.net_contacts import (
     NetContact,
     analyse_net_contact,
@@ -87,6 +88,10 @@ class TrackAnalysis:
     refusals
         Every event between flights that is not reported as a contact, with its
         frames and a one-line reason (:class:`~.contact_physics.Refusal`).
+    bridged
+        One line per impact with two or more frames between its flights (frames
+        lost to blur, samples off both flights): the frames bridged and the
+        uncertainty of the impact time, which grows with them.
     measured_velocity
         Velocity of every track sample by local differentiation (not from the fits).
     """
@@ -97,6 +102,7 @@ class TrackAnalysis:
     contacts: list[NetContact]
     warnings: list[str]
     refusals: list[Refusal] = dataclasses.field(default_factory=list)
+    bridged: list[str] = dataclasses.field(default_factory=list)
 
     @property
     def net_rows(self) -> np.ndarray:
@@ -365,7 +371,35 @@ def analyse_track(
                         line.split(" refused as an impact: ", 1)[1])
             )  # fmt: skip
     refusals.sort(key=lambda r: r.t_start_s)
-    return TrackAnalysis(track, flights, table, contacts, warnings, refusals)
+    bridged = bridged_impacts(track, flights, events, seg.frame_interval_s)
+    return TrackAnalysis(track, flights, table, contacts, warnings, refusals, bridged)
+
+
+def bridged_impacts(
+    track: Track, flights: list[FlightFit], events: list[ContactEvent], dt: float
+) -> list[str]:
+    """A line per instantaneous impact with two or more frames between its flights:
+    how many, how many had no detection, and the impact time with its uncertainty
+    (:func:`~.impact_uncertainty.contact_time_sd`)."""
+    lines = []
+    if not (np.isfinite(dt) and dt > 0):
+        return lines
+    for ev in events:
+        if ev.extended:
+            continue
+        fa, fb = flights[ev.before], flights[ev.after]
+        between = int(round((fb.t_start_s - fa.t_end_s) / dt)) - 1
+        if between < 2:
+            continue
+        missing = between - len(ev.rows)
+        sd = contact_time_sd(fa, fb, ev.t_impact_s)
+        lines.append(
+            f"impact at t = {ev.t_impact_s:.4f} +/- {sd:.2g} s "
+            f"({sd / dt:.2f} frame): {between} frames between its flights "
+            f"({missing} without a detection, {len(ev.rows)} off both flights) "
+            "bridged by extrapolating both flights to where they meet"
+        )
+    return lines
 
 
 def _frame(track: Track, position: int) -> int:
