@@ -63,6 +63,11 @@ from fieldkit.tracking.flights.segment_growth import CHI2_JOIN, grow_segment
 #: Largest relative distance of the track's apparent g from 9.81 for the
 #: free-flight tests to use 9.81 (beyond it the capture rate or scale is off).
 G_TRUSTED_FRACTION = 0.2
+#: Samples of the shortest noise window (a quadratic: 2 degrees of freedom left per
+#: coordinate) and the median residual RMS of such windows over Gaussian noise of
+#: sd 1 (``sqrt(median(chi2_4) / 4)`` = ``sqrt(3.357 / 4)``).
+SHORT_WINDOW = 5
+SHORT_MEDIAN = 0.916
 #: A contact with at least this many samples off both flights is extended (a net, a
 #: rolling phase) rather than an impact.
 EXTENDED_CONTACT_SAMPLES = 5
@@ -251,6 +256,13 @@ def find_flights(
     # straddle impacts when flights are short in samples, so it can at most raise
     # the estimate by half
     local_sigma = float(np.median(local)) * 1.05
+    # flights of few samples (a bounce every ~12 frames at 30 fps): most windows
+    # straddle a bounce and their median is the bounces, not the noise; the
+    # shortest windows (5 samples) straddle fewer. Their median residual RMS
+    # (2 x 2 degrees of freedom) is 0.92 sigma for Gaussian noise.
+    short = estimate_noise(t, x, z, SHORT_WINDOW)
+    if len(short) and np.median(short) / SHORT_MEDIAN < 0.5 * local_sigma:
+        local_sigma = float(np.median(short)) / SHORT_MEDIAN
     long = estimate_noise(t, x, z, min(4 * window - 3, n))
     long_sigma = min(float(np.median(long)), 1.5 * local_sigma) if len(long) else 0.0
     sigma = max(local_sigma, long_sigma, noise_floor_m, 1e-9 * extent)
