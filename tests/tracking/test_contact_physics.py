@@ -285,3 +285,32 @@ def test_a_30_fps_clip_with_little_noise_keeps_its_flights(seed):
     assert a.impacts.frame["e_n"].iloc[0] == pytest.approx(0.8, abs=0.01)
     for f in a.flights:
         assert abs(f.g_mps2 - G) <= 3 * f.g_se_mps2
+
+
+def test_a_net_between_flights_that_miss_g_is_not_reduced():
+    # the flights of a real phone clip whose scale varies with depth fit g 6 %
+    # high (+9 standard errors): an extended "contact" between them is refused
+    from fieldkit.tracking.flights.contact_impacts import ContactEvent
+    from fieldkit.tracking.flights.pipeline import not_free_beside
+
+    rng = np.random.default_rng(4)
+    t = np.arange(60) / 240.0
+
+    def flight(g, t0):
+        z = 1.0 - 0.5 * g * t**2 + rng.normal(0.0, 2e-4, t.size)
+        return fit_flight(t + t0, 1.0 * t + rng.normal(0.0, 2e-4, t.size), z)
+
+    ev = ContactEvent(0, 1, True, 0.25, 0.35, 0, 0, 0, 0, (1, -2), (1, 1), np.nan,
+                      np.nan, np.arange(0))  # fmt: skip
+    good = [flight(G, 0.0), flight(G, 0.35)]
+    assert not_free_beside(ev, good, set(), G) is None
+    off = [flight(G, 0.0), flight(1.06 * G, 0.35)]
+    sigmas = (off[1].g_mps2 - G) / off[1].g_se_mps2
+    assert sigmas > 3
+    why = not_free_beside(ev, off, set(), G)
+    assert why is not None and f"{sigmas:+.1f} standard errors" in why
+    # a dragged flight's g is off by its drag, not the frame: not judged by g
+    assert not_free_beside(ev, off, {1}, G) is None
+    # an impact is judged by its velocities, not by its flights' g
+    ev.extended = False
+    assert not_free_beside(ev, off, set(), G) is None

@@ -30,7 +30,11 @@ from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.impact_table import ImpactTable
 from fieldkit.physics.constants import G
 from fieldkit.track import Track
-from fieldkit.tracking.flights.ballistic_fit import FlightFit, fit_flight
+from fieldkit.tracking.flights.ballistic_fit import (
+    GRAVITY_WARNING_SIGMAS,
+    FlightFit,
+    fit_flight,
+)
 from fieldkit.tracking.flights.contact_impacts import (
     ContactEvent,
     build_impact_table,
@@ -288,6 +292,7 @@ def analyse_track(
         track, rows_of, flights, events, seg.frame_interval_s,
         sigma_m=seg.noise_m, radius_m=radius_m, gyration_m=gyration_m,
         off_floor=ground is None, misfit_flights=misfit_flights,
+        g_reference_mps2=free_flight_gravity(seg.g_common_mps2),
     )  # fmt: skip
     refusals.extend(judged)
 
@@ -457,6 +462,37 @@ def _one_flight_through(
     )
 
 
+def free_flight_gravity(g_common_mps2: float) -> float:
+    """The g a free flight of the track must fit [m/s^2]: 9.81, or the track's own
+    g when that is more than 20 % off (a wrong capture rate or scale, warned)."""
+    if np.isfinite(g_common_mps2) and abs(g_common_mps2 / G - 1.0) >= 0.2:
+        return float(g_common_mps2)
+    return G
+
+
+def not_free_beside(
+    ev: ContactEvent, flights: list[FlightFit], misfits: set[int], g_mps2: float
+) -> str | None:
+    """Why an extended contact's flights are not free flights, or None."""
+    if not ev.extended:
+        return None
+    for k in (ev.before, ev.after):
+        f = flights[k]
+        if k in misfits or not (np.isfinite(f.g_se_mps2) and f.g_se_mps2 > 0):
+            continue
+        sigmas = (f.g_mps2 - g_mps2) / f.g_se_mps2
+        if abs(sigmas) > GRAVITY_WARNING_SIGMAS:
+            return (
+                f"flight {k} beside it (t = {f.t_start_s:.4f}-{f.t_end_s:.4f} s) is "
+                f"not a free flight in this frame (g = {f.g_text()} m/s^2, "
+                f"{sigmas:+.1f} standard errors from {g_mps2:.4g}: a scale that "
+                "varies with depth, lens distortion, a moving camera, a contact "
+                "inside it?), so the samples between cannot be told from a contact; "
+                "the clip is not reduced here"
+            )
+    return None
+
+
 def judge_contacts(
     track: Track,
     rows_of: list[np.ndarray],
@@ -469,6 +505,7 @@ def judge_contacts(
     gyration_m: float | None,
     off_floor: bool,
     misfit_flights: set[int],
+    g_reference_mps2: float = G,
 ):
     """Refuse the events that are not contacts; join the flights one flight explains.
 
@@ -477,7 +514,13 @@ def judge_contacts(
     :func:`~.contact_physics.off_the_floor`. The first refused event's flights
     become one when :func:`~.free_flight.classify_join` (slow drift allowed) does not
     choose two flights; otherwise they stay apart with no contact between them.
-    Repeated until every event left is a contact.
+    An extended contact whose flights are not free flights (their fitted g off
+    ``g_reference_mps2`` by more than
+    :data:`~.ballistic_fit.GRAVITY_WARNING_SIGMAS` standard errors, drag
+    misfits aside) is refused too: its start and end come from those flights, and
+    the samples between cannot be told from a flight the frame bends (an
+    uncorrected lens, a moving camera). Repeated until every event left is a
+    contact.
 
     Returns
     -------
@@ -506,6 +549,12 @@ def judge_contacts(
                 verdict = _one_flight_through(track, rows_of, ev, sigma_m, radius_m)
             if verdict is not None:
                 verdicts[id(ev)] = verdict
+        if not verdicts:
+            for ev in kept:
+                why = not_free_beside(ev, flights, misfit_flights, g_reference_mps2)
+                if why is not None:
+                    verdicts[id(ev)] = ("unreduced", why)
+                    break
         if off_floor and not verdicts:
             short = [ev for ev in kept if not ev.extended]
             high = off_the_floor(
