@@ -314,3 +314,25 @@ def test_a_net_between_flights_that_miss_g_is_not_reduced():
     # an impact is judged by its velocities, not by its flights' g
     ev.extended = False
     assert not_free_beside(ev, off, set(), G) is None
+
+
+def test_a_short_first_flight_after_a_mis_detected_frame_is_found():
+    # 30 fps: 8 clean frames, the first mis-detected (frame 0, 0.1 m off), then
+    # the frames around the bounce lost to blur; no 9-sample window fits, the
+    # 7-sample seeds find the flight and the bounce is placed between the flights
+    s = bouncing_ball(fps=30.0, duration_s=1.0, start_xz_m=(0.0, 0.7),
+                      start_velocity_mps=(1.4, 0.3), surface_angle_deg=0.0,
+                      radius_m=0.06, e_n=0.8, e_t=0.9, noise_m=3e-4,
+                      rng=np.random.default_rng(0))  # fmt: skip
+    t_true = float(s.truth["t_s"].iloc[0])
+    k = int(np.searchsorted(s.track.t, t_true))
+    f = s.track.frame
+    f.loc[0, "z_m"] += 0.1
+    gone = [j for j in range(9, k + 2)]
+    f = f.drop(index=gone).reset_index(drop=True)
+    track = Track(f, source="blurred", fps=30.0, meta=dict(s.track.meta))
+    a = analyse_track(track, radius_m=0.06, surface_angle_deg=0.0)
+    table = a.impacts.frame
+    assert a.contacts == [] and len(table) >= 1
+    assert abs(float(table["t_s"].iloc[0]) - t_true) < 1 / 30
+    assert float(a.flights[0].t_end_s) < t_true and a.flights[0].n_samples == 8

@@ -269,15 +269,21 @@ def find_flights(
 
     free = np.ones(n, bool)
     segments: list[tuple[int, int, list[int]]] = []
-    for start in np.argsort(local, kind="stable"):
-        if local[start] > 3.0 * sigma:
-            break
-        stop = start + window - 1
-        if not free[start : stop + 1].all():
-            continue
-        lo, hi, outl = grow_segment(t, x, z, start, stop, free, sigma)
-        free[lo : hi + 1] = False
-        segments.append((lo, hi, outl))
+    # then shorter seeds where no window of `window` samples fits: a flight of a
+    # few frames next to a mis-detected one (30 fps, a blurred bounce)
+    seeds = [(local, window)]
+    if window > min_samples - 1 >= 5:
+        seeds.append((estimate_noise(t, x, z, min_samples - 1), min_samples - 1))
+    for scores, width in seeds:
+        for start in np.argsort(scores, kind="stable"):
+            if scores[start] > 3.0 * sigma:
+                break
+            stop = start + width - 1
+            if not free[start : stop + 1].all():
+                continue
+            lo, hi, outl = grow_segment(t, x, z, start, stop, free, sigma)
+            free[lo : hi + 1] = False
+            segments.append((lo, hi, outl))
 
     fits = []
     for lo, hi, outl in segments:
