@@ -260,9 +260,12 @@ def find_flights(
     # straddle a bounce and their median is the bounces, not the noise; the
     # shortest windows (5 samples) straddle fewer. Their median residual RMS
     # (2 x 2 degrees of freedom) is 0.92 sigma for Gaussian noise.
+    # Errors correlated over a few frames (a rolling shutter) still show in the
+    # cleanest tenth of the long windows: the estimate does not go below those.
     short = estimate_noise(t, x, z, SHORT_WINDOW)
     if len(short) and np.median(short) / SHORT_MEDIAN < 0.5 * local_sigma:
-        local_sigma = float(np.median(short)) / SHORT_MEDIAN
+        clean = float(np.quantile(local, 0.1)) * 1.05
+        local_sigma = max(float(np.median(short)) / SHORT_MEDIAN, clean)
     long = estimate_noise(t, x, z, min(4 * window - 3, n))
     long_sigma = min(float(np.median(long)), 1.5 * local_sigma) if len(long) else 0.0
     sigma = max(local_sigma, long_sigma, noise_floor_m, 1e-9 * extent)
