@@ -389,6 +389,10 @@ def track(
     for message in later:
         warn(message)
     warned += later
+    for refusal in analysis.refusals:
+        if refusal.kind != "surface":  # the impact table's own: warned above
+            warn(refusal.message())
+            warned.append(refusal.message())
 
     if out is not None:
         analysis.track.write(out, outputs=outputs)
@@ -545,6 +549,8 @@ def _summary(video, track_data, detections, analysis, calibration_text) -> None:
             f"omega {row['omega_i_radps']:.1f} -> {row['omega_f_radps']:.1f} rad/s  "
             f"slope {row['slope_deg']:.2f} deg"
         )
+    for line in analysis.bridged:
+        typer.echo(f"  {line}")
     for contact in analysis.contacts:
         typer.echo(f"  {contact.summary()}")
     for line in analysis.net_rows_text():

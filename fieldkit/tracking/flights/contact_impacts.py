@@ -4,7 +4,9 @@ For each contact between two fitted flights
 (:mod:`fieldkit.tracking.flights.segmentation`):
 
 * **Contact time.** A short contact (fewer than ``EXTENDED_CONTACT_SAMPLES`` measured
-  samples off both parabolas) is treated as instantaneous: the impact instant is where
+  samples off both parabolas, or paths that cross within one frame interval
+  whatever the samples between show: :func:`sub_frame`) is treated as
+  instantaneous: the impact instant is where
   the two fixed-g parabolas come closest (both share ``g``, so their separation is
   linear in time and the instant has a closed form), searched near the gap. An
   extended contact (a net, a rolling phase) starts and ends where the deviation from
@@ -43,6 +45,7 @@ from fieldkit.impact_table import ImpactTable
 from fieldkit.physics.constants import G
 from fieldkit.track import Track
 from fieldkit.tracking.flights.ballistic_fit import FlightFit
+from fieldkit.tracking.flights.contact_physics import join_duration
 from fieldkit.tracking.flights.contact_surface import surface_angles
 from fieldkit.tracking.flights.ground import Ground
 from fieldkit.tracking.flights.impact_uncertainty import contact_sds
@@ -101,6 +104,44 @@ def contact_instant(
     return float(np.clip(t0 - (d0 @ dv) / (dv @ dv), lo, hi))
 
 
+def sub_frame(
+    track: Track, before: FlightFit, after: FlightFit, span: ContactSpan, dt: float
+) -> bool:
+    """True when the samples off both flights are an impact seen through blurred or
+    mis-detected frames, not an extended contact.
+
+    Two conditions: the two flights' paths cross within one frame interval of each
+    other in time, inside the span (where the paths cross,
+    :func:`~.contact_physics.join_duration`, the incoming flight passes the
+    crossing at ``t1`` and the outgoing one at ``t2``); and the samples of the span
+    lie on the impact's path -- the flight before until the crossing, the flight
+    after from it -- within the distance the body travels in one frame (what blur
+    or a mis-detection can shift a centre by; median over the span) plus three
+    times the flights' residual RMS. A net holds the body back from both flights by
+    decimetres: its samples are off that path, although a contact force along one
+    normal leaves crossing paths with ``t1 = t2``.
+    """
+    if not np.isfinite(dt) or dt <= 0 or len(span.rows) == 0:
+        return False
+    guess = contact_instant(before, after, span, dt)
+    t1, t2, miss = join_duration(before, after, guess)
+    if not (np.isfinite(t1) and np.isfinite(t2)):
+        return False
+    lo, hi = span.t_last_before_s - dt, span.t_first_after_s + dt
+    rms = 3.0 * max(before.rms_m, after.rms_m)
+    if not (lo <= t1 <= hi and lo <= t2 <= hi and abs(t2 - t1) < dt and miss <= rms):
+        return False
+    t = track.t[span.rows]
+    crossing = 0.5 * (t1 + t2)
+    xa, za = before.position(t)
+    xb, zb = after.position(t)
+    px, pz = np.where(t < crossing, xa, xb), np.where(t < crossing, za, zb)
+    off = np.hypot(track.x[span.rows] - px, track.z[span.rows] - pz)
+    off = off[np.isfinite(off)]
+    travel = dt * max(float(before.speed(t1)), float(after.speed(t2)))
+    return bool(len(off) and np.median(off) <= travel + rms)
+
+
 def flight_spin(track: Track, rows: np.ndarray) -> float:
     """Spin over a flight [rad/s]: line fit to the marker angle, else median omega."""
     t = track.t[rows]
@@ -125,6 +166,8 @@ def find_contact_events(
     for span in spans:
         fa, fb = flights[span.before], flights[span.after]
         extended = len(span.rows) >= EXTENDED_CONTACT_SAMPLES
+        if extended and sub_frame(track, fa, fb, span, frame_interval_s):
+            extended = False  # the flights meet within a frame: an impact
         if extended:
             ti = contact_onset(track, fa, span.rows, forward=True)
             tf = contact_onset(track, fb, span.rows, forward=False)
@@ -349,8 +392,7 @@ def refused_impacts(
             )
         elif np.isfinite(e_n) and e_n < 0:
             out[i] = (
-                f"e_n = {e_n:.3f} < 0 (the body does not leave the surface it "
-                "struck)"
+                f"e_n = {e_n:.3f} < 0 (the body does not leave the surface it struck)"
             )
         elif touching.any() and np.isfinite(gap[i]) and gap[i] > tolerance:
             out[i] = (

@@ -66,6 +66,12 @@ class JoinTest:
         The drag factor of the dragged flight [1/m].
     rms_drag_m
         RMS residual per coordinate of the dragged flight [m].
+    bic_drift
+        BIC of one parabola seen through a slowly drifting detection error
+        (:func:`drift_fit`); infinite when no drift is allowed or the drift it
+        needs exceeds the limit.
+    drift_m
+        Size of that drift [m] (0 when not fitted).
     """
 
     bic_contact: float
@@ -73,14 +79,19 @@ class JoinTest:
     bic_drag: float
     k_per_m: float
     rms_drag_m: float
+    bic_drift: float = math.inf
+    drift_m: float = 0.0
 
     @property
     def model(self) -> str:
-        """``contact``, ``ballistic`` or ``air_drag``: the model the data choose."""
-        best = min(self.bic_contact, self.bic_ballistic, self.bic_drag)
+        """``contact``, ``ballistic``, ``air_drag`` or ``drift`` (one parabola with a
+        slow detection drift): the model the data choose."""
+        best = min(self.bic_contact, self.bic_ballistic, self.bic_drag, self.bic_drift)
         if best == self.bic_contact:
             return "contact"
-        return "ballistic" if best == self.bic_ballistic else "air_drag"
+        if best == self.bic_ballistic:
+            return "ballistic"
+        return "air_drag" if best == self.bic_drag else "drift"
 
 
 def _bic(sse: float, n: int, p: int, floor: float) -> float:
@@ -181,12 +192,56 @@ def extend_flight(
     return rows
 
 
+#: Parameters of the drift model beyond the parabola: ``tau^2, tau^3, tau^4`` in x
+#: and in z (a drift linear in time is the parabola's own velocity).
+DRIFT_PARAMETERS = 6
+
+
+def drift_fit(t, x, z, g: float) -> tuple[float, float]:
+    """One fixed-g parabola plus a slow detection drift: ``(sse [m^2], drift [m])``.
+
+    The drift is a polynomial in time added to the centre, ``tau^2 .. tau^4`` in x
+    and z (lower orders are the parabola's own position and velocity; in z the
+    quadratic term is also a drift of the apparent g, bounded by the drift's size).
+    Its size is the largest distance, over the samples, of the fitted drift from
+    its own best straight line (what the parabola cannot take up). A contact's kink
+    is not smooth: a quartic leaves it in the residuals.
+
+    Examples
+    --------
+    >>> t = np.linspace(0.0, 0.3, 301)
+    >>> drift = 5e-4 * (t / 0.3) ** 3
+    >>> sse, size = drift_fit(t, 2.0 * t, 1.0 - 4.905 * t**2 + drift, 9.81)
+    >>> sse < 1e-20, round(size * 1e3, 3)
+    (True, 0.149)
+    """
+    t = np.asarray(t, float)
+    half = max(0.5 * float(np.ptp(t)), 1e-12)
+    s = (t - 0.5 * (t.max() + t.min())) / half
+    ones = np.ones_like(s)
+    ax = np.column_stack([ones, s, s**2, s**3, s**4])
+    az = ax
+    zg = np.asarray(z, float) + 0.5 * g * (s * half) ** 2
+    cx, *_ = np.linalg.lstsq(ax, np.asarray(x, float), rcond=None)
+    cz, *_ = np.linalg.lstsq(az, zg, rcond=None)
+    rx = np.asarray(x, float) - ax @ cx
+    rz = zg - az @ cz
+    sse = float(rx @ rx + rz @ rz)
+    line = np.column_stack([ones, s])
+    size = 0.0
+    for drift in (ax[:, 2:] @ cx[2:], az[:, 2:] @ cz[2:]):
+        c, *_ = np.linalg.lstsq(line, drift, rcond=None)
+        size = max(size, float(np.abs(drift - line @ c).max()))
+    return sse, size
+
+
 def classify_join(
     a: tuple[np.ndarray, np.ndarray, np.ndarray],
     b: tuple[np.ndarray, np.ndarray, np.ndarray],
     *,
     g_mps2: float,
     sigma_m: float,
+    drift_limit_m: float = 0.0,
 ) -> JoinTest:
     """Contact, one parabola or one dragged flight for the samples ``a`` then ``b``.
 
@@ -199,6 +254,10 @@ def classify_join(
         The track's gravity [m/s^2].
     sigma_m
         Position noise per coordinate [m] (the BIC's variance floor is its square).
+    drift_limit_m
+        Largest slow detection drift [m] allowed to explain the two flights as one
+        (:func:`drift_fit`; a fourth model, ``drift``, when > 0): a drifting centre
+        must not split a free flight into "contacts".
 
     Examples
     --------
@@ -220,10 +279,57 @@ def classify_join(
     sse_two_drag = drag_flight.fit_drag(t, x, z, start, g_mps2).sse_m2
     sse_one = _flight_sse(t, x, z, 0.0, g_mps2)
     k, sse_drag = drag_fit(t, x, z, g_mps2)
+    bic_drift, drift = math.inf, 0.0
+    if drift_limit_m > 0 and t.size > 4 + DRIFT_PARAMETERS:
+        sse_drift, drift = drift_fit(t, x, z, g_mps2)
+        if drift <= drift_limit_m:
+            bic_drift = _bic(sse_drift, n, 4 + DRIFT_PARAMETERS, floor)
     return JoinTest(
         bic_contact=min(_bic(sse_two, n, 8, floor), _bic(sse_two_drag, n, 9, floor)),
         bic_ballistic=_bic(sse_one, n, 4, floor),
         bic_drag=_bic(sse_drag, n, 5, floor),
         k_per_m=k,
         rms_drag_m=math.sqrt(sse_drag / n),
+        bic_drift=bic_drift,
+        drift_m=drift,
     )
+
+
+#: RMS residual per coordinate, in noise standard deviations, within which one
+#: flight with a slow drift explains samples (:func:`explained_by_drift`).
+DRIFT_RMS_SIGMAS = 2.0
+
+
+def explained_by_drift(
+    t, x, z, *, g_mps2: float, sigma_m: float, drift_limit_m: float
+) -> float | None:
+    """Size of the slow detection drift [m] through which one free flight explains
+    the samples to the noise, or None.
+
+    One fixed-g parabola plus a drift (:func:`drift_fit`) of at most
+    ``drift_limit_m`` must leave an RMS residual per coordinate within
+    :data:`DRIFT_RMS_SIGMAS` noise standard deviations. Used on joins the physics of
+    a contact has already refused (no impulse, energy gained, an apex) and on
+    extended "contacts" to ask whether the samples are one flight after all; a
+    contact's kink leaves residuals far above the noise.
+
+    Examples
+    --------
+    >>> t = np.linspace(0.0, 0.3, 301)
+    >>> z = 1.0 - 4.905 * t**2 + 5e-4 * np.sin(5 * t / 0.3)
+    >>> round(explained_by_drift(t, 2 * t, z, g_mps2=9.81, sigma_m=5e-5,
+    ...                          drift_limit_m=2e-3) * 1e3, 2)
+    0.59
+    >>> bounce = np.where(t < 0.15, z, 2 * z[150] - z)  # a kink at t = 0.15 s
+    >>> explained_by_drift(t, 2 * t, bounce, g_mps2=9.81, sigma_m=5e-5,
+    ...                    drift_limit_m=2e-3) is None
+    True
+    """
+    t = np.asarray(t, float)
+    if t.size <= 4 + DRIFT_PARAMETERS or not sigma_m > 0:
+        return None
+    sse, size = drift_fit(t, x, z, g_mps2)
+    rms = math.sqrt(sse / (2 * t.size))
+    if size <= drift_limit_m and rms <= DRIFT_RMS_SIGMAS * sigma_m:
+        return size
+    return None

@@ -195,3 +195,43 @@ def contact_sds(
         column: np.array([row[column] for row in rows], float)
         for column in SD_COLUMNS.values()
     }
+
+
+def contact_time_sd(before: FlightFit, after: FlightFit, t_s: float) -> float:
+    """Standard uncertainty [s] of an instantaneous contact's time: the closest
+    approach of the two parabolas, moved by the fits' parameter errors (first-order
+    propagation as in :func:`contact_sd`). It grows with the time the flights are
+    extrapolated over, so with the frames missing around the contact.
+
+    Examples
+    --------
+    Level flights ``vz`` -4 and +2 m/s meeting at t = 0, position sd 1 mm each
+    in z (velocity exact): the meeting moves by ``dz / (vz_after - vz_before)``,
+    ``sd = sqrt(2) 1e-3 / 6``.
+
+    >>> def flight(vz):
+    ...     return FlightFit(0, np.arange(4), -0.1, 0.1, 0.0, 0.0, 0.0, 3.0, vz,
+    ...                      0.0, 0.0, 9.81, 0.0, 9.81, 0.0, 0.0, np.empty(0),
+    ...                      covariance=np.diag([1e-6, 0.0]))
+    >>> sd = contact_time_sd(flight(-4.0), flight(2.0), 0.0)
+    >>> round(sd * 1e6, 3), round(float(np.sqrt(2) * 1e-3 / 6 * 1e6), 3)
+    (235.702, 235.702)
+    """
+    theta_a, cov_a = _parameters(before)
+    theta_b, cov_b = _parameters(after)
+    theta = np.concatenate([theta_a, theta_b])
+    cov = np.zeros((8, 8))
+    cov[:4, :4], cov[4:, 4:] = cov_a, cov_b
+    if not np.all(np.isfinite(cov)):
+        return float("nan")
+    jacobian = np.zeros(8)
+    for k in range(8):
+        se = float(np.sqrt(cov[k, k]))
+        if se == 0.0:
+            continue
+        step = np.zeros(8)
+        step[k] = STEP_FRACTION * se
+        plus = _closest_approach(theta + step, before, after, t_s)
+        minus = _closest_approach(theta - step, before, after, t_s)
+        jacobian[k] = (plus - minus) / (2 * step[k])
+    return float(np.sqrt(max(float(jacobian @ cov @ jacobian), 0.0)))

@@ -10,11 +10,16 @@ Tracker or Kinovea):
 3. :mod:`fieldkit.tracking.flights.contact_impacts` evaluates the fits at each contact
    and builds the ImpactTable (the ground given -- one angle, a profile, a DEM:
    :mod:`fieldkit.tracking.flights.ground` -- or its angle estimated);
-4. :mod:`fieldkit.tracking.flights.net_contacts` describes every extended contact (net).
+4. :mod:`fieldkit.tracking.flights.contact_physics` judges every join: one with no
+   impulse, at an apex, gaining energy or in mid-air above the floor the other
+   impacts touch is refused with its reason (:attr:`TrackAnalysis.refusals`), and
+   the flights on either side become one when one free flight explains them;
+5. :mod:`fieldkit.tracking.flights.net_contacts` describes every extended contact (net).
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -23,19 +28,33 @@ import pandas as pd
 
 from fieldkit.errors import ArgumentError, InputFileError
 from fieldkit.impact_table import ImpactTable
+from fieldkit.physics.constants import G
 from fieldkit.track import Track
-from fieldkit.tracking.flights.ballistic_fit import FlightFit, fit_flight
+from fieldkit.tracking.flights.ballistic_fit import (
+    GRAVITY_WARNING_SIGMAS,
+    FlightFit,
+    fit_flight,
+)
 from fieldkit.tracking.flights.contact_impacts import (
+    ContactEvent,
     build_impact_table,
     find_contact_events,
 )
+from fieldkit.tracking.flights.contact_physics import (
+    Refusal,
+    judge_join,
+    off_the_floor,
+    velocity_se,
+)
+from fieldkit.tracking.flights.free_flight import classify_join, explained_by_drift
 from fieldkit.tracking.flights.ground import ConstantGround, Ground, in_track_frame
+from fieldkit.tracking.flights.impact_uncertainty import contact_time_sd
 from fieldkit.tracking.flights.net_contacts import (
     NetContact,
     analyse_net_contact,
     local_velocity,
 )
-from fieldkit.tracking.flights.segmentation import find_flights
+from fieldkit.tracking.flights.segmentation import ContactSpan, find_flights
 
 #: Fewest samples a track needs to be analysed.
 MIN_TRACK_SAMPLES = 10
@@ -43,6 +62,9 @@ MIN_TRACK_SAMPLES = 10
 MIN_FLIGHT_SAMPLES = 8
 #: Fewest usable samples for the measured velocities of a track.
 MIN_VELOCITY_SAMPLES = 5
+#: Largest slow detection drift, as a share of the body radius, that may explain two
+#: flights as one free flight (a drifting centre must not split a flight).
+DRIFT_LIMIT_FRACTION = 0.25
 
 
 @dataclass
@@ -67,6 +89,13 @@ class TrackAnalysis:
         is also a row of ``impacts``.
     warnings
         One-line warnings for the user (gravity off, surface angle assumed, ...).
+    refusals
+        Every event between flights that is not reported as a contact, with its
+        frames and a one-line reason (:class:`~.contact_physics.Refusal`).
+    bridged
+        One line per impact with two or more frames between its flights (frames
+        lost to blur, samples off both flights): the frames bridged and the
+        uncertainty of the impact time, which grows with them.
     measured_velocity
         Velocity of every track sample by local differentiation (not from the fits).
     """
@@ -76,6 +105,8 @@ class TrackAnalysis:
     impacts: ImpactTable
     contacts: list[NetContact]
     warnings: list[str]
+    refusals: list[Refusal] = dataclasses.field(default_factory=list)
+    bridged: list[str] = dataclasses.field(default_factory=list)
 
     @property
     def net_rows(self) -> np.ndarray:
@@ -224,7 +255,10 @@ def analyse_track(
             source=track.source or None,
         )
 
-    seg = find_flights(track.t, track.x, track.z, noise_floor_m=noise_floor(track))
+    seg = find_flights(
+        track.t, track.x, track.z, noise_floor_m=noise_floor(track),
+        drift_limit_m=DRIFT_LIMIT_FRACTION * radius_m,
+    )  # fmt: skip
     rows_of = list(seg.flights)
     flights = _fit_all(track, rows_of)
     events = find_contact_events(track, flights, seg.contacts, seg.frame_interval_s)
@@ -243,11 +277,33 @@ def analyse_track(
     if changed:
         flights = _fit_all(track, rows_of)
         events = find_contact_events(track, flights, seg.contacts, seg.frame_interval_s)
+    refusals = [
+        Refusal(
+            float(track.t[a]), float(track.t[b]), (_frame(track, a), _frame(track, b)),
+            "drift",
+            f"one free flight explains the samples through a slow detection drift of "
+            f"{1e3 * drift:.2f} mm (at most {DRIFT_LIMIT_FRACTION:g} radius)",
+            merged=True,
+        )
+        for a, b, drift in seg.drift_joins
+    ]  # fmt: skip
+    misfit_flights = {m.flight for m in seg.misfits}
+    rows_of, flights, events, judged, misfit_flights = judge_contacts(
+        track, rows_of, flights, events, seg.frame_interval_s,
+        sigma_m=seg.noise_m, radius_m=radius_m, gyration_m=gyration_m,
+        off_floor=ground is None, misfit_flights=misfit_flights,
+        g_reference_mps2=free_flight_gravity(seg.g_common_mps2),
+    )  # fmt: skip
+    refusals.extend(judged)
 
     warnings: list[str] = []
     if not flights:
         warnings.append("no ballistic flight found in the track")
-    misfit = {m.flight: m for m in seg.misfits}
+    misfit = {}
+    for m in seg.misfits:  # flights renumbered by joins the physics refused
+        at = [f.index for f in flights if f.t_start_s <= m.t_start_s <= f.t_end_s]
+        if at and at[0] in misfit_flights:
+            misfit[at[0]] = m
     for f in flights:
         if f.index in misfit:  # its g is off because drag bends it, not the scale
             warnings.append(misfit[f.index].message())
@@ -311,7 +367,240 @@ def analyse_track(
                 t_end_s=ev.t_restitution_s,
             )
         )
-    return TrackAnalysis(track, flights, table, contacts, warnings)
+    for line in warnings:  # the table's own refusals (surface, e_n < 0)
+        if " refused as an impact: " in line:
+            t_text = line.split("t = ", 1)[1].split(" s", 1)[0]
+            t_ref = float(t_text)
+            refusals.append(
+                Refusal(t_ref, t_ref, _frames_at(track, t_ref), "surface",
+                        line.split(" refused as an impact: ", 1)[1])
+            )  # fmt: skip
+    refusals.sort(key=lambda r: r.t_start_s)
+    bridged = bridged_impacts(track, flights, events, seg.frame_interval_s)
+    return TrackAnalysis(track, flights, table, contacts, warnings, refusals, bridged)
+
+
+def bridged_impacts(
+    track: Track, flights: list[FlightFit], events: list[ContactEvent], dt: float
+) -> list[str]:
+    """A line per instantaneous impact with two or more frames between its flights:
+    how many, how many had no detection, and the impact time with its uncertainty
+    (:func:`~.impact_uncertainty.contact_time_sd`)."""
+    lines = []
+    if not (np.isfinite(dt) and dt > 0):
+        return lines
+    for ev in events:
+        if ev.extended:
+            continue
+        fa, fb = flights[ev.before], flights[ev.after]
+        between = int(round((fb.t_start_s - fa.t_end_s) / dt)) - 1
+        if between < 2:
+            continue
+        missing = between - len(ev.rows)
+        sd = contact_time_sd(fa, fb, ev.t_impact_s)
+        lines.append(
+            f"impact at t = {ev.t_impact_s:.4f} +/- {sd:.2g} s "
+            f"({sd / dt:.2f} frame): {between} frames between its flights "
+            f"({missing} without a detection, {len(ev.rows)} off both flights) "
+            "bridged by extrapolating both flights to where they meet"
+        )
+    return lines
+
+
+def _frame(track: Track, position: int) -> int:
+    """The frame number of a sample: the track's ``frame`` column, else its position."""
+    if "frame" in track.frame.columns:
+        value = track.frame["frame"].iloc[position]
+        if np.isfinite(value):
+            return int(value)
+    return int(position)
+
+
+def _frames_at(track: Track, t_s: float) -> tuple[int, int]:
+    """Frames of the samples on either side of the instant ``t_s``."""
+    k = int(np.searchsorted(track.t, t_s))
+    lo, hi = max(k - 1, 0), min(k, len(track) - 1)
+    return _frame(track, lo), _frame(track, hi)
+
+
+def contact_spans(track: Track, rows_of: list[np.ndarray]) -> list[ContactSpan]:
+    """The spans between consecutive flights (rows: the usable samples between)."""
+    usable = np.isfinite(track.t + track.x + track.z)
+    spans = []
+    for k in range(len(rows_of) - 1):
+        a, b = rows_of[k], rows_of[k + 1]
+        inside = np.arange(a[-1] + 1, b[0])
+        spans.append(
+            ContactSpan(
+                before=k, after=k + 1, rows=inside[usable[inside]],
+                t_last_before_s=float(track.t[a[-1]]),
+                t_first_after_s=float(track.t[b[0]]),
+            )
+        )  # fmt: skip
+    return spans
+
+
+def _one_flight_through(
+    track: Track, rows_of: list[np.ndarray], ev: ContactEvent, sigma_m: float,
+    radius_m: float,
+) -> tuple[str, str] | None:  # fmt: skip
+    """``("free_flight", reason)`` when one flight with a slow detection drift
+    explains the flights on either side of ``ev`` and the samples between."""
+    rows = np.concatenate([rows_of[ev.before], ev.rows, rows_of[ev.after]])
+    rows = np.sort(rows[np.isfinite(track.t[rows] + track.x[rows] + track.z[rows])])
+    drift = explained_by_drift(
+        track.t[rows], track.x[rows], track.z[rows], g_mps2=G, sigma_m=sigma_m,
+        drift_limit_m=DRIFT_LIMIT_FRACTION * radius_m,
+    )  # fmt: skip
+    if drift is None:
+        return None
+    return (
+        "free_flight",
+        f"one free flight explains all {rows.size} samples across it, through a slow "
+        f"detection drift of {1e3 * drift:.2f} mm (at most "
+        f"{DRIFT_LIMIT_FRACTION:g} radius); nothing struck the body",
+    )
+
+
+def free_flight_gravity(g_common_mps2: float) -> float:
+    """The g a free flight of the track must fit [m/s^2]: 9.81, or the track's own
+    g when that is more than 20 % off (a wrong capture rate or scale, warned)."""
+    if np.isfinite(g_common_mps2) and abs(g_common_mps2 / G - 1.0) >= 0.2:
+        return float(g_common_mps2)
+    return G
+
+
+def not_free_beside(
+    ev: ContactEvent, flights: list[FlightFit], misfits: set[int], g_mps2: float
+) -> str | None:
+    """Why an extended contact's flights are not free flights, or None."""
+    if not ev.extended:
+        return None
+    for k in (ev.before, ev.after):
+        f = flights[k]
+        if k in misfits or not (np.isfinite(f.g_se_mps2) and f.g_se_mps2 > 0):
+            continue
+        sigmas = (f.g_mps2 - g_mps2) / f.g_se_mps2
+        if abs(sigmas) > GRAVITY_WARNING_SIGMAS:
+            return (
+                f"flight {k} beside it (t = {f.t_start_s:.4f}-{f.t_end_s:.4f} s) is "
+                f"not a free flight in this frame (g = {f.g_text()} m/s^2, "
+                f"{sigmas:+.1f} standard errors from {g_mps2:.4g}: a scale that "
+                "varies with depth, lens distortion, a moving camera, a contact "
+                "inside it?), so the samples between cannot be told from a contact; "
+                "the clip is not reduced here"
+            )
+    return None
+
+
+def judge_contacts(
+    track: Track,
+    rows_of: list[np.ndarray],
+    flights: list[FlightFit],
+    events: list[ContactEvent],
+    frame_interval_s: float,
+    *,
+    sigma_m: float,
+    radius_m: float,
+    gyration_m: float | None,
+    off_floor: bool,
+    misfit_flights: set[int],
+    g_reference_mps2: float = G,
+):
+    """Refuse the events that are not contacts; join the flights one flight explains.
+
+    Each event is judged by :func:`~.contact_physics.judge_join` (an impulse, no
+    energy gained, not an apex) and, with ``off_floor``, the instantaneous ones by
+    :func:`~.contact_physics.off_the_floor`. The first refused event's flights
+    become one when :func:`~.free_flight.classify_join` (slow drift allowed) does not
+    choose two flights; otherwise they stay apart with no contact between them.
+    An extended contact whose flights are not free flights (their fitted g off
+    ``g_reference_mps2`` by more than
+    :data:`~.ballistic_fit.GRAVITY_WARNING_SIGMAS` standard errors, drag
+    misfits aside) is refused too: its start and end come from those flights, and
+    the samples between cannot be told from a flight the frame bends (an
+    uncorrected lens, a moving camera). Repeated until every event left is a
+    contact.
+
+    Returns
+    -------
+    rows_of, flights, events, refusals, misfit_flights
+        The flights (rows and fits), the contact events kept, the refusals and the
+        indices of the flights only a dragged flight explains, renumbered.
+    """
+    k_gyr = gyration_m if gyration_m is not None else np.sqrt(0.4) * radius_m
+    refusals: list[Refusal] = []
+    apart: set[tuple[int, int]] = set()  # joins refused, flights kept apart
+    rows_of = list(rows_of)
+    while True:
+        kept = [
+            ev for ev in events
+            if (int(rows_of[ev.before][-1]), int(rows_of[ev.after][0])) not in apart
+        ]  # fmt: skip
+        verdicts = {}
+        for ev in kept:
+            fa, fb = flights[ev.before], flights[ev.after]
+            verdict = judge_join(
+                ev.vi_mps, ev.vf_mps, velocity_se(fa), velocity_se(fb),
+                omega_i=ev.omega_i_radps, omega_f=ev.omega_f_radps, gyration_m=k_gyr,
+                rise_m=ev.z_end_m - ev.z_m, instantaneous=not ev.extended,
+            )  # fmt: skip
+            if verdict is None:
+                verdict = _one_flight_through(track, rows_of, ev, sigma_m, radius_m)
+            if verdict is not None:
+                verdicts[id(ev)] = verdict
+        if not verdicts:
+            for ev in kept:
+                why = not_free_beside(ev, flights, misfit_flights, g_reference_mps2)
+                if why is not None:
+                    verdicts[id(ev)] = ("unreduced", why)
+                    break
+        if off_floor and not verdicts:
+            short = [ev for ev in kept if not ev.extended]
+            high = off_the_floor(
+                np.array([ev.x_m for ev in short]),
+                np.array([ev.z_m for ev in short]),
+                radius_m,
+            )
+            verdicts = {id(short[i]): ("mid_air", why) for i, why in high.items()}
+        if not verdicts:
+            return rows_of, flights, kept, refusals, misfit_flights
+        ev = next(e for e in kept if id(e) in verdicts)
+        kind, reason = verdicts[id(ev)]
+        a, b = rows_of[ev.before], rows_of[ev.after]
+        both = np.concatenate([a, b])
+        limit = DRIFT_LIMIT_FRACTION * radius_m
+        test = classify_join(
+            (track.t[a], track.x[a], track.z[a]), (track.t[b], track.x[b], track.z[b]),
+            g_mps2=G, sigma_m=sigma_m, drift_limit_m=limit,
+        )  # fmt: skip
+        merge = kind == "free_flight" or test.model != "contact"
+        if not merge:
+            drift = explained_by_drift(
+                track.t[both], track.x[both], track.z[both], g_mps2=G,
+                sigma_m=sigma_m, drift_limit_m=limit,
+            )  # fmt: skip
+            merge = drift is not None
+        refusals.append(
+            Refusal(
+                float(track.t[a[-1]]), float(track.t[b[0]]),
+                (_frame(track, int(a[-1])), _frame(track, int(b[0]))),
+                kind, reason, merged=merge,
+            )
+        )  # fmt: skip
+        if not merge:
+            apart.add((int(a[-1]), int(b[0])))
+            events = kept
+            continue
+        rows_of[ev.before] = both
+        del rows_of[ev.after]
+        misfit_flights = {i if i <= ev.before else i - 1 for i in misfit_flights}
+        if test.model == "air_drag":
+            misfit_flights.add(ev.before)
+        flights = _fit_all(track, rows_of)
+        events = find_contact_events(
+            track, flights, contact_spans(track, rows_of), frame_interval_s
+        )
 
 
 def _fit_all(track: Track, rows_of: list[np.ndarray]) -> list[FlightFit]:

@@ -63,6 +63,11 @@ from fieldkit.tracking.flights.segment_growth import CHI2_JOIN, grow_segment
 #: Largest relative distance of the track's apparent g from 9.81 for the
 #: free-flight tests to use 9.81 (beyond it the capture rate or scale is off).
 G_TRUSTED_FRACTION = 0.2
+#: Samples of the shortest noise window (a quadratic: 2 degrees of freedom left per
+#: coordinate) and the median residual RMS of such windows over Gaussian noise of
+#: sd 1 (``sqrt(median(chi2_4) / 4)`` = ``sqrt(3.357 / 4)``).
+SHORT_WINDOW = 5
+SHORT_MEDIAN = 0.916
 #: A contact with at least this many samples off both flights is extended (a net, a
 #: rolling phase) rather than an impact.
 EXTENDED_CONTACT_SAMPLES = 5
@@ -147,6 +152,10 @@ class Segmentation:
         Median time between samples [s].
     misfits
         Flights that only a dragged flight explains (:func:`merge_free_flights`).
+    drift_joins
+        Joins that one flight seen through a slow detection drift explains (no
+        contact there): ``(last_before, first_after, drift_m)``, the track positions
+        of the samples on either side and the drift's size [m].
     """
 
     flights: list[np.ndarray]
@@ -155,6 +164,7 @@ class Segmentation:
     g_common_mps2: float
     frame_interval_s: float
     misfits: list[FlightMisfit] = field(default_factory=list)
+    drift_joins: list[tuple[int, int, float]] = field(default_factory=list)
 
 
 def estimate_noise(
@@ -190,6 +200,7 @@ def find_flights(
     window: int = 9,
     min_samples: int = 8,
     noise_floor_m: float = 0.0,
+    drift_limit_m: float = 0.0,
 ) -> Segmentation:
     """Find the ballistic flights of a track (see the module docstring for the method).
 
@@ -207,6 +218,9 @@ def find_flights(
         several frames (slowly changing background under the rim, compression), so
         the sample-to-sample scatter understates them; a floor of a few hundredths of
         a pixel keeps good samples in their flights.
+    drift_limit_m
+        Largest slow detection drift [m] that may explain two flights as one
+        (:func:`fieldkit.tracking.flights.free_flight.classify_join`); 0: none.
 
     Returns
     -------
@@ -242,21 +256,37 @@ def find_flights(
     # straddle impacts when flights are short in samples, so it can at most raise
     # the estimate by half
     local_sigma = float(np.median(local)) * 1.05
+    # flights of few samples (a bounce every ~12 frames at 30 fps): most windows
+    # straddle a bounce and their median is the bounces, not the noise; the
+    # shortest windows (5 samples) straddle fewer. Their median residual RMS
+    # (2 x 2 degrees of freedom) is 0.92 sigma for Gaussian noise.
+    # Errors correlated over a few frames (a rolling shutter) still show in the
+    # cleanest tenth of the long windows: the estimate does not go below those.
+    short = estimate_noise(t, x, z, SHORT_WINDOW)
+    if len(short) and np.median(short) / SHORT_MEDIAN < 0.5 * local_sigma:
+        clean = float(np.quantile(local, 0.1)) * 1.05
+        local_sigma = max(float(np.median(short)) / SHORT_MEDIAN, clean)
     long = estimate_noise(t, x, z, min(4 * window - 3, n))
     long_sigma = min(float(np.median(long)), 1.5 * local_sigma) if len(long) else 0.0
     sigma = max(local_sigma, long_sigma, noise_floor_m, 1e-9 * extent)
 
     free = np.ones(n, bool)
     segments: list[tuple[int, int, list[int]]] = []
-    for start in np.argsort(local, kind="stable"):
-        if local[start] > 3.0 * sigma:
-            break
-        stop = start + window - 1
-        if not free[start : stop + 1].all():
-            continue
-        lo, hi, outl = grow_segment(t, x, z, start, stop, free, sigma)
-        free[lo : hi + 1] = False
-        segments.append((lo, hi, outl))
+    # then shorter seeds where no window of `window` samples fits: a flight of a
+    # few frames next to a mis-detected one (30 fps, a blurred bounce)
+    seeds = [(local, window)]
+    if window > min_samples - 1 >= 5:
+        seeds.append((estimate_noise(t, x, z, min_samples - 1), min_samples - 1))
+    for scores, width in seeds:
+        for start in np.argsort(scores, kind="stable"):
+            if scores[start] > 3.0 * sigma:
+                break
+            stop = start + width - 1
+            if not free[start : stop + 1].all():
+                continue
+            lo, hi, outl = grow_segment(t, x, z, start, stop, free, sigma)
+            free[lo : hi + 1] = False
+            segments.append((lo, hi, outl))
 
     fits = []
     for lo, hi, outl in segments:
@@ -299,7 +329,11 @@ def find_flights(
     # (a few %); far from it the capture rate or scale is wrong, and the track's g
     # stands in (the gravity check warns)
     g_free = G if abs(g_fix / G - 1.0) < G_TRUSTED_FRACTION else g_fix
-    flights, misfits = merge_free_flights(t, x, z, flights, g_free, sigma)
+    drift_joins: list[tuple[int, int, float]] = []
+    flights, misfits = merge_free_flights(
+        t, x, z, flights, g_free, sigma, drift_limit_m=drift_limit_m,
+        drift_joins=drift_joins,
+    )  # fmt: skip
     for k in range(len(flights) - 1):
         if flights[k + 1][0] - flights[k][-1] - 1 >= EXTENDED_CONTACT_SAMPLES:
             flights[k] = stable_end(t, x, z, flights[k], sigma, g_fix, at_start=False)
@@ -324,6 +358,7 @@ def find_flights(
         g_common_mps2=g_common,
         frame_interval_s=dt,
         misfits=misfits,
+        drift_joins=[(int(valid[a]), int(valid[b]), d) for a, b, d in drift_joins],
     )
 
 
@@ -334,6 +369,9 @@ def merge_free_flights(
     flights: list[np.ndarray],
     g_mps2: float,
     sigma: float,
+    *,
+    drift_limit_m: float = 0.0,
+    drift_joins: list[tuple[int, int, float]] | None = None,
 ) -> tuple[list[np.ndarray], list[FlightMisfit]]:
     """Join consecutive flights that one free flight explains (no contact between).
 
@@ -347,6 +385,9 @@ def merge_free_flights(
     on it (chi-square of :data:`~.segment_growth.CHI2_JOIN`), and the test is
     repeated with the next flight. A flight grown or joined as a dragged flight is
     returned as a :class:`FlightMisfit` (indices into the returned flights).
+    A join one flight explains only through a slow detection drift of at most
+    ``drift_limit_m`` is joined too and appended to ``drift_joins`` as
+    ``(last sample before, first after, drift [m])``.
     """
     flights = [np.asarray(r) for r in flights]
     joined: list[list[tuple[float, JoinTest | float]]] = [[] for _ in flights]
@@ -377,11 +418,14 @@ def merge_free_flights(
     while i < len(flights) - 1:
         a, b = flights[i], flights[i + 1]
         test = classify_join(
-            (t[a], x[a], z[a]), (t[b], x[b], z[b]), g_mps2=g_mps2, sigma_m=sigma
-        )
+            (t[a], x[a], z[a]), (t[b], x[b], z[b]), g_mps2=g_mps2, sigma_m=sigma,
+            drift_limit_m=drift_limit_m,
+        )  # fmt: skip
         if test.model == "contact":
             i += 1
             continue
+        if test.model == "drift" and drift_joins is not None:
+            drift_joins.append((int(a[-1]), int(b[0]), test.drift_m))
         rows = np.concatenate([a, b])
         gap = np.arange(a[-1] + 1, b[0])
         if gap.size:
