@@ -85,6 +85,24 @@ def track(
             "instead of --scale-points.",
         ),
     ] = None,
+    scale_sd: Annotated[
+        float,
+        typer.Option(
+            "--scale-sd",
+            help="Standard uncertainty of the length scale (--scale-length or "
+            "--homography), in percent (default 0: taken as exact). With --fps-sd "
+            "it widens each flight's check of g against 9.81 (g scales with the "
+            "length), not the velocities.",
+        ),
+    ] = 0.0,
+    fps_sd: Annotated[
+        float,
+        typer.Option(
+            "--fps-sd",
+            help="Standard uncertainty of --fps (frames/s; default 0: exact). g "
+            "scales with the square of the rate.",
+        ),
+    ] = 0.0,
     radius: RadiusOpt = None,
     surface_angle: Annotated[
         float | None,
@@ -246,6 +264,7 @@ def track(
           -o out/bounce_track.csv --impacts out/bounce_impacts.csv \\
           --figures out/bounce --report out/bounce_report
     """
+    from fieldkit.tracking.flights.ballistic_fit import calibration_rel_sd
     from fieldkit.tracking.flights.pipeline import analyse_track
     from fieldkit.tracking.video.calibration import (
         parse_scale_points,
@@ -263,6 +282,15 @@ def track(
             source="--fps",
         )
     check_frame_rate(fps, "fps")
+    for value, flag in ((scale_sd, "--scale-sd"), (fps_sd, "--fps-sd")):
+        if not (math.isfinite(value) and value >= 0):
+            raise ArgumentError(f"must be >= 0, got {value:g}", source=flag)
+    if fps_sd >= fps:
+        raise ArgumentError(
+            f"{fps_sd:g} frames/s is not an uncertainty of --fps {fps:g}",
+            source="--fps-sd",
+        )
+    stated_rel_sd = calibration_rel_sd(scale_sd / 100.0, fps_sd / fps)
     body = body_from_options(mass, radius, gyration, shape, dimensions, unit_weight)
     if surface_angle is not None and not (
         math.isfinite(surface_angle) and -90 < surface_angle < 90
@@ -380,7 +408,14 @@ def track(
         gyration_m=body.gyration_m,
         path_id=path_id or video.stem,
         ground=ground,
+        calibration_rel_sd=stated_rel_sd,
     )
+    if stated_rel_sd > 0:
+        note(
+            f"g is checked against 9.81 with the stated calibration: scale "
+            f"+/- {scale_sd:g} %, rate +/- {fps_sd:g} frames/s "
+            f"(g +/- {100 * stated_rel_sd:.3g} %)"
+        )
     print_body_notes(body)
     later = list(analysis.warnings)
     if ground is not None:

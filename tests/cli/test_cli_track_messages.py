@@ -300,3 +300,43 @@ def test_ffmpeg_messages_are_silenced(repo, clip, tmp_path):
         done.stderr
     )
     assert any("damaged.avi: frames" in line for line in lines), done.stderr
+
+
+# --- the stated calibration uncertainty ----------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("args", "flag"),
+    [
+        (("--scale-sd", "-1"), "--scale-sd"),
+        (("--fps-sd", "nan"), "--fps-sd"),
+        (("--fps-sd", "2000"), "--fps-sd"),
+    ],
+    ids=["negative-scale-sd", "nan-fps-sd", "fps-sd-past-fps"],
+)
+def test_a_bad_stated_uncertainty_names_its_flag(cli, clip, tmp_path, args, flag):
+    track_fails(cli, tmp_path, clip, [*SCALE, "--radius", "0.0375", *args], flag)
+
+
+def test_the_stated_uncertainty_widens_the_printed_g(cli, clip, tmp_path):
+    """The same clip with the scale stated to 5 %: each flight's printed SE is the
+    fit's and 5 % of g in quadrature, and the note says what was stated."""
+    base = [clip, "--fps", FPS, *SCALE, "--radius", "0.0375"]
+    exact = cli("track", *base)
+    stated = cli("track", *base, "--scale-sd", "5")
+    assert exact.exit_code == 0 and stated.exit_code == 0, stated.stderr
+    assert "scale +/- 5 %" in stated.stdout + stated.stderr
+
+    def g_and_se(text):
+        import re
+
+        return [
+            (float(g), float(se))
+            for g, se in re.findall(r"g = ([0-9.]+) \+/- ([0-9.]+) m/s\^2", text)
+        ]
+
+    plain, wide = g_and_se(exact.stdout), g_and_se(stated.stdout)
+    assert plain and len(plain) == len(wide)
+    for (g0, se0), (g1, se1) in zip(plain, wide, strict=True):
+        assert g1 == pytest.approx(g0, abs=0.01)
+        assert se1 == pytest.approx(np.hypot(se0, 0.05 * g0), rel=0.05, abs=0.01)

@@ -189,6 +189,7 @@ def analyse_track(
     gyration_m: float | None = None,
     path_id: str = "video",
     ground: Ground | None = None,
+    calibration_rel_sd: float = 0.0,
 ) -> TrackAnalysis:
     """Find flights, impacts and net contacts in a track.
 
@@ -212,6 +213,12 @@ def analyse_track(
         :func:`~fieldkit.tracking.flights.ground.in_track_frame` when the track is
         stored mirrored): a dip per contact from a surveyed profile or a DEM;
         excludes ``surface_angle_deg``.
+    calibration_rel_sd
+        Relative standard uncertainty of g from the stated length scale and
+        capture rate [-] (:func:`~fieldkit.tracking.flights.ballistic_fit.calibration_rel_sd`):
+        widens each flight's check of g against 9.81
+        (``FlightFit.g_check_se_mps2``), not the comparison of one clip's flights,
+        which share the calibration. 0: the scale and rate taken as exact.
 
     Returns
     -------
@@ -243,10 +250,16 @@ def analyse_track(
         raise ArgumentError(
             f"gyration_m must be > 0 (got {gyration_m:g})", source="gyration_m"
         )
+    if not (np.isfinite(calibration_rel_sd) and calibration_rel_sd >= 0):
+        raise ArgumentError(
+            f"calibration_rel_sd must be >= 0 (got {calibration_rel_sd:g})",
+            source="calibration_rel_sd",
+        )
     frame = track.frame.sort_values("t_s", kind="stable").reset_index(drop=True)
     track = Track(
         frame.copy(), source=track.source, fps=track.fps, meta=dict(track.meta)
     )
+    track.meta["calibration_rel_sd"] = float(calibration_rel_sd)
     n_valid = int(np.isfinite(track.t + track.x + track.z).sum())
     if n_valid < MIN_TRACK_SAMPLES:
         raise InputFileError(
@@ -605,9 +618,13 @@ def judge_contacts(
 
 def _fit_all(track: Track, rows_of: list[np.ndarray]) -> list[FlightFit]:
     slow = noise_floor(track)  # detection error that varies slowly along a flight
+    stated = float(track.meta.get("calibration_rel_sd", 0.0))
     return [
-        fit_flight(
-            track.t[r], track.x[r], track.z[r], index=i, rows=r, systematic_m=slow
+        dataclasses.replace(
+            fit_flight(
+                track.t[r], track.x[r], track.z[r], index=i, rows=r, systematic_m=slow
+            ),
+            g_calibration_rel_sd=stated,
         )
         for i, r in enumerate(rows_of)
     ]
