@@ -215,10 +215,10 @@ def analyse_track(
         excludes ``surface_angle_deg``.
     calibration_rel_sd
         Relative standard uncertainty of g from the stated length scale and
-        capture rate [-] (:func:`~fieldkit.tracking.flights.ballistic_fit.calibration_rel_sd`):
-        widens each flight's check of g against 9.81
-        (``FlightFit.g_check_se_mps2``), not the comparison of one clip's flights,
-        which share the calibration. 0: the scale and rate taken as exact.
+        capture rate [-] (``ballistic_fit.calibration_rel_sd``): widens each
+        flight's check of g against 9.81 (``FlightFit.g_check_se_mps2``), not the
+        comparison of one clip's flights, which share the calibration. 0: the
+        scale and rate taken as exact.
 
     Returns
     -------
