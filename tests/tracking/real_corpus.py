@@ -105,7 +105,8 @@ def scale_of(label: dict) -> tuple[tuple[float, float, float, float], float, flo
 def g_standard_error(
     g: float, g_se: float, scale_rel_sd: float, fps_rel_sd: float
 ) -> float:
-    """Standard error of a fitted g with the scale and rate uncertainty.
+    """Standard error of a fitted g with the scale and rate uncertainty (the
+    library's ``FlightFit.g_check_se_mps2``).
 
     g is proportional to the length scale and to the capture rate squared.
 
@@ -114,7 +115,9 @@ def g_standard_error(
     >>> round(g_standard_error(10.0, 0.3, 0.04, 0.0), 6)
     0.5
     """
-    return math.sqrt(g_se**2 + (g * scale_rel_sd) ** 2 + (2.0 * g * fps_rel_sd) ** 2)
+    from fieldkit.tracking.flights.ballistic_fit import calibration_rel_sd
+
+    return math.hypot(g_se, g * calibration_rel_sd(scale_rel_sd, fps_rel_sd))
 
 
 @dataclass
@@ -280,22 +283,31 @@ def score_events(
 
 
 def evaluate_clip(corpus: Path, label: dict) -> ClipResult:
-    """Run the tracker (as `fieldkit track` does) on one clip and check its labels."""
+    """Run the tracker (as `fieldkit track` does) on one clip of the corpus and check
+    its labels; a clip absent or not the labelled file is reported, not run."""
+    path = clip_file(corpus, label)
+    if not path.exists():
+        return ClipResult(label["clip"], status="missing", message=f"{path} not found")
+    if sha256(path) != label["sha256"]:
+        return ClipResult(
+            label["clip"], status="bad-checksum", message=f"{path}: SHA-256 differs"
+        )
+    return evaluate_video(path, label)
+
+
+def evaluate_video(path: Path, label: dict) -> ClipResult:
+    """Run the tracker (as `fieldkit track` does) on the video at ``path`` and check
+    it against ``label`` (a corpus label, or a rendered clip's from video/hard.py)."""
     from fieldkit.errors import FieldkitError
+    from fieldkit.tracking.flights.ballistic_fit import calibration_rel_sd
     from fieldkit.tracking.flights.pipeline import analyse_track
     from fieldkit.tracking.video.calibration import two_point_scale
     from fieldkit.tracking.video.pipeline import track_video
 
     result = ClipResult(label["clip"])
-    path = clip_file(corpus, label)
-    if not path.exists():
-        result.status, result.message = "missing", f"{path} not found"
-        return result
-    if sha256(path) != label["sha256"]:
-        result.status, result.message = "bad-checksum", f"{path}: SHA-256 differs"
-        return result
     fps = float(label["capture_fps"])
-    points, length_m, _ = scale_of(label)
+    points, length_m, scale_rel = scale_of(label)
+    stated = calibration_rel_sd(scale_rel, label["capture_fps_sd"] / fps)
     radius_m = label["body"]["radius_m"]
     start = time.perf_counter()
     try:
@@ -303,7 +315,10 @@ def evaluate_clip(corpus: Path, label: dict) -> ClipResult:
         track, _ = track_video(
             path, fps=fps, calibration=calibration, radius_m=radius_m
         )
-        analysis = analyse_track(track, radius_m=radius_m, path_id=label["clip"])
+        analysis = analyse_track(
+            track, radius_m=radius_m, path_id=label["clip"],
+            calibration_rel_sd=stated,
+        )  # fmt: skip
     except FieldkitError as error:
         result.status, result.message = "refused", str(error)
         return result
