@@ -5,7 +5,8 @@ noise) gives one extended contact with its truth. Two ways a real clip spoils it
 each known exactly here: the body hidden (by a net, a hoop, a person) in most
 frames of the contact, and one wrong detection a body could not reach (a metre
 off in one frame interval). Either must turn the contact into a one-line
-refusal naming its frames, not a row.
+refusal naming its frames, not a row. Likewise a bounce at a track's end with too
+few samples beyond it for a flight (a synthetic bouncing ball cut short).
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import pytest
 
 from fieldkit.track import Track
 from fieldkit.tracking.flights.pipeline import analyse_track
-from fieldkit.tracking.flights.synthetic_tracks import net_capture
+from fieldkit.tracking.flights.synthetic_tracks import bouncing_ball, net_capture
 
 MASS, R = 0.14, 0.0375
 
@@ -81,3 +82,34 @@ def test_a_detection_no_body_could_reach_is_refused(capture):
     (refusal,) = _unreduced(analysis)
     assert f"between frames {k - 1} and {k}" in refusal.reason
     assert "not one body's path" in refusal.reason
+
+
+def _bounce_cut(after: int):
+    """A bouncing ball (e_n 0.6 on a 10 deg slope) cut ``after`` samples past the
+    sample nearest its impact, and that sample's position."""
+    truth = bouncing_ball(duration_s=0.5, e_n=0.6, e_t=0.8)
+    frame = truth.track.frame
+    t_hit = float(truth.truth["t_s"].iloc[0])
+    k = int(np.argmin(np.abs(frame["t_s"].to_numpy() - t_hit)))
+    cut = frame.iloc[: k + after + 1].reset_index(drop=True)
+    return Track(cut, source="synthetic", fps=truth.track.fps), k
+
+
+def test_a_contact_with_too_few_samples_after_it_is_refused():
+    # 3 samples after the bounce: too few for a flight (8), and off the parabola
+    # before it, so the bounce is refused in one line, not left unsaid
+    track, k = _bounce_cut(3)
+    a = analyse_track(track, radius_m=0.0375, surface_angle_deg=10.0)
+    assert len(a.flights) == 1 and len(a.impacts) == 0
+    (refusal,) = _unreduced(a)
+    first, last = refusal.frames
+    assert first <= k <= last and last == len(track) - 1
+    assert "samples after the last flight" in refusal.reason
+    assert "\n" not in refusal.reason
+
+
+def test_a_track_ending_in_flight_has_no_edge_refusal():
+    # cut before the bounce: the last samples all lie on the one flight
+    track, k = _bounce_cut(-5)
+    a = analyse_track(track, radius_m=0.0375, surface_angle_deg=10.0)
+    assert len(a.flights) == 1 and a.refusals == []

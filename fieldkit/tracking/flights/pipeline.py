@@ -388,6 +388,7 @@ def analyse_track(
                 Refusal(t_ref, t_ref, _frames_at(track, t_ref), "surface",
                         line.split(" refused as an impact: ", 1)[1])
             )  # fmt: skip
+    refusals.extend(edge_refusals(track, flights, seg.noise_m, radius_m))
     refusals.sort(key=lambda r: r.t_start_s)
     bridged = bridged_impacts(track, flights, events, seg.frame_interval_s)
     return TrackAnalysis(track, flights, table, contacts, warnings, refusals, bridged)
@@ -563,6 +564,50 @@ def unmeasured_inside(
         f"({step[k] / dt[k]:.1f} m/s; at most {v_max:.1f} m/s from its speed and "
         "fall): the detections between its flights are not one body's path"
     )
+
+
+def edge_refusals(
+    track: Track, flights: list[FlightFit], sigma_m: float, radius_m: float
+) -> list[Refusal]:
+    """The track's ends that hold a contact no flight pair can reduce.
+
+    Samples before the first flight (after the last) that are too few for a flight
+    of their own and leave that flight's parabola, extrapolated to them, by more
+    than five noise standard deviations plus :data:`DRIFT_LIMIT_FRACTION` radius,
+    met something: a contact between them and the flight, with no flight on the
+    other side to measure it. Each such end is one ``unreduced`` refusal.
+    """
+    if not flights:
+        return []
+    usable = np.flatnonzero(np.isfinite(track.t + track.x + track.z))
+    tolerance = 5.0 * sigma_m + DRIFT_LIMIT_FRACTION * radius_m
+    out = []
+    ends = (
+        (usable[usable < flights[0].rows[0]], flights[0], "before the first"),
+        (usable[usable > flights[-1].rows[-1]], flights[-1], "after the last"),
+    )
+    for rows, fit, where in ends:
+        if not 2 <= rows.size < MIN_FLIGHT_SAMPLES:
+            continue
+        x, z = fit.position(track.t[rows])
+        off = float(np.max(np.hypot(track.x[rows] - x, track.z[rows] - z)))
+        if off <= tolerance:
+            continue
+        if rows[0] < fit.rows[0]:
+            a, b = int(rows[0]), int(fit.rows[0])
+        else:
+            a, b = int(fit.rows[-1]), int(rows[-1])
+        frames = (_frame(track, a), _frame(track, b))
+        out.append(
+            Refusal(
+                float(track.t[a]), float(track.t[b]), frames, "unreduced",
+                f"contact at frames {frames[0]}-{frames[1]} not reduced: "
+                f"{rows.size} samples {where} flight (fewer than "
+                f"{MIN_FLIGHT_SAMPLES} for a flight) leave its parabola by "
+                f"{1e3 * off:.0f} mm; no flight on their side measures the contact",
+            )
+        )  # fmt: skip
+    return out
 
 
 def judge_contacts(
