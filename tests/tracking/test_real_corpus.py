@@ -21,6 +21,7 @@ from real_corpus import (
     find_corpus,
     g_standard_error,
     load_labels,
+    refused_contacts,
     result_table,
     scale_of,
     score_events,
@@ -161,6 +162,17 @@ def test_a_flight_fitted_in_a_rolling_contact_misses_it():
     assert found == [(0, 8, 0)] and missed == [(9, 50)]
 
 
+def test_only_a_refusal_covering_a_missed_contact_refuses_it():
+    # the library refused frames 26-63: the contacts at 29 and 49 lie inside it,
+    # 63-64 ends one frame past it (tolerated); 66 and 20-30 are not covered
+    missed = [(29, 29), (49, 49), (63, 64), (66, 66), (20, 30)]
+    still, refused = refused_contacts(missed, [(26, 63, "why")])
+    assert still == [(66, 66), (20, 30)]
+    assert refused == [(29, 29, "why"), (49, 49, "why"), (63, 64, "why")]
+    # no refusal: every missed contact stays missed
+    assert refused_contacts(missed, []) == (missed, [])
+
+
 def test_a_missing_or_altered_clip_is_reported_not_tracked(tmp_path):
     label = LABELS[0]
     result = evaluate_clip(tmp_path, label)
@@ -200,4 +212,5 @@ def test_every_real_clip_is_checked_or_refused_in_one_line():
             for c in label["contacts"]
             if c["kind"] in (*SURFACE_KINDS, *EXTENDED_KINDS)
         ]
-        assert len(result.found) + len(result.missed) == len(required)
+        verdicts = len(result.found) + len(result.missed) + len(result.refused)
+        assert verdicts == len(required)

@@ -388,6 +388,7 @@ def analyse_track(
                 Refusal(t_ref, t_ref, _frames_at(track, t_ref), "surface",
                         line.split(" refused as an impact: ", 1)[1])
             )  # fmt: skip
+    refusals.extend(edge_refusals(track, flights, seg.noise_m, radius_m))
     refusals.sort(key=lambda r: r.t_start_s)
     bridged = bridged_impacts(track, flights, events, seg.frame_interval_s)
     return TrackAnalysis(track, flights, table, contacts, warnings, refusals, bridged)
@@ -506,6 +507,109 @@ def not_free_beside(
     return None
 
 
+#: An extended contact is refused when the body was not detected in more than this
+#: share of the frames between its flights (occluded by a net, a hoop, a person).
+MAX_UNSEEN_FRACTION = 0.5
+#: ... or when its samples move faster than this many times the speed energy allows.
+MAX_SPEED_RATIO = 2.0
+
+
+def unmeasured_inside(
+    track: Track, rows_of: list[np.ndarray], ev: ContactEvent, sigma_m: float
+) -> str | None:
+    """Why an extended contact's path is not measured, or None.
+
+    Between the last sample of the flight before and the first of the flight
+    after (frames from the track's ``frame`` column):
+
+    - the body was not detected in more than :data:`MAX_UNSEEN_FRACTION` of the
+      frames (at least two): a net, a hoop or a person hid it;
+    - or two consecutive samples lie farther apart than a body could travel:
+      faster than :data:`MAX_SPEED_RATIO` times the speed its entry or exit speed
+      and the fall across the samples allow (``v^2 = v_in^2 + 2 g drop``), plus
+      the detection noise. Those are not one body's positions (a wrong detection),
+      so the contact cannot be reduced.
+    """
+    if not ev.extended:
+        return None
+    a, b = int(rows_of[ev.before][-1]), int(rows_of[ev.after][0])
+    first, last = _frame(track, a), _frame(track, b)
+    where = f"contact at frames {first}-{last} not reduced: "
+    if "frame" in track.frame.columns:
+        between = last - first - 1
+        unseen = between - (b - a - 1)  # the track's samples between them
+        if unseen >= 2 and unseen > MAX_UNSEEN_FRACTION * between:
+            return (
+                f"{where}body not detected in {unseen} of the {between} frames "
+                "between its flights"
+            )
+    rows = np.concatenate([[a], np.sort(ev.rows), [b]]).astype(int)
+    t, x, z = track.t[rows], track.x[rows], track.z[rows]
+    ok = np.isfinite(t + x + z)
+    t, x, z, rows = t[ok], x[ok], z[ok], rows[ok]
+    if rows.size < 3:
+        return None
+    dt = np.diff(t)
+    step = np.hypot(np.diff(x), np.diff(z))
+    v_in = max(float(np.hypot(*ev.vi_mps)), float(np.hypot(*ev.vf_mps)))
+    drop = float(np.ptp(z))
+    v_max = MAX_SPEED_RATIO * np.sqrt(v_in**2 + 2.0 * G * drop)
+    limit = v_max * dt + 3.0 * np.sqrt(2.0) * sigma_m
+    k = int(np.argmax(step - limit))
+    if step[k] <= limit[k]:
+        return None
+    return (
+        f"{where}the body moves {step[k]:.2f} m between frames "
+        f"{_frame(track, int(rows[k]))} and {_frame(track, int(rows[k + 1]))} "
+        f"({step[k] / dt[k]:.1f} m/s; at most {v_max:.1f} m/s from its speed and "
+        "fall): the detections between its flights are not one body's path"
+    )
+
+
+def edge_refusals(
+    track: Track, flights: list[FlightFit], sigma_m: float, radius_m: float
+) -> list[Refusal]:
+    """The track's ends that hold a contact no flight pair can reduce.
+
+    Samples before the first flight (after the last) that are too few for a flight
+    of their own and leave that flight's parabola, extrapolated to them, by more
+    than five noise standard deviations plus :data:`DRIFT_LIMIT_FRACTION` radius,
+    met something: a contact between them and the flight, with no flight on the
+    other side to measure it. Each such end is one ``unreduced`` refusal.
+    """
+    if not flights:
+        return []
+    usable = np.flatnonzero(np.isfinite(track.t + track.x + track.z))
+    tolerance = 5.0 * sigma_m + DRIFT_LIMIT_FRACTION * radius_m
+    out = []
+    ends = (
+        (usable[usable < flights[0].rows[0]], flights[0], "before the first"),
+        (usable[usable > flights[-1].rows[-1]], flights[-1], "after the last"),
+    )
+    for rows, fit, where in ends:
+        if not 2 <= rows.size < MIN_FLIGHT_SAMPLES:
+            continue
+        x, z = fit.position(track.t[rows])
+        off = float(np.max(np.hypot(track.x[rows] - x, track.z[rows] - z)))
+        if off <= tolerance:
+            continue
+        if rows[0] < fit.rows[0]:
+            a, b = int(rows[0]), int(fit.rows[0])
+        else:
+            a, b = int(fit.rows[-1]), int(rows[-1])
+        frames = (_frame(track, a), _frame(track, b))
+        out.append(
+            Refusal(
+                float(track.t[a]), float(track.t[b]), frames, "unreduced",
+                f"contact at frames {frames[0]}-{frames[1]} not reduced: "
+                f"{rows.size} samples {where} flight (fewer than "
+                f"{MIN_FLIGHT_SAMPLES} for a flight) leave its parabola by "
+                f"{1e3 * off:.0f} mm; no flight on their side measures the contact",
+            )
+        )  # fmt: skip
+    return out
+
+
 def judge_contacts(
     track: Track,
     rows_of: list[np.ndarray],
@@ -564,7 +668,9 @@ def judge_contacts(
                 verdicts[id(ev)] = verdict
         if not verdicts:
             for ev in kept:
-                why = not_free_beside(ev, flights, misfit_flights, g_reference_mps2)
+                why = unmeasured_inside(track, rows_of, ev, sigma_m)
+                if why is None:
+                    why = not_free_beside(ev, flights, misfit_flights, g_reference_mps2)
                 if why is not None:
                     verdicts[id(ev)] = ("unreduced", why)
                     break

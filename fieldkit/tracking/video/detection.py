@@ -95,6 +95,10 @@ class Candidate:
     streak_px: float = 0.0  # streak length beyond the body's diameter
     colour: np.ndarray | None = None  # mean BGR inside the blob (with a body colour)
     twin: bool = False  # the streak reading of a blob also read as a larger circle
+    #: radius [px] of the blob's half-contrast core (NaN when not measured): a soft
+    #: edge (defocus, chroma subsampling, compression) widens the low-threshold
+    #: silhouette by a few pixels, not the core
+    core_r: float = float("nan")
 
 
 @dataclass(frozen=True)
@@ -146,6 +150,53 @@ def _closed(mask: np.ndarray, size: int) -> np.ndarray:
         return mask
     kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (size, size))
     return cv2.morphologyEx(mask, cv2.MORPH_CLOSE, kernel)
+
+
+def _core_radius(part, bg, contour, inner=None) -> float:
+    """Radius [px] of a blob's half-contrast core: the pixels that differ from the
+    background by more than half the blob's contrast (its 95th-percentile colour
+    difference), the body's edge when its rim is soft.
+
+    The radius is that of the disc of the core's area or, when ``inner`` (a callable
+    telling which ``(u, v)`` points of ``part`` lie inside the frame) is given for a
+    body cut by the frame border, of a circle fitted to the core's rim inside it.
+
+    Examples
+    --------
+    >>> bg = np.zeros((40, 40, 3), np.uint8)
+    >>> img = bg.copy()
+    >>> _ = cv2.circle(img, (20, 20), 10, (200, 200, 200), -1)
+    >>> soft = cv2.GaussianBlur(img, (0, 0), 2.0)
+    >>> mask = (soft.max(axis=2) > 10).astype(np.uint8) * 255
+    >>> c = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)[-2][0]
+    >>> bool(abs(_core_radius(soft, bg, c) - 10.0) < 0.8)
+    True
+    >>> cut = lambda u, v: u < 35  # the frame ends at u = 35
+    >>> bool(abs(_core_radius(soft[:, :36], bg[:, :36], c, cut) - 10.0) < 0.8)
+    True
+    """
+    x, y, w, h = cv2.boundingRect(contour)
+    fill = np.zeros((h, w), np.uint8)
+    cv2.drawContours(fill, [contour], -1, 255, -1, offset=(-x, -y))
+    diff = colour_difference(part[y : y + h, x : x + w], bg[y : y + h, x : x + w])
+    inside = diff[fill > 0].astype(np.float64)
+    if inside.size < 12:
+        return float("nan")
+    contrast = float(np.percentile(inside, 95))
+    core = (fill > 0) & (diff > 0.5 * contrast)
+    if inner is None:
+        return float(np.sqrt(np.count_nonzero(core) / np.pi))
+    rims = cv2.findContours(
+        core.astype(np.uint8) * 255, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE
+    )[-2]
+    if not rims:
+        return float("nan")
+    pts = max(rims, key=cv2.contourArea).reshape(-1, 2).astype(np.float64) + (x, y)
+    keep = inner(pts[:, 0], pts[:, 1])
+    if keep.sum() < 10:
+        return float("nan")
+    _, _, r, _ = fit_circle(pts[keep, 0], pts[keep, 1])
+    return float(r + 0.5)
 
 
 def _is_shadow(part, bg, contour, detector) -> bool:
@@ -341,6 +392,10 @@ class BallDetector:
                 self._refused.append((area, "shadow"))
                 continue
             cand, reason = self._round(u, v, inner, area, partial)
+            if cand is not None:
+                cand.core_r = _core_radius(
+                    part, bg, contour, self._inside(u0, v0) if partial else None
+                )
             streak = None
             if not partial:
                 streak = self._streak(contour, u0, v0, area, velocity)
@@ -370,6 +425,17 @@ class BallDetector:
                 streak.colour = cand.colour
                 out.append(streak)
         return out
+
+    def _inside(self, u0: int, v0: int):
+        """Tells which points ``(u, v)`` of a window at ``(u0, v0)`` lie off the
+        frame border (the test of :meth:`_shapes`)."""
+        w, h = self.size
+
+        def inside(u, v):
+            u, v = u + u0, v + v0
+            return (u > 0.5) & (u < w - 1.5) & (v > 0.5) & (v < h - 1.5)
+
+        return inside
 
     def _round(self, u, v, inner, area, partial):
         """Circle fit and shape test of one blob: (Candidate, "") or (None, reason)."""
@@ -463,6 +529,10 @@ class BallDetector:
             cost = 0.0
             if expected is not None:
                 rel = abs(cand.r / expected - 1.0)
+                soft = rel <= 2.0 * self.settings.radius_tolerance
+                if soft and np.isfinite(cand.core_r):
+                    # a soft rim (a halo of a few pixels): the core may be the body
+                    rel = min(rel, abs(cand.core_r / expected - 1.0))
                 if cand.blurred and cand.r < expected:  # a dim streak looks narrower
                     rel *= 0.5
                 if rel > self.settings.radius_tolerance:
