@@ -25,6 +25,21 @@ def repo() -> Path:
 
 
 @pytest.fixture(scope="session")
+def video_render():
+    """The clip renderer ``video/render.py`` (a script, not a package), loaded once."""
+    import importlib.util
+
+    name = "fieldkit_video_render"
+    if name not in sys.modules:
+        path = REPO / "video" / "render.py"
+        spec = importlib.util.spec_from_file_location(name, path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        spec.loader.exec_module(module)
+    return sys.modules[name]
+
+
+@pytest.fixture(scope="session")
 def external_data() -> Path:
     """Third-party reference data copied into ``tests/data/`` with its licences.
 

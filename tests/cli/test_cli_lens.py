@@ -7,9 +7,6 @@ undistorted position, so the corners sit where the true lens puts them.
 
 from __future__ import annotations
 
-import importlib.util
-import sys
-
 import cv2
 import numpy as np
 import pandas as pd
@@ -196,15 +193,11 @@ def test_large_reprojection_error_is_warned():
     assert ok.warnings == []
 
 
-def test_track_undistorts_with_the_lens_file(cli, calibrated, repo, tmp_path):
+def test_track_undistorts_with_the_lens_file(cli, calibrated, video_render, tmp_path):
     """One round trip: `track --lens` reads the file and its u_px, v_px are the
     undistorted centres of the run without it."""
     _, lens_file = calibrated
-    name = "fieldkit_video_render_for_cli_lens"
-    spec = importlib.util.spec_from_file_location(name, repo / "video" / "render.py")
-    render = importlib.util.module_from_spec(spec)
-    sys.modules[name] = render
-    spec.loader.exec_module(render)
+    render = video_render
     camera = render.Camera(width=W, height=H, origin_u_px=20.0, origin_v_px=220.0)
     rng = np.random.default_rng(4)
     scene = render.BounceScene(plate_point_m=(0.0, -1.0))  # plate out of view

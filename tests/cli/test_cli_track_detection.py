@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
-import sys
 
 import numpy as np
 import pandas as pd
@@ -15,13 +13,9 @@ SCALE = ("--scale-points", "20,20,300,20", "--scale-length", "0.56")  # 2 mm/px
 
 
 @pytest.fixture(scope="module")
-def clip(repo, tmp_path_factory):
+def clip(video_render, tmp_path_factory):
     """A ball thrown across a 320x240 scene (video/render.py), frames 40-42 empty."""
-    name = "fieldkit_video_render_for_cli_detection"
-    spec = importlib.util.spec_from_file_location(name, repo / "video" / "render.py")
-    render = importlib.util.module_from_spec(spec)
-    sys.modules[name] = render
-    spec.loader.exec_module(render)
+    render = video_render
     camera = render.Camera(width=320, height=240, origin_u_px=20.0, origin_v_px=220.0)
     rng = np.random.default_rng(4)
     scene = render.BounceScene(plate_point_m=(0.0, -1.0))  # plate out of view

@@ -8,10 +8,8 @@ the track result and the drawn circles against the renderer's exact centres.
 from __future__ import annotations
 
 import doctest
-import importlib.util
 import json
 import re
-import sys
 
 import numpy as np
 import pandas as pd
@@ -41,13 +39,9 @@ FRAMES = 230  # one impact (frame ~170), two flights
 
 
 @pytest.fixture(scope="module")
-def clip(repo, tmp_path_factory):
+def clip(video_render, tmp_path_factory):
     """The rendered clip, its truth and the library's track result of it."""
-    name = "fieldkit_video_render_for_report"
-    spec = importlib.util.spec_from_file_location(name, repo / "video" / "render.py")
-    render = importlib.util.module_from_spec(spec)
-    sys.modules[name] = render
-    spec.loader.exec_module(render)
+    render = video_render
     folder = tmp_path_factory.mktemp("report_clip")
     render.render("bounce_short", folder, frames=FRAMES)
     calib = json.loads((folder / "bounce_short.calibration.json").read_text())
