@@ -38,6 +38,16 @@ from fieldkit.tracking.flights.ballistic_fit import FlightFit
 STEP_FRACTION = 1e-3
 
 
+def _joint_parameters(before: FlightFit, after: FlightFit):
+    """The two flights' parameters end to end (8) and their block-diagonal
+    covariance (the flights are fitted to different samples)."""
+    theta_a, cov_a = _parameters(before)
+    theta_b, cov_b = _parameters(after)
+    cov = np.zeros((8, 8))
+    cov[:4, :4], cov[4:, 4:] = cov_a, cov_b
+    return np.concatenate([theta_a, theta_b]), cov
+
+
 def _parameters(fit: FlightFit) -> tuple[np.ndarray, np.ndarray]:
     """``(x0, vx, z0, vz)`` at ``t_ref_s`` and their 4 x 4 covariance."""
     theta = np.array([fit.x0_m, fit.vx_mps, fit.z0_m, fit.vz_mps], float)
@@ -139,11 +149,7 @@ def contact_sd(
     >>> round(sd["e_n_sd"], 6), round(float(0.1 * np.sqrt(1.25) / 4), 6)
     (0.027951, 0.027951)
     """
-    theta_a, cov_a = _parameters(before)
-    theta_b, cov_b = _parameters(after)
-    theta = np.concatenate([theta_a, theta_b])
-    cov = np.zeros((8, 8))
-    cov[:4, :4], cov[4:, 4:] = cov_a, cov_b
+    theta, cov = _joint_parameters(before, after)
     names = list(SD_COLUMNS)
     nan = dict.fromkeys(SD_COLUMNS.values(), float("nan"))
     if not np.all(np.isfinite(cov)):
@@ -217,11 +223,7 @@ def contact_time_sd(before: FlightFit, after: FlightFit, t_s: float) -> float:
     >>> round(sd * 1e6, 3), round(float(np.sqrt(2) * 1e-3 / 6 * 1e6), 3)
     (235.702, 235.702)
     """
-    theta_a, cov_a = _parameters(before)
-    theta_b, cov_b = _parameters(after)
-    theta = np.concatenate([theta_a, theta_b])
-    cov = np.zeros((8, 8))
-    cov[:4, :4], cov[4:, 4:] = cov_a, cov_b
+    theta, cov = _joint_parameters(before, after)
     if not np.all(np.isfinite(cov)):
         return float("nan")
     jacobian = np.zeros(8)
